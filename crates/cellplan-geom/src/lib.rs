@@ -1,0 +1,24 @@
+//! Geometry for cellplan: meshes (STL, OBJ), primitive shapes and the collision world.
+//!
+//! Everything is in SI units (metres) and uses glam's `f64` types; poses are parry's
+//! [`Pose`] (a rotation quaternion plus a translation, always rigid).
+//!
+//! - [`mesh`]: [`Mesh`] and its loaders, [`load_mesh`] (binary/ASCII STL, OBJ), with errors
+//!   that name the file and line.
+//! - [`shape`]: [`ShapeSpec`], the shapes a cell file can state (box, cylinder, sphere, mesh).
+//! - [`world`]: [`CollisionWorld`], the static scene plus articulated body groups (robots),
+//!   with contact, distance and ray queries.
+#![warn(missing_docs)]
+
+pub mod error;
+mod hull;
+pub mod mesh;
+pub mod shape;
+pub mod world;
+
+pub use error::MeshError;
+pub use glam::{DMat3, DQuat, DVec3};
+pub use mesh::{Mesh, load_mesh};
+pub use parry3d_f64::math::Pose;
+pub use shape::ShapeSpec;
+pub use world::{BodyContact, CollisionWorld, GroupBody, GroupId, RayHit, StaticId};

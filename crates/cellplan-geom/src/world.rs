@@ -1,0 +1,764 @@
+//! The collision world: a static scene and articulated body groups (one per robot).
+//!
+//! # Shapes
+//!
+//! - **Static objects** keep their exact shape: a box, a cylinder (axis z), a sphere, or a
+//!   triangle mesh. A mesh is a **surface, not a solid**: a body wholly inside a closed mesh,
+//!   touching none of its triangles, does not collide with it. That is the right model for
+//!   sheet-metal parts such as car bodies (the robot works inside their openings); a solid
+//!   that must not be entered is better stated with primitives (or a convex mesh as a body).
+//! - **Bodies** of a group (robot links, the tool) are each **one convex shape**: the
+//!   primitive itself when the body has exactly one box, cylinder or sphere, else the convex
+//!   hull of all its shapes (cylinders and spheres enter the hull through circumscribing
+//!   polytopes, so the hull is conservative: it contains every shape). A body without shapes
+//!   never collides.
+//!
+//! # Queries
+//!
+//! "Closer than `margin`" means the distance between the two shapes is at most `margin`
+//! (`margin = 0`: touching or overlapping). Queries report the **first** contact in a fixed
+//! order (bodies in order, then objects or other bodies in order), so results are
+//! deterministic. They allocate nothing, and the world is `Send + Sync`: share it across
+//! threads by reference.
+//!
+//! Poses must be finite. A body at a non-finite pose is treated as colliding (with the first
+//! static object, or with its pair partner), and as at distance 0; rays ignore it.
+use crate::hull::FastHull;
+use crate::shape::{body_shape, shape_as_mesh, static_shape};
+use crate::{DVec3, Mesh, Pose, ShapeSpec};
+use parry3d_f64::bounding_volume::Aabb;
+use parry3d_f64::partitioning::TraversalAction;
+use parry3d_f64::query::gjk::{self, CsoPoint, GJKResult, VoronoiSimplex};
+use parry3d_f64::query::{self, Ray, RayCast};
+use parry3d_f64::shape::{Shape, SharedShape, SupportMap, TriMesh, Triangle};
+
+/// Index of a static object in a [`CollisionWorld`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct StaticId(pub u32);
+
+/// Index of a body group (a robot with its tool) in a [`CollisionWorld`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct GroupId(pub u32);
+
+/// One rigid body of a group (a robot link, or the tool): shapes fixed in the body frame.
+#[derive(Clone, Debug)]
+pub struct GroupBody {
+    /// Name, for reports (the link name).
+    pub name: String,
+    /// Shapes and their poses in the body frame. They are merged into one convex hull.
+    pub shapes: Vec<(ShapeSpec, Pose)>,
+}
+
+/// What touched what.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BodyContact {
+    /// Body `body` of the group is within the margin of static object `object`.
+    Static {
+        /// Body index in the group.
+        body: usize,
+        /// The static object.
+        object: StaticId,
+    },
+    /// Two bodies of the same group.
+    SelfPair(usize, usize),
+    /// Body `a` of the first group and body `b` of the second.
+    Pair(usize, usize),
+}
+
+/// The first object a ray hits.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RayHit {
+    /// The object hit.
+    pub object: StaticId,
+    /// Distance along the ray (the direction is unit length).
+    pub distance: f64,
+}
+
+/// A static object: its parry shape at its world pose.
+struct StaticObject {
+    name: String,
+    /// `None` for a shape with no geometry (it never collides).
+    shape: Option<SharedShape>,
+    /// World pose of the parry shape.
+    pose: Pose,
+    /// World AABB of the shape.
+    aabb: Aabb,
+}
+
+/// One convex body of a group.
+struct Body {
+    name: String,
+    /// `None` for a body without shapes (it never collides).
+    convex: Option<BodyConvex>,
+}
+
+/// The convex shape of a body, with what speeds up its queries.
+struct BodyConvex {
+    /// A primitive or a `ConvexPolyhedron`.
+    shape: SharedShape,
+    /// Pose of `shape` in the body frame.
+    local: Pose,
+    /// Bounds of the shape in the body frame.
+    local_aabb: Aabb,
+    /// Hill-climbing support for large hulls.
+    fast: Option<FastHull>,
+}
+
+impl BodyConvex {
+    fn new(shape: SharedShape, local: Pose) -> Option<Self> {
+        shape.as_support_map()?;
+        let fast = shape.as_convex_polyhedron().and_then(FastHull::new);
+        Some(BodyConvex {
+            local_aabb: shape.compute_aabb(&local),
+            shape,
+            local,
+            fast,
+        })
+    }
+
+    fn support(&self) -> &dyn SupportMap {
+        match &self.fast {
+            Some(f) => f,
+            // `new` checked that the shape is a support map; a ball is a harmless stand-in.
+            None => self.shape.as_support_map().unwrap_or(&NO_SUPPORT),
+        }
+    }
+}
+
+const NO_SUPPORT: parry3d_f64::shape::Ball = parry3d_f64::shape::Ball { radius: 0.0 };
+
+struct Group {
+    name: String,
+    bodies: Vec<Body>,
+    /// Sorted, deduplicated pairs `(i, j)`, `i < j < bodies.len()`.
+    self_pairs: Vec<(usize, usize)>,
+}
+
+/// The static scene and the robots' bodies.
+///
+/// Group and object ids are only meaningful for the world that issued them: methods panic
+/// on an id from elsewhere (a programming error, like an out-of-range index).
+#[derive(Default)]
+pub struct CollisionWorld {
+    statics: Vec<StaticObject>,
+    groups: Vec<Group>,
+}
+
+/// A body placed in the world for one query.
+struct Placed<'a> {
+    shape: &'a dyn Shape,
+    support: &'a dyn SupportMap,
+    /// World pose of the shape.
+    pose: Pose,
+    /// World AABB (conservative).
+    aabb: Aabb,
+}
+
+impl CollisionWorld {
+    /// An empty world.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Adds a static object. Meshes become a triangle-mesh surface with a BVH.
+    ///
+    /// A shape without geometry (a mesh without valid triangles, non-finite dimensions) or a
+    /// non-finite pose gives an object that never collides and no ray hits.
+    pub fn add_static(&mut self, name: &str, shape: &ShapeSpec, pose: Pose) -> StaticId {
+        let id = StaticId(self.statics.len() as u32);
+        let converted = if pose.is_finite() {
+            static_shape(shape)
+        } else {
+            None
+        };
+        let (shape, pose, aabb) = match converted {
+            Some((s, local)) => {
+                let world = pose * local;
+                let aabb = s.compute_aabb(&world);
+                (Some(s), world, aabb)
+            }
+            None => (None, Pose::IDENTITY, Aabb::new_invalid()),
+        };
+        self.statics.push(StaticObject {
+            name: name.to_string(),
+            shape,
+            pose,
+            aabb,
+        });
+        id
+    }
+
+    /// Name of a static object.
+    pub fn static_name(&self, id: StaticId) -> &str {
+        &self.statics[id.0 as usize].name
+    }
+
+    /// Number of static objects.
+    pub fn static_count(&self) -> usize {
+        self.statics.len()
+    }
+
+    /// World-space bounds `(min, max)` of a static object; `None` when it has no geometry.
+    pub fn static_aabb(&self, id: StaticId) -> Option<(DVec3, DVec3)> {
+        let s = &self.statics[id.0 as usize];
+        s.shape.as_ref().map(|_| (s.aabb.mins, s.aabb.maxs))
+    }
+
+    /// Adds a body group; each body becomes one convex hull (conservative).
+    ///
+    /// No self pairs are checked until [`CollisionWorld::set_self_pairs`] says which.
+    pub fn add_group(&mut self, name: &str, bodies: Vec<GroupBody>) -> GroupId {
+        let id = GroupId(self.groups.len() as u32);
+        let bodies = bodies
+            .into_iter()
+            .map(|b| Body {
+                convex: body_shape(&b.shapes).and_then(|(s, l)| BodyConvex::new(s, l)),
+                name: b.name,
+            })
+            .collect();
+        self.groups.push(Group {
+            name: name.to_string(),
+            bodies,
+            self_pairs: Vec::new(),
+        });
+        id
+    }
+
+    /// Number of groups.
+    pub fn group_count(&self) -> usize {
+        self.groups.len()
+    }
+
+    /// Name of a group.
+    pub fn group_name(&self, g: GroupId) -> &str {
+        &self.group(g).name
+    }
+
+    /// Number of bodies in a group.
+    pub fn body_count(&self, g: GroupId) -> usize {
+        self.group(g).bodies.len()
+    }
+
+    /// Name of body `i` of group `g`.
+    pub fn body_name(&self, g: GroupId, i: usize) -> &str {
+        &self.group(g).bodies[i].name
+    }
+
+    /// The convex shape that stands for body `i` of group `g`, as a mesh in the body frame
+    /// (for drawing and checks); `None` for a body without shapes.
+    pub fn body_hull(&self, g: GroupId, i: usize) -> Option<Mesh> {
+        let c = self.group(g).bodies[i].convex.as_ref()?;
+        shape_as_mesh(&*c.shape, &c.local)
+    }
+
+    /// Sets which self pairs `(i, j)` (i < j) of group `g` are checked; all others are skipped.
+    ///
+    /// Until this is called a group checks **no** self pairs. Pairs are normalised to
+    /// `i < j`, sorted and deduplicated; pairs `(i, i)` and pairs naming a body the group does
+    /// not have are dropped.
+    pub fn set_self_pairs(&mut self, g: GroupId, pairs: Vec<(usize, usize)>) {
+        let group = &mut self.groups[g.0 as usize];
+        let n = group.bodies.len();
+        let mut pairs: Vec<(usize, usize)> = pairs
+            .into_iter()
+            .map(|(i, j)| (i.min(j), i.max(j)))
+            .filter(|&(i, j)| i != j && j < n)
+            .collect();
+        pairs.sort_unstable();
+        pairs.dedup();
+        group.self_pairs = pairs;
+    }
+
+    /// The self pairs checked for group `g` (see [`CollisionWorld::set_self_pairs`]).
+    pub fn self_pairs(&self, g: GroupId) -> &[(usize, usize)] {
+        &self.group(g).self_pairs
+    }
+
+    /// First contact of any body of `g` (at `poses`, world frame, one per body) with the static
+    /// scene, closer than `margin`.
+    ///
+    /// Bodies are taken in order and, for each, the objects in order. A body whose AABB
+    /// (loosened by `margin`) misses an object's AABB is not tested further against it.
+    pub fn group_vs_static(&self, g: GroupId, poses: &[Pose], margin: f64) -> Option<BodyContact> {
+        let group = self.group(g);
+        debug_assert_eq!(poses.len(), group.bodies.len(), "one pose per body");
+        let margin = sanitize_margin(margin);
+        for (i, (body, pose)) in group.bodies.iter().zip(poses).enumerate() {
+            let placed = match place(body, pose) {
+                Placement::Empty => continue,
+                Placement::Invalid => {
+                    if let Some(object) = self.first_solid_static() {
+                        return Some(BodyContact::Static { body: i, object });
+                    }
+                    continue;
+                }
+                Placement::At(p) => p,
+            };
+            let query_aabb = loosened(&placed.aabb, margin);
+            for (k, s) in self.statics.iter().enumerate() {
+                let Some(shape) = s.shape.as_deref() else {
+                    continue;
+                };
+                if !overlap(&query_aabb, &s.aabb) {
+                    continue;
+                }
+                if static_within(s, shape, &placed, margin) {
+                    return Some(BodyContact::Static {
+                        body: i,
+                        object: StaticId(k as u32),
+                    });
+                }
+            }
+        }
+        None
+    }
+
+    /// First checked self pair of `g` closer than `margin`.
+    ///
+    /// Only the pairs set by [`CollisionWorld::set_self_pairs`] are checked (none by default),
+    /// in sorted order.
+    pub fn group_self(&self, g: GroupId, poses: &[Pose], margin: f64) -> Option<BodyContact> {
+        let group = self.group(g);
+        debug_assert_eq!(poses.len(), group.bodies.len(), "one pose per body");
+        let margin = sanitize_margin(margin);
+        group
+            .self_pairs
+            .iter()
+            .find(|&&(i, j)| bodies_touch(group, i, group, j, poses, poses, margin))
+            .map(|&(i, j)| BodyContact::SelfPair(i, j))
+    }
+
+    /// First pair of bodies of two groups closer than `margin`.
+    ///
+    /// Every pair is checked (bodies of `a` in order, and for each the bodies of `b` in order),
+    /// with an AABB pretest. `a` and `b` may be the same group (then every pair `(i, j)`,
+    /// `i < j`, is checked, regardless of the self-pair list).
+    pub fn group_vs_group(
+        &self,
+        a: GroupId,
+        poses_a: &[Pose],
+        b: GroupId,
+        poses_b: &[Pose],
+        margin: f64,
+    ) -> Option<BodyContact> {
+        let (ga, gb) = (self.group(a), self.group(b));
+        debug_assert_eq!(poses_a.len(), ga.bodies.len(), "one pose per body");
+        debug_assert_eq!(poses_b.len(), gb.bodies.len(), "one pose per body");
+        let margin = sanitize_margin(margin);
+        let na = ga.bodies.len().min(poses_a.len());
+        let nb = gb.bodies.len().min(poses_b.len());
+        for i in 0..na {
+            for j in 0..nb {
+                if a == b && j <= i {
+                    continue;
+                }
+                if bodies_touch(ga, i, gb, j, poses_a, poses_b, margin) {
+                    return Some(BodyContact::Pair(i, j));
+                }
+            }
+        }
+        None
+    }
+
+    /// Whether bodies `i` and `j` of group `g` are closer than `margin` (for pair sampling).
+    ///
+    /// Checks the pair regardless of the self-pair list. False when `i == j` or either index
+    /// has no body or no pose.
+    pub fn bodies_within(&self, g: GroupId, i: usize, j: usize, poses: &[Pose], margin: f64) -> bool {
+        let group = self.group(g);
+        let n = group.bodies.len().min(poses.len());
+        if i == j || i >= n || j >= n {
+            return false;
+        }
+        bodies_touch(group, i, group, j, poses, poses, sanitize_margin(margin))
+    }
+
+    /// Smallest distance from any body of `g` to the static scene (0 when touching).
+    ///
+    /// Exact (up to the convex hulls of the bodies), so slower than
+    /// [`CollisionWorld::group_vs_static`]. `f64::INFINITY` when the group has no body with
+    /// shapes or the scene has no object.
+    pub fn min_distance_to_static(&self, g: GroupId, poses: &[Pose]) -> f64 {
+        let group = self.group(g);
+        debug_assert_eq!(poses.len(), group.bodies.len(), "one pose per body");
+        let mut best = f64::INFINITY;
+        for (body, pose) in group.bodies.iter().zip(poses) {
+            let placed = match place(body, pose) {
+                Placement::Empty => continue,
+                Placement::Invalid => {
+                    if self.first_solid_static().is_some() {
+                        return 0.0;
+                    }
+                    continue;
+                }
+                Placement::At(p) => p,
+            };
+            for s in &self.statics {
+                let Some(shape) = s.shape.as_deref() else {
+                    continue;
+                };
+                if aabb_distance(&placed.aabb, &s.aabb) >= best {
+                    continue;
+                }
+                if let Some(d) = static_distance(s, shape, &placed, best) {
+                    best = d;
+                    if best <= 0.0 {
+                        return 0.0;
+                    }
+                }
+            }
+        }
+        best
+    }
+
+    /// First static object hit by the ray `origin + t·dir`, `0 ≤ t ≤ max_distance`.
+    ///
+    /// `dir` need not be unit length: it is normalised, and the distance is in metres. Boxes,
+    /// cylinders and spheres are solid (a ray starting inside one hits it at distance 0);
+    /// meshes are surfaces, hit from either side. Ties go to the object added first. `None`
+    /// for a zero or non-finite direction.
+    pub fn cast_ray_static(&self, origin: DVec3, dir: DVec3, max_distance: f64) -> Option<RayHit> {
+        let (ray, max) = make_ray(origin, dir, max_distance)?;
+        let mut best: Option<RayHit> = None;
+        for (k, s) in self.statics.iter().enumerate() {
+            let Some(shape) = s.shape.as_deref() else {
+                continue;
+            };
+            let limit = best.map_or(max, |b| b.distance);
+            if s.aabb.cast_local_ray(&ray, limit, true).is_none() {
+                continue;
+            }
+            if let Some(t) = shape.cast_ray(&s.pose, &ray, limit, true)
+                && best.is_none_or(|b| t < b.distance)
+            {
+                best = Some(RayHit {
+                    object: StaticId(k as u32),
+                    distance: t,
+                });
+            }
+        }
+        best
+    }
+
+    /// First body of group `g` at `poses` hit by the ray, as `(body, distance)`.
+    ///
+    /// Bodies are solid convex shapes (a ray starting inside one hits it at distance 0).
+    /// Same conventions as [`CollisionWorld::cast_ray_static`].
+    pub fn cast_ray_group(
+        &self,
+        g: GroupId,
+        poses: &[Pose],
+        origin: DVec3,
+        dir: DVec3,
+        max_distance: f64,
+    ) -> Option<(usize, f64)> {
+        let (ray, max) = make_ray(origin, dir, max_distance)?;
+        let group = self.group(g);
+        let mut best: Option<(usize, f64)> = None;
+        for (i, (body, pose)) in group.bodies.iter().zip(poses).enumerate() {
+            let Placement::At(p) = place(body, pose) else {
+                continue;
+            };
+            let limit = best.map_or(max, |b| b.1);
+            if p.aabb.cast_local_ray(&ray, limit, true).is_none() {
+                continue;
+            }
+            if let Some(t) = p.shape.cast_ray(&p.pose, &ray, limit, true)
+                && best.is_none_or(|b| t < b.1)
+            {
+                best = Some((i, t));
+            }
+        }
+        best
+    }
+
+    fn group(&self, g: GroupId) -> &Group {
+        &self.groups[g.0 as usize]
+    }
+
+    fn first_solid_static(&self) -> Option<StaticId> {
+        self.statics
+            .iter()
+            .position(|s| s.shape.is_some())
+            .map(|k| StaticId(k as u32))
+    }
+}
+
+enum Placement<'a> {
+    /// The body has no shape.
+    Empty,
+    /// The pose is not finite.
+    Invalid,
+    At(Placed<'a>),
+}
+
+fn place<'a>(body: &'a Body, pose: &Pose) -> Placement<'a> {
+    let Some(c) = body.convex.as_ref() else {
+        return Placement::Empty;
+    };
+    if !pose.is_finite() {
+        return Placement::Invalid;
+    }
+    Placement::At(Placed {
+        shape: &*c.shape,
+        support: c.support(),
+        // The body-frame box, turned: looser than the shape's own world box, but O(1).
+        aabb: c.local_aabb.transform_by(pose),
+        pose: *pose * c.local,
+    })
+}
+
+/// Whether body `i` of `ga` (at `poses_a[i]`) and body `j` of `gb` (at `poses_b[j]`) are
+/// closer than `margin`. Bodies without shapes never touch; a missing pose means no test.
+fn bodies_touch(
+    ga: &Group,
+    i: usize,
+    gb: &Group,
+    j: usize,
+    poses_a: &[Pose],
+    poses_b: &[Pose],
+    margin: f64,
+) -> bool {
+    let (Some(ba), Some(bb), Some(pa), Some(pb)) =
+        (ga.bodies.get(i), gb.bodies.get(j), poses_a.get(i), poses_b.get(j))
+    else {
+        return false;
+    };
+    let (a, b) = match (place(ba, pa), place(bb, pb)) {
+        (Placement::Empty, _) | (_, Placement::Empty) => return false,
+        (Placement::Invalid, _) | (_, Placement::Invalid) => return true,
+        (Placement::At(a), Placement::At(b)) => (a, b),
+    };
+    if !overlap(&loosened(&a.aabb, margin), &b.aabb) {
+        return false;
+    }
+    convex_within(&a.pose.inv_mul(&b.pose), a.support, b.support, margin)
+}
+
+/// Negative and NaN margins count as 0.
+fn sanitize_margin(margin: f64) -> f64 {
+    if margin > 0.0 { margin } else { 0.0 }
+}
+
+fn loosened(aabb: &Aabb, margin: f64) -> Aabb {
+    Aabb::new(aabb.mins - DVec3::splat(margin), aabb.maxs + DVec3::splat(margin))
+}
+
+#[inline]
+fn overlap(a: &Aabb, b: &Aabb) -> bool {
+    a.mins.cmple(b.maxs).all() && b.mins.cmple(a.maxs).all()
+}
+
+#[inline]
+fn box_overlap(a: &Aabb, mins: DVec3, maxs: DVec3) -> bool {
+    a.mins.cmple(maxs).all() && mins.cmple(a.maxs).all()
+}
+
+fn aabb_distance(a: &Aabb, b: &Aabb) -> f64 {
+    let gap = (a.mins - b.maxs).max(b.mins - a.maxs).max(DVec3::ZERO);
+    gap.length()
+}
+
+fn make_ray(origin: DVec3, dir: DVec3, max_distance: f64) -> Option<(Ray, f64)> {
+    let dir = dir.try_normalize()?;
+    if !origin.is_finite() || max_distance.is_nan() || max_distance < 0.0 {
+        return None;
+    }
+    Some((Ray::new(origin, dir), max_distance))
+}
+
+/// The AABB, in the frame where it stands at `pose`, of a convex shape (six support queries).
+fn support_aabb(support: &dyn SupportMap, pose: &Pose) -> Aabb {
+    let mut mins = DVec3::ZERO;
+    let mut maxs = DVec3::ZERO;
+    for (i, axis) in [DVec3::X, DVec3::Y, DVec3::Z].into_iter().enumerate() {
+        maxs[i] = support.support_point(pose, axis)[i];
+        mins[i] = support.support_point(pose, -axis)[i];
+    }
+    Aabb::new(mins, maxs)
+}
+
+/// Whether a static object and a placed body are closer than `margin` (`margin ≥ 0`).
+///
+/// Convex pairs run GJK without exact distance: it stops as soon as it proves the distance
+/// above or below the margin. A triangle mesh is handled by [`mesh_within`].
+fn static_within(s: &StaticObject, shape: &dyn Shape, b: &Placed, margin: f64) -> bool {
+    let pos12 = s.pose.inv_mul(&b.pose);
+    if let Some(c) = shape.as_support_map() {
+        convex_within(&pos12, c, b.support, margin)
+    } else if let Some(mesh) = shape.as_trimesh() {
+        mesh_within(&pos12, mesh, b.support, margin)
+    } else {
+        // Never built by this crate; kept for safety. An unsupported pair counts as touching.
+        !matches!(
+            query::closest_points(&s.pose, shape, &b.pose, b.shape, margin),
+            Ok(query::ClosestPoints::Disjoint)
+        )
+    }
+}
+
+/// GJK decision "distance ≤ margin" for two convex shapes; `pos12` places `g2` in `g1`'s frame.
+#[inline]
+fn convex_within<G1, G2>(pos12: &Pose, g1: &G1, g2: &G2, margin: f64) -> bool
+where
+    G1: ?Sized + SupportMap,
+    G2: ?Sized + SupportMap,
+{
+    !matches!(
+        convex_gjk(pos12, g1, g2, margin, false, None),
+        GJKResult::NoIntersection(_)
+    )
+}
+
+/// A GJK run; `init` seeds the search direction, pointing from `g1` towards `g2`.
+#[inline]
+fn convex_gjk<G1, G2>(
+    pos12: &Pose,
+    g1: &G1,
+    g2: &G2,
+    max_dist: f64,
+    exact: bool,
+    init: Option<DVec3>,
+) -> GJKResult
+where
+    G1: ?Sized + SupportMap,
+    G2: ?Sized + SupportMap,
+{
+    // GJK's CSO is g1 − g2, so its first direction points from g2 towards g1.
+    let dir = init
+        .map(|d| -d)
+        .or_else(|| (-pos12.translation).try_normalize())
+        .unwrap_or(DVec3::X);
+    let mut simplex = VoronoiSimplex::new();
+    simplex.reset(CsoPoint::from_shapes(pos12, g1, g2, dir));
+    gjk::closest_points(pos12, g1, g2, max_dist, exact, &mut simplex)
+}
+
+/// Whether a triangle mesh (frame 1) and a convex shape (at `pos12` in the mesh's frame) are
+/// closer than `margin`.
+///
+/// Walks the mesh's BVH, pruning nodes and triangles that lie outside the convex shape's box
+/// (loosened by the margin) or beyond an axis that already separated a triangle, then tries
+/// the triangle's plane as a separating axis, and runs GJK on the rest, stopping at the first
+/// triangle within the margin. Each separating axis found (plane or GJK) is cached: along a
+/// panel, one axis usually disposes of the neighbouring triangles and whole BVH nodes.
+fn mesh_within(pos12: &Pose, mesh: &TriMesh, convex: &dyn SupportMap, margin: f64) -> bool {
+    let query = loosened(&support_aabb(convex, pos12), margin);
+    if !overlap(&query, &mesh.local_aabb()) {
+        return false;
+    }
+    let mut cache = AxisCache::default();
+    let centre = query.center();
+    let mut hit = false;
+    mesh.bvh().traverse(|node| {
+        let (lo, hi) = (node.mins(), node.maxs());
+        if !box_overlap(&query, lo, hi) || cache.separates_box(lo, hi) {
+            return TraversalAction::Prune;
+        }
+        let Some(i) = node.leaf_data() else {
+            return TraversalAction::Continue;
+        };
+        let t = mesh.triangle(i);
+        if cache.separates(&t) {
+            return TraversalAction::Continue;
+        }
+        // The triangle's plane often separates (a link above a panel), for one support query.
+        if let Some(n) = (t.b - t.a).cross(t.c - t.a).try_normalize() {
+            let n = if n.dot(centre - t.a) < 0.0 { -n } else { n };
+            let lowest = n.dot(convex.support_point(pos12, -n));
+            if lowest - margin > n.dot(t.a) {
+                cache.push(n, lowest - margin);
+                return TraversalAction::Continue;
+            }
+        }
+        match convex_gjk(pos12, &t, convex, margin, false, cache.last_dir()) {
+            GJKResult::NoIntersection(dir) => {
+                // The convex shape lies beyond the triangle along `dir`: remember by how much.
+                let lowest = dir.dot(convex.support_point(pos12, -dir));
+                cache.push(dir, lowest - margin);
+                TraversalAction::Continue
+            }
+            _ => {
+                hit = true;
+                TraversalAction::EarlyExit
+            }
+        }
+    });
+    hit
+}
+
+/// The last few axes that separated a triangle from the convex shape, each with the shape's
+/// lowest projection on it minus the margin. Neighbouring triangles (and whole BVH nodes) are
+/// usually separated by the same axis: testing it costs a dot product or three instead of a
+/// GJK run.
+#[derive(Default)]
+struct AxisCache {
+    axes: [(DVec3, f64); 4],
+    len: usize,
+    next: usize,
+}
+
+impl AxisCache {
+    #[inline]
+    fn separates(&self, t: &Triangle) -> bool {
+        self.axes[..self.len]
+            .iter()
+            .any(|&(d, limit)| d.dot(t.a).max(d.dot(t.b)).max(d.dot(t.c)) < limit)
+    }
+
+    #[inline]
+    fn separates_box(&self, mins: DVec3, maxs: DVec3) -> bool {
+        let c = (mins + maxs) * 0.5;
+        let e = (maxs - mins) * 0.5;
+        self.axes[..self.len]
+            .iter()
+            .any(|&(d, limit)| d.dot(c) + d.abs().dot(e) < limit)
+    }
+
+    fn push(&mut self, dir: DVec3, limit: f64) {
+        self.axes[self.next] = (dir, limit);
+        self.next = (self.next + 1) % self.axes.len();
+        self.len = (self.len + 1).min(self.axes.len());
+    }
+
+    fn last_dir(&self) -> Option<DVec3> {
+        (self.len > 0).then(|| self.axes[(self.next + self.axes.len() - 1) % self.axes.len()].0)
+    }
+}
+
+/// Exact distance between a static object and a placed body (0 when they overlap), if it is
+/// below `best`; `None` otherwise.
+fn static_distance(s: &StaticObject, shape: &dyn Shape, b: &Placed, best: f64) -> Option<f64> {
+    let pos12 = s.pose.inv_mul(&b.pose);
+    if let Some(c) = shape.as_support_map() {
+        convex_distance(&pos12, c, b.support, best)
+    } else if let Some(mesh) = shape.as_trimesh() {
+        let query = support_aabb(b.support, &pos12);
+        mesh.bvh()
+            .find_best(
+                best,
+                |node, _| aabb_distance(&query, &Aabb::new(node.mins(), node.maxs())),
+                |i, best| convex_distance(&pos12, &mesh.triangle(i), b.support, best),
+            )
+            .map(|(_, d)| d)
+    } else {
+        let d = query::distance(&s.pose, shape, &b.pose, b.shape).map_or(0.0, |d| d.distance);
+        (d < best).then_some(d.max(0.0))
+    }
+}
+
+/// Exact distance between two convex shapes (0 when they overlap) if below `max`.
+fn convex_distance<G1, G2>(pos12: &Pose, g1: &G1, g2: &G2, max: f64) -> Option<f64>
+where
+    G1: ?Sized + SupportMap,
+    G2: ?Sized + SupportMap,
+{
+    match convex_gjk(pos12, g1, g2, max, true, None) {
+        GJKResult::ClosestPoints(p1, p2, _) => Some((p1 - p2).length()).filter(|&d| d < max),
+        GJKResult::Intersection => Some(0.0),
+        GJKResult::NoIntersection(_) | GJKResult::Proximity(_) => None,
+    }
+}
+
+#[cfg(test)]
+mod tests;
