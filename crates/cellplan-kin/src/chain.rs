@@ -1,0 +1,307 @@
+//! Serial kinematic chains and forward kinematics.
+use cellplan_geom::{DQuat, DVec3, Pose};
+
+/// How a joint moves.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum JointKind {
+    /// Rotation about the axis, within limits.
+    Revolute,
+    /// Rotation about the axis without limits (limits are set to ±2π by the loader).
+    Continuous,
+    /// Translation along the axis.
+    Prismatic,
+}
+
+/// A movable joint.
+#[derive(Clone, Debug)]
+pub struct Joint {
+    /// Name in the URDF.
+    pub name: String,
+    /// Kind of motion.
+    pub kind: JointKind,
+    /// Unit axis in the joint frame (= child link frame).
+    pub axis: DVec3,
+    /// Lower limit (rad or m).
+    pub lower: f64,
+    /// Upper limit (rad or m).
+    pub upper: f64,
+    /// Velocity limit (rad/s or m/s); infinite when the URDF states none (or 0).
+    pub max_velocity: f64,
+    /// Effort limit as stated (0 when unknown).
+    pub max_effort: f64,
+}
+
+/// A link on the chain from the root to the tip.
+#[derive(Clone, Debug)]
+pub struct ChainLink {
+    /// Name in the URDF.
+    pub name: String,
+    /// Pose of this link's frame in its parent link's frame at zero joint value
+    /// (identity for the root).
+    pub origin: Pose,
+    /// Index into [`Chain::joints`] of the joint that moves this link, `None` when fixed.
+    pub joint: Option<usize>,
+}
+
+/// A serial chain from a root link to a tip link. Link 0 is the root.
+#[derive(Clone, Debug)]
+pub struct Chain {
+    /// Links from root to tip.
+    pub links: Vec<ChainLink>,
+    /// Movable joints from root to tip; `q[i]` is the value of `joints[i]`.
+    pub joints: Vec<Joint>,
+}
+
+impl Chain {
+    /// Number of movable joints.
+    pub fn dof(&self) -> usize {
+        self.joints.len()
+    }
+    /// Index of the link named `name`.
+    pub fn link_index(&self, name: &str) -> Option<usize> {
+        self.links.iter().position(|l| l.name == name)
+    }
+    /// Poses of every link (in the root frame) at joint values `q`; `out.len() == links.len()`.
+    ///
+    /// Does not allocate. Missing joint values (a `q` shorter than [`Chain::dof`]) count as
+    /// zero; when `out` is shorter than the chain only its first links are written.
+    pub fn fk_all(&self, q: &[f64], out: &mut [Pose]) {
+        let mut parent = Pose::IDENTITY;
+        for (link, slot) in self.links.iter().zip(out.iter_mut()) {
+            let mut pose = parent * link.origin;
+            if let Some(j) = link.joint {
+                let value = q.get(j).copied().unwrap_or(0.0);
+                if let Some(joint) = self.joints.get(j) {
+                    pose = joint.apply(pose, value);
+                }
+            }
+            *slot = pose;
+            parent = pose;
+        }
+    }
+    /// Pose of the tip (last link) in the root frame.
+    pub fn fk_tip(&self, q: &[f64]) -> Pose {
+        let mut pose = Pose::IDENTITY;
+        for link in &self.links {
+            pose *= link.origin;
+            if let Some(j) = link.joint {
+                let value = q.get(j).copied().unwrap_or(0.0);
+                if let Some(joint) = self.joints.get(j) {
+                    pose = joint.apply(pose, value);
+                }
+            }
+        }
+        pose
+    }
+    /// Whether every joint value lies within its limits (with tolerance `tol`).
+    ///
+    /// False when `q` does not hold exactly one finite value per joint.
+    pub fn within_limits(&self, q: &[f64], tol: f64) -> bool {
+        q.len() == self.joints.len()
+            && self
+                .joints
+                .iter()
+                .zip(q)
+                .all(|(j, &v)| v.is_finite() && v >= j.lower - tol && v <= j.upper + tol)
+    }
+    /// Name of the root link (empty for an empty chain).
+    pub fn root_name(&self) -> &str {
+        self.links.first().map(|l| l.name.as_str()).unwrap_or("")
+    }
+    /// Name of the tip link (empty for an empty chain).
+    pub fn tip_name(&self) -> &str {
+        self.links.last().map(|l| l.name.as_str()).unwrap_or("")
+    }
+    /// Index into [`Chain::links`] of the link moved by joint `j`.
+    pub fn joint_link(&self, j: usize) -> Option<usize> {
+        self.links.iter().position(|l| l.joint == Some(j))
+    }
+    /// The middle of every joint's range (0 for a joint without finite limits).
+    pub fn mid_configuration(&self) -> Vec<f64> {
+        self.joints.iter().map(Joint::mid).collect()
+    }
+}
+
+impl Joint {
+    /// The motion of the joint at value `value`: a rotation about the axis (revolute,
+    /// continuous) or a translation along it (prismatic), in the joint frame.
+    #[inline]
+    pub fn motion(&self, value: f64) -> Pose {
+        match self.kind {
+            JointKind::Revolute | JointKind::Continuous => {
+                Pose::from_rotation(DQuat::from_axis_angle(self.axis, value))
+            }
+            JointKind::Prismatic => Pose::from_translation(self.axis * value),
+        }
+    }
+    /// `frame * self.motion(value)`, computed with less work.
+    #[inline]
+    pub fn apply(&self, frame: Pose, value: f64) -> Pose {
+        match self.kind {
+            JointKind::Revolute | JointKind::Continuous => Pose::from_parts(
+                frame.translation,
+                frame.rotation * DQuat::from_axis_angle(self.axis, value),
+            ),
+            JointKind::Prismatic => Pose::from_parts(
+                frame.translation + frame.rotation * (self.axis * value),
+                frame.rotation,
+            ),
+        }
+    }
+    /// Whether the joint rotates (revolute or continuous).
+    pub fn is_rotational(&self) -> bool {
+        matches!(self.kind, JointKind::Revolute | JointKind::Continuous)
+    }
+    /// Middle of the range, or 0 when a limit is not finite.
+    pub fn mid(&self) -> f64 {
+        if self.lower.is_finite() && self.upper.is_finite() {
+            0.5 * (self.lower + self.upper)
+        } else {
+            0.0
+        }
+    }
+    /// Clamps `value` into `[lower, upper]` (NaN becomes the middle of the range).
+    pub fn clamp(&self, value: f64) -> f64 {
+        if value.is_nan() {
+            return self.mid();
+        }
+        value.max(self.lower).min(self.upper)
+    }
+}
+
+/// Distance between two poses: `(translation distance (m), rotation angle (rad, in [0, π]))`.
+pub fn pose_error(a: &Pose, b: &Pose) -> (f64, f64) {
+    let dp = (a.translation - b.translation).length();
+    let d = a.rotation.conjugate() * b.rotation;
+    let s = DVec3::new(d.x, d.y, d.z).length();
+    (dp, 2.0 * s.atan2(d.w.abs()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::f64::consts::{FRAC_PI_2, PI};
+
+    fn joint(name: &str, kind: JointKind, axis: DVec3, lower: f64, upper: f64) -> Joint {
+        Joint {
+            name: name.into(),
+            kind,
+            axis,
+            lower,
+            upper,
+            max_velocity: 1.0,
+            max_effort: 0.0,
+        }
+    }
+
+    /// base → (revolute z at 1 m up) l1 → (revolute y, 0.5 m along x) l2 → (prismatic x,
+    /// 0.3 m along x) l3 → (fixed, rotated 90° about z) tip.
+    fn arm() -> Chain {
+        Chain {
+            links: vec![
+                ChainLink {
+                    name: "base".into(),
+                    origin: Pose::IDENTITY,
+                    joint: None,
+                },
+                ChainLink {
+                    name: "l1".into(),
+                    origin: Pose::translation(0.0, 0.0, 1.0),
+                    joint: Some(0),
+                },
+                ChainLink {
+                    name: "l2".into(),
+                    origin: Pose::translation(0.5, 0.0, 0.0),
+                    joint: Some(1),
+                },
+                ChainLink {
+                    name: "l3".into(),
+                    origin: Pose::translation(0.3, 0.0, 0.0),
+                    joint: Some(2),
+                },
+                ChainLink {
+                    name: "tip".into(),
+                    origin: Pose::from_rotation(DQuat::from_rotation_z(FRAC_PI_2)),
+                    joint: None,
+                },
+            ],
+            joints: vec![
+                joint("j1", JointKind::Revolute, DVec3::Z, -PI, PI),
+                joint("j2", JointKind::Continuous, DVec3::Y, -2.0 * PI, 2.0 * PI),
+                joint("j3", JointKind::Prismatic, DVec3::X, 0.0, 0.2),
+            ],
+        }
+    }
+
+    #[test]
+    fn forward_kinematics_of_every_link() {
+        let c = arm();
+        let mut poses = vec![Pose::IDENTITY; c.links.len()];
+        c.fk_all(&[0.0, 0.0, 0.0], &mut poses);
+        assert!((poses[3].translation - DVec3::new(0.8, 0.0, 1.0)).length() < 1e-15);
+
+        // Turn the base by 90°: the arm points along y. Pitch j2 by 90° about y: it points down.
+        let q = [FRAC_PI_2, FRAC_PI_2, 0.1];
+        c.fk_all(&q, &mut poses);
+        assert!((poses[1].translation - DVec3::new(0.0, 0.0, 1.0)).length() < 1e-15);
+        assert!((poses[2].translation - DVec3::new(0.0, 0.5, 1.0)).length() < 1e-15);
+        // l3 sits 0.3 m along l2's x, plus 0.1 of travel, which now points down (-z).
+        assert!(
+            (poses[3].translation - DVec3::new(0.0, 0.5, 0.6)).length() < 1e-12,
+            "{:?}",
+            poses[3]
+        );
+        assert_eq!(c.fk_tip(&q), poses[4]);
+        // Tip x axis = l3's y axis = base -x after the base turn.
+        assert!((poses[4].rotation * DVec3::X - DVec3::new(-1.0, 0.0, 0.0)).length() < 1e-12);
+    }
+
+    #[test]
+    fn apply_equals_composition_with_motion() {
+        let frame = Pose::from_parts(DVec3::new(0.1, -0.2, 0.3), DQuat::from_rotation_y(0.7));
+        for j in arm().joints {
+            let (dp, dr) = pose_error(&j.apply(frame, 0.37), &(frame * j.motion(0.37)));
+            assert!(dp < 1e-15 && dr < 1e-15, "{:?}", j.kind);
+        }
+    }
+
+    #[test]
+    fn short_inputs_do_not_panic() {
+        let c = arm();
+        let mut two = [Pose::IDENTITY; 2];
+        c.fk_all(&[0.3], &mut two);
+        assert!((two[1].translation.z - 1.0).abs() < 1e-15);
+        assert_eq!(c.fk_tip(&[]), c.fk_tip(&[0.0, 0.0, 0.0]));
+    }
+
+    #[test]
+    fn names_and_limits() {
+        let c = arm();
+        assert_eq!(c.link_index("l2"), Some(2));
+        assert_eq!(c.link_index("nope"), None);
+        assert_eq!(c.root_name(), "base");
+        assert_eq!(c.tip_name(), "tip");
+        assert_eq!(c.joint_link(2), Some(3));
+        assert!(c.within_limits(&[0.0, 5.0, 0.2], 0.0));
+        assert!(!c.within_limits(&[0.0, 5.0, 0.2 + 1e-6], 0.0));
+        assert!(c.within_limits(&[0.0, 5.0, 0.2 + 1e-6], 1e-5));
+        assert!(!c.within_limits(&[0.0, 5.0], 0.0));
+        assert!(!c.within_limits(&[f64::NAN, 0.0, 0.0], 1.0));
+        assert_eq!(c.mid_configuration(), vec![0.0, 0.0, 0.1]);
+    }
+
+    #[test]
+    fn pose_error_measures_both_parts() {
+        let a = Pose::translation(1.0, 0.0, 0.0);
+        let b = Pose::from_parts(DVec3::new(1.0, 2.0, 0.0), DQuat::from_rotation_x(0.25));
+        let (dp, dr) = pose_error(&a, &b);
+        assert!((dp - 2.0).abs() < 1e-15);
+        assert!((dr - 0.25).abs() < 1e-15);
+        // q and -q are the same rotation.
+        let c = Pose::from_parts(b.translation, -b.rotation);
+        assert!(pose_error(&b, &c).1 < 1e-15);
+        // Tiny angles keep their precision.
+        let d = Pose::from_rotation(DQuat::from_rotation_z(1e-12));
+        assert!((pose_error(&Pose::IDENTITY, &d).1 - 1e-12).abs() < 1e-24);
+    }
+}

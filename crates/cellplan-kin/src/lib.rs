@@ -1,0 +1,24 @@
+//! Robot kinematics for cellplan: URDF serial chains, forward kinematics of every link,
+//! analytic inverse kinematics for ortho-parallel industrial arms (OPW) and a numeric
+//! damped-least-squares solver for the rest.
+//!
+//! - [`urdf`]: [`load_urdf`] reads a URDF (resolving `package://` URIs) into a [`RobotModel`].
+//! - [`chain`]: the serial [`Chain`], its [`Joint`]s and forward kinematics.
+//! - [`opw`]: [`OpwParameters`] and the closed-form solution with all eight branches.
+//! - [`ik`]: the [`IkSolver`] trait, [`OpwIk`] (OPW on a URDF chain), [`DlsIk`] (numeric),
+//!   and joint-limit filtering with ±2π variants.
+//!
+//! Units: metres and radians. Poses are `cellplan_geom::Pose`.
+#![warn(missing_docs)]
+
+pub mod chain;
+pub mod error;
+pub mod ik;
+pub mod opw;
+pub mod urdf;
+
+pub use chain::{Chain, ChainLink, Joint, JointKind, pose_error};
+pub use error::KinError;
+pub use ik::{DlsIk, DlsParams, IkSolver, LIMIT_TOLERANCE, OpwIk, limit_variants};
+pub use opw::{OpwParameters, wrap_angle};
+pub use urdf::{RobotModel, load_urdf, load_urdf_str};

@@ -1,0 +1,775 @@
+//! Reading URDF files.
+use crate::{Chain, ChainLink, Joint, JointKind, KinError};
+use cellplan_geom::{DQuat, DVec3, Mesh, MeshError, Pose, ShapeSpec, load_mesh};
+use std::collections::{BTreeMap, HashMap};
+use std::f64::consts::TAU;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+mod xml;
+
+/// A robot read from a URDF: its serial chain and the collision geometry of each chain link.
+#[derive(Clone, Debug)]
+pub struct RobotModel {
+    /// `<robot name>`.
+    pub name: String,
+    /// The URDF file.
+    pub path: PathBuf,
+    /// Chain from the URDF root link to the tip link.
+    pub chain: Chain,
+    /// Collision shapes per chain link (same index as `chain.links`), in the link frame, metres.
+    /// Links rigidly attached off the chain have their shapes merged into their chain parent.
+    pub collision: Vec<Vec<(ShapeSpec, Pose)>>,
+}
+
+/// Loads a URDF. `packages` maps a ROS package name to its folder (for `package://name/...`);
+/// relative mesh paths resolve against the URDF's folder. `tip` picks the chain's last link
+/// (default: `tool0` when present, else the end of the longest root-to-leaf path).
+///
+/// Only `<collision>` geometry is read (visual meshes need not exist). Links off the chain
+/// (e.g. `base`, `flange`, or anything below the tip) have their shapes merged into the chain
+/// link they hang from; movable joints off the chain are taken at zero.
+pub fn load_urdf(
+    path: &Path,
+    packages: &BTreeMap<String, PathBuf>,
+    tip: Option<&str>,
+) -> Result<RobotModel, KinError> {
+    let text = std::fs::read_to_string(path).map_err(|source| KinError::Io {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    load_urdf_str(&text, path, packages, tip)
+}
+
+/// As [`load_urdf`] on URDF text already read; `path` names the file in errors and relative
+/// mesh paths resolve against its folder.
+pub fn load_urdf_str(
+    text: &str,
+    path: &Path,
+    packages: &BTreeMap<String, PathBuf>,
+    tip: Option<&str>,
+) -> Result<RobotModel, KinError> {
+    Loader { text, path, packages }.load(tip)
+}
+
+struct Loader<'a> {
+    text: &'a str,
+    path: &'a Path,
+    packages: &'a BTreeMap<String, PathBuf>,
+}
+
+/// Where an off-chain link hangs: its chain link and its pose in that link's frame.
+#[derive(Clone, Copy)]
+struct Attachment {
+    chain_link: usize,
+    pose: Pose,
+}
+
+impl Loader<'_> {
+    fn err(&self, line: Option<usize>, message: impl Into<String>, hint: impl Into<String>) -> KinError {
+        KinError::Urdf {
+            path: self.path.to_path_buf(),
+            line,
+            message: message.into(),
+            hint: hint.into(),
+        }
+    }
+
+    fn load(&self, tip: Option<&str>) -> Result<RobotModel, KinError> {
+        let doc = xml::parse(self.text).map_err(|(line, msg)| {
+            self.err(
+                Some(line),
+                format!("not well-formed XML: {msg}"),
+                "fix the XML syntax at that line (a URDF is an XML file with a <robot> root)",
+            )
+        })?;
+        self.validate(&doc)?;
+        let robot = urdf_rs::read_from_string(self.text).map_err(|e| {
+            let msg = e.to_string();
+            let msg = msg.strip_prefix("custom: ").unwrap_or(&msg);
+            let line = self.guess_line(msg);
+            self.err(
+                line,
+                format!("invalid URDF: {msg}"),
+                if line.is_some() {
+                    "check the element at that line against the URDF specification"
+                } else {
+                    "check the file against the URDF specification"
+                },
+            )
+        })?;
+        let elem_line = |kind: &str, name: &str| -> Option<usize> {
+            doc.children(doc.root())
+                .find(|e| e.name == kind && e.attr("name") == Some(name))
+                .map(|e| e.line)
+        };
+
+        // Tree structure.
+        let link_index: HashMap<&str, usize> = robot
+            .links
+            .iter()
+            .enumerate()
+            .map(|(i, l)| (l.name.as_str(), i))
+            .collect();
+        let mut parent_joint: Vec<Option<usize>> = vec![None; robot.links.len()];
+        let mut child_joints: Vec<Vec<usize>> = vec![Vec::new(); robot.links.len()];
+        for (ji, joint) in robot.joints.iter().enumerate() {
+            let line = elem_line("joint", &joint.name);
+            let find = |name: &str, role: &str| {
+                link_index.get(name).copied().ok_or_else(|| {
+                    self.err(
+                        line,
+                        format!(
+                            "joint '{}' names {role} link '{name}', which does not exist",
+                            joint.name
+                        ),
+                        "every <parent link> and <child link> must name a <link> of the file",
+                    )
+                })
+            };
+            let parent = find(&joint.parent.link, "parent")?;
+            let child = find(&joint.child.link, "child")?;
+            if let Some(other) = parent_joint[child] {
+                return Err(self.err(
+                    line,
+                    format!(
+                        "link '{}' is the child of two joints ('{}' and '{}')",
+                        joint.child.link, robot.joints[other].name, joint.name
+                    ),
+                    "a URDF is a tree: each link has at most one parent joint",
+                ));
+            }
+            parent_joint[child] = Some(ji);
+            child_joints[parent].push(ji);
+        }
+        let roots: Vec<usize> = (0..robot.links.len())
+            .filter(|&i| parent_joint[i].is_none())
+            .collect();
+        let root = match roots.as_slice() {
+            [r] => *r,
+            [] => {
+                return Err(self.err(
+                    None,
+                    if robot.links.is_empty() {
+                        "the URDF has no <link>".to_string()
+                    } else {
+                        "the joints form a cycle: no link is without a parent".to_string()
+                    },
+                    "a URDF is a tree with one root link",
+                ));
+            }
+            many => {
+                let names: Vec<&str> = many.iter().map(|&i| robot.links[i].name.as_str()).collect();
+                return Err(self.err(
+                    many.get(1).and_then(|&i| elem_line("link", &robot.links[i].name)),
+                    format!(
+                        "the URDF has {} root links (links without a parent joint): {}",
+                        many.len(),
+                        names.join(", ")
+                    ),
+                    "connect every link to the tree with a joint (a URDF has one root link)",
+                ));
+            }
+        };
+        // Depth-first order from the root; links never reached sit on a cycle.
+        let mut depth = vec![usize::MAX; robot.links.len()];
+        let mut order = Vec::with_capacity(robot.links.len());
+        let mut stack = vec![(root, 0usize)];
+        while let Some((l, d)) = stack.pop() {
+            depth[l] = d;
+            order.push(l);
+            for &ji in child_joints[l].iter().rev() {
+                if let Some(&c) = link_index.get(robot.joints[ji].child.link.as_str()) {
+                    stack.push((c, d + 1));
+                }
+            }
+        }
+        if let Some(l) = (0..robot.links.len()).find(|&l| depth[l] == usize::MAX) {
+            return Err(self.err(
+                elem_line("link", &robot.links[l].name),
+                format!("link '{}' is on a cycle of joints", robot.links[l].name),
+                "a URDF is a tree: remove the joint that closes the loop",
+            ));
+        }
+
+        // Tip and chain path.
+        let tip_link = match tip {
+            Some(name) => link_index.get(name).copied().ok_or_else(|| {
+                let names: Vec<&str> = robot.links.iter().map(|l| l.name.as_str()).collect();
+                self.err(
+                    None,
+                    format!(
+                        "tip link '{name}' does not exist; the links are: {}",
+                        names.join(", ")
+                    ),
+                    "set the tip to one of these links",
+                )
+            })?,
+            None => match link_index.get("tool0") {
+                Some(&t) => t,
+                None => {
+                    // Deepest leaf, first in depth-first order on ties.
+                    let mut best = root;
+                    for &l in &order {
+                        if child_joints[l].is_empty() && depth[l] > depth[best] {
+                            best = l;
+                        }
+                    }
+                    best
+                }
+            },
+        };
+        let mut path_links = vec![tip_link];
+        let mut cur = tip_link;
+        while let Some(ji) = parent_joint[cur] {
+            cur = link_index[robot.joints[ji].parent.link.as_str()];
+            path_links.push(cur);
+        }
+        path_links.reverse();
+
+        // Chain.
+        let mut links = Vec::with_capacity(path_links.len());
+        let mut joints = Vec::new();
+        let mut chain_pos: Vec<Option<usize>> = vec![None; robot.links.len()];
+        for (ci, &l) in path_links.iter().enumerate() {
+            chain_pos[l] = Some(ci);
+            let name = robot.links[l].name.clone();
+            let Some(ji) = parent_joint[l] else {
+                links.push(ChainLink {
+                    name,
+                    origin: Pose::IDENTITY,
+                    joint: None,
+                });
+                continue;
+            };
+            let uj = &robot.joints[ji];
+            let line = elem_line("joint", &uj.name);
+            let origin = origin_pose(&uj.origin);
+            let kind = match uj.joint_type {
+                urdf_rs::JointType::Fixed => None,
+                urdf_rs::JointType::Revolute => Some(JointKind::Revolute),
+                urdf_rs::JointType::Continuous => Some(JointKind::Continuous),
+                urdf_rs::JointType::Prismatic => Some(JointKind::Prismatic),
+                ref other => {
+                    return Err(self.err(
+                        line,
+                        format!(
+                            "joint '{}' on the chain is of type {other:?}, which is not supported",
+                            uj.name
+                        ),
+                        "the chain may hold revolute, continuous, prismatic and fixed joints only",
+                    ));
+                }
+            };
+            let joint = match kind {
+                None => None,
+                Some(kind) => {
+                    let axis = DVec3::from_array(uj.axis.xyz.0);
+                    let len = axis.length();
+                    if !(len > 1e-12 && len.is_finite()) {
+                        return Err(self.err(
+                            line,
+                            format!(
+                                "joint '{}' has a zero or invalid axis {:?}",
+                                uj.name, uj.axis.xyz.0
+                            ),
+                            "give <axis xyz=\"...\"> a non-zero direction",
+                        ));
+                    }
+                    let (mut lower, mut upper) = (uj.limit.lower, uj.limit.upper);
+                    if kind == JointKind::Continuous {
+                        (lower, upper) = (-TAU, TAU);
+                    } else if kind == JointKind::Revolute && !(lower.is_finite() && upper.is_finite()) {
+                        // URDF 1.2: a revolute joint without limits turns freely.
+                        lower = if lower.is_finite() { lower } else { -TAU };
+                        upper = if upper.is_finite() { upper } else { TAU };
+                    }
+                    if lower.is_nan() || upper.is_nan() || lower > upper {
+                        return Err(self.err(
+                            line,
+                            format!("joint '{}' has limits lower {lower} > upper {upper}", uj.name),
+                            "make <limit lower> at most <limit upper>",
+                        ));
+                    }
+                    joints.push(Joint {
+                        name: uj.name.clone(),
+                        kind,
+                        axis: axis / len,
+                        lower,
+                        upper,
+                        // No <limit> (continuous) or a zero velocity: unknown, no limit.
+                        max_velocity: if uj.limit.velocity > 0.0 {
+                            uj.limit.velocity
+                        } else {
+                            f64::INFINITY
+                        },
+                        max_effort: uj.limit.effort,
+                    });
+                    Some(joints.len() - 1)
+                }
+            };
+            links.push(ChainLink { name, origin, joint });
+        }
+
+        // Where each link's shapes go: walk up to the nearest chain link.
+        let mut attach: Vec<Option<Attachment>> = vec![None; robot.links.len()];
+        for &l in &order {
+            attach[l] = Some(match chain_pos[l] {
+                Some(ci) => Attachment {
+                    chain_link: ci,
+                    pose: Pose::IDENTITY,
+                },
+                None => {
+                    // The parent comes earlier in depth-first order, so it is set already.
+                    let ji =
+                        parent_joint[l].ok_or_else(|| self.err(None, "internal: root off the chain", ""))?;
+                    let p = link_index[robot.joints[ji].parent.link.as_str()];
+                    let up = attach[p].ok_or_else(|| self.err(None, "internal: unordered tree", ""))?;
+                    Attachment {
+                        chain_link: up.chain_link,
+                        pose: up.pose * origin_pose(&robot.joints[ji].origin),
+                    }
+                }
+            });
+        }
+        let mut collision: Vec<Vec<(ShapeSpec, Pose)>> = vec![Vec::new(); links.len()];
+        let mut meshes: HashMap<PathBuf, Arc<Mesh>> = HashMap::new();
+        // Line of each collision <mesh>, by link and filename, for errors.
+        let mut mesh_lines: HashMap<(&str, &str), usize> = HashMap::new();
+        for link in doc.children(doc.root()).filter(|e| e.name == "link") {
+            let name = link.attr("name").unwrap_or_default();
+            for c in doc.children(link).filter(|c| c.name == "collision") {
+                for g in doc.children(c).filter(|g| g.name == "geometry") {
+                    for m in doc.children(g).filter(|m| m.name == "mesh") {
+                        if let Some(f) = m.attr("filename") {
+                            mesh_lines.entry((name, f)).or_insert(m.line);
+                        }
+                    }
+                }
+            }
+        }
+        for (l, link) in robot.links.iter().enumerate() {
+            let Some(at) = attach[l] else { continue };
+            for c in &link.collision {
+                let pose = at.pose * origin_pose(&c.origin);
+                for (shape, local) in self.shapes(&link.name, &c.geometry, &mut meshes, &mesh_lines)? {
+                    collision[at.chain_link].push((shape, pose * local));
+                }
+            }
+        }
+        Ok(RobotModel {
+            name: robot.name.clone(),
+            path: self.path.to_path_buf(),
+            chain: Chain { links, joints },
+            collision,
+        })
+    }
+
+    /// Checks the structure urdf-rs would reject (or silently accept) with a line number.
+    fn validate(&self, doc: &xml::Document) -> Result<(), KinError> {
+        let root = doc.root();
+        if root.name != "robot" {
+            let hint = if root.name.contains("xacro") || self.text.contains("xmlns:xacro") {
+                "this looks like xacro: run `xacro file.urdf.xacro > file.urdf` first"
+            } else {
+                "a URDF file has a <robot> root element"
+            };
+            return Err(self.err(
+                Some(root.line),
+                format!(
+                    "the root element is <{}>, not <robot>: this is not a URDF",
+                    root.name
+                ),
+                hint,
+            ));
+        }
+        let xacro_hint = "this looks like xacro: run `xacro file.urdf.xacro > file.urdf` first";
+        let mut link_names: HashMap<&str, usize> = HashMap::new();
+        let mut joint_names: HashMap<&str, usize> = HashMap::new();
+        for e in doc.children(root) {
+            if e.name.starts_with("xacro:") {
+                return Err(self.err(
+                    Some(e.line),
+                    format!("<{}> is a xacro macro, not URDF", e.name),
+                    xacro_hint,
+                ));
+            }
+            let (names, what) = match e.name.as_str() {
+                "link" => (&mut link_names, "link"),
+                "joint" => (&mut joint_names, "joint"),
+                _ => continue,
+            };
+            let Some(name) = e.attr("name") else {
+                return Err(self.err(
+                    Some(e.line),
+                    format!("<{what}> without a name"),
+                    format!("give the {what} a name=\"...\" attribute"),
+                ));
+            };
+            if let Some(first) = names.insert(name, e.line) {
+                return Err(self.err(
+                    Some(e.line),
+                    format!("{what} '{name}' is defined twice (first on line {first})"),
+                    format!("{what} names must be unique"),
+                ));
+            }
+            if what == "link" {
+                for c in doc.children(e) {
+                    match c.name.as_str() {
+                        "collision" | "visual" => {
+                            self.validate_origin(doc, c)?;
+                            self.validate_geometry(doc, c)?;
+                        }
+                        "inertial" => self.validate_inertial(doc, c)?,
+                        _ => {}
+                    }
+                }
+            } else {
+                self.validate_joint(doc, e, name)?;
+            }
+        }
+        Ok(())
+    }
+
+    fn validate_joint(&self, doc: &xml::Document, e: &xml::Element, name: &str) -> Result<(), KinError> {
+        const TYPES: [&str; 7] = [
+            "revolute",
+            "continuous",
+            "prismatic",
+            "fixed",
+            "floating",
+            "planar",
+            "spherical",
+        ];
+        let Some(ty) = e.attr("type") else {
+            return Err(self.err(
+                Some(e.line),
+                format!("joint '{name}' has no type"),
+                "add type=\"revolute\" (or continuous, prismatic, fixed)",
+            ));
+        };
+        if !TYPES.contains(&ty) {
+            return Err(self.err(
+                Some(e.line),
+                format!("joint '{name}' has unknown type '{ty}'"),
+                "use revolute, continuous, prismatic, fixed, floating or planar",
+            ));
+        }
+        for role in ["parent", "child"] {
+            match doc.child(e, role) {
+                Some(p) if p.attr("link").is_some() => {}
+                Some(p) => {
+                    return Err(self.err(
+                        Some(p.line),
+                        format!("<{role}> of joint '{name}' has no link attribute"),
+                        format!("write <{role} link=\"...\"/>"),
+                    ));
+                }
+                None => {
+                    return Err(self.err(
+                        Some(e.line),
+                        format!("joint '{name}' has no <{role}>"),
+                        format!("add <{role} link=\"...\"/>"),
+                    ));
+                }
+            }
+        }
+        self.validate_origin(doc, e)?;
+        if let Some(axis) = doc.child(e, "axis") {
+            self.numbers(axis, "xyz", 3, true)?;
+        }
+        match doc.child(e, "limit") {
+            Some(limit) => {
+                for attr in ["lower", "upper", "effort"] {
+                    self.numbers(limit, attr, 1, false)?;
+                }
+                self.numbers(limit, "velocity", 1, true)?;
+            }
+            None if ty == "revolute" || ty == "prismatic" => {
+                return Err(self.err(
+                    Some(e.line),
+                    format!("{ty} joint '{name}' has no <limit>"),
+                    "add <limit lower=\"..\" upper=\"..\" effort=\"..\" velocity=\"..\"/> (or make it continuous)",
+                ));
+            }
+            None => {}
+        }
+        Ok(())
+    }
+
+    fn validate_inertial(&self, doc: &xml::Document, e: &xml::Element) -> Result<(), KinError> {
+        self.validate_origin(doc, e)?;
+        match doc.child(e, "mass") {
+            Some(m) => self.numbers(m, "value", 1, true)?,
+            None => {
+                return Err(self.err(
+                    Some(e.line),
+                    "<inertial> without <mass>",
+                    "add <mass value=\"...\"/> or remove the <inertial>",
+                ));
+            }
+        }
+        match doc.child(e, "inertia") {
+            Some(i) => {
+                for attr in ["ixx", "ixy", "ixz", "iyy", "iyz", "izz"] {
+                    self.numbers(i, attr, 1, true)?;
+                }
+                Ok(())
+            }
+            None => Err(self.err(
+                Some(e.line),
+                "<inertial> without <inertia>",
+                "add <inertia ixx=.. ixy=.. ixz=.. iyy=.. iyz=.. izz=../>",
+            )),
+        }
+    }
+
+    fn validate_origin(&self, doc: &xml::Document, e: &xml::Element) -> Result<(), KinError> {
+        if let Some(o) = doc.child(e, "origin") {
+            self.numbers(o, "xyz", 3, false)?;
+            self.numbers(o, "rpy", 3, false)?;
+        }
+        Ok(())
+    }
+
+    fn validate_geometry(&self, doc: &xml::Document, collision: &xml::Element) -> Result<(), KinError> {
+        let Some(g) = doc.child(collision, "geometry") else {
+            return Err(self.err(
+                Some(collision.line),
+                format!("<{}> without <geometry>", collision.name),
+                "add <geometry> with a box, cylinder, sphere or mesh",
+            ));
+        };
+        let Some(shape) = doc.children(g).next() else {
+            return Err(self.err(
+                Some(g.line),
+                "empty <geometry>",
+                "add a box, cylinder, sphere or mesh",
+            ));
+        };
+        match shape.name.as_str() {
+            "box" => self.numbers(shape, "size", 3, true),
+            "cylinder" | "capsule" => {
+                self.numbers(shape, "radius", 1, true)?;
+                self.numbers(shape, "length", 1, true)
+            }
+            "sphere" => self.numbers(shape, "radius", 1, true),
+            "mesh" => {
+                if shape.attr("filename").is_none() {
+                    return Err(self.err(
+                        Some(shape.line),
+                        "<mesh> without filename",
+                        "add filename=\"package://...\"",
+                    ));
+                }
+                self.numbers(shape, "scale", 3, false)
+            }
+            other => Err(self.err(
+                Some(shape.line),
+                format!("unknown geometry <{other}>"),
+                "use box, cylinder, sphere or mesh",
+            )),
+        }
+    }
+
+    /// Attribute `attr` of `e` holds `n` numbers (not NaN).
+    fn numbers(&self, e: &xml::Element, attr: &str, n: usize, required: bool) -> Result<(), KinError> {
+        let Some(v) = e.attr(attr) else {
+            if required {
+                return Err(self.err(
+                    Some(e.line),
+                    format!("<{}> needs attribute {attr}", e.name),
+                    format!("add {attr}=\"...\" with {n} number(s)"),
+                ));
+            }
+            return Ok(());
+        };
+        let parsed: Vec<Option<f64>> = v
+            .split_whitespace()
+            .map(|s| s.parse::<f64>().ok().filter(|x| !x.is_nan()))
+            .collect();
+        if parsed.len() != n || parsed.iter().any(Option::is_none) {
+            return Err(self.err(
+                Some(e.line),
+                format!("attribute {attr}=\"{v}\" of <{}> must be {n} number(s)", e.name),
+                format!("write {n} number(s) separated by spaces"),
+            ));
+        }
+        Ok(())
+    }
+
+    /// A line for an urdf-rs error message: the one it states, else where a quoted value of
+    /// the message first occurs in the file.
+    fn guess_line(&self, msg: &str) -> Option<usize> {
+        if let Some(rest) = msg.split("Line: ").nth(1) {
+            let digits: String = rest.chars().take_while(char::is_ascii_digit).collect();
+            if let Ok(l) = digits.parse() {
+                return Some(l);
+            }
+        }
+        for (open, close) in [('`', '`'), ('[', ']')] {
+            if let Some(start) = msg.find(open) {
+                let rest = &msg[start + 1..];
+                if let Some(end) = rest.find(close) {
+                    let needle = &rest[..end];
+                    let found = (!needle.is_empty())
+                        .then(|| line_of(self.text, &format!("\"{needle}\"")))
+                        .flatten();
+                    if found.is_some() {
+                        return found;
+                    }
+                }
+            }
+        }
+        None
+    }
+
+    /// The shapes of one `<collision>` geometry in the collision frame.
+    fn shapes(
+        &self,
+        link: &str,
+        g: &urdf_rs::Geometry,
+        meshes: &mut HashMap<PathBuf, Arc<Mesh>>,
+        mesh_lines: &HashMap<(&str, &str), usize>,
+    ) -> Result<Vec<(ShapeSpec, Pose)>, KinError> {
+        Ok(match g {
+            urdf_rs::Geometry::Box { size } => vec![(
+                ShapeSpec::Box {
+                    half_extents: DVec3::from_array(size.0) * 0.5,
+                },
+                Pose::IDENTITY,
+            )],
+            urdf_rs::Geometry::Cylinder { radius, length } => vec![(
+                ShapeSpec::Cylinder {
+                    radius: *radius,
+                    half_height: length * 0.5,
+                },
+                Pose::IDENTITY,
+            )],
+            urdf_rs::Geometry::Sphere { radius } => {
+                vec![(ShapeSpec::Sphere { radius: *radius }, Pose::IDENTITY)]
+            }
+            urdf_rs::Geometry::Capsule { radius, length } => {
+                // A capsule along z: a cylinder and two end spheres.
+                let h = length * 0.5;
+                vec![
+                    (
+                        ShapeSpec::Cylinder {
+                            radius: *radius,
+                            half_height: h,
+                        },
+                        Pose::IDENTITY,
+                    ),
+                    (
+                        ShapeSpec::Sphere { radius: *radius },
+                        Pose::translation(0.0, 0.0, h),
+                    ),
+                    (
+                        ShapeSpec::Sphere { radius: *radius },
+                        Pose::translation(0.0, 0.0, -h),
+                    ),
+                ]
+            }
+            urdf_rs::Geometry::Mesh { filename, scale } => {
+                let line = mesh_lines
+                    .get(&(link, filename.as_str()))
+                    .copied()
+                    .or_else(|| line_of(self.text, filename));
+                let file = self.resolve(link, filename, line)?;
+                let mesh = match meshes.get(&file) {
+                    Some(m) => m.clone(),
+                    None => {
+                        let mesh_err = |source| KinError::Mesh {
+                            urdf: self.path.to_path_buf(),
+                            link: link.to_string(),
+                            source,
+                        };
+                        if !file.is_file() {
+                            return Err(mesh_err(MeshError::Io {
+                                path: file.clone(),
+                                source: std::io::Error::new(
+                                    std::io::ErrorKind::NotFound,
+                                    format!("no such file (from \"{filename}\")"),
+                                ),
+                            }));
+                        }
+                        let m = Arc::new(load_mesh(&file).map_err(mesh_err)?);
+                        meshes.insert(file, m.clone());
+                        m
+                    }
+                };
+                let mesh = match scale {
+                    Some(s) if s.0 != [1.0, 1.0, 1.0] => Arc::new(scale_mesh(&mesh, DVec3::from_array(s.0))),
+                    _ => mesh,
+                };
+                vec![(ShapeSpec::Mesh(mesh), Pose::IDENTITY)]
+            }
+        })
+    }
+
+    /// The file a mesh URI names.
+    fn resolve(&self, link: &str, uri: &str, line: Option<usize>) -> Result<PathBuf, KinError> {
+        let base = self.path.parent().unwrap_or(Path::new(""));
+        if let Some(rest) = uri.strip_prefix("package://") {
+            let (pkg, rel) = rest.split_once('/').unwrap_or((rest, ""));
+            return match self.packages.get(pkg) {
+                Some(dir) => Ok(dir.join(rel)),
+                None => {
+                    let known: Vec<&str> = self.packages.keys().map(String::as_str).collect();
+                    Err(self.err(
+                        line,
+                        format!(
+                            "mesh \"{uri}\" of link '{link}' is in ROS package '{pkg}', which is not known (known: {})",
+                            if known.is_empty() { "none".to_string() } else { known.join(", ") }
+                        ),
+                        format!("add it under packages in the cell file: {pkg} = the folder holding the package"),
+                    ))
+                }
+            };
+        }
+        let p = if let Some(rest) = uri.strip_prefix("file://") {
+            PathBuf::from(rest)
+        } else if uri.contains("://") {
+            return Err(self.err(
+                line,
+                format!(
+                    "mesh \"{uri}\" of link '{link}': only package://, file:// and plain paths are supported"
+                ),
+                "download the mesh and refer to it by a path",
+            ));
+        } else {
+            PathBuf::from(uri)
+        };
+        Ok(if p.is_absolute() { p } else { base.join(p) })
+    }
+}
+
+/// 1-based line of the first occurrence of `needle` in `text`.
+fn line_of(text: &str, needle: &str) -> Option<usize> {
+    text.find(needle)
+        .map(|i| text[..i].bytes().filter(|&b| b == b'\n').count() + 1)
+}
+
+/// The pose of a URDF `<origin xyz rpy>`: `Rz(yaw) · Ry(pitch) · Rx(roll)` then translation.
+fn origin_pose(o: &urdf_rs::Pose) -> Pose {
+    let [r, p, y] = o.rpy.0;
+    let rot = DQuat::from_rotation_z(y) * DQuat::from_rotation_y(p) * DQuat::from_rotation_x(r);
+    Pose::from_parts(DVec3::from_array(o.xyz.0), rot.normalize())
+}
+
+/// A copy of `mesh` with its vertices scaled per axis (winding flipped for a mirroring scale).
+fn scale_mesh(mesh: &Mesh, s: DVec3) -> Mesh {
+    let mut m = Mesh {
+        vertices: mesh.vertices.iter().map(|v| *v * s).collect(),
+        triangles: mesh.triangles.clone(),
+    };
+    if s.x * s.y * s.z < 0.0 {
+        for t in &mut m.triangles {
+            t.swap(1, 2);
+        }
+    }
+    m
+}
+
+#[cfg(test)]
+mod tests;

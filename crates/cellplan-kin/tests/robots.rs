@@ -1,0 +1,250 @@
+//! The real robot files in data/robots: the FANUC R-2000iC/125L (OPW) and the UR5 (DLS).
+use cellplan_geom::ShapeSpec;
+use cellplan_kin::{
+    DlsIk, DlsParams, IkSolver, JointKind, KinError, OpwIk, OpwParameters, load_urdf, pose_error,
+};
+use rand::{RngExt, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use std::collections::BTreeMap;
+use std::path::PathBuf;
+
+fn data() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../data")
+}
+
+fn fanuc_packages() -> BTreeMap<String, PathBuf> {
+    BTreeMap::from([(
+        "fanuc_r2000ic_support".to_string(),
+        data().join("robots/fanuc_r2000ic/fanuc_r2000ic_support"),
+    )])
+}
+
+fn ur_packages() -> BTreeMap<String, PathBuf> {
+    BTreeMap::from([(
+        "ur_description".to_string(),
+        data().join("robots/ur5/ur_description"),
+    )])
+}
+
+fn fanuc_urdf() -> PathBuf {
+    data().join("robots/fanuc_r2000ic/urdf/r2000ic125l.urdf")
+}
+
+fn fanuc_opw() -> OpwParameters {
+    let path =
+        data().join("robots/fanuc_r2000ic/fanuc_r2000ic_support/config/opw_parameters_r2000ic125l.yaml");
+    OpwParameters::from_ros_yaml(&std::fs::read_to_string(path).unwrap()).unwrap()
+}
+
+fn ur5_urdf() -> PathBuf {
+    data().join("robots/ur5/urdf/ur5.urdf")
+}
+
+#[test]
+fn fanuc_opw_matches_urdf() {
+    let p = fanuc_opw();
+    assert_eq!(p.c3, 1.730);
+    assert!((p.offsets[2] + std::f64::consts::FRAC_PI_2).abs() < 1e-15);
+    let model = load_urdf(&fanuc_urdf(), &fanuc_packages(), None).unwrap();
+    let chain = &model.chain;
+    assert_eq!(chain.tip_name(), "tool0");
+    assert_eq!(chain.dof(), 6);
+    let names: Vec<_> = chain.links.iter().map(|l| l.name.as_str()).collect();
+    assert_eq!(
+        names,
+        [
+            "base_link",
+            "link_1",
+            "link_2",
+            "link_3",
+            "link_4",
+            "link_5",
+            "link_6",
+            "tool0"
+        ]
+    );
+    // One mesh per arm link; `base` and `flange` carry no geometry.
+    for (i, shapes) in model.collision.iter().enumerate() {
+        let expected = usize::from(i < 7);
+        assert_eq!(shapes.len(), expected, "link {}", chain.links[i].name);
+        if let Some((ShapeSpec::Mesh(m), _)) = shapes.first() {
+            assert!(!m.triangles.is_empty());
+            // ROS-I meshes are in metres: every link fits in a few metres and is not tiny.
+            let (lo, hi) = m.aabb().unwrap();
+            let size = (hi - lo).max_element();
+            assert!(
+                size > 0.1 && size < 3.0,
+                "link {} mesh size {size}",
+                chain.links[i].name
+            );
+        }
+    }
+    let ik = OpwIk::new(chain, p).expect("the ROS-I parameters match the URDF");
+    let c = ik.flange_to_tip();
+    println!("FANUC flange_to_tip C = {c:?}");
+    assert!(c.translation.length() < 1e-12);
+}
+
+fn random_q(chain: &cellplan_kin::Chain, rng: &mut ChaCha8Rng) -> Vec<f64> {
+    chain
+        .joints
+        .iter()
+        .map(|j| rng.random_range(j.lower.max(-std::f64::consts::PI)..j.upper.min(std::f64::consts::PI)))
+        .collect()
+}
+
+#[test]
+fn fanuc_opw_solve_round_trip() {
+    let model = load_urdf(&fanuc_urdf(), &fanuc_packages(), None).unwrap();
+    let chain = &model.chain;
+    let ik = OpwIk::new(chain, fanuc_opw()).unwrap();
+    let mut rng = ChaCha8Rng::seed_from_u64(7);
+    let mut out = Vec::new();
+    let mut worst = (0.0f64, 0.0f64);
+    for _ in 0..500 {
+        let q = random_q(chain, &mut rng);
+        let target = chain.fk_tip(&q);
+        out.clear();
+        let raw = ik.solve(&target, &mut out);
+        assert!((1..=8).contains(&raw), "raw branch count {raw}");
+        assert!(
+            out.iter()
+                .any(|s| s.iter().zip(&q).all(|(a, b)| (a - b).abs() < 1e-7)),
+            "the configuration itself is among the solutions: {q:?} / {out:?}"
+        );
+        for s in &out {
+            assert!(chain.within_limits(s, 0.0));
+            let (dp, dr) = pose_error(&chain.fk_tip(s), &target);
+            worst = (worst.0.max(dp), worst.1.max(dr));
+        }
+    }
+    println!("FANUC OpwIk FK(IK) worst {:.2e} m {:.2e} rad", worst.0, worst.1);
+    assert!(worst.0 < 1e-9 && worst.1 < 1e-9);
+}
+
+#[test]
+fn fanuc_joints_4_and_6_get_two_pi_variants() {
+    let model = load_urdf(&fanuc_urdf(), &fanuc_packages(), None).unwrap();
+    let chain = &model.chain;
+    let ik = OpwIk::new(chain, fanuc_opw()).unwrap();
+    // Joints 4 and 6 range over ±360°: every branch comes with its ±2π variants.
+    let q = [0.3, 0.2, -0.1, 0.5, 0.7, -0.4];
+    let mut out = Vec::new();
+    let raw = ik.solve(&chain.fk_tip(&q), &mut out);
+    assert_eq!(raw, 8);
+    assert!(out.len() > raw);
+    let twins = out
+        .iter()
+        .filter(|s| (s[0] - q[0]).abs() < 1e-9 && (s[1] - q[1]).abs() < 1e-9 && (s[4] - q[4]).abs() < 1e-9)
+        .count();
+    assert_eq!(twins, 4, "q4 and q6 each in two turns: {out:?}");
+}
+
+#[test]
+fn opw_parameters_that_do_not_fit_are_rejected() {
+    let model = load_urdf(&fanuc_urdf(), &fanuc_packages(), None).unwrap();
+    let mut p = fanuc_opw();
+    p.c2 += 0.01;
+    let err = OpwIk::for_robot(&model, p).unwrap_err();
+    assert!(matches!(err, KinError::Opw { .. }), "{err}");
+    let text = err.to_string();
+    assert!(
+        text.contains("do not match") && text.contains("r2000ic125l.urdf"),
+        "{text}"
+    );
+
+    let mut p = fanuc_opw();
+    p.sign_corrections[3] = 1.0;
+    assert!(OpwIk::new(&model.chain, p).is_err());
+
+    // The UR5 is no OPW arm.
+    let ur5 = load_urdf(&ur5_urdf(), &ur_packages(), None).unwrap();
+    let err = OpwIk::new(&ur5.chain, fanuc_opw()).unwrap_err();
+    assert!(err.to_string().contains("do not match"), "{err}");
+}
+
+#[test]
+fn ur5_loads_with_collision_meshes_only() {
+    let model = load_urdf(&ur5_urdf(), &ur_packages(), None).unwrap();
+    assert_eq!(model.name, "ur5_robot");
+    let chain = &model.chain;
+    let names: Vec<_> = chain.links.iter().map(|l| l.name.as_str()).collect();
+    assert_eq!(
+        names,
+        [
+            "base_link",
+            "base_link_inertia",
+            "shoulder_link",
+            "upper_arm_link",
+            "forearm_link",
+            "wrist_1_link",
+            "wrist_2_link",
+            "wrist_3_link",
+            "flange",
+            "tool0"
+        ]
+    );
+    assert_eq!(chain.dof(), 6);
+    assert!(chain.joints.iter().all(|j| j.kind == JointKind::Revolute));
+    assert_eq!(chain.joints[2].name, "elbow_joint");
+    assert!((chain.joints[2].upper - std::f64::consts::PI).abs() < 1e-12);
+    let counts: Vec<usize> = model.collision.iter().map(Vec::len).collect();
+    assert_eq!(counts, [0, 1, 1, 1, 1, 1, 1, 1, 0, 0]);
+    // Collision origin of the upper arm: rpy (π/2, 0, -π/2), xyz (0, 0, 0.13585).
+    let (_, pose) = &model.collision[3][0];
+    assert!((pose.translation.z - 0.13585).abs() < 1e-12);
+}
+
+fn dls_round_trips(seed: u64, targets: usize) -> (usize, usize) {
+    let model = load_urdf(&ur5_urdf(), &ur_packages(), None).unwrap();
+    let chain = &model.chain;
+    let ik = DlsIk::new(chain, DlsParams::default());
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let mut multi = 0;
+    let mut solved = 0;
+    let mut out = Vec::new();
+    for _ in 0..targets {
+        let q = random_q(chain, &mut rng);
+        let target = chain.fk_tip(&q);
+        out.clear();
+        let distinct = ik.solve(&target, &mut out);
+        let best = out
+            .iter()
+            .map(|s| {
+                assert!(chain.within_limits(s, 0.0));
+                let (dp, dr) = pose_error(&chain.fk_tip(s), &target);
+                dp.max(dr)
+            })
+            .fold(f64::INFINITY, f64::min);
+        if best < 1e-6 {
+            solved += 1;
+        }
+        assert!(
+            distinct <= 8,
+            "a UR5 pose has at most 8 solutions modulo 2π: {distinct}"
+        );
+        if distinct > 1 {
+            multi += 1;
+        }
+        for s in &out {
+            let (dp, dr) = pose_error(&chain.fk_tip(s), &target);
+            assert!(
+                dp < 1e-6 && dr < 1e-6,
+                "every returned solution reaches the target"
+            );
+        }
+    }
+    (solved, multi)
+}
+
+#[test]
+fn ur5_dls_reaches_random_targets() {
+    let n = 40;
+    let (solved, multi) = dls_round_trips(11, n);
+    println!("UR5 DLS: {solved}/{n} solved, {multi}/{n} with several distinct solutions");
+    assert_eq!(solved, n);
+    assert!(
+        multi * 4 >= n * 3,
+        "most targets have several distinct solutions: {multi}/{n}"
+    );
+}
