@@ -1,0 +1,98 @@
+//! Errors of the cellplan core: bad input that names its file, line and a fix.
+use miette::{NamedSource, SourceSpan};
+use std::ops::Range;
+use std::path::{Path, PathBuf};
+
+/// Input that cellplan cannot use: a malformed or inconsistent cell file, task list, URDF or
+/// mesh, or a cell in which a robot can do nothing. It names the file, the line where there is
+/// one, what is wrong and what to do about it.
+#[derive(Debug, thiserror::Error, miette::Diagnostic)]
+#[error("{}{}: {message}", path.display(), line.map(|l| format!(":{l}")).unwrap_or_default())]
+#[diagnostic(code(cellplan::input))]
+pub struct InputError {
+    /// The file at fault.
+    pub path: PathBuf,
+    /// 1-based line, where the fault has one.
+    pub line: Option<usize>,
+    /// What is wrong.
+    pub message: String,
+    /// What to do about it.
+    #[help]
+    pub hint: Option<String>,
+    #[source_code]
+    source_code: Option<NamedSource<String>>,
+    #[label("here")]
+    label: Option<SourceSpan>,
+}
+
+impl InputError {
+    /// An error about a whole file (no line).
+    pub fn new(path: &Path, message: impl Into<String>) -> Self {
+        InputError {
+            path: path.to_path_buf(),
+            line: None,
+            message: message.into(),
+            hint: None,
+            source_code: None,
+            label: None,
+        }
+    }
+
+    /// An error at a 1-based line of a file whose text we do not hold.
+    pub fn at_line(path: &Path, line: Option<usize>, message: impl Into<String>) -> Self {
+        InputError {
+            line,
+            ..InputError::new(path, message)
+        }
+    }
+
+    /// An error at a byte range of a text we hold (the line is derived, the snippet shown).
+    pub fn at_span(path: &Path, text: &str, span: Range<usize>, message: impl Into<String>) -> Self {
+        let start = span.start.min(text.len());
+        let end = span.end.clamp(start, text.len());
+        InputError {
+            path: path.to_path_buf(),
+            line: Some(line_of(text, start)),
+            message: message.into(),
+            hint: None,
+            source_code: Some(NamedSource::new(path.display().to_string(), text.to_string())),
+            label: Some((start, end - start).into()),
+        }
+    }
+
+    /// Adds the hint.
+    pub fn hint(mut self, hint: impl Into<String>) -> Self {
+        self.hint = Some(hint.into());
+        self
+    }
+}
+
+/// 1-based line of byte offset `offset` in `text`.
+pub fn line_of(text: &str, offset: usize) -> usize {
+    text.as_bytes()[..offset.min(text.len())]
+        .iter()
+        .filter(|&&b| b == b'\n')
+        .count()
+        + 1
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn span_errors_carry_the_line() {
+        let text = "a = 1\nb = 2\nc = oops\n";
+        let at = text.find("oops").unwrap();
+        let e = InputError::at_span(Path::new("cell.toml"), text, at..at + 4, "bad value");
+        assert_eq!(e.line, Some(3));
+        assert_eq!(e.to_string(), "cell.toml:3: bad value");
+    }
+
+    #[test]
+    fn line_of_counts_newlines_before_offset() {
+        assert_eq!(line_of("x\ny\nz", 0), 1);
+        assert_eq!(line_of("x\ny\nz", 2), 2);
+        assert_eq!(line_of("x\ny\nz", 100), 3);
+    }
+}

@@ -1,0 +1,766 @@
+//! Loading a cell file: parse, apply units, resolve paths, load robots and meshes, build the
+//! collision world, and refuse anything inconsistent with an error that names file and line.
+use super::pose::pose_from_spec;
+use super::robot::{BodyFrame, IkKind, Robot, RobotId, Scratch, Tool};
+use super::self_pairs::{SelfPairs, cached_self_pairs, geometry_key};
+use super::spec::{CellSpec, OpwSpec, PoseSpec, ProcessSpec, ShapeEntry};
+use super::tasks::read_tasks;
+use super::{Cell, Object, Process, Source};
+use crate::InputError;
+use crate::process::optical::{OpticalProcess, Sampling};
+use cellplan_geom::{BodyContact, CollisionWorld, DVec3, GroupBody, MeshError, Pose, ShapeSpec, load_mesh};
+use cellplan_kin::{
+    DlsIk, DlsParams, IkSolver, JointKind, KinError, OpwIk, OpwParameters, RobotModel, load_urdf,
+};
+use std::collections::{BTreeMap, HashMap};
+use std::ops::Range;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use toml::Spanned;
+
+/// How to load a cell.
+#[derive(Clone, Debug)]
+pub struct LoadOptions {
+    /// Folder for cached self-collision pair lists (`None`: no cache).
+    pub cache_dir: Option<PathBuf>,
+    /// Random configurations sampled to find the self-collision pairs.
+    pub self_pair_samples: usize,
+    /// Seed of that sampling.
+    pub seed: u64,
+}
+
+impl Default for LoadOptions {
+    fn default() -> Self {
+        LoadOptions {
+            cache_dir: None,
+            self_pair_samples: 5000,
+            seed: 0,
+        }
+    }
+}
+
+impl LoadOptions {
+    /// The usual cache folder: `$CELLPLAN_CACHE_DIR`, else `$XDG_CACHE_HOME/cellplan`, else
+    /// `$HOME/.cache/cellplan`.
+    pub fn default_cache_dir() -> Option<PathBuf> {
+        let env = |k: &str| std::env::var_os(k).filter(|v| !v.is_empty()).map(PathBuf::from);
+        env("CELLPLAN_CACHE_DIR")
+            .or_else(|| env("XDG_CACHE_HOME").map(|d| d.join("cellplan")))
+            .or_else(|| env("HOME").map(|d| d.join(".cache/cellplan")))
+    }
+}
+
+/// Time in which a joint reaches full speed when no acceleration limit is given (s).
+pub const DEFAULT_ACCELERATION_TIME: f64 = 0.25;
+
+struct Ctx<'a> {
+    path: &'a Path,
+    dir: PathBuf,
+    text: &'a str,
+    to_m: f64,
+    to_rad: f64,
+}
+
+impl Ctx<'_> {
+    fn err(&self, span: Range<usize>, msg: impl Into<String>) -> InputError {
+        InputError::at_span(self.path, self.text, span, msg)
+    }
+
+    /// The span of `key = ...` inside `within` (extended to the next table header, since a
+    /// table's span may cover its header only), or `within` itself.
+    fn key_span(&self, within: &Range<usize>, key: &str) -> Range<usize> {
+        let start = within.start.min(self.text.len());
+        let first_line_end = self.text[start..]
+            .find('\n')
+            .map_or(self.text.len(), |i| start + i);
+        let next_header = self.text[first_line_end..]
+            .find("\n[")
+            .map_or(self.text.len(), |i| first_line_end + i);
+        let end = within.end.max(next_header).clamp(start, self.text.len());
+        let hay = &self.text[start..end];
+        let mut from = 0;
+        while let Some(i) = hay[from..].find(key) {
+            let at = from + i;
+            let before_ok =
+                at == 0 || !hay.as_bytes()[at - 1].is_ascii_alphanumeric() && hay.as_bytes()[at - 1] != b'_';
+            let rest = hay[at + key.len()..].trim_start_matches([' ', '\t']);
+            if before_ok && rest.starts_with('=') {
+                let line_end = hay[at..].find('\n').map_or(hay.len(), |e| at + e);
+                return start + at..start + line_end;
+            }
+            from = at + key.len();
+        }
+        within.clone()
+    }
+
+    fn resolve(&self, rel: &str) -> PathBuf {
+        self.dir.join(rel)
+    }
+
+    fn pose(&self, spec: &Spanned<PoseSpec>) -> Result<Pose, InputError> {
+        pose_from_spec(spec.get_ref(), self.to_m, self.to_rad).map_err(|m| self.err(spec.span(), m))
+    }
+}
+
+/// Loads and checks a cell file.
+pub fn load(path: &Path, opts: &LoadOptions) -> Result<Cell, InputError> {
+    let text = std::fs::read_to_string(path).map_err(|e| {
+        InputError::new(path, format!("cannot read the cell file: {e}"))
+            .hint("give the path of a cell TOML file, e.g. examples/autobody-4r/cell.toml")
+    })?;
+    let spec: CellSpec = toml::from_str(&text).map_err(|e| {
+        let span = e.span().unwrap_or(0..0);
+        InputError::at_span(
+            path,
+            &text,
+            span,
+            format!("invalid cell file: {}", e.message().trim()),
+        )
+        .hint("docs/cell-format.md lists every key and its type")
+    })?;
+    let ctx = Ctx {
+        path,
+        dir: path.parent().map(Path::to_path_buf).unwrap_or_default(),
+        text: &text,
+        to_m: spec.units.length.to_m(),
+        to_rad: spec.units.angle.to_rad(),
+    };
+
+    let process = process(&ctx, &spec)?;
+
+    // Tools.
+    let mut tools = BTreeMap::new();
+    for (name, tool) in &spec.tools {
+        let tcp = ctx.pose(&tool.get_ref().tcp)?;
+        let mut shapes = Vec::new();
+        for entry in &tool.get_ref().shapes {
+            shapes.push(shape(&ctx, entry, tool.span(), &format!("tool `{name}`"))?);
+        }
+        tools.insert(
+            name.clone(),
+            Tool {
+                name: name.clone(),
+                tcp,
+                shapes,
+            },
+        );
+    }
+
+    // Static objects.
+    let mut world = CollisionWorld::new();
+    let mut objects: Vec<Object> = Vec::new();
+    for entry in &spec.objects {
+        let span = entry.span();
+        let e = entry.get_ref();
+        let name = e
+            .name
+            .clone()
+            .ok_or_else(|| ctx.err(span.clone(), "an object needs a `name`"))?;
+        if objects.iter().any(|o| o.name == name) {
+            return Err(ctx.err(
+                ctx.key_span(&span, "name"),
+                format!("object name `{name}` is used twice"),
+            ));
+        }
+        let (shape, local) = shape(&ctx, e, span, &format!("object `{name}`"))?;
+        let id = world.add_static(&name, &shape, local);
+        objects.push(Object {
+            name,
+            shape,
+            pose: local,
+            id,
+        });
+    }
+
+    // Robots.
+    let mut models: HashMap<String, Arc<RobotModel>> = HashMap::new();
+    let mut robots: Vec<Robot> = Vec::new();
+    let mut source = Source {
+        text: text.clone(),
+        ..Source::default()
+    };
+    for entry in &spec.robots {
+        let robot = robot(&ctx, entry, RobotId(robots.len()), &tools, &mut models, &robots)?;
+        source.robot.push(entry.span());
+        source.robot_base.push(entry.get_ref().base.span());
+        robots.push(robot);
+    }
+    if robots.is_empty() {
+        return Err(InputError::new(path, "the cell has no robots").hint("add a [[robots]] table"));
+    }
+
+    // Bodies into the world, then the self-collision pairs.
+    let mut sampled: HashMap<u64, SelfPairs> = HashMap::new();
+    for robot in &mut robots {
+        let mut bodies = Vec::new();
+        let mut frames = Vec::new();
+        for (i, shapes) in robot.model.collision.iter().enumerate() {
+            if !shapes.is_empty() {
+                bodies.push(GroupBody {
+                    name: robot.model.chain.links[i].name.clone(),
+                    shapes: shapes.clone(),
+                });
+                frames.push(BodyFrame::Link(i));
+            }
+        }
+        if !robot.tool.shapes.is_empty() {
+            bodies.push(GroupBody {
+                name: format!("tool:{}", robot.tool.name),
+                shapes: robot.tool.shapes.clone(),
+            });
+            frames.push(BodyFrame::Tool);
+        }
+        robot.group = world.add_group(&robot.name, bodies);
+        robot.bodies = frames;
+    }
+    for robot in &mut robots {
+        let key = geometry_key(robot, opts.self_pair_samples, opts.seed);
+        let pairs = match sampled.get(&key) {
+            Some(p) => p.clone(),
+            None => {
+                let p = cached_self_pairs(
+                    robot,
+                    &world,
+                    opts.self_pair_samples,
+                    opts.seed,
+                    opts.cache_dir.as_deref(),
+                );
+                sampled.insert(key, p.clone());
+                p
+            }
+        };
+        world.set_self_pairs(robot.group, pairs.pairs.clone());
+        robot.self_pairs = pairs.pairs;
+    }
+
+    // Every robot must stand clear at home: of the scene, of itself, of the other robots.
+    let mut home_poses: Vec<Vec<Pose>> = Vec::new();
+    for (i, robot) in robots.iter().enumerate() {
+        let mut scratch = Scratch::default();
+        robot.body_poses(&robot.home, &mut scratch);
+        let entry = &spec.robots[i];
+        let home_span = entry.get_ref().home.as_ref().map_or(entry.span(), |h| h.span());
+        if let Some(contact) = world
+            .group_vs_static(robot.group, &scratch.bodies, 0.0)
+            .or_else(|| world.group_self(robot.group, &scratch.bodies, 0.0))
+        {
+            let what = describe_contact(&world, robot, None, contact);
+            return Err(ctx
+                .err(
+                    home_span,
+                    format!(
+                        "robot `{}` collides at its home configuration: {what}",
+                        robot.name
+                    ),
+                )
+                .hint("move the robot's `base` or change its `home` so that it stands clear"));
+        }
+        for (j, other) in robots[..i].iter().enumerate() {
+            if let Some(contact) =
+                world.group_vs_group(robot.group, &scratch.bodies, other.group, &home_poses[j], 0.0)
+            {
+                let what = describe_contact(&world, robot, Some(other), contact);
+                return Err(ctx
+                    .err(
+                        entry.get_ref().base.span(),
+                        format!(
+                            "robots `{}` and `{}` collide at home: {what}",
+                            robot.name, other.name
+                        ),
+                    )
+                    .hint("place the robots further apart or change their `home`"));
+            }
+        }
+        home_poses.push(scratch.bodies.clone());
+    }
+
+    let tasks_path = ctx.resolve(&spec.tasks.get_ref().file);
+    let tasks = read_tasks(&tasks_path, ctx.to_m, ctx.to_rad)?;
+
+    let name = spec.name.clone().unwrap_or_else(|| {
+        path.canonicalize()
+            .ok()
+            .and_then(|p| {
+                p.parent()
+                    .and_then(|d| d.file_name())
+                    .map(|n| n.to_string_lossy().into_owned())
+            })
+            .unwrap_or_else(|| "cell".into())
+    });
+    Ok(Cell {
+        name,
+        path: path.to_path_buf(),
+        units: spec.units,
+        process,
+        robots,
+        objects,
+        tasks,
+        world,
+        tasks_path,
+        source,
+    })
+}
+
+fn describe_contact(world: &CollisionWorld, robot: &Robot, other: Option<&Robot>, c: BodyContact) -> String {
+    let body = |r: &Robot, i: usize| world.body_name(r.group, i).to_string();
+    match c {
+        BodyContact::Static { body: b, object } => {
+            format!(
+                "`{}` touches object `{}`",
+                body(robot, b),
+                world.static_name(object)
+            )
+        }
+        BodyContact::SelfPair(a, b) => format!("`{}` touches `{}`", body(robot, a), body(robot, b)),
+        BodyContact::Pair(a, b) => match other {
+            Some(o) => format!("`{}` touches `{}` of `{}`", body(robot, a), body(o, b), o.name),
+            None => format!("bodies {a} and {b}"),
+        },
+    }
+}
+
+fn positive(ctx: &Ctx, span: &Range<usize>, key: &str, v: f64) -> Result<f64, InputError> {
+    if v.is_finite() && v > 0.0 {
+        Ok(v)
+    } else {
+        Err(ctx.err(
+            ctx.key_span(span, key),
+            format!("`{key}` must be positive, not {v}"),
+        ))
+    }
+}
+
+fn process(ctx: &Ctx, spec: &CellSpec) -> Result<Process, InputError> {
+    let span = spec.process.span();
+    let parsed = ProcessSpec::parse(ctx.text, spec.process.get_ref().kind).map_err(|e| {
+        ctx.err(
+            e.span().unwrap_or(span.clone()),
+            format!("invalid process: {}", e.message().trim()),
+        )
+        .hint("docs/cell-format.md lists the process keys, their units and defaults")
+    })?;
+    match &parsed {
+        ProcessSpec::OpticalInspection(o) => {
+            let standoff = positive(ctx, &span, "standoff", o.standoff)? * ctx.to_m;
+            let depth_of_field = match o.depth_of_field {
+                Some(v) => positive(ctx, &span, "depth_of_field", v)? * ctx.to_m,
+                None => 0.100,
+            };
+            let view_angle = match o.view_angle {
+                Some(v) => positive(ctx, &span, "view_angle", v)? * ctx.to_rad,
+                None => 15f64.to_radians(),
+            };
+            if view_angle >= std::f64::consts::FRAC_PI_2 {
+                return Err(ctx
+                    .err(ctx.key_span(&span, "view_angle"), "`view_angle` must be below 90°")
+                    .hint("θ0 is the largest angle between the beam and the surface normal; optical probes allow about 10–30°"));
+            }
+            if depth_of_field / 2.0 >= standoff {
+                return Err(ctx
+                    .err(
+                        ctx.key_span(&span, "depth_of_field"),
+                        "half the depth of field reaches past the laser source",
+                    )
+                    .hint("the depth of field must be smaller than twice the standoff"));
+            }
+            let stripe_length = positive(ctx, &span, "stripe_length", o.stripe_length)? * ctx.to_m;
+            let baseline = positive(ctx, &span, "baseline", o.baseline)? * ctx.to_m;
+            let measure_time = match o.measure_time {
+                Some(v) if v.is_finite() && v >= 0.0 => v,
+                Some(v) => {
+                    return Err(ctx.err(
+                        ctx.key_span(&span, "measure_time"),
+                        format!("`measure_time` must be ≥ 0 s, not {v}"),
+                    ));
+                }
+                None => 1.5,
+            };
+            let task_cap = match o.task_cap {
+                Some(0) => {
+                    return Err(ctx.err(ctx.key_span(&span, "task_cap"), "`task_cap` must be at least 1"));
+                }
+                Some(v) => v,
+                None => 14,
+            };
+            let balance_limit = match o.balance_limit {
+                Some(v) => Some(positive(ctx, &span, "balance_limit", v)?),
+                None => None,
+            };
+            let clearance = match o.clearance {
+                Some(v) if v.is_finite() && v >= 0.0 => v * ctx.to_m,
+                Some(v) => {
+                    return Err(ctx.err(
+                        ctx.key_span(&span, "clearance"),
+                        format!("`clearance` must be ≥ 0, not {v}"),
+                    ));
+                }
+                None => 0.010,
+            };
+            let s = o.sampling;
+            if s.spin_steps == 0 || (s.tilt_steps > 0 && s.azimuth_steps == 0) {
+                return Err(ctx
+                    .err(
+                        ctx.key_span(&span, "spin_steps"),
+                        "sampling needs at least one spin, and one azimuth per tilt ring",
+                    )
+                    .hint("e.g. tilt_steps = 2, azimuth_steps = 8, spin_steps = 8"));
+            }
+            Ok(Process::Optical(OpticalProcess {
+                standoff,
+                depth_of_field,
+                view_angle,
+                stripe_length,
+                baseline,
+                measure_time,
+                task_cap,
+                balance_limit,
+                clearance,
+                sampling: Sampling {
+                    tilt_steps: s.tilt_steps,
+                    azimuth_steps: s.azimuth_steps,
+                    spin_steps: s.spin_steps,
+                },
+            }))
+        }
+    }
+}
+
+fn shape(
+    ctx: &Ctx,
+    e: &ShapeEntry,
+    span: Range<usize>,
+    owner: &str,
+) -> Result<(ShapeSpec, Pose), InputError> {
+    let given = [
+        e.box_size.is_some(),
+        e.cylinder.is_some(),
+        e.sphere.is_some(),
+        e.mesh.is_some(),
+    ]
+    .iter()
+    .filter(|&&b| b)
+    .count();
+    if given != 1 {
+        return Err(ctx.err(
+            span,
+            format!("{owner} needs exactly one of `box`, `cylinder`, `sphere`, `mesh` (found {given})"),
+        ));
+    }
+    let pose = ctx.pose(&e.pose)?;
+    let m = ctx.to_m;
+    let shape = if let Some(b) = e.box_size {
+        for v in b {
+            positive(ctx, &span, "box", v)?;
+        }
+        ShapeSpec::Box {
+            half_extents: DVec3::from_array(b) * (m / 2.0),
+        }
+    } else if let Some(c) = e.cylinder {
+        ShapeSpec::Cylinder {
+            radius: positive(ctx, &span, "cylinder", c.radius)? * m,
+            half_height: positive(ctx, &span, "cylinder", c.length)? * m / 2.0,
+        }
+    } else if let Some(r) = e.sphere {
+        ShapeSpec::Sphere {
+            radius: positive(ctx, &span, "sphere", r)? * m,
+        }
+    } else {
+        let rel = e.mesh.as_deref().unwrap_or_default();
+        let file = ctx.resolve(rel);
+        let mesh = load_mesh(&file).map_err(|err| match err {
+            MeshError::Parse { path, line, message } => {
+                InputError::at_line(&path, line, message).hint(format!(
+                    "the mesh of {owner} ({}:{}); fix or re-export the file",
+                    ctx.path.display(),
+                    super::super::error::line_of(ctx.text, span.start)
+                ))
+            }
+            other => ctx
+                .err(ctx.key_span(&span, "mesh"), format!("{owner}: {other}"))
+                .hint("mesh paths are relative to the cell file; STL (binary or ASCII) and OBJ are read"),
+        })?;
+        let factor = e.mesh_units.map_or(m, |u| u.to_m());
+        ShapeSpec::Mesh(Arc::new(mesh.scaled(factor)))
+    };
+    Ok((shape, pose))
+}
+
+fn kin_error(ctx: &Ctx, span: Range<usize>, robot: &str, e: KinError) -> InputError {
+    let at = format!(
+        "robot `{robot}` ({}:{})",
+        ctx.path.display(),
+        super::super::error::line_of(ctx.text, span.start)
+    );
+    match e {
+        KinError::Urdf {
+            path,
+            line,
+            message,
+            hint,
+        } => InputError::at_line(&path, line, message).hint(format!("{hint} (used by {at})")),
+        KinError::Mesh { urdf, link, source } => {
+            InputError::at_line(&urdf, None, format!("link `{link}`: {source}"))
+                .hint(format!("check the mesh file and the `packages` of {at}"))
+        }
+        KinError::Io { path, source } => InputError::new(&path, format!("cannot read: {source}"))
+            .hint(format!("check the path given for {at}")),
+        KinError::Opw { path, line, message } => {
+            InputError::at_line(&path, line, message).hint(format!("check the `opw` parameters of {at}"))
+        }
+    }
+}
+
+fn robot(
+    ctx: &Ctx,
+    entry: &Spanned<super::spec::RobotSpec>,
+    id: RobotId,
+    tools: &BTreeMap<String, Tool>,
+    models: &mut HashMap<String, Arc<RobotModel>>,
+    earlier: &[Robot],
+) -> Result<Robot, InputError> {
+    let span = entry.span();
+    let r = entry.get_ref();
+    if earlier.iter().any(|o| o.name == r.name) {
+        return Err(ctx.err(
+            ctx.key_span(&span, "name"),
+            format!("robot name `{}` is used twice", r.name),
+        ));
+    }
+    // The URDF model, shared by robots that name the same file, packages and tip.
+    let urdf = ctx.resolve(r.urdf.get_ref());
+    let packages: BTreeMap<String, PathBuf> = r
+        .packages
+        .iter()
+        .map(|(k, v)| (k.clone(), ctx.resolve(v)))
+        .collect();
+    let key = format!("{}|{:?}|{:?}", urdf.display(), packages, r.tip);
+    let model = match models.get(&key) {
+        Some(m) => m.clone(),
+        None => {
+            if !urdf.exists() {
+                return Err(ctx
+                    .err(
+                        r.urdf.span(),
+                        format!("URDF file {} does not exist", urdf.display()),
+                    )
+                    .hint("`urdf` is relative to the cell file"));
+            }
+            let m = Arc::new(
+                load_urdf(&urdf, &packages, r.tip.as_deref())
+                    .map_err(|e| kin_error(ctx, span.clone(), &r.name, e))?,
+            );
+            models.insert(key, m.clone());
+            m
+        }
+    };
+    let chain = &model.chain;
+    let dof = chain.dof();
+    let joint_scale = |j: usize| match chain.joints[j].kind {
+        JointKind::Prismatic => ctx.to_m,
+        _ => ctx.to_rad,
+    };
+
+    // Inverse kinematics.
+    let (ik, ik_kind): (Arc<dyn IkSolver>, IkKind) = match &r.opw {
+        Some(opw) => {
+            let params = match opw.get_ref() {
+                OpwSpec::File(rel) => {
+                    let file = ctx.resolve(rel);
+                    let text = std::fs::read_to_string(&file).map_err(|e| {
+                        ctx.err(
+                            opw.span(),
+                            format!("cannot read OPW parameters {}: {e}", file.display()),
+                        )
+                        .hint("`opw` is a path relative to the cell file, or an inline table")
+                    })?;
+                    OpwParameters::from_ros_yaml(&text).map_err(|(line, m)| {
+                        InputError::at_line(&file, line, m)
+                            .hint("expected a ROS-Industrial opw_parameters yaml")
+                    })?
+                }
+                OpwSpec::Inline(p) => OpwParameters {
+                    a1: p.a1 * ctx.to_m,
+                    a2: p.a2 * ctx.to_m,
+                    b: p.b * ctx.to_m,
+                    c1: p.c1 * ctx.to_m,
+                    c2: p.c2 * ctx.to_m,
+                    c3: p.c3 * ctx.to_m,
+                    c4: p.c4 * ctx.to_m,
+                    offsets: p.offsets.map(|o| o * ctx.to_rad),
+                    sign_corrections: p.sign_corrections,
+                },
+            };
+            if dof != 6 {
+                return Err(ctx
+                    .err(
+                        opw.span(),
+                        format!(
+                            "OPW needs a 6-joint arm; the chain of `{}` has {dof} joints",
+                            r.name
+                        ),
+                    )
+                    .hint("remove `opw` to use the numeric IK"));
+            }
+            let solver = OpwIk::for_robot(&model, params).map_err(|e| match e {
+                KinError::Opw { message, .. } => ctx
+                    .err(opw.span(), format!("robot `{}`: {message}", r.name))
+                    .hint("the OPW parameters must describe this URDF (same robot model and tip link)"),
+                other => kin_error(ctx, span.clone(), &r.name, other),
+            })?;
+            (Arc::new(solver), IkKind::Opw)
+        }
+        None => (Arc::new(DlsIk::new(chain, DlsParams::default())), IkKind::Numeric),
+    };
+
+    let base = ctx.pose(&r.base)?;
+
+    // Home: given, else zero where that is within limits, else mid-range.
+    let home = match &r.home {
+        Some(h) => {
+            if h.get_ref().len() != dof {
+                return Err(ctx.err(
+                    h.span(),
+                    format!(
+                        "`home` has {} values but `{}` has {dof} joints",
+                        h.get_ref().len(),
+                        r.name
+                    ),
+                ));
+            }
+            let q: Vec<f64> = h
+                .get_ref()
+                .iter()
+                .enumerate()
+                .map(|(j, v)| v * joint_scale(j))
+                .collect();
+            for (j, joint) in chain.joints.iter().enumerate() {
+                if !(joint.lower - 1e-9..=joint.upper + 1e-9).contains(&q[j]) {
+                    return Err(ctx
+                        .err(
+                            h.span(),
+                            format!("`home` puts joint `{}` outside its limits", joint.name),
+                        )
+                        .hint(format!(
+                            "its range is [{:.4}, {:.4}] in file units",
+                            joint.lower / joint_scale(j),
+                            joint.upper / joint_scale(j)
+                        )));
+                }
+            }
+            q
+        }
+        None => chain
+            .joints
+            .iter()
+            .map(|j| {
+                if j.lower <= 0.0 && 0.0 <= j.upper {
+                    0.0
+                } else {
+                    (j.lower + j.upper) / 2.0
+                }
+            })
+            .collect(),
+    };
+
+    let tool = match &r.tool {
+        Some(name) => tools.get(name.get_ref()).cloned().ok_or_else(|| {
+            let known: Vec<&str> = tools.keys().map(String::as_str).collect();
+            ctx.err(name.span(), format!("no tool named `{}`", name.get_ref()))
+                .hint(format!(
+                    "tools defined under [tools]: {}",
+                    if known.is_empty() {
+                        "none".into()
+                    } else {
+                        known.join(", ")
+                    }
+                ))
+        })?,
+        None => Tool {
+            name: "flange".into(),
+            tcp: Pose::IDENTITY,
+            shapes: Vec::new(),
+        },
+    };
+
+    let limits = |given: &Option<Spanned<Vec<f64>>>, key: &str| -> Result<Option<Vec<f64>>, InputError> {
+        let Some(v) = given else { return Ok(None) };
+        if v.get_ref().len() != dof {
+            return Err(ctx.err(
+                v.span(),
+                format!(
+                    "`{key}` has {} values but `{}` has {dof} joints",
+                    v.get_ref().len(),
+                    r.name
+                ),
+            ));
+        }
+        v.get_ref()
+            .iter()
+            .enumerate()
+            .map(|(j, &x)| {
+                if x.is_finite() && x > 0.0 {
+                    Ok(x * joint_scale(j))
+                } else {
+                    Err(ctx.err(v.span(), format!("`{key}` values must be positive")))
+                }
+            })
+            .collect::<Result<Vec<_>, _>>()
+            .map(Some)
+    };
+    let max_velocity = match limits(&r.max_velocity, "max_velocity")? {
+        Some(v) => v,
+        None => {
+            if let Some(j) = chain
+                .joints
+                .iter()
+                .find(|j| !(j.max_velocity.is_finite() && j.max_velocity > 0.0))
+            {
+                return Err(ctx
+                    .err(
+                        ctx.key_span(&span, "urdf"),
+                        format!("joint `{}` has no velocity limit in the URDF", j.name),
+                    )
+                    .hint("give `max_velocity` for the robot in the cell file"));
+            }
+            chain.joints.iter().map(|j| j.max_velocity).collect()
+        }
+    };
+    let max_acceleration = match limits(&r.max_acceleration, "max_acceleration")? {
+        Some(a) => a,
+        None => max_velocity
+            .iter()
+            .map(|v| v / DEFAULT_ACCELERATION_TIME)
+            .collect(),
+    };
+
+    // Upper bound of the TCP's distance from the base: link offsets, prismatic strokes, TCP.
+    let reach = chain
+        .links
+        .iter()
+        .map(|l| l.origin.translation.length())
+        .sum::<f64>()
+        + chain
+            .joints
+            .iter()
+            .filter(|j| j.kind == JointKind::Prismatic)
+            .map(|j| j.lower.abs().max(j.upper.abs()))
+            .sum::<f64>()
+        + tool.tcp.translation.length();
+
+    Ok(Robot {
+        id,
+        name: r.name.clone(),
+        model,
+        base,
+        home,
+        tool,
+        ik,
+        ik_kind,
+        max_velocity,
+        max_acceleration,
+        group: cellplan_geom::GroupId(u32::MAX),
+        bodies: Vec::new(),
+        self_pairs: Vec::new(),
+        reach,
+    })
+}

@@ -1,0 +1,93 @@
+//! The cell: robots, tools, static objects, tasks and the process, loaded from a cell file and
+//! checked, in SI units, with the collision world built.
+pub mod load;
+pub mod pose;
+pub mod robot;
+pub mod self_pairs;
+pub mod spec;
+pub mod tasks;
+
+use crate::InputError;
+use crate::process::optical::OpticalProcess;
+use cellplan_geom::{CollisionWorld, Pose, ShapeSpec, StaticId};
+use robot::{Robot, RobotId};
+use spec::UnitsSpec;
+use std::ops::Range;
+use std::path::PathBuf;
+use tasks::Task;
+
+pub use load::LoadOptions;
+
+/// The process a cell runs, with its parameters.
+#[derive(Clone, Debug)]
+pub enum Process {
+    /// Optical inspection (paper 000).
+    Optical(OpticalProcess),
+}
+
+/// A static object of the scene.
+#[derive(Clone, Debug)]
+pub struct Object {
+    /// Unique name.
+    pub name: String,
+    /// Shape in its own frame (m).
+    pub shape: ShapeSpec,
+    /// Pose in the world.
+    pub pose: Pose,
+    /// Its id in the collision world.
+    pub id: StaticId,
+}
+
+/// Where things were written in the cell file, for messages about them.
+#[derive(Clone, Debug, Default)]
+pub struct Source {
+    /// The cell file's text.
+    pub text: String,
+    /// Span of each robot's `base` (by robot index).
+    pub robot_base: Vec<Range<usize>>,
+    /// Span of each robot's table.
+    pub robot: Vec<Range<usize>>,
+}
+
+/// A loaded, checked cell.
+pub struct Cell {
+    /// Name for reports.
+    pub name: String,
+    /// The cell file.
+    pub path: PathBuf,
+    /// Units the file was written in (outputs for people use them too).
+    pub units: UnitsSpec,
+    /// The process.
+    pub process: Process,
+    /// Robots, in file order.
+    pub robots: Vec<Robot>,
+    /// Static objects, in file order.
+    pub objects: Vec<Object>,
+    /// Tasks, in file order.
+    pub tasks: Vec<Task>,
+    /// Static scene and robot bodies.
+    pub world: CollisionWorld,
+    /// The task file.
+    pub tasks_path: PathBuf,
+    /// Spans in the cell file.
+    pub source: Source,
+}
+
+impl Cell {
+    /// An error pointing at robot `r`'s `base` in the cell file.
+    pub fn error_at_robot_base(&self, r: RobotId, message: impl Into<String>) -> InputError {
+        let span = self.source.robot_base.get(r.0).cloned().unwrap_or(0..0);
+        InputError::at_span(&self.path, &self.source.text, span, message)
+    }
+
+    /// The optical process parameters.
+    pub fn optical(&self) -> &OpticalProcess {
+        let Process::Optical(p) = &self.process;
+        p
+    }
+
+    /// Robot by name.
+    pub fn robot(&self, name: &str) -> Option<&Robot> {
+        self.robots.iter().find(|r| r.name == name)
+    }
+}

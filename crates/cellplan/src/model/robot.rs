@@ -1,0 +1,153 @@
+//! A robot placed in the cell: its URDF chain, base, tool, IK and collision bodies.
+use cellplan_geom::{BodyContact, CollisionWorld, GroupId, Pose, ShapeSpec};
+use cellplan_kin::{IkSolver, RobotModel};
+use serde::Serialize;
+use std::sync::Arc;
+
+/// Index of a robot in [`crate::Cell::robots`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize)]
+pub struct RobotId(pub usize);
+
+/// The end effector a robot carries.
+#[derive(Clone, Debug)]
+pub struct Tool {
+    /// Name in `[tools]`.
+    pub name: String,
+    /// Tool centre point in the tip-link frame.
+    pub tcp: Pose,
+    /// Shapes in the tip-link frame.
+    pub shapes: Vec<(ShapeSpec, Pose)>,
+}
+
+/// Which inverse kinematics a robot uses.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum IkKind {
+    /// Closed form for ortho-parallel arms, all branches.
+    Opw,
+    /// Damped least squares from several starts.
+    Numeric,
+}
+
+/// What a collision body of a robot is attached to.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BodyFrame {
+    /// A chain link (index into `chain.links`).
+    Link(usize),
+    /// The tool (on the tip link).
+    Tool,
+}
+
+/// A robot placed in the cell.
+#[derive(Clone)]
+pub struct Robot {
+    /// Index in the cell.
+    pub id: RobotId,
+    /// Unique name.
+    pub name: String,
+    /// The URDF model (shared between robots of the same model).
+    pub model: Arc<RobotModel>,
+    /// Pose of the URDF root link in the world.
+    pub base: Pose,
+    /// Home configuration (where every tour starts and ends).
+    pub home: Vec<f64>,
+    /// The tool.
+    pub tool: Tool,
+    /// Inverse kinematics of the chain.
+    pub ik: Arc<dyn IkSolver>,
+    /// Which IK that is.
+    pub ik_kind: IkKind,
+    /// Joint velocity limits (rad/s or m/s).
+    pub max_velocity: Vec<f64>,
+    /// Joint acceleration limits (rad/s² or m/s²).
+    pub max_acceleration: Vec<f64>,
+    /// The robot's body group in the cell's collision world.
+    pub group: GroupId,
+    /// What each body of the group is attached to.
+    pub bodies: Vec<BodyFrame>,
+    /// Body pairs checked for self-collision (the rest are adjacent, never or always in contact).
+    pub self_pairs: Vec<(usize, usize)>,
+    /// Upper bound on the distance from the base origin to the TCP (m): the sum of the
+    /// chain's link offsets and the TCP offset.
+    pub reach: f64,
+}
+
+impl std::fmt::Debug for Robot {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Robot")
+            .field("name", &self.name)
+            .field("model", &self.model.name)
+            .field("ik", &self.ik_kind)
+            .finish_non_exhaustive()
+    }
+}
+
+/// Reusable buffers for the hot path (one per thread).
+#[derive(Default, Clone)]
+pub struct Scratch {
+    links: Vec<Pose>,
+    /// Body poses in the world, after [`Robot::body_poses`].
+    pub bodies: Vec<Pose>,
+}
+
+impl Robot {
+    /// Number of joints.
+    pub fn dof(&self) -> usize {
+        self.model.chain.dof()
+    }
+
+    /// TCP pose in the world at `q`.
+    pub fn tcp_pose(&self, q: &[f64]) -> Pose {
+        self.base * self.model.chain.fk_tip(q) * self.tool.tcp
+    }
+
+    /// The tip pose in the chain root frame that puts the TCP at `tcp` (world).
+    pub fn tip_target(&self, tcp: &Pose) -> Pose {
+        self.base.inverse() * *tcp * self.tool.tcp.inverse()
+    }
+
+    /// Appends every configuration within limits that puts the TCP at `tcp` (world); returns
+    /// the number of solutions before joint-limit filtering.
+    pub fn ik(&self, tcp: &Pose, out: &mut Vec<Vec<f64>>) -> usize {
+        self.ik.solve(&self.tip_target(tcp), out)
+    }
+
+    /// World poses of the robot's collision bodies at `q` into `scratch.bodies`.
+    pub fn body_poses(&self, q: &[f64], scratch: &mut Scratch) {
+        let chain = &self.model.chain;
+        scratch.links.resize(chain.links.len(), Pose::IDENTITY);
+        chain.fk_all(q, &mut scratch.links);
+        let tip = chain.links.len() - 1;
+        scratch.bodies.clear();
+        for b in &self.bodies {
+            let local = match *b {
+                BodyFrame::Link(i) => scratch.links[i],
+                BodyFrame::Tool => scratch.links[tip],
+            };
+            scratch.bodies.push(self.base * local);
+        }
+    }
+
+    /// First contact of the robot at `q` with the static scene (closer than `clearance`) or
+    /// with itself. Call after [`Robot::body_poses`] for the same `q`.
+    pub fn contact_at(
+        &self,
+        world: &CollisionWorld,
+        scratch: &Scratch,
+        clearance: f64,
+    ) -> Option<BodyContact> {
+        world
+            .group_vs_static(self.group, &scratch.bodies, clearance)
+            .or_else(|| world.group_self(self.group, &scratch.bodies, 0.0))
+    }
+
+    /// Whether every joint is within its limits.
+    pub fn within_limits(&self, q: &[f64]) -> bool {
+        q.len() == self.dof() && self.model.chain.within_limits(q, 1e-9)
+    }
+
+    /// Joint names.
+    pub fn joint_names(&self) -> Vec<&str> {
+        self.model.chain.joints.iter().map(|j| j.name.as_str()).collect()
+    }
+}

@@ -1,0 +1,240 @@
+//! Which body pairs of a robot need self-collision checks, found by sampling as MoveIt's
+//! setup assistant does: adjacent pairs, pairs in contact at home, pairs always in contact and
+//! pairs never near each other in many random configurations are left out. The result depends
+//! only on the robot's geometry, so it is cached on disk keyed by a hash of that geometry.
+use super::robot::{BodyFrame, Robot, Scratch};
+use cellplan_geom::{CollisionWorld, Pose, ShapeSpec};
+use rand::{RngExt, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+use std::hash::Hasher;
+use std::path::Path;
+
+/// A pair closer than this in any sample is kept ("never in contact" must mean never near).
+const NEAR: f64 = 0.02;
+/// Bumped when the sampling rule changes, so old cache files are not reused.
+const RULE_VERSION: u64 = 2;
+
+/// Outcome of sampling one robot.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct SelfPairs {
+    /// Pairs to check.
+    pub pairs: Vec<(usize, usize)>,
+}
+
+/// Bodies adjacent in the chain: `a` is the nearest body up the chain from `b` (links without
+/// geometry are skipped over).
+fn adjacent(robot: &Robot) -> Vec<(usize, usize)> {
+    let chain = &robot.model.chain;
+    let tip = chain.links.len() - 1;
+    let body_of_link = |l: usize| robot.bodies.iter().position(|b| *b == BodyFrame::Link(l));
+    let mut pairs = Vec::new();
+    for (bi, b) in robot.bodies.iter().enumerate() {
+        // The link this body hangs from, then walk towards the root.
+        let mut l = match *b {
+            BodyFrame::Link(0) => continue,
+            BodyFrame::Link(l) => l - 1,
+            BodyFrame::Tool => tip,
+        };
+        loop {
+            if let Some(a) = body_of_link(l) {
+                if a != bi {
+                    pairs.push((a.min(bi), a.max(bi)));
+                }
+                break;
+            }
+            if l == 0 {
+                break;
+            }
+            l -= 1;
+        }
+    }
+    pairs
+}
+
+/// Samples `samples` random configurations (seeded) and returns the pairs to check.
+pub fn sample_self_pairs(robot: &Robot, world: &CollisionWorld, samples: usize, seed: u64) -> SelfPairs {
+    let n = robot.bodies.len();
+    let adjacent = adjacent(robot);
+    let candidates: Vec<(usize, usize)> = (0..n)
+        .flat_map(|i| (i + 1..n).map(move |j| (i, j)))
+        .filter(|p| !adjacent.contains(p))
+        .collect();
+    let chain = &robot.model.chain;
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let configs: Vec<Vec<f64>> = (0..samples)
+        .map(|_| {
+            chain
+                .joints
+                .iter()
+                .map(|j| {
+                    let (lo, hi) = (
+                        j.lower.max(-std::f64::consts::PI),
+                        j.upper.min(std::f64::consts::PI),
+                    );
+                    if hi > lo { rng.random_range(lo..hi) } else { lo }
+                })
+                .collect()
+        })
+        .collect();
+    // Per pair: (samples in contact, samples near). Sums are order-free, so
+    // the parallel split cannot change the result.
+    let counts = configs
+        .par_chunks(256)
+        .map(|chunk| {
+            let mut scratch = Scratch::default();
+            let mut touch = vec![0usize; candidates.len()];
+            let mut near = vec![0usize; candidates.len()];
+            for q in chunk {
+                robot.body_poses(q, &mut scratch);
+                for (k, &(i, j)) in candidates.iter().enumerate() {
+                    if world.bodies_within(robot.group, i, j, &scratch.bodies, NEAR) {
+                        near[k] += 1;
+                        if world.bodies_within(robot.group, i, j, &scratch.bodies, 0.0) {
+                            touch[k] += 1;
+                        }
+                    }
+                }
+            }
+            (touch, near)
+        })
+        .reduce(
+            || (vec![0; candidates.len()], vec![0; candidates.len()]),
+            |mut a, b| {
+                for k in 0..a.0.len() {
+                    a.0[k] += b.0[k];
+                    a.1[k] += b.1[k];
+                }
+                a
+            },
+        );
+    let mut scratch = Scratch::default();
+    robot.body_poses(&robot.home, &mut scratch);
+    let pairs = candidates
+        .iter()
+        .enumerate()
+        .filter(|&(k, &(i, j))| {
+            let never = counts.1[k] == 0;
+            let always = counts.0[k] == samples;
+            let at_home = world.bodies_within(robot.group, i, j, &scratch.bodies, 0.0);
+            !(never || always || at_home)
+        })
+        .map(|(_, &p)| p)
+        .collect();
+    SelfPairs { pairs }
+}
+
+/// FNV-1a, stable across runs and platforms (std's hasher makes no such promise).
+struct Fnv(u64);
+
+impl Hasher for Fnv {
+    fn finish(&self) -> u64 {
+        self.0
+    }
+    fn write(&mut self, bytes: &[u8]) {
+        for b in bytes {
+            self.0 ^= u64::from(*b);
+            self.0 = self.0.wrapping_mul(0x100_0000_01b3);
+        }
+    }
+}
+
+fn hash_pose(h: &mut Fnv, p: &Pose) {
+    for v in p.translation.to_array().into_iter().chain(p.rotation.to_array()) {
+        h.write_u64(v.to_bits());
+    }
+}
+
+fn hash_shape(h: &mut Fnv, s: &ShapeSpec) {
+    match s {
+        ShapeSpec::Box { half_extents } => {
+            h.write_u8(1);
+            half_extents
+                .to_array()
+                .iter()
+                .for_each(|v| h.write_u64(v.to_bits()));
+        }
+        ShapeSpec::Cylinder { radius, half_height } => {
+            h.write_u8(2);
+            h.write_u64(radius.to_bits());
+            h.write_u64(half_height.to_bits());
+        }
+        ShapeSpec::Sphere { radius } => {
+            h.write_u8(3);
+            h.write_u64(radius.to_bits());
+        }
+        ShapeSpec::Mesh(m) => {
+            h.write_u8(4);
+            for v in &m.vertices {
+                v.to_array().iter().for_each(|x| h.write_u64(x.to_bits()));
+            }
+            for t in &m.triangles {
+                t.iter().for_each(|&i| h.write_u32(i));
+            }
+        }
+    }
+}
+
+/// A key for everything the sampling result depends on: the chain, its geometry, the tool,
+/// the home configuration, the sample count and seed.
+pub fn geometry_key(robot: &Robot, samples: usize, seed: u64) -> u64 {
+    let mut h = Fnv(0xcbf2_9ce4_8422_2325);
+    h.write_u64(RULE_VERSION);
+    h.write_u64(samples as u64);
+    h.write_u64(seed);
+    let chain = &robot.model.chain;
+    for l in &chain.links {
+        h.write(l.name.as_bytes());
+        hash_pose(&mut h, &l.origin);
+        h.write_u64(l.joint.map_or(u64::MAX, |j| j as u64));
+    }
+    for j in &chain.joints {
+        j.axis.to_array().iter().for_each(|v| h.write_u64(v.to_bits()));
+        h.write_u64(j.lower.to_bits());
+        h.write_u64(j.upper.to_bits());
+    }
+    for shapes in &robot.model.collision {
+        h.write_u64(shapes.len() as u64);
+        for (s, p) in shapes {
+            hash_shape(&mut h, s);
+            hash_pose(&mut h, p);
+        }
+    }
+    hash_pose(&mut h, &robot.tool.tcp);
+    for (s, p) in &robot.tool.shapes {
+        hash_shape(&mut h, s);
+        hash_pose(&mut h, p);
+    }
+    robot.home.iter().for_each(|v| h.write_u64(v.to_bits()));
+    h.finish()
+}
+
+/// [`sample_self_pairs`] through a cache folder (`None`: no cache). A cache that cannot be read
+/// or written is ignored: it only saves time.
+pub fn cached_self_pairs(
+    robot: &Robot,
+    world: &CollisionWorld,
+    samples: usize,
+    seed: u64,
+    cache_dir: Option<&Path>,
+) -> SelfPairs {
+    let file = cache_dir.map(|d| {
+        d.join(format!(
+            "self-pairs-{:016x}.json",
+            geometry_key(robot, samples, seed)
+        ))
+    });
+    if let Some(f) = &file
+        && let Ok(text) = std::fs::read_to_string(f)
+        && let Ok(cached) = serde_json::from_str::<SelfPairs>(&text)
+        && cached.pairs.iter().all(|&(i, j)| i < j && j < robot.bodies.len())
+    {
+        return cached;
+    }
+    let result = sample_self_pairs(robot, world, samples, seed);
+    if let (Some(f), Ok(text)) = (&file, serde_json::to_string(&result)) {
+        let _ = crate::io::write_atomic(f, text.as_bytes());
+    }
+    result
+}
