@@ -1,0 +1,269 @@
+//! The `cellplan` command: thin argument parsing over the `cellplan` library.
+//!
+//! Exit codes: 0 done; 2 bad input (the message names file, line and a fix; nothing written);
+//! 3 the cell is valid but some task no robot can do (the report says which and why);
+//! 1 anything else.
+use cellplan::report::{check, svg};
+use cellplan::taskgen::{GenOptions, sample_tasks};
+use cellplan::{InputError, LoadOptions, candidates, io::write_atomic};
+use cellplan_geom::{DVec3, load_mesh};
+use clap::{Args, Parser, Subcommand};
+use std::path::PathBuf;
+use std::process::ExitCode;
+use std::time::Instant;
+
+#[derive(Parser)]
+#[command(
+    name = "cellplan",
+    version,
+    about = "Plans the work of multi-robot manufacturing cells"
+)]
+struct Cli {
+    /// Worker threads (default: all cores). Results do not depend on it.
+    #[arg(long, global = true)]
+    threads: Option<usize>,
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Load and validate a cell, find every task's candidates per robot, report reachability.
+    Check(CheckArgs),
+    /// Generate inputs for building cells.
+    #[command(subcommand)]
+    Gen(GenCommand),
+}
+
+#[derive(Args)]
+struct CheckArgs {
+    /// The cell file (TOML).
+    cell: PathBuf,
+    /// Print the report as JSON (stable keys: tasks, robots, candidates, unmeasurable, shared).
+    #[arg(long)]
+    json: bool,
+    /// Also draw the cell from above and from the side into this SVG file.
+    #[arg(long, value_name = "FILE")]
+    svg: Option<PathBuf>,
+    /// No progress output.
+    #[arg(long, short)]
+    quiet: bool,
+    /// Cache folder for self-collision pair lists (default: $CELLPLAN_CACHE_DIR, else the
+    /// user cache folder).
+    #[arg(long, value_name = "DIR")]
+    cache_dir: Option<PathBuf>,
+    /// Do not read or write the cache.
+    #[arg(long)]
+    no_cache: bool,
+}
+
+#[derive(Subcommand)]
+enum GenCommand {
+    /// Sample measurement points on a mesh surface: area-weighted, spread apart, with outward
+    /// normals. Writes a task CSV in the mesh's own units and frame.
+    Tasks(GenTasksArgs),
+}
+
+#[derive(Args)]
+struct GenTasksArgs {
+    /// The part mesh (STL or OBJ).
+    #[arg(long)]
+    mesh: PathBuf,
+    /// Number of points.
+    #[arg(long)]
+    count: usize,
+    /// RNG seed.
+    #[arg(long, default_value_t = 0)]
+    seed: u64,
+    /// Keep points within a range of one axis, e.g. `x=0..` or `z=300..1200` (mesh units);
+    /// repeat for several axes.
+    #[arg(long, value_name = "AXIS=LO..HI", value_parser = parse_region)]
+    region: Vec<(usize, f64, f64)>,
+    /// Keep points whose outward normal points this way: +x, -x, +y, -y, +z, -z or `x,y,z`.
+    #[arg(long, value_parser = parse_direction)]
+    facing: Option<DVec3>,
+    /// Largest angle between normal and `--facing`, in degrees.
+    #[arg(long, default_value_t = 60.0)]
+    max_angle: f64,
+    /// Move the points by this offset `x,y,z` (mesh units) after sampling — where the cell
+    /// file places the part, when its pose is a pure translation. Regions and directions
+    /// apply before the move, in the mesh frame.
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vector)]
+    translate: Option<DVec3>,
+    /// Output file (default: standard output).
+    #[arg(long, short)]
+    out: Option<PathBuf>,
+}
+
+fn parse_vector(s: &str) -> Result<DVec3, String> {
+    let parts: Result<Vec<f64>, _> = s.split(',').map(|p| p.trim().parse::<f64>()).collect();
+    match parts.as_deref() {
+        Ok([x, y, z]) if x.is_finite() && y.is_finite() && z.is_finite() => Ok(DVec3::new(*x, *y, *z)),
+        _ => Err("expected three numbers `x,y,z`".into()),
+    }
+}
+
+fn parse_region(s: &str) -> Result<(usize, f64, f64), String> {
+    let (axis, range) = s.split_once('=').ok_or("expected AXIS=LO..HI, e.g. x=0..1500")?;
+    let axis = match axis.trim() {
+        "x" => 0,
+        "y" => 1,
+        "z" => 2,
+        other => return Err(format!("unknown axis `{other}`: use x, y or z")),
+    };
+    let (lo, hi) = range
+        .split_once("..")
+        .ok_or("expected LO..HI (either end may be left out)")?;
+    let bound = |v: &str, default: f64| -> Result<f64, String> {
+        if v.trim().is_empty() {
+            Ok(default)
+        } else {
+            v.trim().parse().map_err(|_| format!("`{v}` is not a number"))
+        }
+    };
+    Ok((axis, bound(lo, f64::NEG_INFINITY)?, bound(hi, f64::INFINITY)?))
+}
+
+fn parse_direction(s: &str) -> Result<DVec3, String> {
+    let d = match s.trim() {
+        "+x" | "x" => DVec3::X,
+        "-x" => -DVec3::X,
+        "+y" | "y" => DVec3::Y,
+        "-y" => -DVec3::Y,
+        "+z" | "z" => DVec3::Z,
+        "-z" => -DVec3::Z,
+        v => {
+            parse_vector(v).map_err(|_| "use +x, -x, +y, -y, +z, -z or three numbers `x,y,z`".to_string())?
+        }
+    };
+    if d.length() < 1e-12 || !d.is_finite() {
+        return Err("the direction must not be zero".into());
+    }
+    Ok(d.normalize())
+}
+
+enum Failure {
+    Input(Box<InputError>),
+    Infeasible,
+    Other(String),
+}
+
+impl From<InputError> for Failure {
+    fn from(e: InputError) -> Self {
+        Failure::Input(Box::new(e))
+    }
+}
+
+fn spinner(show: bool, message: &str) -> indicatif::ProgressBar {
+    if !show {
+        return indicatif::ProgressBar::hidden();
+    }
+    let pb = indicatif::ProgressBar::new_spinner();
+    pb.set_message(message.to_string());
+    pb.enable_steady_tick(std::time::Duration::from_millis(120));
+    pb
+}
+
+fn run_check(args: &CheckArgs) -> Result<(), Failure> {
+    let start = Instant::now();
+    let show = !args.quiet && !args.json;
+    let opts = LoadOptions {
+        cache_dir: if args.no_cache {
+            None
+        } else {
+            args.cache_dir.clone().or_else(LoadOptions::default_cache_dir)
+        },
+        ..LoadOptions::default()
+    };
+    let pb = spinner(show, "loading the cell");
+    let cell = cellplan::model::load::load(&args.cell, &opts)?;
+    pb.set_message(format!(
+        "finding candidates for {} tasks × {} robots",
+        cell.tasks.len(),
+        cell.robots.len()
+    ));
+    let table = candidates::generate(&cell);
+    pb.finish_and_clear();
+    if let Some(e) = check::idle_robot_error(&cell, &table) {
+        return Err(e.into());
+    }
+    let report = check::report(&cell, &table);
+    if let Some(path) = &args.svg {
+        let drawing = svg::render(&cell, Some(&table));
+        write_atomic(path, drawing.as_bytes())
+            .map_err(|e| Failure::Other(format!("cannot write {}: {e}", path.display())))?;
+    }
+    if args.json {
+        let text = serde_json::to_string_pretty(&report).map_err(|e| Failure::Other(e.to_string()))?;
+        println!("{text}");
+    } else {
+        print!("{}", check::render_text(&cell, &table, &report));
+        let _ = std::io::Write::flush(&mut std::io::stdout());
+        if !args.quiet {
+            eprintln!("checked in {:.2} s", start.elapsed().as_secs_f64());
+        }
+    }
+    if report.unmeasurable.is_empty() {
+        Ok(())
+    } else {
+        Err(Failure::Infeasible)
+    }
+}
+
+fn run_gen_tasks(args: &GenTasksArgs) -> Result<(), Failure> {
+    let mesh = load_mesh(&args.mesh).map_err(|e| match e {
+        cellplan_geom::MeshError::Parse { path, line, message } => InputError::at_line(&path, line, message),
+        other => InputError::new(&args.mesh, other.to_string()).hint("give an STL or OBJ file"),
+    })?;
+    if args.count == 0 {
+        return Err(InputError::new(&args.mesh, "`--count` must be at least 1").into());
+    }
+    let mut opts = GenOptions::new(args.count, args.seed);
+    for &(axis, lo, hi) in &args.region {
+        opts.region[axis] = (lo, hi);
+    }
+    opts.facing = args.facing.map(|d| (d, args.max_angle.to_radians()));
+    let mut tasks = sample_tasks(&mesh, &opts).map_err(|m| {
+        InputError::new(&args.mesh, m)
+            .hint("widen `--region`, loosen `--facing`/`--max-angle`, or ask for fewer points")
+    })?;
+    if let Some(offset) = args.translate {
+        tasks.iter_mut().for_each(|t| t.position += offset);
+    }
+    let text = cellplan::model::tasks::tasks_to_csv(&tasks, 1.0);
+    match &args.out {
+        Some(path) => write_atomic(path, text.as_bytes())
+            .map_err(|e| Failure::Other(format!("cannot write {}: {e}", path.display())))?,
+        None => print!("{text}"),
+    }
+    Ok(())
+}
+
+fn main() -> ExitCode {
+    // Long messages stay on one line, so that they can be searched for.
+    let _ = miette::set_hook(Box::new(|_| {
+        Box::new(miette::MietteHandlerOpts::new().wrap_lines(false).build())
+    }));
+    let cli = Cli::parse();
+    if let Some(n) = cli.threads {
+        let _ = rayon::ThreadPoolBuilder::new()
+            .num_threads(n.max(1))
+            .build_global();
+    }
+    let result = match &cli.command {
+        Command::Check(a) => run_check(a),
+        Command::Gen(GenCommand::Tasks(a)) => run_gen_tasks(a),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(Failure::Input(e)) => {
+            eprintln!("{:?}", miette::Report::new(*e));
+            ExitCode::from(2)
+        }
+        Err(Failure::Infeasible) => ExitCode::from(3),
+        Err(Failure::Other(m)) => {
+            eprintln!("error: {m}");
+            ExitCode::from(1)
+        }
+    }
+}
