@@ -242,3 +242,87 @@ pub fn classes(table: &CandidateTable, robots: usize) -> Classes {
         unmeasurable,
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::load::{LoadOptions, load};
+    use std::path::Path;
+
+    #[test]
+    fn every_candidate_rechecks_clean() {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/autobody-2r/cell.toml");
+        let cell = load(&path, &LoadOptions::default()).unwrap();
+        let table = generate(&cell);
+        let process = cell.optical();
+        let mut scratch = Scratch::default();
+        let mut checked = 0;
+        for task in &cell.tasks {
+            for robot in &cell.robots {
+                // Every 7th candidate: enough to catch frame mistakes, cheap in a debug build.
+                for c in table.get(task.id, robot.id).candidates.iter().step_by(7) {
+                    assert!(robot.within_limits(&c.q));
+                    let tcp = robot.tcp_pose(&c.q);
+                    assert!(
+                        (tcp.translation - c.tcp.translation).length() < 1e-6,
+                        "FK disagrees with the pose"
+                    );
+                    assert!(tcp.rotation.dot(c.tcp.rotation).abs() > 1.0 - 1e-9);
+                    let angle = process
+                        .measurement(task, &tcp)
+                        .expect("candidate measures its MP");
+                    assert!((angle - c.view_angle).abs() < 1e-6);
+                    assert!(process.beams_clear_of_statics(&cell.world, task, &tcp));
+                    robot.body_poses(&c.q, &mut scratch);
+                    assert!(
+                        robot
+                            .contact_at(&cell.world, &scratch, process.clearance)
+                            .is_none()
+                    );
+                    checked += 1;
+                }
+            }
+        }
+        assert!(checked > 1000, "only {checked} candidates checked");
+        assert!(classes(&table, cell.robots.len()).unmeasurable.is_empty());
+    }
+
+    #[test]
+    fn classes_split_by_who_can() {
+        let reach = |n: usize| Reach {
+            candidates: vec![
+                Candidate {
+                    q: vec![0.0],
+                    tcp: Pose::IDENTITY,
+                    view_angle: 0.0,
+                    spin: 0.0
+                };
+                n
+            ],
+            rejected: BTreeMap::new(),
+        };
+        let table = CandidateTable {
+            table: vec![
+                vec![reach(2), reach(0), reach(0)],
+                vec![reach(1), reach(3), reach(0)],
+                vec![reach(0), reach(0), reach(0)],
+                vec![reach(1), reach(1), reach(1)],
+            ],
+        };
+        let c = classes(&table, 3);
+        assert_eq!(c.exclusive, vec![vec![TaskId(0)], vec![], vec![]]);
+        assert_eq!(c.unmeasurable, vec![TaskId(2)]);
+        let pair = |a, b| {
+            c.shared_pairs
+                .iter()
+                .find(|((x, y), _)| *x == RobotId(a) && *y == RobotId(b))
+                .map(|p| p.1.clone())
+        };
+        assert_eq!(pair(0, 1), Some(vec![TaskId(1), TaskId(3)]));
+        assert_eq!(pair(1, 2), Some(vec![TaskId(3)]));
+        let mut reasons = Reach::default();
+        reasons.rejected.insert(Rejection::NoIk, 5);
+        reasons.rejected.insert(Rejection::Collision, 2);
+        assert_eq!(reasons.reason(), Some(Rejection::Collision));
+    }
+}

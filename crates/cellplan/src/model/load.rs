@@ -33,7 +33,7 @@ impl Default for LoadOptions {
     fn default() -> Self {
         LoadOptions {
             cache_dir: None,
-            self_pair_samples: 5000,
+            self_pair_samples: 10_000,
             seed: 0,
         }
     }

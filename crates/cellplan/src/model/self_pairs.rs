@@ -238,3 +238,67 @@ pub fn cached_self_pairs(
     }
     result
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::load::{LoadOptions, load};
+
+    fn example() -> crate::Cell {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/autobody-2r/cell.toml");
+        load(
+            &path,
+            &LoadOptions {
+                self_pair_samples: 2000,
+                ..LoadOptions::default()
+            },
+        )
+        .unwrap()
+    }
+
+    #[test]
+    fn adjacent_pairs_are_never_checked_and_reachable_pairs_are() {
+        let cell = example();
+        let robot = &cell.robots[0];
+        let names: Vec<&str> = (0..robot.bodies.len())
+            .map(|i| cell.world.body_name(robot.group, i))
+            .collect();
+        assert_eq!(names.first(), Some(&"base_link"));
+        assert_eq!(names.last(), Some(&"tool:probe"));
+        for i in 0..names.len() - 1 {
+            assert!(
+                !robot.self_pairs.contains(&(i, i + 1)),
+                "adjacent {} / {} checked",
+                names[i],
+                names[i + 1]
+            );
+        }
+        // The probe can swing down onto the robot's own base: that pair must be checked.
+        assert!(
+            robot.self_pairs.contains(&(0, names.len() - 1)),
+            "{:?}",
+            robot.self_pairs
+        );
+    }
+
+    #[test]
+    fn sampling_is_reproducible_and_cached() {
+        let cell = example();
+        let robot = &cell.robots[0];
+        let a = sample_self_pairs(robot, &cell.world, 1500, 9);
+        let b = sample_self_pairs(robot, &cell.world, 1500, 9);
+        assert_eq!(a, b);
+        let dir = std::env::temp_dir().join(format!("cellplan-selfpairs-{}", std::process::id()));
+        let first = cached_self_pairs(robot, &cell.world, 1500, 9, Some(&dir));
+        assert_eq!(first, a);
+        let file = dir.join(format!("self-pairs-{:016x}.json", geometry_key(robot, 1500, 9)));
+        assert!(file.exists());
+        // A damaged cache entry is ignored and rewritten.
+        std::fs::write(&file, "{not json").unwrap();
+        assert_eq!(cached_self_pairs(robot, &cell.world, 1500, 9, Some(&dir)), a);
+        assert!(serde_json::from_str::<SelfPairs>(&std::fs::read_to_string(&file).unwrap()).is_ok());
+        // Another seed is another key.
+        assert_ne!(geometry_key(robot, 1500, 9), geometry_key(robot, 1500, 10));
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+}
