@@ -188,6 +188,7 @@ fn run_check(args: &CheckArgs) -> Result<(), Failure> {
         return Err(e.into());
     }
     let report = check::report(&cell, &table);
+    cell.save_cache();
     if let Some(path) = &args.svg {
         let drawing = svg::render(&cell, Some(&table));
         write_atomic(path, drawing.as_bytes())
@@ -212,7 +213,9 @@ fn run_check(args: &CheckArgs) -> Result<(), Failure> {
 
 fn run_gen_tasks(args: &GenTasksArgs) -> Result<(), Failure> {
     let mesh = load_mesh(&args.mesh).map_err(|e| match e {
-        cellplan_geom::MeshError::Parse { path, line, message } => InputError::at_line(&path, line, message),
+        cellplan_geom::MeshError::Parse { path, line, message } => {
+            InputError::at_line(&path, line, message).hint("fix or re-export the mesh (STL or OBJ)")
+        }
         other => InputError::new(&args.mesh, other.to_string()).hint("give an STL or OBJ file"),
     })?;
     if args.count == 0 {

@@ -93,7 +93,17 @@ fn refused(dir: &Path, cache: &Path, file_in_message: &str, line: Option<usize>,
     };
     assert!(stderr.contains(&expected), "expected `{expected}` in: {stderr}");
     assert!(stderr.contains(words), "expected `{words}` in: {stderr}");
+    assert!(
+        stderr.contains("help:"),
+        "every refusal says what to do: {stderr}"
+    );
     assert!(!svg.exists(), "nothing may be written on bad input");
+    let cached = std::fs::read_dir(cache).map_or(0, |d| {
+        d.filter_map(Result::ok)
+            .filter(|e| e.file_name().to_string_lossy().starts_with("self-pairs"))
+            .count()
+    });
+    assert_eq!(cached, 0, "not even the cache is written on bad input");
     assert!(out.stdout.is_empty(), "no report on bad input");
     stderr
 }
@@ -193,7 +203,7 @@ fn urdf_that_is_not_xml_is_refused() {
         cell.replace(urdf_line, "urdf = \"bad.urdf\""),
     )
     .unwrap();
-    refused(&dir, &dir, "bad.urdf", None, "");
+    refused(&dir, &dir, "bad.urdf", Some(4), "not well-formed XML");
 }
 
 #[test]
@@ -211,7 +221,11 @@ fn urdf_naming_a_missing_mesh_is_refused() {
         cell.replace(urdf_line, "urdf = \"robot.urdf\""),
     )
     .unwrap();
-    refused(&dir, &dir, "robot.urdf", None, "link_3_missing.stl");
+    // The second mention is the <collision> mesh, the one cellplan reads.
+    let text = std::fs::read_to_string(dir.join("robot.urdf")).unwrap();
+    let lines: Vec<&str> = text.lines().collect();
+    let line = lines.iter().rposition(|l| l.contains("link_3_missing")).unwrap() + 1;
+    refused(&dir, &dir, "robot.urdf", Some(line), "link_3_missing.stl");
 }
 
 #[test]
@@ -487,4 +501,129 @@ file = "tasks.csv"
     for t in v["candidates"].as_array().unwrap() {
         assert!(t["robots"]["ur5"].as_u64().unwrap() > 0, "{t}");
     }
+}
+
+#[test]
+fn home_in_collision_is_refused() {
+    let dir = scratch("home-static");
+    let (cell, _) = small_cell(&dir);
+    // A block where the upper arm stands at home.
+    let block =
+        "[[objects]]\nname = \"block\"\nbox = [300, 300, 300]\npose = { xyz = [40, 0, 1150] }\n\n[tasks]";
+    std::fs::write(dir.join("cell.toml"), cell.replace("[tasks]", block)).unwrap();
+    refused(
+        &dir,
+        &dir,
+        "cell.toml",
+        Some(23),
+        "collides at its home configuration",
+    );
+}
+
+#[test]
+fn robots_colliding_at_home_are_refused() {
+    let dir = scratch("home-pair");
+    let (cell, _) = small_cell(&dir);
+    let start = cell.find("[[robots]]").unwrap();
+    let end = cell.find("[[objects]]").unwrap();
+    let second = cell[start..end]
+        .replace("name = \"R1\"", "name = \"R2\"")
+        .replace("xyz = [0, 0, 0]", "xyz = [0, 300, 0]");
+    std::fs::write(
+        dir.join("cell.toml"),
+        format!("{}{second}{}", &cell[..end], &cell[end..]),
+    )
+    .unwrap();
+    refused(
+        &dir,
+        &dir,
+        "cell.toml",
+        Some(31),
+        "robots `R2` and `R1` collide at home",
+    );
+}
+
+#[test]
+fn beam_blocked_by_a_fixture_is_the_reason() {
+    let dir = scratch("beam");
+    let (cell, _) = small_cell(&dir);
+    // A small plate 100 mm above A: the probe (250 mm up) clears it, the beams do not.
+    let plate =
+        "[[objects]]\nname = \"plate\"\nbox = [100, 100, 4]\npose = { xyz = [1900, 0, 700] }\n\n[tasks]";
+    std::fs::write(dir.join("cell.toml"), cell.replace("[tasks]", plate)).unwrap();
+    let out = cellplan(
+        &["check", dir.join("cell.toml").to_str().unwrap(), "--json"],
+        &dir,
+    );
+    assert_eq!(
+        out.status.code(),
+        Some(3),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: Value = serde_json::from_slice(&out.stdout).unwrap();
+    let un = v["unmeasurable"].as_array().unwrap();
+    assert_eq!(un.len(), 1, "{un:?}");
+    assert_eq!(un[0]["task"], "A");
+    assert_eq!(un[0]["reasons"][0]["reason"], "beam-occluded");
+}
+
+#[test]
+fn task_tolerance_widens_the_poses() {
+    let dir = scratch("tolerance");
+    small_cell(&dir);
+    let count = |csv: &str| {
+        std::fs::write(dir.join("tasks.csv"), csv).unwrap();
+        let out = cellplan(
+            &["check", dir.join("cell.toml").to_str().unwrap(), "--json"],
+            &dir,
+        );
+        assert_eq!(
+            out.status.code(),
+            Some(0),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let v: Value = serde_json::from_slice(&out.stdout).unwrap();
+        v["candidates"][0]["robots"]["R1"].as_u64().unwrap()
+    };
+    let default = count("id,x,y,z,nx,ny,nz\nA,1900,0,600,0,0,1\n");
+    let narrow = count("id,x,y,z,nx,ny,nz,tolerance\nA,1900,0,600,0,0,1,1\n");
+    let wide = count("id,x,y,z,nx,ny,nz,tolerance\nA,1900,0,600,0,0,1,40\n");
+    // The same number of poses is sampled, spread over a wider or narrower cone.
+    assert!(narrow > 0 && default > 0 && wide > 0);
+    assert_ne!(narrow, wide, "the tolerance must change the poses tried");
+}
+
+#[test]
+fn svg_draws_every_task() {
+    let dir = scratch("svg");
+    small_cell(&dir);
+    let svg = dir.join("cell.svg");
+    let out = cellplan(
+        &[
+            "check",
+            dir.join("cell.toml").to_str().unwrap(),
+            "--svg",
+            svg.to_str().unwrap(),
+        ],
+        &dir,
+    );
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = std::fs::read_to_string(&svg).unwrap();
+    assert!(text.starts_with("<svg") && text.trim_end().ends_with("</svg>"));
+    for t in ["A", "B", "C"] {
+        // Once per view.
+        assert_eq!(
+            text.matches(&format!("<title>{t}</title>")).count(),
+            2,
+            "task {t}"
+        );
+    }
+    assert!(text.contains("<title>R1</title>") && text.contains("<title>part</title>"));
 }

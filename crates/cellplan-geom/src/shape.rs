@@ -31,6 +31,82 @@ pub enum ShapeSpec {
 pub const CYLINDER_HULL_SIDES: usize = 16;
 
 impl ShapeSpec {
+    /// Triangles of the shape in its own frame: a mesh as it is, primitives tessellated (a box
+    /// exactly, cylinders with 24 sides, spheres with 12 rings of 24) — for drawing and sampling.
+    pub fn to_mesh(&self) -> Mesh {
+        match self {
+            ShapeSpec::Mesh(m) => (**m).clone(),
+            ShapeSpec::Box { half_extents: h } => {
+                let v: Vec<DVec3> = (0..8)
+                    .map(|i| {
+                        DVec3::new(
+                            if i & 1 == 0 { -h.x } else { h.x },
+                            if i & 2 == 0 { -h.y } else { h.y },
+                            if i & 4 == 0 { -h.z } else { h.z },
+                        )
+                    })
+                    .collect();
+                let faces = [
+                    [0, 2, 3, 1],
+                    [4, 5, 7, 6],
+                    [0, 1, 5, 4],
+                    [2, 6, 7, 3],
+                    [0, 4, 6, 2],
+                    [1, 3, 7, 5],
+                ];
+                let triangles = faces
+                    .iter()
+                    .flat_map(|f| [[f[0], f[1], f[2]], [f[0], f[2], f[3]]])
+                    .collect();
+                Mesh {
+                    vertices: v,
+                    triangles,
+                }
+            }
+            ShapeSpec::Cylinder { radius, half_height } => {
+                let n = 24u32;
+                let mut vertices = Vec::new();
+                for k in 0..n {
+                    let a = std::f64::consts::TAU * f64::from(k) / f64::from(n);
+                    let (x, y) = (radius * a.cos(), radius * a.sin());
+                    vertices.push(DVec3::new(x, y, -half_height));
+                    vertices.push(DVec3::new(x, y, *half_height));
+                }
+                vertices.push(DVec3::new(0.0, 0.0, -half_height));
+                vertices.push(DVec3::new(0.0, 0.0, *half_height));
+                let (bottom, top) = (2 * n, 2 * n + 1);
+                let mut triangles = Vec::new();
+                for k in 0..n {
+                    let (a0, a1) = (2 * k, 2 * k + 1);
+                    let (b0, b1) = (2 * ((k + 1) % n), 2 * ((k + 1) % n) + 1);
+                    triangles.extend([[a0, b0, b1], [a0, b1, a1], [bottom, b0, a0], [top, a1, b1]]);
+                }
+                Mesh { vertices, triangles }
+            }
+            ShapeSpec::Sphere { radius } => {
+                let (rings, segs) = (12u32, 24u32);
+                let mut vertices = Vec::new();
+                for i in 0..=rings {
+                    let th = std::f64::consts::PI * f64::from(i) / f64::from(rings);
+                    for j in 0..segs {
+                        let ph = std::f64::consts::TAU * f64::from(j) / f64::from(segs);
+                        vertices
+                            .push(DVec3::new(th.sin() * ph.cos(), th.sin() * ph.sin(), th.cos()) * *radius);
+                    }
+                }
+                let mut triangles = Vec::new();
+                for i in 0..rings {
+                    for j in 0..segs {
+                        let a = i * segs + j;
+                        let b = i * segs + (j + 1) % segs;
+                        triangles.extend([[a, a + segs, b + segs], [a, b + segs, b]]);
+                    }
+                }
+                Mesh { vertices, triangles }
+            }
+        }
+    }
+
     /// Points whose convex hull contains the shape (in the shape's frame): the corners of a
     /// box, a prism circumscribing a cylinder ([`CYLINDER_HULL_SIDES`] sides), a polyhedron
     /// (a subdivided icosahedron) circumscribing a sphere, the vertices of a mesh. Non-finite
@@ -264,6 +340,26 @@ pub(crate) fn shape_as_mesh(shape: &dyn Shape, local: &Pose) -> Option<Mesh> {
 mod tests {
     use super::*;
     use parry3d_f64::query::PointQuery;
+
+    #[test]
+    fn tessellated_primitives_are_closed_and_sized() {
+        let b = ShapeSpec::Box {
+            half_extents: DVec3::new(1.0, 2.0, 3.0),
+        }
+        .to_mesh();
+        assert_eq!(b.triangles.len(), 12);
+        let (lo, hi) = b.aabb().unwrap();
+        assert!((hi - lo - DVec3::new(2.0, 4.0, 6.0)).length() < 1e-12);
+        let c = ShapeSpec::Cylinder {
+            radius: 0.5,
+            half_height: 1.0,
+        }
+        .to_mesh();
+        let (lo, hi) = c.aabb().unwrap();
+        assert!((hi.z - lo.z - 2.0).abs() < 1e-12 && (hi.x - 0.5).abs() < 1e-12);
+        let s = ShapeSpec::Sphere { radius: 2.0 }.to_mesh();
+        assert!(s.vertices.iter().all(|v| (v.length() - 2.0).abs() < 1e-9));
+    }
 
     #[test]
     fn sphere_polytope_contains_sphere() {

@@ -130,6 +130,8 @@ const NO_SUPPORT: parry3d_f64::shape::Ball = parry3d_f64::shape::Ball { radius: 
 struct Group {
     name: String,
     bodies: Vec<Body>,
+    /// Bodies left out of static checks (they never move: a robot's base on its floor).
+    exempt: Vec<bool>,
     /// Sorted, deduplicated pairs `(i, j)`, `i < j < bodies.len()`.
     self_pairs: Vec<(usize, usize)>,
 }
@@ -215,13 +217,27 @@ impl CollisionWorld {
                 convex: body_shape(&b.shapes).and_then(|(s, l)| BodyConvex::new(s, l)),
                 name: b.name,
             })
-            .collect();
+            .collect::<Vec<_>>();
         self.groups.push(Group {
             name: name.to_string(),
+            exempt: vec![false; bodies.len()],
             bodies,
             self_pairs: Vec::new(),
         });
         id
+    }
+
+    /// Leaves bodies of group `g` out of [`CollisionWorld::group_vs_static`]: bodies that never
+    /// move (a robot's base standing on its floor or pedestal) would otherwise touch the scene
+    /// in every configuration. Out-of-range indices are ignored.
+    pub fn set_static_exempt(&mut self, g: GroupId, bodies: &[usize]) {
+        let group = &mut self.groups[g.0 as usize];
+        group.exempt.iter_mut().for_each(|e| *e = false);
+        for &b in bodies {
+            if let Some(e) = group.exempt.get_mut(b) {
+                *e = true;
+            }
+        }
     }
 
     /// Number of groups.
@@ -284,6 +300,9 @@ impl CollisionWorld {
         debug_assert_eq!(poses.len(), group.bodies.len(), "one pose per body");
         let margin = sanitize_margin(margin);
         for (i, (body, pose)) in group.bodies.iter().zip(poses).enumerate() {
+            if group.exempt[i] {
+                continue;
+            }
             let placed = match place(body, pose) {
                 Placement::Empty => continue,
                 Placement::Invalid => {
@@ -452,10 +471,27 @@ impl CollisionWorld {
         dir: DVec3,
         max_distance: f64,
     ) -> Option<(usize, f64)> {
+        self.cast_ray_group_except(g, poses, origin, dir, max_distance, None)
+    }
+
+    /// [`CollisionWorld::cast_ray_group`] ignoring body `except` (for rays that start on it,
+    /// such as the beams of a probe, which must not hide the bodies behind it).
+    pub fn cast_ray_group_except(
+        &self,
+        g: GroupId,
+        poses: &[Pose],
+        origin: DVec3,
+        dir: DVec3,
+        max_distance: f64,
+        except: Option<usize>,
+    ) -> Option<(usize, f64)> {
         let (ray, max) = make_ray(origin, dir, max_distance)?;
         let group = self.group(g);
         let mut best: Option<(usize, f64)> = None;
         for (i, (body, pose)) in group.bodies.iter().zip(poses).enumerate() {
+            if except == Some(i) {
+                continue;
+            }
             let Placement::At(p) = place(body, pose) else {
                 continue;
             };

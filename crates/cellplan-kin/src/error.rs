@@ -25,14 +25,16 @@ pub enum KinError {
         hint: String,
     },
     /// A mesh named by the URDF could not be loaded.
-    #[error("mesh of link '{link}' in {urdf}: {source}")]
+    #[error("mesh of link '{link}' in {}{}: {source}", urdf.display(), line.map(|l| format!(":{l}")).unwrap_or_default())]
     Mesh {
         /// The URDF file.
         urdf: PathBuf,
+        /// 1-based line of the `<mesh>` element, where known.
+        line: Option<usize>,
         /// The link.
         link: String,
         /// The cause.
-        source: cellplan_geom::MeshError,
+        source: Box<cellplan_geom::MeshError>,
     },
     /// OPW parameters are malformed, or do not match the chain they are used with.
     #[error("{path}{}: {message}", line.map(|l| format!(":{l}")).unwrap_or_default())]

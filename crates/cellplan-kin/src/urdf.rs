@@ -681,8 +681,9 @@ impl Loader<'_> {
                     None => {
                         let mesh_err = |source| KinError::Mesh {
                             urdf: self.path.to_path_buf(),
+                            line,
                             link: link.to_string(),
-                            source,
+                            source: Box::new(source),
                         };
                         if !file.is_file() {
                             return Err(mesh_err(MeshError::Io {

@@ -177,7 +177,7 @@ pub fn optical_reach(
     reach
 }
 
-/// Collision and own-arm beam checks of one configuration.
+/// Own-arm beam and collision checks of one configuration (the cheap rays first).
 fn check_configuration(
     process: &OpticalProcess,
     world: &CollisionWorld,
@@ -188,16 +188,18 @@ fn check_configuration(
     scratch: &mut Scratch,
 ) -> Result<(), Rejection> {
     robot.body_poses(q, scratch);
-    if robot.contact_at(world, scratch, process.clearance).is_some() {
-        return Err(Rejection::Collision);
-    }
+    // The beams start on the probe, so the probe itself is left out: only the arm can block them.
+    let tool = robot.bodies.iter().position(|b| *b == BodyFrame::Tool);
     for (from, dir, len) in process.beams(task, tcp) {
-        // The beams start at the probe, so only the arm can block them.
-        if let Some((body, _)) = world.cast_ray_group(robot.group, &scratch.bodies, from, dir, len)
-            && robot.bodies[body] != BodyFrame::Tool
+        if world
+            .cast_ray_group_except(robot.group, &scratch.bodies, from, dir, len, tool)
+            .is_some()
         {
             return Err(Rejection::BeamOccluded);
         }
+    }
+    if robot.contact_at(world, scratch, process.clearance).is_some() {
+        return Err(Rejection::Collision);
     }
     Ok(())
 }

@@ -141,9 +141,10 @@ mod tests {
 
     /// A closed unit cube as a mesh.
     fn cube() -> Mesh {
-        crate::report::svg::tessellate(&ShapeSpec::Box {
+        ShapeSpec::Box {
             half_extents: DVec3::splat(0.5),
-        })
+        }
+        .to_mesh()
     }
 
     #[test]

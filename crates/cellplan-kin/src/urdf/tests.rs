@@ -301,7 +301,7 @@ fn missing_mesh_names_link_and_file() {
         panic!("{err}")
     };
     assert_eq!(link, "shell");
-    assert!(matches!(source, MeshError::Io { path, .. } if path.ends_with("nothere.stl")));
+    assert!(matches!(source.as_ref(), MeshError::Io { path, .. } if path.ends_with("nothere.stl")));
     let shown = err.to_string();
     assert!(
         shown.contains("shell") && shown.contains("nothere.stl"),

@@ -2,7 +2,7 @@
 //! collision world, and refuse anything inconsistent with an error that names file and line.
 use super::pose::pose_from_spec;
 use super::robot::{BodyFrame, IkKind, Robot, RobotId, Scratch, Tool};
-use super::self_pairs::{SelfPairs, cached_self_pairs, geometry_key};
+use super::self_pairs::{SelfPairs, adjacent, cached_self_pairs, geometry_key};
 use super::spec::{CellSpec, OpwSpec, PoseSpec, ProcessSpec, ShapeEntry};
 use super::tasks::read_tasks;
 use super::{Cell, Object, Process, Source};
@@ -50,6 +50,9 @@ impl LoadOptions {
     }
 }
 
+/// Most probe poses tried per task and robot.
+pub const MAX_POSES_PER_TASK: usize = 20_000;
+
 /// Time in which a joint reaches full speed when no acceleration limit is given (s).
 pub const DEFAULT_ACCELERATION_TIME: f64 = 0.25;
 
@@ -62,8 +65,10 @@ struct Ctx<'a> {
 }
 
 impl Ctx<'_> {
+    /// An error at `span` of the cell file, with a general hint that callers may replace.
     fn err(&self, span: Range<usize>, msg: impl Into<String>) -> InputError {
         InputError::at_span(self.path, self.text, span, msg)
+            .hint("docs/cell-format.md describes every key of the cell file, its unit and default")
     }
 
     /// The span of `key = ...` inside `within` (extended to the next table header, since a
@@ -98,7 +103,11 @@ impl Ctx<'_> {
     }
 
     fn pose(&self, spec: &Spanned<PoseSpec>) -> Result<Pose, InputError> {
-        pose_from_spec(spec.get_ref(), self.to_m, self.to_rad).map_err(|m| self.err(spec.span(), m))
+        pose_from_spec(spec.get_ref(), self.to_m, self.to_rad).map_err(|m| {
+            self.err(spec.span(), m).hint(
+                "a pose is { xyz = [x, y, z] } plus at most one of rpy = [r, p, y], quat = [x, y, z, w], matrix = [[..], [..], [..]] (rows)",
+            )
+        })
     }
 }
 
@@ -181,7 +190,6 @@ pub fn load(path: &Path, opts: &LoadOptions) -> Result<Cell, InputError> {
     };
     for entry in &spec.robots {
         let robot = robot(&ctx, entry, RobotId(robots.len()), &tools, &mut models, &robots)?;
-        source.robot.push(entry.span());
         source.robot_base.push(entry.get_ref().base.span());
         robots.push(robot);
     }
@@ -189,8 +197,7 @@ pub fn load(path: &Path, opts: &LoadOptions) -> Result<Cell, InputError> {
         return Err(InputError::new(path, "the cell has no robots").hint("add a [[robots]] table"));
     }
 
-    // Bodies into the world, then the self-collision pairs.
-    let mut sampled: HashMap<u64, SelfPairs> = HashMap::new();
+    // Bodies into the world.
     for robot in &mut robots {
         let mut bodies = Vec::new();
         let mut frames = Vec::new();
@@ -213,47 +220,54 @@ pub fn load(path: &Path, opts: &LoadOptions) -> Result<Cell, InputError> {
         robot.group = world.add_group(&robot.name, bodies);
         robot.bodies = frames;
     }
-    for robot in &mut robots {
-        let key = geometry_key(robot, opts.self_pair_samples, opts.seed);
-        let pairs = match sampled.get(&key) {
-            Some(p) => p.clone(),
-            None => {
-                let p = cached_self_pairs(
-                    robot,
-                    &world,
-                    opts.self_pair_samples,
-                    opts.seed,
-                    opts.cache_dir.as_deref(),
-                );
-                sampled.insert(key, p.clone());
-                p
-            }
-        };
-        world.set_self_pairs(robot.group, pairs.pairs.clone());
-        robot.self_pairs = pairs.pairs;
+    // A robot's base (the bodies before its first joint) never moves: it stands on its floor or
+    // pedestal, so it is left out of the static checks.
+    for robot in &robots {
+        let chain = &robot.model.chain;
+        let first_moving = chain
+            .links
+            .iter()
+            .position(|l| l.joint.is_some())
+            .unwrap_or(chain.links.len());
+        let fixed: Vec<usize> = robot
+            .bodies
+            .iter()
+            .enumerate()
+            .filter(|(_, b)| matches!(b, BodyFrame::Link(l) if *l < first_moving))
+            .map(|(i, _)| i)
+            .collect();
+        world.set_static_exempt(robot.group, &fixed);
     }
 
-    // Every robot must stand clear at home: of the scene, of itself, of the other robots.
+    let clearance = match &process {
+        Process::Optical(p) => p.clearance,
+    };
+    let tasks_path = ctx.resolve(&spec.tasks.get_ref().file);
+    let tasks = read_tasks(&tasks_path, ctx.to_m, ctx.to_rad)?;
+
+    // Every robot must stand clear at home: of the scene (by the clearance), of itself (every
+    // non-adjacent pair) and of the other robots.
     let mut home_poses: Vec<Vec<Pose>> = Vec::new();
     for (i, robot) in robots.iter().enumerate() {
         let mut scratch = Scratch::default();
         robot.body_poses(&robot.home, &mut scratch);
         let entry = &spec.robots[i];
         let home_span = entry.get_ref().home.as_ref().map_or(entry.span(), |h| h.span());
+        let adjacent = adjacent(robot);
+        let n = robot.bodies.len();
+        let self_contact = (0..n)
+            .flat_map(|a| (a + 1..n).map(move |b| (a, b)))
+            .filter(|p| !adjacent.contains(p))
+            .find(|&(a, b)| world.bodies_within(robot.group, a, b, &scratch.bodies, 0.0))
+            .map(|(a, b)| BodyContact::SelfPair(a, b));
         if let Some(contact) = world
-            .group_vs_static(robot.group, &scratch.bodies, 0.0)
-            .or_else(|| world.group_self(robot.group, &scratch.bodies, 0.0))
+            .group_vs_static(robot.group, &scratch.bodies, clearance)
+            .or(self_contact)
         {
             let what = describe_contact(&world, robot, None, contact);
             return Err(ctx
-                .err(
-                    home_span,
-                    format!(
-                        "robot `{}` collides at its home configuration: {what}",
-                        robot.name
-                    ),
-                )
-                .hint("move the robot's `base` or change its `home` so that it stands clear"));
+                .err(home_span, format!("robot `{}` collides at its home configuration: {what}", robot.name))
+                .hint("move the robot's `base` or change its `home` so that it stands clear (by the process `clearance` from static objects)"));
         }
         for (j, other) in robots[..i].iter().enumerate() {
             if let Some(contact) =
@@ -274,8 +288,29 @@ pub fn load(path: &Path, opts: &LoadOptions) -> Result<Cell, InputError> {
         home_poses.push(scratch.bodies.clone());
     }
 
-    let tasks_path = ctx.resolve(&spec.tasks.get_ref().file);
-    let tasks = read_tasks(&tasks_path, ctx.to_m, ctx.to_rad)?;
+    // Self-collision pairs, sampled once per distinct robot geometry (or read from the cache).
+    let mut sampled: HashMap<u64, SelfPairs> = HashMap::new();
+    let mut pending_cache = Vec::new();
+    for robot in &mut robots {
+        let key = geometry_key(robot, opts.self_pair_samples, opts.seed);
+        let pairs = match sampled.get(&key) {
+            Some(p) => p.clone(),
+            None => {
+                let (p, pending) = cached_self_pairs(
+                    robot,
+                    &world,
+                    opts.self_pair_samples,
+                    opts.seed,
+                    opts.cache_dir.as_deref(),
+                );
+                pending_cache.extend(pending);
+                sampled.insert(key, p.clone());
+                p
+            }
+        };
+        world.set_self_pairs(robot.group, pairs.pairs.clone());
+        robot.self_pairs = pairs.pairs;
+    }
 
     let name = spec.name.clone().unwrap_or_else(|| {
         path.canonicalize()
@@ -298,6 +333,7 @@ pub fn load(path: &Path, opts: &LoadOptions) -> Result<Cell, InputError> {
         world,
         tasks_path,
         source,
+        pending_cache,
     })
 }
 
@@ -498,10 +534,13 @@ fn kin_error(ctx: &Ctx, span: Range<usize>, robot: &str, e: KinError) -> InputEr
             message,
             hint,
         } => InputError::at_line(&path, line, message).hint(format!("{hint} (used by {at})")),
-        KinError::Mesh { urdf, link, source } => {
-            InputError::at_line(&urdf, None, format!("link `{link}`: {source}"))
-                .hint(format!("check the mesh file and the `packages` of {at}"))
-        }
+        KinError::Mesh {
+            urdf,
+            line,
+            link,
+            source,
+        } => InputError::at_line(&urdf, line, format!("link `{link}`: {source}"))
+            .hint(format!("check the mesh file and the `packages` of {at}")),
         KinError::Io { path, source } => InputError::new(&path, format!("cannot read: {source}"))
             .hint(format!("check the path given for {at}")),
         KinError::Opw { path, line, message } => {

@@ -45,8 +45,6 @@ pub struct Source {
     pub text: String,
     /// Span of each robot's `base` (by robot index).
     pub robot_base: Vec<Range<usize>>,
-    /// Span of each robot's table.
-    pub robot: Vec<Range<usize>>,
 }
 
 /// A loaded, checked cell.
@@ -71,6 +69,9 @@ pub struct Cell {
     pub tasks_path: PathBuf,
     /// Spans in the cell file.
     pub source: Source,
+    /// Cache entries computed while loading, written by [`Cell::save_cache`] once the run has
+    /// succeeded.
+    pub pending_cache: Vec<self_pairs::PendingCache>,
 }
 
 impl Cell {
@@ -78,6 +79,14 @@ impl Cell {
     pub fn error_at_robot_base(&self, r: RobotId, message: impl Into<String>) -> InputError {
         let span = self.source.robot_base.get(r.0).cloned().unwrap_or(0..0);
         InputError::at_span(&self.path, &self.source.text, span, message)
+    }
+
+    /// Writes the cache entries computed while loading (call once the run has succeeded; a
+    /// cache that cannot be written is skipped, it only saves time).
+    pub fn save_cache(&self) {
+        for entry in &self.pending_cache {
+            let _ = crate::io::write_atomic(&entry.file, entry.text.as_bytes());
+        }
     }
 
     /// The optical process parameters.

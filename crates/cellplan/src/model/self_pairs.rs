@@ -1,7 +1,8 @@
 //! Which body pairs of a robot need self-collision checks, found by sampling as MoveIt's
-//! setup assistant does: adjacent pairs, pairs in contact at home, pairs always in contact and
-//! pairs never near each other in many random configurations are left out. The result depends
-//! only on the robot's geometry, so it is cached on disk keyed by a hash of that geometry.
+//! setup assistant does: adjacent pairs, pairs always in contact and pairs never near each other
+//! in many random configurations are left out. (MoveIt also drops pairs touching in the default
+//! pose; here the loader refuses a home where any non-adjacent pair touches instead.) The result
+//! depends only on the robot's geometry, so it is cached on disk keyed by a hash of that geometry.
 use super::robot::{BodyFrame, Robot, Scratch};
 use cellplan_geom::{CollisionWorld, Pose, ShapeSpec};
 use rand::{RngExt, SeedableRng};
@@ -9,12 +10,12 @@ use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use std::hash::Hasher;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 /// A pair closer than this in any sample is kept ("never in contact" must mean never near).
 const NEAR: f64 = 0.02;
 /// Bumped when the sampling rule changes, so old cache files are not reused.
-const RULE_VERSION: u64 = 2;
+const RULE_VERSION: u64 = 3;
 
 /// Outcome of sampling one robot.
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
@@ -25,7 +26,7 @@ pub struct SelfPairs {
 
 /// Bodies adjacent in the chain: `a` is the nearest body up the chain from `b` (links without
 /// geometry are skipped over).
-fn adjacent(robot: &Robot) -> Vec<(usize, usize)> {
+pub fn adjacent(robot: &Robot) -> Vec<(usize, usize)> {
     let chain = &robot.model.chain;
     let tip = chain.links.len() - 1;
     let body_of_link = |l: usize| robot.bodies.iter().position(|b| *b == BodyFrame::Link(l));
@@ -109,16 +110,13 @@ pub fn sample_self_pairs(robot: &Robot, world: &CollisionWorld, samples: usize, 
                 a
             },
         );
-    let mut scratch = Scratch::default();
-    robot.body_poses(&robot.home, &mut scratch);
     let pairs = candidates
         .iter()
         .enumerate()
-        .filter(|&(k, &(i, j))| {
+        .filter(|&(k, _)| {
             let never = counts.1[k] == 0;
             let always = counts.0[k] == samples;
-            let at_home = world.bodies_within(robot.group, i, j, &scratch.bodies, 0.0);
-            !(never || always || at_home)
+            !(never || always)
         })
         .map(|(_, &p)| p)
         .collect();
@@ -210,15 +208,25 @@ pub fn geometry_key(robot: &Robot, samples: usize, seed: u64) -> u64 {
     h.finish()
 }
 
-/// [`sample_self_pairs`] through a cache folder (`None`: no cache). A cache that cannot be read
-/// or written is ignored: it only saves time.
+/// A cache entry to write once the run has succeeded (bad input writes nothing, not even this).
+#[derive(Clone, Debug)]
+pub struct PendingCache {
+    /// The cache file.
+    pub file: PathBuf,
+    /// Its contents.
+    pub text: String,
+}
+
+/// [`sample_self_pairs`] through a cache folder (`None`: no cache): a hit is read, a miss is
+/// sampled and returned with the entry to write. A cache that cannot be read is ignored: it
+/// only saves time.
 pub fn cached_self_pairs(
     robot: &Robot,
     world: &CollisionWorld,
     samples: usize,
     seed: u64,
     cache_dir: Option<&Path>,
-) -> SelfPairs {
+) -> (SelfPairs, Option<PendingCache>) {
     let file = cache_dir.map(|d| {
         d.join(format!(
             "self-pairs-{:016x}.json",
@@ -230,13 +238,14 @@ pub fn cached_self_pairs(
         && let Ok(cached) = serde_json::from_str::<SelfPairs>(&text)
         && cached.pairs.iter().all(|&(i, j)| i < j && j < robot.bodies.len())
     {
-        return cached;
+        return (cached, None);
     }
     let result = sample_self_pairs(robot, world, samples, seed);
-    if let (Some(f), Ok(text)) = (&file, serde_json::to_string(&result)) {
-        let _ = crate::io::write_atomic(f, text.as_bytes());
-    }
-    result
+    let pending = match (file, serde_json::to_string(&result)) {
+        (Some(file), Ok(text)) => Some(PendingCache { file, text }),
+        _ => None,
+    };
+    (result, pending)
 }
 
 #[cfg(test)]
@@ -289,14 +298,20 @@ mod tests {
         let b = sample_self_pairs(robot, &cell.world, 1500, 9);
         assert_eq!(a, b);
         let dir = std::env::temp_dir().join(format!("cellplan-selfpairs-{}", std::process::id()));
-        let first = cached_self_pairs(robot, &cell.world, 1500, 9, Some(&dir));
+        let (first, pending) = cached_self_pairs(robot, &cell.world, 1500, 9, Some(&dir));
         assert_eq!(first, a);
-        let file = dir.join(format!("self-pairs-{:016x}.json", geometry_key(robot, 1500, 9)));
-        assert!(file.exists());
-        // A damaged cache entry is ignored and rewritten.
-        std::fs::write(&file, "{not json").unwrap();
-        assert_eq!(cached_self_pairs(robot, &cell.world, 1500, 9, Some(&dir)), a);
-        assert!(serde_json::from_str::<SelfPairs>(&std::fs::read_to_string(&file).unwrap()).is_ok());
+        let pending = pending.expect("a miss yields an entry to write");
+        assert!(
+            !pending.file.exists(),
+            "nothing is written before the run succeeds"
+        );
+        crate::io::write_atomic(&pending.file, pending.text.as_bytes()).unwrap();
+        let (hit, again) = cached_self_pairs(robot, &cell.world, 1500, 9, Some(&dir));
+        assert_eq!((hit, again.is_none()), (a.clone(), true));
+        // A damaged cache entry is ignored.
+        std::fs::write(&pending.file, "{not json").unwrap();
+        let (redone, again) = cached_self_pairs(robot, &cell.world, 1500, 9, Some(&dir));
+        assert_eq!((redone, again.is_some()), (a, true));
         // Another seed is another key.
         assert_ne!(geometry_key(robot, 1500, 9), geometry_key(robot, 1500, 10));
         std::fs::remove_dir_all(&dir).unwrap();

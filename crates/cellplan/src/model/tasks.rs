@@ -114,12 +114,21 @@ pub fn parse_tasks(path: &Path, text: &str, to_m: f64, to_rad: f64) -> Result<Ve
         let record = record.map_err(|e| {
             let line = e.position().map(|p| p.line() as usize);
             InputError::at_line(path, line, format!("unreadable row: {e}"))
+                .hint("save the task list as plain UTF-8 CSV with one task per line")
         })?;
         let line = record.position().map(|p| p.line() as usize).unwrap_or(0);
         if record.iter().all(|f| f.is_empty()) {
             continue;
         }
         let err = |msg: String| InputError::at_line(path, Some(line), msg);
+        if record.len() > headers.len() {
+            return Err(err(format!(
+                "the row has {} fields but the header names {}",
+                record.len(),
+                headers.len()
+            ))
+            .hint("remove the extra fields, or name the column in the header"));
+        }
         let field = |i: usize, name: &str| -> Result<&str, InputError> {
             match record.get(i) {
                 Some(v) if !v.is_empty() => Ok(v),
@@ -132,7 +141,8 @@ pub fn parse_tasks(path: &Path, text: &str, to_m: f64, to_rad: f64) -> Result<Ve
             let v = field(i, name)?;
             match v.parse::<f64>() {
                 Ok(x) if x.is_finite() => Ok(x),
-                _ => Err(err(format!("`{name}` is not a number: `{v}`"))),
+                _ => Err(err(format!("`{name}` is not a number: `{v}`"))
+                    .hint("write numbers with a decimal point and no units, e.g. 1250.5")),
             }
         };
         let name = field(index[0], "id")?.to_string();
@@ -168,10 +178,17 @@ pub fn parse_tasks(path: &Path, text: &str, to_m: f64, to_rad: f64) -> Result<Ve
             .filter(|s| !s.is_empty())
         {
             None => None,
-            Some(v) => match v.parse::<f64>() {
-                Ok(t) if t.is_finite() && t > 0.0 => Some(t * to_rad),
-                _ => return Err(err(format!("`tolerance` must be a positive angle, not `{v}`"))),
-            },
+            Some(v) => {
+                match v.parse::<f64>() {
+                    Ok(t) if t.is_finite() && t > 0.0 && t * to_rad < std::f64::consts::FRAC_PI_2 => {
+                        Some(t * to_rad)
+                    }
+                    _ => {
+                        return Err(err(format!("`tolerance` must be an angle above 0 and below 90°, not `{v}`"))
+                        .hint("the largest angle between beam and normal for this task, in the cell's angle unit"));
+                    }
+                }
+            }
         };
         let feature = match feature_col.and_then(|i| record.get(i)).filter(|s| !s.is_empty()) {
             None => Feature::default(),
@@ -261,6 +278,15 @@ mod tests {
         assert!(e.message.contains("unknown column"));
         let e = parse("id,x,y,z,nx,ny\n").unwrap_err();
         assert!(e.message.contains("no column `nz`"));
+    }
+
+    #[test]
+    fn extra_fields_and_bad_tolerances_are_refused() {
+        let e = parse("id,x,y,z,nx,ny,nz\nM1,0,0,0,0,0,1,7\n").unwrap_err();
+        assert!(e.message.contains("8 fields"), "{e}");
+        let e = parse("id,x,y,z,nx,ny,nz,tolerance\nM1,0,0,0,0,0,1,95\n").unwrap_err();
+        assert!(e.message.contains("below 90"), "{e}");
+        assert!(e.hint.is_some());
     }
 
     #[test]

@@ -63,24 +63,13 @@ pub enum Rejection {
     NoIk,
     /// Solutions exist but none within the joint limits.
     JointLimits,
+    /// The incident or reflected beam is blocked (by a static object, or by the robot's arm).
+    BeamOccluded,
     /// Every configuration hits the part, a fixture or the robot itself.
     Collision,
-    /// The incident or reflected beam is blocked.
-    BeamOccluded,
 }
 
 impl Rejection {
-    /// All reasons, in pipeline order.
-    pub const ALL: [Rejection; 7] = [
-        Rejection::ViewAngle,
-        Rejection::Stripe,
-        Rejection::DepthOfField,
-        Rejection::NoIk,
-        Rejection::JointLimits,
-        Rejection::Collision,
-        Rejection::BeamOccluded,
-    ];
-
     /// Stable short name (as in JSON).
     pub fn name(self) -> &'static str {
         match self {

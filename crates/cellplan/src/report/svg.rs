@@ -3,7 +3,7 @@
 use crate::candidates::CandidateTable;
 use crate::model::robot::{BodyFrame, Scratch};
 use crate::{Cell, TaskId};
-use cellplan_geom::{DVec3, Mesh, Pose, ShapeSpec};
+use cellplan_geom::{DVec3, Mesh, Pose};
 use std::fmt::Write;
 
 /// Robot colours, in robot order (repeats after eight).
@@ -13,78 +13,12 @@ pub const ROBOT_COLOURS: [&str; 8] = [
 const SHARED: &str = "#d6278c";
 const UNMEASURABLE: &str = "#d62728";
 
-/// Triangles of a shape (primitives tessellated) in its own frame.
-pub fn tessellate(shape: &ShapeSpec) -> Mesh {
-    match shape {
-        ShapeSpec::Mesh(m) => (**m).clone(),
-        ShapeSpec::Box { half_extents: h } => {
-            let v: Vec<DVec3> = (0..8)
-                .map(|i| {
-                    DVec3::new(
-                        if i & 1 == 0 { -h.x } else { h.x },
-                        if i & 2 == 0 { -h.y } else { h.y },
-                        if i & 4 == 0 { -h.z } else { h.z },
-                    )
-                })
-                .collect();
-            let faces = [
-                [0, 2, 3, 1],
-                [4, 5, 7, 6],
-                [0, 1, 5, 4],
-                [2, 6, 7, 3],
-                [0, 4, 6, 2],
-                [1, 3, 7, 5],
-            ];
-            let triangles = faces
-                .iter()
-                .flat_map(|f| [[f[0], f[1], f[2]], [f[0], f[2], f[3]]])
-                .collect();
-            Mesh {
-                vertices: v,
-                triangles,
-            }
-        }
-        ShapeSpec::Cylinder { radius, half_height } => {
-            let n = 24u32;
-            let mut vertices = Vec::new();
-            for k in 0..n {
-                let a = std::f64::consts::TAU * f64::from(k) / f64::from(n);
-                let (x, y) = (radius * a.cos(), radius * a.sin());
-                vertices.push(DVec3::new(x, y, -half_height));
-                vertices.push(DVec3::new(x, y, *half_height));
-            }
-            vertices.push(DVec3::new(0.0, 0.0, -half_height));
-            vertices.push(DVec3::new(0.0, 0.0, *half_height));
-            let (bottom, top) = (2 * n, 2 * n + 1);
-            let mut triangles = Vec::new();
-            for k in 0..n {
-                let (a0, a1) = (2 * k, 2 * k + 1);
-                let (b0, b1) = (2 * ((k + 1) % n), 2 * ((k + 1) % n) + 1);
-                triangles.extend([[a0, b0, b1], [a0, b1, a1], [bottom, b0, a0], [top, a1, b1]]);
-            }
-            Mesh { vertices, triangles }
-        }
-        ShapeSpec::Sphere { radius } => {
-            let (rings, segs) = (12u32, 24u32);
-            let mut vertices = Vec::new();
-            for i in 0..=rings {
-                let th = std::f64::consts::PI * f64::from(i) / f64::from(rings);
-                for j in 0..segs {
-                    let ph = std::f64::consts::TAU * f64::from(j) / f64::from(segs);
-                    vertices.push(DVec3::new(th.sin() * ph.cos(), th.sin() * ph.sin(), th.cos()) * *radius);
-                }
-            }
-            let mut triangles = Vec::new();
-            for i in 0..rings {
-                for j in 0..segs {
-                    let a = i * segs + j;
-                    let b = i * segs + (j + 1) % segs;
-                    triangles.extend([[a, a + segs, b + segs], [a, b + segs, b]]);
-                }
-            }
-            Mesh { vertices, triangles }
-        }
-    }
+/// Text made safe for XML.
+fn escape(s: &str) -> String {
+    s.replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
+        .replace('"', "&quot;")
 }
 
 /// A 2D occupancy grid that triangles are rasterised into.
@@ -217,7 +151,7 @@ fn scene(cell: &Cell) -> Vec<Item> {
         .fold(f64::INFINITY, f64::min);
     let mut items = Vec::new();
     for (k, o) in cell.objects.iter().enumerate() {
-        let mesh = tessellate(&o.shape).transformed(&o.pose);
+        let mesh = o.shape.to_mesh().transformed(&o.pose);
         let ground = mesh.aabb().is_some_and(|(_, hi)| hi.z <= lowest_base + 1e-6);
         let colour = if ground {
             "#9aa0a8"
@@ -244,7 +178,7 @@ fn scene(cell: &Cell) -> Vec<Item> {
             };
             for (s, local) in shapes {
                 let world: Pose = *pose * *local;
-                meshes.push(tessellate(s).transformed(&world));
+                meshes.push(s.to_mesh().transformed(&world));
             }
         }
         items.push(Item {
@@ -322,8 +256,9 @@ pub fn render(cell: &Cell, table: Option<&CandidateTable>) -> String {
             }
             let _ = writeln!(
                 body,
-                "<path d=\"{}\" fill=\"{colour}\" fill-opacity=\"0.75\"><title>{label}</title></path>",
-                raster.path(&map)
+                "<path d=\"{}\" fill=\"{colour}\" fill-opacity=\"0.75\"><title>{}</title></path>",
+                raster.path(&map),
+                escape(label)
             );
         }
         // Robot names at their bases.
@@ -335,7 +270,7 @@ pub fn render(cell: &Cell, table: Option<&CandidateTable>) -> String {
                 p[0] + 6.0,
                 p[1] + 14.0,
                 ROBOT_COLOURS[r.id.0 % 8],
-                r.name
+                escape(&r.name)
             );
         }
         let normal_len = span / 40.0;
@@ -346,7 +281,13 @@ pub fn render(cell: &Cell, table: Option<&CandidateTable>) -> String {
             let _ = writeln!(
                 body,
                 "<g><title>{}</title><line x1=\"{:.1}\" y1=\"{:.1}\" x2=\"{:.1}\" y2=\"{:.1}\" stroke=\"{c}\" stroke-width=\"1.2\"/><circle cx=\"{:.1}\" cy=\"{:.1}\" r=\"3.2\" fill=\"{c}\" stroke=\"#000\" stroke-width=\"0.5\"/></g>",
-                t.name, p[0], p[1], q[0], q[1], p[0], p[1]
+                escape(&t.name),
+                p[0],
+                p[1],
+                q[0],
+                q[1],
+                p[0],
+                p[1]
             );
         }
         y_offset += height + 40.0;
@@ -378,7 +319,7 @@ pub fn render(cell: &Cell, table: Option<&CandidateTable>) -> String {
     let total_h = y_offset + 20.0;
     format!(
         "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{width}\" height=\"{total_h:.0}\" viewBox=\"0 0 {width} {total_h:.0}\">\n<style>text{{font-family:sans-serif}} .title{{font-size:14px;font-weight:bold}} .robot{{font-size:13px;font-weight:bold}} .legend{{font-size:12px}}</style>\n<rect width=\"100%\" height=\"100%\" fill=\"#ffffff\"/>\n<text x=\"{margin}\" y=\"20\" class=\"title\">cell {} — {} robots, {} tasks</text>\n{body}{legend}\n</svg>\n",
-        cell.name,
+        escape(&cell.name),
         cell.robots.len(),
         cell.tasks.len()
     )
@@ -389,21 +330,8 @@ mod tests {
     use super::*;
 
     #[test]
-    fn tessellated_primitives_are_closed_and_sized() {
-        let b = tessellate(&ShapeSpec::Box {
-            half_extents: DVec3::new(1.0, 2.0, 3.0),
-        });
-        assert_eq!(b.triangles.len(), 12);
-        let (lo, hi) = b.aabb().unwrap();
-        assert!((hi - lo - DVec3::new(2.0, 4.0, 6.0)).length() < 1e-12);
-        let c = tessellate(&ShapeSpec::Cylinder {
-            radius: 0.5,
-            half_height: 1.0,
-        });
-        let (lo, hi) = c.aabb().unwrap();
-        assert!((hi.z - lo.z - 2.0).abs() < 1e-12 && (hi.x - 0.5).abs() < 1e-12);
-        let s = tessellate(&ShapeSpec::Sphere { radius: 2.0 });
-        assert!(s.vertices.iter().all(|v| (v.length() - 2.0).abs() < 1e-9));
+    fn escape_makes_text_safe() {
+        assert_eq!(escape("a<b & \"c\">"), "a&lt;b &amp; &quot;c&quot;&gt;");
     }
 
     #[test]
