@@ -31,22 +31,11 @@ fn one_on_one(s: &ShapeSpec, static_pose: Pose, b: &ShapeSpec) -> (CollisionWorl
 
 /// The closed surface of the box [0,1]³ (12 triangles).
 fn unit_cube_mesh() -> Mesh {
-    let vertices = (0..8)
-        .map(|i| DVec3::new((i & 1) as f64, ((i >> 1) & 1) as f64, ((i >> 2) & 1) as f64))
-        .collect();
-    let quads = [
-        [0, 2, 3, 1],
-        [4, 5, 7, 6],
-        [0, 1, 5, 4],
-        [2, 6, 7, 3],
-        [0, 4, 6, 2],
-        [1, 3, 7, 5],
-    ];
-    let triangles = quads
-        .iter()
-        .flat_map(|q| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]])
-        .collect();
-    Mesh { vertices, triangles }
+    ShapeSpec::Box {
+        half_extents: DVec3::splat(0.5),
+    }
+    .to_mesh()
+    .transformed(&Pose::from_translation(DVec3::splat(0.5)))
 }
 
 #[test]

@@ -258,15 +258,19 @@ pub fn render_text(cell: &Cell, table: &CandidateTable, r: &CheckReport) -> Stri
     let _ = writeln!(s);
     for (name, tasks) in &r.classes.exclusive {
         let n = tasks.as_array().map_or(0, Vec::len);
-        let _ = writeln!(s, "δ {name}: {n} tasks only it can do");
-    }
-    for p in &r.classes.pairs {
         let _ = writeln!(
             s,
-            "Q {}+{}: {} tasks both can do",
-            p.robots[0],
-            p.robots[1],
-            p.tasks.len()
+            "δ {name}: {n} task{} only it can do",
+            if n == 1 { "" } else { "s" }
+        );
+    }
+    for p in &r.classes.pairs {
+        let n = p.tasks.len();
+        let plural = if n == 1 { "" } else { "s" };
+        let _ = writeln!(
+            s,
+            "Q {}+{}: {n} task{plural} both can do",
+            p.robots[0], p.robots[1]
         );
     }
     if r.unmeasurable.is_empty() {
