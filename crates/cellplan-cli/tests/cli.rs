@@ -627,3 +627,23 @@ fn svg_draws_every_task() {
     }
     assert!(text.contains("<title>R1</title>") && text.contains("<title>part</title>"));
 }
+
+#[test]
+fn robot_without_joints_is_refused() {
+    let dir = scratch("nojoints");
+    let (cell, _) = small_cell(&dir);
+    std::fs::write(
+        dir.join("stick.urdf"),
+        "<robot name=\"stick\"><link name=\"base_link\"><collision><geometry><box size=\"0.1 0.1 0.1\"/></geometry></collision></link></robot>\n",
+    )
+    .unwrap();
+    let urdf_line = cell.lines().find(|l| l.starts_with("urdf =")).unwrap();
+    let opw_line = cell.lines().find(|l| l.starts_with("opw =")).unwrap();
+    let home_line = cell.lines().find(|l| l.starts_with("home =")).unwrap();
+    let cell = cell
+        .replace(urdf_line, "urdf = \"stick.urdf\"")
+        .replace(opw_line, "")
+        .replace(home_line, "");
+    std::fs::write(dir.join("cell.toml"), cell).unwrap();
+    refused(&dir, &dir, "cell.toml", Some(19), "has no movable joint");
+}

@@ -594,6 +594,16 @@ fn robot(
     };
     let chain = &model.chain;
     let dof = chain.dof();
+    if dof == 0 {
+        return Err(ctx
+            .err(
+                r.urdf.span(),
+                format!("the chain of robot `{}` has no movable joint", r.name),
+            )
+            .hint(
+                "check the URDF and the robot's `tip`: the chain runs from the URDF root to the tip link",
+            ));
+    }
     let joint_scale = |j: usize| match chain.joints[j].kind {
         JointKind::Prismatic => ctx.to_m,
         _ => ctx.to_rad,
