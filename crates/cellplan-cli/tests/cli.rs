@@ -647,3 +647,41 @@ fn robot_without_joints_is_refused() {
     std::fs::write(dir.join("cell.toml"), cell).unwrap();
     refused(&dir, &dir, "cell.toml", Some(19), "has no movable joint");
 }
+
+#[test]
+fn example_task_lists_are_what_their_cell_files_say() {
+    let dir = scratch("regen");
+    for (name, count) in [("autobody-4r", "45"), ("autobody-2r", "20")] {
+        let out = dir.join(format!("{name}.csv"));
+        let o = cellplan(
+            &[
+                "gen",
+                "tasks",
+                "--mesh",
+                "data/parts/body-in-white/car5.obj",
+                "--count",
+                count,
+                "--seed",
+                "2",
+                "--region",
+                "x=0..",
+                "--facing",
+                "+x",
+                "--max-angle",
+                "80",
+                "--translate",
+                "0,-2212,400",
+                "-o",
+                out.to_str().unwrap(),
+            ],
+            &dir,
+        );
+        assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
+        let committed = std::fs::read_to_string(root().join(format!("examples/{name}/tasks.csv"))).unwrap();
+        assert_eq!(
+            std::fs::read_to_string(&out).unwrap(),
+            committed,
+            "{name}: regenerate with the command in its cell.toml"
+        );
+    }
+}
