@@ -1,0 +1,662 @@
+//! TSPLIB95 symmetric TSP files (Reinelt 1991) and the core parser shared with GTSPLIB.
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use super::{Ctx, read_text, text_path};
+use crate::error::ReadError;
+use crate::problem::CostMatrix;
+
+/// A TSPLIB instance: its name, size and full cost matrix (the TSPLIB distance rules applied).
+#[derive(Clone, Debug, PartialEq)]
+pub struct TsplibInstance {
+    /// The NAME field (empty if absent).
+    pub name: String,
+    /// The DIMENSION field: number of nodes.
+    pub dimension: usize,
+    /// The `dimension × dimension` costs; the diagonal is 0 for coordinate types and as given
+    /// for EXPLICIT matrices.
+    pub costs: CostMatrix,
+}
+
+/// Read a TSPLIB `.tsp` file of TYPE TSP. Supports EDGE_WEIGHT_TYPE EUC_2D, CEIL_2D, ATT, GEO
+/// and EXPLICIT (formats FULL_MATRIX, UPPER_ROW, LOWER_ROW, UPPER_DIAG_ROW, LOWER_DIAG_ROW and
+/// their *_COL equivalents). DISPLAY_DATA_SECTION and FIXED_EDGES_SECTION are skipped.
+pub fn read_tsplib(path: impl AsRef<Path>) -> Result<TsplibInstance, ReadError> {
+    let path = path.as_ref();
+    parse_tsplib_at(&read_text(path)?, path)
+}
+
+/// [`read_tsplib`] on text; errors name the path `<text>`.
+pub fn parse_tsplib(text: &str) -> Result<TsplibInstance, ReadError> {
+    parse_tsplib_at(text, &text_path())
+}
+
+fn parse_tsplib_at(text: &str, path: &Path) -> Result<TsplibInstance, ReadError> {
+    let doc = parse_document(text, Ctx { path }, Kind::Tsp)?;
+    Ok(TsplibInstance {
+        name: doc.name,
+        dimension: doc.dimension,
+        costs: doc.costs,
+    })
+}
+
+/// Read the `solutions` file of the TSPLIB benchmark folder: lines `name : value`, optionally
+/// followed by a note such as `(CEIL_2D)`. Blank lines are skipped.
+pub fn read_optima(path: impl AsRef<Path>) -> Result<BTreeMap<String, f64>, ReadError> {
+    let path = path.as_ref();
+    parse_optima_at(&read_text(path)?, path)
+}
+
+/// [`read_optima`] on text.
+pub fn parse_optima(text: &str) -> Result<BTreeMap<String, f64>, ReadError> {
+    parse_optima_at(text, &text_path())
+}
+
+fn parse_optima_at(text: &str, path: &Path) -> Result<BTreeMap<String, f64>, ReadError> {
+    let ctx = Ctx { path };
+    let mut out = BTreeMap::new();
+    for (i, line) in text.lines().enumerate() {
+        let ln = i + 1;
+        let line = line.trim();
+        if line.is_empty() {
+            continue;
+        }
+        let Some((name, rest)) = line.split_once(':') else {
+            return Err(ctx.syntax(Some(ln), format!("expected `name : optimum`, found `{line}`")));
+        };
+        let name = name.trim();
+        let Some(tok) = rest.split_whitespace().next() else {
+            return Err(ctx.syntax(Some(ln), format!("expected a value after `{name} :`")));
+        };
+        if name.is_empty() {
+            return Err(ctx.syntax(Some(ln), "expected an instance name before `:`"));
+        }
+        let v = ctx.number(ln, tok, "the optimal tour length")?;
+        out.insert(name.to_string(), v);
+    }
+    Ok(out)
+}
+
+/// Which TYPE values the caller accepts.
+#[derive(Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Kind {
+    Tsp,
+    Gtsp,
+}
+
+/// One set of GTSP_SET_SECTION: the line it starts on, its id and its 1-based nodes.
+pub(crate) struct RawSet {
+    pub line: usize,
+    pub id: usize,
+    pub nodes: Vec<(usize, i64)>,
+}
+
+pub(crate) struct Document {
+    pub name: String,
+    pub dimension: usize,
+    pub costs: CostMatrix,
+    /// GTSP_SETS with its line, if given.
+    pub gtsp_sets: Option<(usize, usize)>,
+    /// GTSP_SET_SECTION's sets, with the line of the section keyword.
+    pub sets: Option<(usize, Vec<RawSet>)>,
+}
+
+#[derive(Clone, Copy, PartialEq, Eq, Debug)]
+enum WeightType {
+    Euc2d,
+    Ceil2d,
+    Att,
+    Geo,
+    Explicit,
+}
+
+#[derive(Clone, Copy, PartialEq, Eq, Debug)]
+enum Format {
+    Full,
+    UpperRow,
+    LowerRow,
+    UpperDiagRow,
+    LowerDiagRow,
+}
+
+const WEIGHT_TYPES: &str = "EUC_2D, CEIL_2D, ATT, GEO or EXPLICIT";
+const FORMATS: &str =
+    "FULL_MATRIX, UPPER_ROW, LOWER_ROW, UPPER_DIAG_ROW, LOWER_DIAG_ROW (or the *_COL equivalents)";
+const KEYWORDS: &str = "NAME, TYPE, COMMENT, DIMENSION, EDGE_WEIGHT_TYPE, EDGE_WEIGHT_FORMAT, \
+    NODE_COORD_TYPE, DISPLAY_DATA_TYPE, GTSP_SETS, NODE_COORD_SECTION, EDGE_WEIGHT_SECTION, \
+    DISPLAY_DATA_SECTION, FIXED_EDGES_SECTION, GTSP_SET_SECTION, EOF";
+
+/// Largest DIMENSION accepted: the dense matrix then takes 3.2 GB.
+pub(crate) const MAX_DIMENSION: usize = 20_000;
+
+fn is_keyword_line(l: &str) -> bool {
+    l.chars().next().is_some_and(|c| c.is_ascii_alphabetic())
+}
+
+/// Parse a TSPLIB-style document (header, sections, EOF) into a cost matrix and optional sets.
+pub(crate) fn parse_document(text: &str, ctx: Ctx<'_>, kind: Kind) -> Result<Document, ReadError> {
+    let lines: Vec<(usize, &str)> = text
+        .lines()
+        .enumerate()
+        .map(|(i, l)| (i + 1, l.trim()))
+        .filter(|(_, l)| !l.is_empty())
+        .collect();
+    let mut name = String::new();
+    let mut dimension: Option<usize> = None;
+    let mut weight_type: Option<(usize, WeightType)> = None;
+    let mut format: Option<(usize, Format)> = None;
+    let mut gtsp_sets: Option<(usize, usize)> = None;
+    let mut coords: Option<Vec<(f64, f64)>> = None;
+    let mut weights: Option<(usize, Vec<f64>)> = None;
+    let mut sets: Option<(usize, Vec<RawSet>)> = None;
+
+    let need_dim = |dimension: Option<usize>, ln: usize, section: &str| {
+        dimension.ok_or_else(|| {
+            ctx.syntax(
+                Some(ln),
+                format!(
+                    "{section} before DIMENSION; add `DIMENSION : <number of nodes>` to the header above it"
+                ),
+            )
+        })
+    };
+
+    let mut i = 0;
+    while i < lines.len() {
+        let (ln, l) = lines[i];
+        i += 1;
+        if !is_keyword_line(l) {
+            return Err(ctx.syntax(
+                Some(ln),
+                format!("expected a keyword ({KEYWORDS}), found `{l}`; numbers belong in a section"),
+            ));
+        }
+        let (key, value) = match l.split_once(':') {
+            Some((k, v)) => (k.trim().to_ascii_uppercase(), v.trim()),
+            None => {
+                let mut it = l.splitn(2, char::is_whitespace);
+                let k = it.next().unwrap_or("").to_ascii_uppercase();
+                (k, it.next().unwrap_or("").trim())
+            }
+        };
+        match key.as_str() {
+            "NAME" => name = value.to_string(),
+            "COMMENT" | "DISPLAY_DATA_TYPE" => {}
+            "NODE_COORD_TYPE" => {
+                let v = value.to_ascii_uppercase();
+                if v != "TWOD_COORDS" && v != "NO_COORDS" {
+                    return Err(ctx.unsupported(
+                        Some(ln),
+                        format!("NODE_COORD_TYPE `{value}` is not supported; use TWOD_COORDS or NO_COORDS"),
+                    ));
+                }
+            }
+            "TYPE" => check_type(ctx, ln, value, kind)?,
+            "DIMENSION" => {
+                let n = ctx.integer(ln, value, "the number of nodes after DIMENSION :")?;
+                if n == 0 || n > MAX_DIMENSION {
+                    return Err(ctx.invalid(
+                        Some(ln),
+                        format!("DIMENSION is {n}; this reader builds a dense matrix and takes 1..={MAX_DIMENSION} nodes"),
+                    ));
+                }
+                dimension = Some(n);
+            }
+            "GTSP_SETS" => {
+                let m = ctx.integer(ln, value, "the number of sets after GTSP_SETS :")?;
+                if m > MAX_DIMENSION {
+                    return Err(ctx.invalid(
+                        Some(ln),
+                        format!(
+                            "GTSP_SETS is {m}; sets are disjoint and non-empty, so at most {MAX_DIMENSION}"
+                        ),
+                    ));
+                }
+                gtsp_sets = Some((ln, m));
+            }
+            "EDGE_WEIGHT_TYPE" => {
+                let t = match value.to_ascii_uppercase().as_str() {
+                    "EUC_2D" => WeightType::Euc2d,
+                    "CEIL_2D" => WeightType::Ceil2d,
+                    "ATT" => WeightType::Att,
+                    "GEO" => WeightType::Geo,
+                    "EXPLICIT" => WeightType::Explicit,
+                    _ => {
+                        return Err(ctx.unsupported(
+                            Some(ln),
+                            format!(
+                                "unknown or unsupported EDGE_WEIGHT_TYPE `{value}`; expected {WEIGHT_TYPES}"
+                            ),
+                        ));
+                    }
+                };
+                weight_type = Some((ln, t));
+            }
+            "EDGE_WEIGHT_FORMAT" => {
+                let f = match value.to_ascii_uppercase().as_str() {
+                    "FUNCTION" => None,
+                    "FULL_MATRIX" => Some(Format::Full),
+                    "UPPER_ROW" | "LOWER_COL" => Some(Format::UpperRow),
+                    "LOWER_ROW" | "UPPER_COL" => Some(Format::LowerRow),
+                    "UPPER_DIAG_ROW" | "LOWER_DIAG_COL" => Some(Format::UpperDiagRow),
+                    "LOWER_DIAG_ROW" | "UPPER_DIAG_COL" => Some(Format::LowerDiagRow),
+                    _ => {
+                        return Err(ctx.unsupported(
+                            Some(ln),
+                            format!(
+                                "unknown or unsupported EDGE_WEIGHT_FORMAT `{value}`; expected {FORMATS}"
+                            ),
+                        ));
+                    }
+                };
+                format = f.map(|f| (ln, f));
+            }
+            "NODE_COORD_SECTION" => {
+                let n = need_dim(dimension, ln, "NODE_COORD_SECTION")?;
+                let mut c: Vec<Option<(f64, f64)>> = vec![None; n];
+                for k in 0..n {
+                    let Some(&(cl, line)) = lines.get(i).filter(|(_, l)| !is_keyword_line(l)) else {
+                        let at = lines.get(i).map(|x| x.0);
+                        return Err(ctx.syntax(
+                            at,
+                            format!(
+                                "NODE_COORD_SECTION (line {ln}) ends after {k} of {n} nodes; \
+                                 expected one `id x y` line per node (DIMENSION = {n})"
+                            ),
+                        ));
+                    };
+                    i += 1;
+                    let toks: Vec<&str> = line.split_whitespace().collect();
+                    if toks.len() != 3 {
+                        return Err(ctx.syntax(
+                            Some(cl),
+                            format!(
+                                "expected a node line `id x y` (3 numbers), found {} fields: `{line}`",
+                                toks.len()
+                            ),
+                        ));
+                    }
+                    let id = ctx.integer(cl, toks[0], "the node id")?;
+                    let x = ctx.number(cl, toks[1], "the x coordinate")?;
+                    let y = ctx.number(cl, toks[2], "the y coordinate")?;
+                    if id == 0 || id > n {
+                        return Err(
+                            ctx.invalid(Some(cl), format!("node id {id} is out of range; ids run 1..={n}"))
+                        );
+                    }
+                    if c[id - 1].is_some() {
+                        return Err(ctx.invalid(Some(cl), format!("node {id} is given twice; each id once")));
+                    }
+                    c[id - 1] = Some((x, y));
+                }
+                coords = Some(c.into_iter().map(|p| p.unwrap_or((0.0, 0.0))).collect());
+            }
+            "EDGE_WEIGHT_SECTION" => {
+                let n = need_dim(dimension, ln, "EDGE_WEIGHT_SECTION")?;
+                let Some((_, f)) = format else {
+                    return Err(ctx.syntax(
+                        Some(ln),
+                        format!("EDGE_WEIGHT_SECTION without EDGE_WEIGHT_FORMAT; add `EDGE_WEIGHT_FORMAT : <{FORMATS}>` to the header"),
+                    ));
+                };
+                let count = match f {
+                    Format::Full => n * n,
+                    Format::UpperRow | Format::LowerRow => n * (n - 1) / 2,
+                    Format::UpperDiagRow | Format::LowerDiagRow => n * (n + 1) / 2,
+                };
+                let mut vals = Vec::with_capacity(count);
+                while vals.len() < count {
+                    let Some(&(cl, line)) = lines.get(i).filter(|(_, l)| !is_keyword_line(l)) else {
+                        let at = lines.get(i).map(|x| x.0);
+                        return Err(ctx.syntax(
+                            at,
+                            format!(
+                                "EDGE_WEIGHT_SECTION (line {ln}) ends after {} of {count} weights; \
+                                 format {f:?} with DIMENSION {n} needs {count}",
+                                vals.len()
+                            ),
+                        ));
+                    };
+                    i += 1;
+                    for tok in line.split_whitespace() {
+                        if vals.len() == count {
+                            return Err(ctx.syntax(
+                                Some(cl),
+                                format!("more than the {count} weights format {f:?} needs; found `{tok}` after them"),
+                            ));
+                        }
+                        let v = ctx.number(cl, tok, "an edge weight")?;
+                        if v < 0.0 {
+                            return Err(ctx.invalid(
+                                Some(cl),
+                                format!("edge weight {v} is negative; weights must be >= 0"),
+                            ));
+                        }
+                        vals.push(v);
+                    }
+                }
+                if let Some(&(cl, line)) = lines.get(i).filter(|(_, l)| !is_keyword_line(l)) {
+                    return Err(ctx.syntax(
+                        Some(cl),
+                        format!("more than the {count} weights format {f:?} needs; expected a keyword, found `{line}`"),
+                    ));
+                }
+                weights = Some((ln, vals));
+            }
+            "DISPLAY_DATA_SECTION" | "FIXED_EDGES_SECTION" => {
+                while lines.get(i).is_some_and(|(_, l)| !is_keyword_line(l)) {
+                    i += 1;
+                }
+            }
+            "GTSP_SET_SECTION" if kind == Kind::Gtsp => {
+                let Some((_, m)) = gtsp_sets else {
+                    return Err(ctx.syntax(
+                        Some(ln),
+                        "GTSP_SET_SECTION before GTSP_SETS; add `GTSP_SETS : <number of sets>` to the header",
+                    ));
+                };
+                let mut toks = Vec::new();
+                while let Some(&(cl, line)) = lines.get(i).filter(|(_, l)| !is_keyword_line(l)) {
+                    i += 1;
+                    toks.extend(line.split_whitespace().map(|t| (cl, t)));
+                }
+                let mut it = toks.into_iter();
+                let mut raw = Vec::with_capacity(m);
+                for k in 0..m {
+                    let Some((sl, tok)) = it.next() else {
+                        return Err(ctx.syntax(
+                            lines.get(i).map(|x| x.0),
+                            format!("GTSP_SET_SECTION (line {ln}) ends after {k} of {m} sets; expected `set-id node ... -1` for each"),
+                        ));
+                    };
+                    let id = ctx.integer(sl, tok, "a set id")?;
+                    let mut nodes = Vec::new();
+                    loop {
+                        let Some((nl, tok)) = it.next() else {
+                            return Err(ctx.syntax(
+                                Some(sl),
+                                format!("set {id} is not terminated; expected its nodes followed by -1"),
+                            ));
+                        };
+                        let v: i64 = tok.parse().map_err(|_| {
+                            ctx.syntax(
+                                Some(nl),
+                                format!("expected a node id or -1 in set {id}, found `{tok}`"),
+                            )
+                        })?;
+                        if v == -1 {
+                            break;
+                        }
+                        nodes.push((nl, v));
+                    }
+                    raw.push(RawSet { line: sl, id, nodes });
+                }
+                if let Some((xl, tok)) = it.next() {
+                    return Err(ctx.syntax(
+                        Some(xl),
+                        format!("more sets than GTSP_SETS = {m}; found `{tok}` after the last one"),
+                    ));
+                }
+                sets = Some((ln, raw));
+            }
+            "EOF" => break,
+            _ => {
+                return Err(ctx.syntax(
+                    Some(ln),
+                    format!("unknown keyword `{key}`; expected one of {KEYWORDS}"),
+                ));
+            }
+        }
+    }
+
+    let Some(n) = dimension else {
+        return Err(ctx.syntax(
+            None,
+            "DIMENSION missing; add `DIMENSION : <number of nodes>` to the header",
+        ));
+    };
+    let Some((wl, wt)) = weight_type else {
+        return Err(ctx.syntax(
+            None,
+            format!("EDGE_WEIGHT_TYPE missing; add `EDGE_WEIGHT_TYPE : <{WEIGHT_TYPES}>`"),
+        ));
+    };
+    let costs = if wt == WeightType::Explicit {
+        let Some((_, vals)) = weights else {
+            return Err(ctx.syntax(
+                Some(wl),
+                "EDGE_WEIGHT_TYPE is EXPLICIT but there is no EDGE_WEIGHT_SECTION",
+            ));
+        };
+        let Some((_, f)) = format else {
+            return Err(ctx.syntax(
+                Some(wl),
+                format!("EXPLICIT weights need EDGE_WEIGHT_FORMAT ({FORMATS})"),
+            ));
+        };
+        explicit_matrix(n, f, &vals)
+    } else {
+        let Some(c) = coords else {
+            return Err(ctx.syntax(
+                Some(wl),
+                format!("EDGE_WEIGHT_TYPE {wt:?} needs a NODE_COORD_SECTION with one `id x y` line per node"),
+            ));
+        };
+        coord_matrix(wt, &c)
+    }
+    .map_err(|e| ctx.invalid(None, e))?;
+    Ok(Document {
+        name,
+        dimension: n,
+        costs,
+        gtsp_sets,
+        sets,
+    })
+}
+
+fn check_type(ctx: Ctx<'_>, ln: usize, value: &str, kind: Kind) -> Result<(), ReadError> {
+    let t = value.split_whitespace().next().unwrap_or("").to_ascii_uppercase();
+    let ok = match kind {
+        Kind::Tsp => t == "TSP",
+        Kind::Gtsp => t == "GTSP" || t == "AGTSP",
+    };
+    if ok {
+        return Ok(());
+    }
+    let hint = match (kind, t.as_str()) {
+        (Kind::Tsp, "GTSP" | "AGTSP") => "; read it with read_gtsplib",
+        (Kind::Gtsp, "TSP") => "; read it with read_tsplib",
+        _ => "",
+    };
+    let want = if kind == Kind::Tsp { "TSP" } else { "GTSP or AGTSP" };
+    Err(ctx.unsupported(
+        Some(ln),
+        format!("TYPE `{value}` is not supported here; this reader takes {want}{hint}"),
+    ))
+}
+
+fn explicit_matrix(n: usize, f: Format, vals: &[f64]) -> Result<CostMatrix, String> {
+    let mut m = vec![0.0; n * n];
+    let mut it = vals.iter().copied();
+    let mut set = |i: usize, j: usize, v: f64| {
+        m[i * n + j] = v;
+        m[j * n + i] = v;
+    };
+    match f {
+        Format::Full => {
+            return CostMatrix::new(n, vals.to_vec());
+        }
+        Format::UpperRow => (0..n).for_each(|i| (i + 1..n).for_each(|j| set(i, j, it.next().unwrap_or(0.0)))),
+        Format::LowerRow => (0..n).for_each(|i| (0..i).for_each(|j| set(i, j, it.next().unwrap_or(0.0)))),
+        Format::UpperDiagRow => (0..n).for_each(|i| (i..n).for_each(|j| set(i, j, it.next().unwrap_or(0.0)))),
+        Format::LowerDiagRow => {
+            (0..n).for_each(|i| (0..=i).for_each(|j| set(i, j, it.next().unwrap_or(0.0))))
+        }
+    }
+    CostMatrix::new(n, m)
+}
+
+/// TSPLIB's `nint`: `(int)(x + 0.5)`.
+fn nint(x: f64) -> f64 {
+    (x + 0.5).floor()
+}
+
+/// Latitude or longitude in radians from TSPLIB's DDD.MM notation.
+fn geo_rad(x: f64) -> f64 {
+    // TSPLIB95 fixes PI to 3.141592; the published optima depend on it.
+    #[allow(clippy::approx_constant)]
+    const PI: f64 = 3.141592;
+    let deg = x.trunc();
+    let min = x - deg;
+    PI * (deg + 5.0 * min / 3.0) / 180.0
+}
+
+fn coord_matrix(wt: WeightType, c: &[(f64, f64)]) -> Result<CostMatrix, String> {
+    let n = c.len();
+    let geo: Vec<(f64, f64)> = if wt == WeightType::Geo {
+        c.iter().map(|&(x, y)| (geo_rad(x), geo_rad(y))).collect()
+    } else {
+        Vec::new()
+    };
+    let mut m = vec![0.0; n * n];
+    for i in 0..n {
+        for j in i + 1..n {
+            let (dx, dy) = (c[i].0 - c[j].0, c[i].1 - c[j].1);
+            let d = match wt {
+                WeightType::Euc2d => nint((dx * dx + dy * dy).sqrt()),
+                WeightType::Ceil2d => (dx * dx + dy * dy).sqrt().ceil(),
+                WeightType::Att => {
+                    let r = ((dx * dx + dy * dy) / 10.0).sqrt();
+                    let t = nint(r);
+                    if t < r { t + 1.0 } else { t }
+                }
+                WeightType::Geo => {
+                    const RRR: f64 = 6378.388;
+                    let ((lat_i, lon_i), (lat_j, lon_j)) = (geo[i], geo[j]);
+                    let q1 = (lon_i - lon_j).cos();
+                    let q2 = (lat_i - lat_j).cos();
+                    let q3 = (lat_i + lat_j).cos();
+                    let a = (0.5 * ((1.0 + q1) * q2 - (1.0 - q1) * q3)).clamp(-1.0, 1.0);
+                    (RRR * a.acos() + 1.0).trunc()
+                }
+                WeightType::Explicit => 0.0,
+            };
+            m[i * n + j] = d;
+            m[j * n + i] = d;
+        }
+    }
+    CostMatrix::new(n, m)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const SMALL: &str = "NAME : small\nTYPE : TSP\nDIMENSION : 3\nEDGE_WEIGHT_TYPE : EUC_2D\n\
+        NODE_COORD_SECTION\n1 0 0\n2 3 4\n3 0 1.4\nEOF\n";
+
+    #[test]
+    fn euc_2d_rounds() {
+        let t = parse_tsplib(SMALL).unwrap();
+        assert_eq!(t.name, "small");
+        assert_eq!(t.costs.get(0, 1), 5.0);
+        assert_eq!(t.costs.get(0, 2), 1.0);
+        assert_eq!(t.costs.get(1, 1), 0.0);
+    }
+
+    #[test]
+    fn explicit_formats_agree() {
+        let full = "0 1 2\n1 0 3\n2 3 0";
+        let forms = [
+            ("FULL_MATRIX", full),
+            ("UPPER_ROW", "1 2 3"),
+            ("LOWER_ROW", "1 2 3"),
+            ("UPPER_DIAG_ROW", "0 1 2 0 3 0"),
+            ("LOWER_DIAG_ROW", "0 1 0 2 3 0"),
+        ];
+        for (f, body) in forms {
+            let text = format!(
+                "TYPE: TSP\nDIMENSION: 3\nEDGE_WEIGHT_TYPE: EXPLICIT\nEDGE_WEIGHT_FORMAT: {f}\nEDGE_WEIGHT_SECTION\n{body}\nEOF\n"
+            );
+            let t = parse_tsplib(&text).unwrap_or_else(|e| panic!("{f}: {e}"));
+            assert_eq!(t.costs.get(0, 1), 1.0, "{f}");
+            assert_eq!(t.costs.get(2, 0), 2.0, "{f}");
+            assert_eq!(t.costs.get(1, 2), 3.0, "{f}");
+        }
+    }
+
+    #[test]
+    fn att_and_ceil_rules() {
+        let t = parse_tsplib(
+            "TYPE: TSP\nDIMENSION: 2\nEDGE_WEIGHT_TYPE: ATT\nNODE_COORD_SECTION\n1 0 0\n2 10 0\n",
+        )
+        .unwrap();
+        // r = sqrt(100/10) = 3.162..., nint = 3 < r, so 4.
+        assert_eq!(t.costs.get(0, 1), 4.0);
+        let t = parse_tsplib(
+            "TYPE: TSP\nDIMENSION: 2\nEDGE_WEIGHT_TYPE: CEIL_2D\nNODE_COORD_SECTION\n1 0 0\n2 1 1\n",
+        )
+        .unwrap();
+        assert_eq!(t.costs.get(0, 1), 2.0);
+    }
+
+    #[test]
+    fn optima_file_format() {
+        let m = parse_optima("a280 : 2579\ndsj1000 : 18660188 (CEIL_2D)\n\n").unwrap();
+        assert_eq!(m["a280"], 2579.0);
+        assert_eq!(m["dsj1000"], 18660188.0);
+        let e = parse_optima("a280 2579\n").unwrap_err();
+        assert_eq!(e.line(), Some(1));
+    }
+
+    #[test]
+    fn errors_name_line_and_expectation() {
+        let e = parse_tsplib(&SMALL.replace("EUC_2D", "EUC_3D")).unwrap_err();
+        assert!(matches!(e, ReadError::Unsupported { line: Some(4), .. }), "{e}");
+        assert!(
+            e.to_string().contains("EUC_3D") && e.to_string().contains("EUC_2D"),
+            "{e}"
+        );
+
+        let e = parse_tsplib(&SMALL.replace("DIMENSION : 3\n", "")).unwrap_err();
+        assert!(e.to_string().contains("DIMENSION"), "{e}");
+        assert!(matches!(e, ReadError::Syntax { line: Some(4), .. }), "{e}");
+
+        let e = parse_tsplib(&SMALL.replace("2 3 4", "2 3 x4")).unwrap_err();
+        assert!(matches!(e, ReadError::Syntax { line: Some(7), .. }), "{e}");
+        assert!(
+            e.to_string().contains("`x4`") && e.to_string().contains("y coordinate"),
+            "{e}"
+        );
+
+        let e = parse_tsplib(&SMALL.replace("3 0 1.4\n", "")).unwrap_err();
+        assert!(matches!(e, ReadError::Syntax { line: Some(8), .. }), "{e}");
+        assert!(e.to_string().contains("2 of 3"), "{e}");
+
+        let e = parse_tsplib(&SMALL.replace("3 0 1.4\nEOF\n", "")).unwrap_err();
+        assert!(matches!(e, ReadError::Syntax { line: None, .. }), "{e}");
+
+        let e = parse_tsplib(&SMALL.replace("TYPE : TSP", "TYPE : ATSP")).unwrap_err();
+        assert!(matches!(e, ReadError::Unsupported { line: Some(2), .. }), "{e}");
+
+        let e = parse_tsplib(&SMALL.replace("NAME", "NAMX")).unwrap_err();
+        assert!(e.to_string().contains("unknown keyword"), "{e}");
+
+        let e = parse_tsplib(&SMALL.replace("3 0 1.4", "4 0 1.4")).unwrap_err();
+        assert!(matches!(e, ReadError::Invalid { line: Some(8), .. }), "{e}");
+    }
+
+    #[test]
+    fn garbage_does_not_panic() {
+        for text in [
+            "",
+            "EOF",
+            ":",
+            "DIMENSION: -3",
+            "DIMENSION: 2\nEDGE_WEIGHT_SECTION\n1",
+            "\u{0}\u{1}",
+        ] {
+            assert!(parse_tsplib(text).is_err(), "{text:?}");
+        }
+    }
+}
