@@ -3,6 +3,8 @@
 //! Exit codes: 0 done; 2 bad input (the message names file, line and a fix; nothing written);
 //! 3 the cell is valid but some task no robot can do (the report says which and why);
 //! 1 anything else.
+mod bench;
+
 use cellplan::report::{check, svg};
 use cellplan::taskgen::{GenOptions, sample_tasks};
 use cellplan::{InputError, LoadOptions, candidates, io::write_atomic};
@@ -33,6 +35,9 @@ enum Command {
     /// Generate inputs for building cells.
     #[command(subcommand)]
     Gen(GenCommand),
+    /// Run the combinatorial solvers on standard instances (TSPLIB, GTSPLIB, OR-Library) and
+    /// compare with the known optima.
+    Bench(bench::BenchArgs),
 }
 
 #[derive(Args)]
@@ -242,6 +247,33 @@ fn run_gen_tasks(args: &GenTasksArgs) -> Result<(), Failure> {
     Ok(())
 }
 
+fn run_bench(args: &bench::BenchArgs) -> Result<(), Failure> {
+    let rows = bench::run(args).map_err(|e| match e {
+        bench::BenchError::Input(e) => {
+            // The reader's message starts with `path:line: `; keep only what follows.
+            let text = e.to_string();
+            let prefix = match e.line() {
+                Some(l) => format!("{}:{l}: ", e.path().display()),
+                None => format!("{}: ", e.path().display()),
+            };
+            let message = text.strip_prefix(&prefix).unwrap_or(&text).to_string();
+            Failure::Input(Box::new(InputError::at_line(e.path(), e.line(), message).hint(
+                "give TSPLIB (.tsp), GTSPLIB (.gtsp) or OR-Library set-cover files of the kind named",
+            )))
+        }
+        bench::BenchError::Usage(m) => Failure::Other(m),
+    })?;
+    if args.json {
+        println!(
+            "{}",
+            serde_json::to_string_pretty(&rows).map_err(|e| Failure::Other(e.to_string()))?
+        );
+    } else {
+        print!("{}", bench::render(&rows));
+    }
+    Ok(())
+}
+
 fn main() -> ExitCode {
     // Long messages stay on one line, so that they can be searched for.
     let _ = miette::set_hook(Box::new(|_| {
@@ -256,6 +288,7 @@ fn main() -> ExitCode {
     let result = match &cli.command {
         Command::Check(a) => run_check(a),
         Command::Gen(GenCommand::Tasks(a)) => run_gen_tasks(a),
+        Command::Bench(a) => run_bench(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

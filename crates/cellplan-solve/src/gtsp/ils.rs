@@ -1,0 +1,76 @@
+//! Iterated local search: construct, improve, then repeatedly kick the accepted tour with a
+//! local double bridge (swap two adjacent segments of random lengths), improve, and accept the
+//! result if it is no worse.
+use std::time::Instant;
+
+use rand::{RngExt, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+
+use super::search::{Queue, local_search};
+use super::{GtspParams, Inst, State, construct, layer};
+
+/// Kicked segments are up to a quarter of the tour long, but at least this many items may be
+/// moved (when the tour has them)...
+const MIN_SEGMENT: usize = 30;
+/// ... and never more than this.
+const MAX_SEGMENT: usize = 200;
+
+/// The best state found and the number of kicks.
+pub(super) fn run(inst: &Inst, params: &GtspParams, deadline: Instant) -> (State, usize) {
+    let order = construct::nearest_neighbour(inst);
+    let mut cur = State::new(inst, order);
+    let mut queue = Queue::default();
+    for &x in &cur.t.clone() {
+        queue.push(x);
+    }
+    local_search(inst, &mut cur, &mut queue);
+    let mut cur_cost = inst.cost(&cur);
+    let m = cur.t.len();
+    let lo = usize::from(inst.depot);
+    let movable = m - lo.min(m);
+    if movable < 3 {
+        return (cur, 0);
+    }
+    let mut rng = ChaCha8Rng::seed_from_u64(params.seed);
+    let mut trial = cur.clone();
+    let mut iterations = 0;
+    loop {
+        if params.max_iterations.is_some_and(|n| iterations >= n) {
+            break;
+        }
+        if Instant::now() >= deadline {
+            break;
+        }
+        iterations += 1;
+        trial.clone_from(&cur);
+        // Double bridge: swap segments [p, p+l1) and [p+l1, p+l1+l2).
+        let cap = (movable / 4).clamp(MIN_SEGMENT, MAX_SEGMENT).min(movable - 1);
+        let l1 = rng.random_range(1..=cap);
+        let l2 = rng.random_range(1..=cap.min(movable - l1));
+        let p = rng.random_range(lo..=m - l1 - l2);
+        let ends = [
+            trial.t[trial.prev(p)],
+            trial.t[p],
+            trial.t[p + l1 - 1],
+            trial.t[p + l1],
+            trial.t[p + l1 + l2 - 1],
+            trial.t[trial.next(p + l1 + l2 - 1)],
+        ];
+        trial.t[p..p + l1 + l2].rotate_left(l1);
+        trial.reindex(inst, p, p + l1 + l2 - 1);
+        for e in ends {
+            queue.push(e);
+        }
+        // Let the nodes follow the new order before improving it.
+        for x in layer::layer_pass(inst, &mut trial) {
+            queue.push(x);
+        }
+        local_search(inst, &mut trial, &mut queue);
+        let cost = inst.cost(&trial);
+        if cost <= cur_cost {
+            std::mem::swap(&mut cur, &mut trial);
+            cur_cost = cost;
+        }
+    }
+    (cur, iterations)
+}

@@ -1,0 +1,80 @@
+//! The layer pass: for the current cluster order, the best node of every cluster, by a
+//! shortest path through the layers (one per cluster). On a cycle the layer of the smallest
+//! cluster is fixed first and each of its nodes tried; with depots the depot item is that layer.
+use super::{EPS, Inst, State};
+
+/// Re-choose every cluster's node optimally for the current order. Returns the items whose node
+/// changed (empty when the tour did not improve).
+pub(super) fn layer_pass(inst: &Inst, st: &mut State) -> Vec<usize> {
+    let m = st.t.len();
+    if m == 0 || inst.clusters.iter().all(|c| c.len() == 1) {
+        return Vec::new();
+    }
+    // The first layer: the depot item, or the smallest cluster.
+    let first = (0..m)
+        .min_by_key(|&i| (inst.clusters[st.t[i]].len(), i))
+        .unwrap_or(0);
+    let first = if inst.depot { st.pos[inst.k] } else { first };
+    let layers: Vec<&[usize]> = (0..m)
+        .map(|i| inst.clusters[st.t[(first + i) % m]].as_slice())
+        .collect();
+    let mut offset = Vec::with_capacity(m + 1);
+    offset.push(0);
+    for l in &layers {
+        offset.push(offset.last().copied().unwrap_or(0) + l.len());
+    }
+    let total = offset[m];
+    let mut value = vec![0.0; total];
+    let mut parent = vec![0usize; total];
+    let mut best = (f64::INFINITY, 0usize, 0usize); // (cost, start index, last index)
+    let mut best_parent = Vec::new();
+    for (si, &s) in layers[0].iter().enumerate() {
+        value[si] = inst.s(s);
+        for l in 0..m {
+            if l == 0 {
+                value[..layers[0].len()].fill(f64::INFINITY);
+                value[si] = inst.s(s);
+                continue;
+            }
+            let (prev, cur) = (layers[l - 1], layers[l]);
+            for (j, &v) in cur.iter().enumerate() {
+                let mut b = (f64::INFINITY, 0);
+                for (i, &u) in prev.iter().enumerate() {
+                    let x = value[offset[l - 1] + i] + inst.w(u, v);
+                    if x < b.0 {
+                        b = (x, i);
+                    }
+                }
+                value[offset[l] + j] = b.0 + inst.s(v);
+                parent[offset[l] + j] = b.1;
+            }
+        }
+        let last = layers[m - 1];
+        for (j, &v) in last.iter().enumerate() {
+            let x = value[offset[m - 1] + j] + inst.w(v, s);
+            if x < best.0 {
+                best = (x, si, j);
+                best_parent.clone_from(&parent);
+            }
+        }
+    }
+    let now = inst.cost(st) - inst.fixed;
+    if best.0 >= now - EPS {
+        return Vec::new();
+    }
+    let mut changed = Vec::new();
+    let mut j = best.2;
+    for l in (0..m).rev() {
+        let node = if l == 0 { layers[0][best.1] } else { layers[l][j] };
+        let item = st.t[(first + l) % m];
+        if st.choice[item] != node {
+            st.choice[item] = node;
+            changed.push(item);
+        }
+        if l > 0 {
+            j = best_parent[offset[l] + j];
+        }
+    }
+    st.refresh(inst);
+    changed
+}

@@ -1,0 +1,360 @@
+//! Anytime heuristic for the GTSP (and the TSP, as singleton clusters): nearest-neighbour
+//! construction over clusters, the layer pass (the best node per cluster for a fixed cluster
+//! order, by DP), 2-opt and Or-opt on neighbour lists with node re-choice, and iterated local
+//! search with local double-bridge kicks. Deterministic for a seed and `max_iterations`; the time
+//! limit only cuts the search short.
+//!
+//! Internally a tour is an array of *items*: the clusters in visiting order and, when the problem
+//! has depots, a fixed pseudo-cluster at position 0 standing for "start … end" (arcs into it go
+//! to `end`, arcs out of it leave `start`). Either way the array is read as a cycle.
+use std::time::{Duration, Instant};
+
+use crate::problem::{Gtsp, Tour};
+
+mod construct;
+mod ils;
+mod layer;
+mod or_opt;
+mod search;
+mod two_opt;
+
+/// Parameters of [`solve`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct GtspParams {
+    /// Stop after this much wall-clock time (checked between iterations).
+    pub time_limit: Duration,
+    /// Seed of the random kicks.
+    pub seed: u64,
+    /// Stop after this many kicks (the result then depends only on the instance and the seed).
+    pub max_iterations: Option<usize>,
+}
+
+impl Default for GtspParams {
+    fn default() -> Self {
+        GtspParams {
+            time_limit: Duration::from_secs(1),
+            seed: 0,
+            max_iterations: None,
+        }
+    }
+}
+
+/// The best tour found, its cost (as [`Gtsp::tour_cost`] counts it) and the kicks made.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Solution {
+    /// The tour (depots excluded).
+    pub tour: Tour,
+    /// Its cost.
+    pub cost: f64,
+    /// Iterated-local-search kicks made.
+    pub iterations: usize,
+}
+
+/// Improvements smaller than this are ignored (guards against cycling on rounding).
+pub(crate) const EPS: f64 = 1e-7;
+
+/// The best GTSP tour found for `p` within `params`. With depots the tour runs start → clusters
+/// → end (back to start when `end` is `None`); without, it is a closed cycle.
+pub fn solve(p: &Gtsp, params: &GtspParams) -> Solution {
+    let deadline = Instant::now() + params.time_limit;
+    let inst = Inst::new(p);
+    let (st, iterations) = ils::run(&inst, params, deadline);
+    let tour = inst.tour_of(&st);
+    let cost = p.tour_cost(&tour);
+    Solution {
+        tour,
+        cost,
+        iterations,
+    }
+}
+
+/// The instance as the search sees it.
+pub(crate) struct Inst<'a> {
+    /// Row-major costs.
+    data: &'a [f64],
+    service: &'a [f64],
+    /// Real nodes; node `n` is the depot item.
+    n: usize,
+    /// Clusters; pseudo-cluster `k` is the depot item (when `depot`).
+    k: usize,
+    clusters: Vec<Vec<usize>>,
+    depot: bool,
+    start: usize,
+    end: usize,
+    /// Whether arc costs are symmetric (2-opt then needs no prefix sums).
+    sym: bool,
+    /// Nearest items of every item (clusters and the depot item).
+    neigh: Vec<Vec<usize>>,
+    /// Service of the depots, constant.
+    fixed: f64,
+}
+
+impl<'a> Inst<'a> {
+    fn new(p: &'a Gtsp) -> Self {
+        let n = p.costs.n();
+        let k = p.clusters.len();
+        let (depot, start, end, fixed) = match p.start {
+            Some(s) => {
+                let e = p.end.unwrap_or(s);
+                let f = p.service[s] + if e != s { p.service[e] } else { 0.0 };
+                (true, s, e, f)
+            }
+            None => (false, 0, 0, 0.0),
+        };
+        let mut clusters = p.clusters.clone();
+        if depot {
+            clusters.push(vec![n]);
+        }
+        let mut inst = Inst {
+            data: p.costs.data(),
+            service: &p.service,
+            n,
+            k,
+            clusters,
+            depot,
+            start,
+            end,
+            sym: p.costs.is_symmetric(0.0),
+            neigh: Vec::new(),
+            fixed,
+        };
+        inst.neigh = construct::neighbours(&inst, 12);
+        inst
+    }
+
+    /// Number of items (clusters plus the depot item).
+    #[inline]
+    pub(crate) fn items(&self) -> usize {
+        self.clusters.len()
+    }
+
+    /// Arc cost between two nodes, the depot item `n` standing for start (out) and end (in).
+    #[inline]
+    pub(crate) fn w(&self, u: usize, v: usize) -> f64 {
+        let n = self.n;
+        let (u, v) = match (u == n, v == n) {
+            (false, false) => (u, v),
+            (true, false) => (self.start, v),
+            (false, true) => (u, self.end),
+            (true, true) => (self.start, self.end),
+        };
+        self.data[u * n + v]
+    }
+
+    /// Service of a node (0 for the depot item, whose service is in `fixed`).
+    #[inline]
+    pub(crate) fn s(&self, v: usize) -> f64 {
+        if v == self.n { 0.0 } else { self.service[v] }
+    }
+
+    /// The cost of a state, as `Gtsp::tour_cost` counts it.
+    pub(crate) fn cost(&self, st: &State) -> f64 {
+        let m = st.t.len();
+        let mut total = self.fixed;
+        for i in 0..m {
+            let u = st.node(i);
+            let v = st.node(if i + 1 == m { 0 } else { i + 1 });
+            total += self.w(u, v) + self.s(u);
+        }
+        total
+    }
+
+    fn tour_of(&self, st: &State) -> Tour {
+        let nodes = if self.depot {
+            st.t[1..].iter().map(|&c| st.choice[c]).collect()
+        } else {
+            st.t.iter().map(|&c| st.choice[c]).collect()
+        };
+        Tour { nodes }
+    }
+}
+
+/// A tour: items in order, their positions, the chosen node of every item, and (for asymmetric
+/// costs) prefix sums of the forward and backward arc costs along the array.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct State {
+    pub t: Vec<usize>,
+    pub pos: Vec<usize>,
+    pub choice: Vec<usize>,
+    pub fwd: Vec<f64>,
+    pub bwd: Vec<f64>,
+}
+
+impl State {
+    pub(crate) fn new(inst: &Inst, order: Vec<usize>) -> Self {
+        let mut pos = vec![0; inst.items()];
+        for (i, &c) in order.iter().enumerate() {
+            pos[c] = i;
+        }
+        let mut st = State {
+            t: order,
+            pos,
+            choice: inst.clusters.iter().map(|c| c[0]).collect(),
+            fwd: Vec::new(),
+            bwd: Vec::new(),
+        };
+        st.refresh(inst);
+        st
+    }
+
+    /// The node at position `i`.
+    #[inline]
+    pub(crate) fn node(&self, i: usize) -> usize {
+        self.choice[self.t[i]]
+    }
+
+    /// The position after `i`, cyclically.
+    #[inline]
+    pub(crate) fn next(&self, i: usize) -> usize {
+        if i + 1 == self.t.len() { 0 } else { i + 1 }
+    }
+
+    /// The position before `i`, cyclically.
+    #[inline]
+    pub(crate) fn prev(&self, i: usize) -> usize {
+        if i == 0 { self.t.len() - 1 } else { i - 1 }
+    }
+
+    /// Recompute positions of `lo..=hi` and, for asymmetric costs, the prefix sums.
+    pub(crate) fn reindex(&mut self, inst: &Inst, lo: usize, hi: usize) {
+        for i in lo..=hi {
+            self.pos[self.t[i]] = i;
+        }
+        if !inst.sym {
+            self.refresh(inst);
+        }
+    }
+
+    /// Recompute the prefix sums (asymmetric costs only).
+    pub(crate) fn refresh(&mut self, inst: &Inst) {
+        if inst.sym {
+            return;
+        }
+        let m = self.t.len();
+        self.fwd.clear();
+        self.bwd.clear();
+        let (mut f, mut b) = (0.0, 0.0);
+        self.fwd.push(0.0);
+        self.bwd.push(0.0);
+        for i in 0..m.saturating_sub(1) {
+            let (u, v) = (self.node(i), self.node(i + 1));
+            f += inst.w(u, v);
+            b += inst.w(v, u);
+            self.fwd.push(f);
+            self.bwd.push(b);
+        }
+    }
+}
+
+#[cfg(test)]
+pub(crate) mod tests {
+    use super::*;
+    use crate::held_karp::{self, HeldKarpLimits};
+    use crate::problem::CostMatrix;
+    use rand::{RngExt, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
+
+    /// `k` clusters of `per` random points in the unit square ×100, plus `depots` extra nodes;
+    /// asymmetric when `asym`.
+    pub(crate) fn random_gtsp(seed: u64, k: usize, per: usize, depots: usize, asym: bool) -> Gtsp {
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        let n = k * per + depots;
+        let pts: Vec<(f64, f64)> = (0..n)
+            .map(|_| (rng.random::<f64>() * 100.0, rng.random::<f64>() * 100.0))
+            .collect();
+        let extra: Vec<f64> = (0..n * n).map(|_| rng.random::<f64>() * 20.0).collect();
+        let costs = CostMatrix::from_fn(n, |i, j| {
+            let d = ((pts[i].0 - pts[j].0).powi(2) + (pts[i].1 - pts[j].1).powi(2)).sqrt();
+            if asym { d + extra[i * n + j] } else { d }
+        });
+        let clusters = (0..k).map(|c| (c * per..(c + 1) * per).collect()).collect();
+        Gtsp::new(costs, clusters).unwrap()
+    }
+
+    fn check(p: &Gtsp, iters: usize, seed: u64) -> Solution {
+        let params = GtspParams {
+            time_limit: Duration::from_secs(3600),
+            seed,
+            max_iterations: Some(iters),
+        };
+        let sol = solve(p, &params);
+        p.check(&sol.tour).unwrap();
+        assert_eq!(sol.cost, p.tour_cost(&sol.tour));
+        sol
+    }
+
+    fn assert_optimal(p: &Gtsp, seed: u64) {
+        let exact = held_karp::solve(p, HeldKarpLimits::default()).unwrap();
+        let sol = check(p, 300, seed);
+        assert!(
+            (sol.cost - exact.cost).abs() < 1e-6,
+            "heuristic {} vs optimum {}",
+            sol.cost,
+            exact.cost
+        );
+    }
+
+    #[test]
+    fn gtsp_matches_held_karp_closed() {
+        for seed in 0..6 {
+            assert_optimal(&random_gtsp(seed, 8, 3, 0, false), seed);
+        }
+    }
+
+    #[test]
+    fn gtsp_matches_held_karp_with_depots() {
+        for seed in 0..6 {
+            let g = random_gtsp(100 + seed, 8, 3, 2, false);
+            let n = g.costs.n();
+            let ret = g.clone().with_depots(Some(n - 2), None).unwrap();
+            assert_optimal(&ret, seed);
+            let path = g.with_depots(Some(n - 2), Some(n - 1)).unwrap();
+            assert_optimal(&path, seed);
+        }
+    }
+
+    #[test]
+    fn gtsp_matches_held_karp_asymmetric_with_service() {
+        for seed in 0..6 {
+            let g = random_gtsp(200 + seed, 8, 3, 1, true);
+            let n = g.costs.n();
+            let service = (0..n).map(|v| (v % 5) as f64).collect();
+            let g = g.with_service(service).unwrap();
+            assert_optimal(&g, seed);
+            assert_optimal(&g.with_depots(Some(n - 1), None).unwrap(), seed);
+        }
+    }
+
+    #[test]
+    fn gtsp_tiny_and_empty() {
+        let g = random_gtsp(7, 0, 1, 2, false);
+        let sol = check(&g, 10, 0);
+        assert!(sol.tour.nodes.is_empty());
+        let d = g.with_depots(Some(0), Some(1)).unwrap();
+        let sol = check(&d, 10, 0);
+        assert_eq!(sol.cost, d.costs.get(0, 1));
+        for k in 1..=4 {
+            assert_optimal(&random_gtsp(k as u64, k, 3, 0, true), 0);
+            let g = random_gtsp(k as u64, k, 2, 1, false);
+            let n = g.costs.n();
+            assert_optimal(&g.with_depots(Some(n - 1), None).unwrap(), 0);
+        }
+    }
+
+    #[test]
+    fn gtsp_same_seed_same_tour() {
+        let g = random_gtsp(5, 40, 4, 0, false);
+        let a = check(&g, 200, 9);
+        let b = check(&g, 200, 9);
+        assert_eq!(a, b);
+    }
+
+    #[test]
+    fn gtsp_tsp_singletons() {
+        let g = random_gtsp(11, 60, 1, 0, false);
+        let g = Gtsp::tsp(g.costs);
+        let zero = check(&g, 0, 0);
+        let more = check(&g, 500, 0);
+        assert!(more.cost <= zero.cost);
+    }
+}
