@@ -685,3 +685,64 @@ fn example_task_lists_are_what_their_cell_files_say() {
         );
     }
 }
+
+#[test]
+fn bench_reports_costs_against_known_optima() {
+    let dir = scratch("bench");
+    let out = cellplan(
+        &[
+            "bench",
+            "setcover",
+            "data/benchmarks/orlib-setcover/scp41.txt",
+            "--json",
+        ],
+        &dir,
+    );
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: Value = serde_json::from_slice(&out.stdout).unwrap();
+    let row = &v[0];
+    assert_eq!(row["instance"], "scp41");
+    assert_eq!(row["cost"], 429.0);
+    assert_eq!(row["optimum"], 429.0);
+    assert_eq!(row["gap_percent"], 0.0);
+    assert_eq!(row["proven_optimal"], true);
+    for key in ["mean_cost", "time_s"] {
+        assert!(row[key].is_number(), "{key}");
+    }
+    let out = cellplan(
+        &[
+            "bench",
+            "tsp",
+            "data/benchmarks/tsplib/burma14.tsp",
+            "--method",
+            "exact",
+            "--json",
+        ],
+        &dir,
+    );
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v[0]["cost"], 3323.0, "Held-Karp proves burma14");
+}
+
+#[test]
+fn bench_refuses_a_malformed_instance() {
+    let dir = scratch("bench-bad");
+    let bad = dir.join("bad.tsp");
+    std::fs::write(&bad, "NAME: bad\nTYPE: TSP\nDIMENSION: 3\nEDGE_WEIGHT_TYPE: EUC_2D\nNODE_COORD_SECTION\n1 0 0\n2 x 1\n3 1 1\nEOF\n").unwrap();
+    let out = cellplan(&["bench", "tsp", bad.to_str().unwrap()], &dir);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(stderr.contains("bad.tsp:7"), "{stderr}");
+    assert!(stderr.contains("help:"), "{stderr}");
+}
