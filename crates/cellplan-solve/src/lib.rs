@@ -21,3 +21,4 @@ pub use gtsp::{GtspParams, Solution, solve as solve_gtsp};
 
 pub mod setcover;
 pub use setcover::Cover;
+pub mod minmax;

@@ -1,0 +1,334 @@
+//! Min-max multi-vehicle routing with alternative nodes: the joint allocation and sequencing of
+//! a multi-robot inspection cell (paper 000 §3). Each vehicle (robot) has its own cost matrix,
+//! a home depot (start = end), a task cap φ and, per task, the nodes (alternative
+//! configurations) with which it can do the task. Every task is done exactly once, by one
+//! vehicle, at one of that vehicle's nodes; the objective is the longest route time (travel plus
+//! service), then the total. An optional balance limit γ bounds the spread of the route times.
+//!
+//! Service times are **per task** (the same whichever vehicle or node does it); the depot has
+//! none. Methods ([`MinMaxMethod`]): the proximity baseline, paper 000's Algorithm 1 generalised
+//! to m vehicles, and an iterated local search between routes on top of the GTSP solver.
+use std::time::Duration;
+
+use crate::problem::CostMatrix;
+
+mod construct;
+mod generate;
+mod ils;
+mod route;
+#[cfg(test)]
+mod tests;
+
+pub use generate::generate;
+
+/// One vehicle (robot).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Vehicle {
+    /// Travel times between the vehicle's own nodes (depot included).
+    pub costs: CostMatrix,
+    /// The home node: every route starts and ends here. In no task's alternatives.
+    pub depot: usize,
+    /// Most tasks the vehicle may take (φ).
+    pub cap: usize,
+    /// `alternatives[t]`: the nodes with which this vehicle does task `t` (empty when it
+    /// cannot). One entry per task; a node serves at most one task.
+    pub alternatives: Vec<Vec<usize>>,
+}
+
+impl Vehicle {
+    /// A vehicle, validated on its own: depot and nodes in range, the depot in no alternative
+    /// list, no node serving two tasks (or listed twice).
+    pub fn new(
+        costs: CostMatrix,
+        depot: usize,
+        cap: usize,
+        alternatives: Vec<Vec<usize>>,
+    ) -> Result<Self, String> {
+        let v = Vehicle {
+            costs,
+            depot,
+            cap,
+            alternatives,
+        };
+        v.validate()?;
+        Ok(v)
+    }
+
+    fn validate(&self) -> Result<(), String> {
+        let n = self.costs.n();
+        if self.depot >= n {
+            return Err(format!("depot {} is out of range ({n} nodes)", self.depot));
+        }
+        let mut owner: Vec<Option<usize>> = vec![None; n];
+        for (t, alts) in self.alternatives.iter().enumerate() {
+            for &a in alts {
+                if a >= n {
+                    return Err(format!("task {t} names node {a}, out of range ({n} nodes)"));
+                }
+                if a == self.depot {
+                    return Err(format!("task {t} names the depot {a} as an alternative"));
+                }
+                if let Some(o) = owner[a] {
+                    return Err(format!("node {a} serves task {o} and again task {t}"));
+                }
+                owner[a] = Some(t);
+            }
+        }
+        Ok(())
+    }
+}
+
+/// A min-max allocation and routing problem; build through [`MinMaxProblem::new`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct MinMaxProblem {
+    /// The vehicles.
+    pub vehicles: Vec<Vehicle>,
+    /// Number of tasks.
+    pub tasks: usize,
+    /// Service time of every task (`tasks` entries), whichever vehicle does it.
+    pub service: Vec<f64>,
+    /// When given, the largest allowed difference between route times (γ); solutions meeting
+    /// it are preferred to any that do not.
+    pub balance_limit: Option<f64>,
+}
+
+impl MinMaxProblem {
+    /// A validated problem: every vehicle valid with one alternative list per task, service
+    /// times finite and non-negative, every task doable by some vehicle, and the caps admit an
+    /// assignment of all tasks (checked by matching, so total cap ≥ tasks and more).
+    pub fn new(
+        vehicles: Vec<Vehicle>,
+        tasks: usize,
+        service: Vec<f64>,
+        balance_limit: Option<f64>,
+    ) -> Result<Self, String> {
+        let p = MinMaxProblem {
+            vehicles,
+            tasks,
+            service,
+            balance_limit,
+        };
+        p.validate()?;
+        Ok(p)
+    }
+
+    /// The checks of [`MinMaxProblem::new`], for a problem built field by field.
+    pub fn validate(&self) -> Result<(), String> {
+        if self.service.len() != self.tasks {
+            return Err(format!(
+                "{} service times for {} tasks",
+                self.service.len(),
+                self.tasks
+            ));
+        }
+        if let Some(t) = self.service.iter().position(|s| !s.is_finite() || *s < 0.0) {
+            return Err(format!("service time of task {t} is {}", self.service[t]));
+        }
+        if let Some(g) = self.balance_limit
+            && (!g.is_finite() || g < 0.0)
+        {
+            return Err(format!("balance limit {g} must be finite and non-negative"));
+        }
+        for (i, v) in self.vehicles.iter().enumerate() {
+            if v.alternatives.len() != self.tasks {
+                return Err(format!(
+                    "vehicle {i} has {} alternative lists for {} tasks",
+                    v.alternatives.len(),
+                    self.tasks
+                ));
+            }
+            v.validate().map_err(|e| format!("vehicle {i}: {e}"))?;
+        }
+        if let Some(t) = (0..self.tasks).find(|&t| self.capable(t).is_empty()) {
+            return Err(format!("no vehicle can do task {t}"));
+        }
+        let cap: usize = self.vehicles.iter().map(|v| v.cap).sum();
+        if cap < self.tasks {
+            return Err(format!("total cap {cap} is below the {} tasks", self.tasks));
+        }
+        let mut sets = vec![Vec::new(); self.vehicles.len()];
+        for t in 0..self.tasks {
+            let (v0, moves) = construct::augment(self, &sets, t)
+                .ok_or_else(|| format!("the caps admit no assignment of every task (stuck at task {t})"))?;
+            for &(u, from, to) in &moves {
+                sets[from].retain(|&x| x != u);
+                sets[to].push(u);
+            }
+            sets[v0].push(t);
+        }
+        Ok(())
+    }
+
+    /// Whether vehicle `v` can do task `t`.
+    pub fn can_do(&self, v: usize, t: usize) -> bool {
+        !self.vehicles[v].alternatives[t].is_empty()
+    }
+
+    /// The vehicles that can do task `t`.
+    pub fn capable(&self, t: usize) -> Vec<usize> {
+        (0..self.vehicles.len()).filter(|&v| self.can_do(v, t)).collect()
+    }
+
+    /// Time of vehicle `v` driving `tour` (depot → nodes → depot, plus the tasks' service).
+    pub fn route_time(&self, v: usize, tour: &[(usize, usize)]) -> f64 {
+        let veh = &self.vehicles[v];
+        let mut prev = veh.depot;
+        let mut time = 0.0;
+        for &(task, node) in tour {
+            time += veh.costs.get(prev, node) + self.service[task];
+            prev = node;
+        }
+        time + veh.costs.get(prev, veh.depot)
+    }
+}
+
+/// One route per vehicle: the (task, node) visits in order, depots excluded.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Routes {
+    /// `tours[v]`: vehicle `v`'s visits.
+    pub tours: Vec<Vec<(usize, usize)>>,
+}
+
+impl Routes {
+    /// Route times, one per vehicle.
+    pub fn times(&self, p: &MinMaxProblem) -> Vec<f64> {
+        self.tours
+            .iter()
+            .enumerate()
+            .map(|(v, t)| p.route_time(v, t))
+            .collect()
+    }
+
+    /// The longest route time.
+    pub fn makespan(&self, p: &MinMaxProblem) -> f64 {
+        self.times(p).into_iter().fold(0.0, f64::max)
+    }
+
+    /// Ok if there is one tour per vehicle, every task is done exactly once by a vehicle that
+    /// can do it at one of its nodes for it, and no vehicle exceeds its cap.
+    pub fn check(&self, p: &MinMaxProblem) -> Result<(), String> {
+        if self.tours.len() != p.vehicles.len() {
+            return Err(format!(
+                "{} tours for {} vehicles",
+                self.tours.len(),
+                p.vehicles.len()
+            ));
+        }
+        let mut done: Vec<Option<usize>> = vec![None; p.tasks];
+        for (v, tour) in self.tours.iter().enumerate() {
+            let veh = &p.vehicles[v];
+            if tour.len() > veh.cap {
+                return Err(format!(
+                    "vehicle {v} has {} tasks, over its cap {}",
+                    tour.len(),
+                    veh.cap
+                ));
+            }
+            for &(t, node) in tour {
+                if t >= p.tasks {
+                    return Err(format!("vehicle {v} visits task {t}, out of range"));
+                }
+                if !veh.alternatives[t].contains(&node) {
+                    return Err(format!(
+                        "vehicle {v} does task {t} at node {node}, not one of its alternatives"
+                    ));
+                }
+                if let Some(w) = done[t] {
+                    return Err(format!("task {t} is done by vehicle {w} and again by {v}"));
+                }
+                done[t] = Some(v);
+            }
+        }
+        if let Some(t) = done.iter().position(Option::is_none) {
+            return Err(format!("task {t} is not done"));
+        }
+        Ok(())
+    }
+}
+
+/// Solution methods.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MinMaxMethod {
+    /// Iterated local search between routes, from the better of the two constructions.
+    Ils,
+    /// Paper 000's Algorithm 1 generalised to m vehicles.
+    Algorithm1,
+    /// Every task to the vehicle whose depot is nearest (the paper's baseline).
+    Proximity,
+}
+
+/// Parameters of [`solve`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct MinMaxParams {
+    /// Wall-clock limit (checked between ILS iterations; the constructions always finish).
+    pub time_limit: Duration,
+    /// Seed of all randomness.
+    pub seed: u64,
+    /// Stop the ILS after this many perturbations (the result then depends only on the
+    /// instance and the seed, if the time limit does not cut first).
+    pub max_iterations: Option<usize>,
+    /// The method.
+    pub method: MinMaxMethod,
+}
+
+impl Default for MinMaxParams {
+    fn default() -> Self {
+        MinMaxParams {
+            time_limit: Duration::from_secs(1),
+            seed: 0,
+            max_iterations: None,
+            method: MinMaxMethod::Ils,
+        }
+    }
+}
+
+/// Routes and their figures.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MinMaxSolution {
+    /// The routes.
+    pub routes: Routes,
+    /// The longest route time.
+    pub makespan: f64,
+    /// The sum of the route times.
+    pub total: f64,
+    /// Whether the route times differ by at most the balance limit (true without one).
+    pub balanced: bool,
+}
+
+/// Solve `p` with `params.method`.
+pub fn solve(p: &MinMaxProblem, params: &MinMaxParams) -> MinMaxSolution {
+    let tours = match params.method {
+        MinMaxMethod::Proximity => construct::proximity(p, params.seed),
+        MinMaxMethod::Algorithm1 => construct::algorithm1(p, params.seed),
+        MinMaxMethod::Ils => ils::run(p, params),
+    };
+    finish(p, Routes { tours })
+}
+
+fn finish(p: &MinMaxProblem, routes: Routes) -> MinMaxSolution {
+    let times = routes.times(p);
+    let makespan = times.iter().copied().fold(0.0, f64::max);
+    let total = times.iter().sum();
+    MinMaxSolution {
+        routes,
+        makespan,
+        total,
+        balanced: is_balanced(p, &times),
+    }
+}
+
+fn is_balanced(p: &MinMaxProblem, times: &[f64]) -> bool {
+    violation(p, times) <= 1e-9
+}
+
+/// How far the spread of `times` exceeds the balance limit (0 without one).
+pub(crate) fn violation(p: &MinMaxProblem, times: &[f64]) -> f64 {
+    match p.balance_limit {
+        None => 0.0,
+        Some(g) => {
+            let hi = times.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+            let lo = times.iter().copied().fold(f64::INFINITY, f64::min);
+            (hi - lo - g).max(0.0)
+        }
+    }
+}

@@ -1,0 +1,240 @@
+use std::time::Duration;
+
+use super::*;
+
+fn params(method: MinMaxMethod, seed: u64, iters: usize) -> MinMaxParams {
+    MinMaxParams {
+        time_limit: Duration::from_secs(3600),
+        seed,
+        max_iterations: Some(iters),
+        method,
+    }
+}
+
+const METHODS: [MinMaxMethod; 3] = [
+    MinMaxMethod::Proximity,
+    MinMaxMethod::Algorithm1,
+    MinMaxMethod::Ils,
+];
+
+/// Optimal route time of vehicle `v` over `tasks`: every order, best nodes by DP.
+fn best_route(p: &MinMaxProblem, v: usize, tasks: &[usize]) -> f64 {
+    let veh = &p.vehicles[v];
+    let c = |a: usize, b: usize| veh.costs.get(a, b);
+    let mut order = tasks.to_vec();
+    let mut best = f64::INFINITY;
+    permute(&mut order, 0, &mut |ord| {
+        // dp over (position, node).
+        let mut prev: Vec<(usize, f64)> = vec![(veh.depot, 0.0)];
+        for &t in ord.iter() {
+            let next = veh.alternatives[t]
+                .iter()
+                .map(|&a| {
+                    let d = prev
+                        .iter()
+                        .map(|&(u, du)| du + c(u, a))
+                        .fold(f64::INFINITY, f64::min);
+                    (a, d + p.service[t])
+                })
+                .collect();
+            prev = next;
+        }
+        let end = prev
+            .iter()
+            .map(|&(u, du)| du + c(u, veh.depot))
+            .fold(f64::INFINITY, f64::min);
+        best = best.min(end);
+    });
+    best
+}
+
+fn permute(a: &mut Vec<usize>, k: usize, f: &mut impl FnMut(&[usize])) {
+    if k == a.len() {
+        f(a);
+        return;
+    }
+    for i in k..a.len() {
+        a.swap(k, i);
+        permute(a, k + 1, f);
+        a.swap(k, i);
+    }
+}
+
+/// The optimal makespan of a 2-vehicle instance by enumeration.
+fn brute_force(p: &MinMaxProblem) -> f64 {
+    assert_eq!(p.vehicles.len(), 2);
+    let mut best = f64::INFINITY;
+    for mask in 0u32..(1 << p.tasks) {
+        let (mut s0, mut s1) = (Vec::new(), Vec::new());
+        let mut ok = true;
+        for t in 0..p.tasks {
+            let v = ((mask >> t) & 1) as usize;
+            ok &= p.can_do(v, t);
+            if v == 0 { s0.push(t) } else { s1.push(t) }
+        }
+        if !ok || s0.len() > p.vehicles[0].cap || s1.len() > p.vehicles[1].cap {
+            continue;
+        }
+        best = best.min(best_route(p, 0, &s0).max(best_route(p, 1, &s1)));
+    }
+    best
+}
+
+/// The instance with every cap lowered to the least feasible common value.
+fn tight(mut p: MinMaxProblem) -> MinMaxProblem {
+    while p.vehicles[0].cap > 0 {
+        let mut q = p.clone();
+        for v in &mut q.vehicles {
+            v.cap -= 1;
+        }
+        if q.validate().is_err() {
+            break;
+        }
+        p = q;
+    }
+    p
+}
+
+#[test]
+fn ils_matches_brute_force_on_tiny_instances() {
+    let mut baseline_gaps = 0;
+    for seed in 0..10 {
+        for n in 2..=6 {
+            let alts = if seed % 2 == 0 { (1, 1) } else { (1, 2) };
+            let mut p = generate(2, n, alts, seed);
+            if seed % 3 == 0 {
+                p = tight(p);
+            }
+            let exact = brute_force(&p);
+            for method in [MinMaxMethod::Proximity, MinMaxMethod::Algorithm1] {
+                let base = solve(&p, &params(method, seed, 0));
+                assert!(base.makespan >= exact - 1e-6);
+                baseline_gaps += usize::from(base.makespan > exact + 1e-6);
+            }
+            let sol = solve(&p, &params(MinMaxMethod::Ils, seed, 40));
+            sol.routes.check(&p).unwrap();
+            assert!(
+                (sol.makespan - exact).abs() < 1e-6,
+                "seed {seed} n {n}: ILS {} vs optimum {exact}",
+                sol.makespan
+            );
+        }
+    }
+    assert!(baseline_gaps > 10, "the baselines should often miss the optimum");
+}
+
+#[test]
+fn every_method_gives_valid_routes() {
+    for (seed, (m, n, alts)) in [(4, 45, (2, 4)), (3, 30, (1, 3)), (5, 20, (1, 2))]
+        .into_iter()
+        .enumerate()
+    {
+        for p in [
+            generate(m, n, alts, seed as u64),
+            tight(generate(m, n, alts, seed as u64)),
+        ] {
+            for method in METHODS {
+                let sol = solve(&p, &params(method, 1, 10));
+                sol.routes.check(&p).unwrap();
+                for (v, t) in sol.routes.tours.iter().enumerate() {
+                    assert!(t.len() <= p.vehicles[v].cap);
+                }
+                let times = sol.routes.times(&p);
+                assert_eq!(sol.makespan, sol.routes.makespan(&p));
+                assert!((sol.total - times.iter().sum::<f64>()).abs() < 1e-9);
+                assert!(sol.balanced);
+            }
+        }
+    }
+}
+
+#[test]
+fn ils_beats_baselines_on_cell_instances() {
+    for seed in 1..=2 {
+        let p = generate(4, 45, (10, 40), seed);
+        let prox = solve(&p, &params(MinMaxMethod::Proximity, seed, 0));
+        let alg1 = solve(&p, &params(MinMaxMethod::Algorithm1, seed, 0));
+        let ils = solve(&p, &params(MinMaxMethod::Ils, seed, 15));
+        ils.routes.check(&p).unwrap();
+        assert!(ils.makespan <= prox.makespan + 1e-9);
+        assert!(ils.makespan <= alg1.makespan + 1e-9);
+    }
+}
+
+#[test]
+fn same_seed_same_routes() {
+    let p = generate(4, 30, (2, 5), 7);
+    for method in METHODS {
+        let a = solve(&p, &params(method, 3, 20));
+        let b = solve(&p, &params(method, 3, 20));
+        assert_eq!(a, b);
+    }
+}
+
+#[test]
+fn balance_limit_is_reported() {
+    let mut p = generate(3, 20, (1, 3), 4);
+    let free = solve(&p, &params(MinMaxMethod::Ils, 0, 20));
+    let times = free.routes.times(&p);
+    let spread =
+        times.iter().copied().fold(0.0, f64::max) - times.iter().copied().fold(f64::INFINITY, f64::min);
+    p.balance_limit = Some(spread + 1.0);
+    assert!(solve(&p, &params(MinMaxMethod::Ils, 0, 20)).balanced);
+    p.balance_limit = Some(0.0);
+    let sol = solve(&p, &params(MinMaxMethod::Ils, 0, 20));
+    sol.routes.check(&p).unwrap();
+    assert!(!sol.balanced, "route times are never exactly equal here");
+}
+
+#[test]
+fn validation_rejects_bad_problems() {
+    let costs = CostMatrix::from_fn(3, |i, j| i.abs_diff(j) as f64);
+    let veh = |cap: usize, alts: Vec<Vec<usize>>| Vehicle::new(costs.clone(), 0, cap, alts);
+    assert!(veh(1, vec![vec![0]]).is_err(), "depot as alternative");
+    assert!(veh(1, vec![vec![3]]).is_err(), "node out of range");
+    assert!(veh(1, vec![vec![1], vec![1]]).is_err(), "node serving two tasks");
+    assert!(
+        Vehicle::new(costs.clone(), 5, 1, vec![]).is_err(),
+        "depot out of range"
+    );
+    let a = veh(1, vec![vec![1], vec![2]]).unwrap();
+    let b = veh(5, vec![vec![], vec![]]).unwrap();
+    let c = veh(5, vec![vec![], vec![1]]).unwrap();
+    // Task 0 only by a; task 1 by a or c.
+    assert!(MinMaxProblem::new(vec![a.clone(), c.clone()], 2, vec![0.0; 2], None).is_ok());
+    // Nobody can do anything but a, whose cap is 1, though the total cap is 6.
+    let err = MinMaxProblem::new(vec![a.clone(), b.clone()], 2, vec![0.0; 2], None);
+    assert!(err.is_err());
+    assert!(MinMaxProblem::new(vec![a.clone(), c.clone()], 2, vec![0.0], None).is_err());
+    assert!(MinMaxProblem::new(vec![a.clone(), c.clone()], 2, vec![0.0, -1.0], None).is_err());
+    assert!(MinMaxProblem::new(vec![a.clone(), c.clone()], 2, vec![0.0; 2], Some(-1.0)).is_err());
+    assert!(
+        MinMaxProblem::new(vec![a, c], 3, vec![0.0; 3], None).is_err(),
+        "wrong list count"
+    );
+    // Routes::check.
+    let p = MinMaxProblem::new(
+        vec![
+            veh(1, vec![vec![1], vec![2]]).unwrap(),
+            veh(5, vec![vec![], vec![1]]).unwrap(),
+        ],
+        2,
+        vec![1.0; 2],
+        None,
+    )
+    .unwrap();
+    let ok = Routes {
+        tours: vec![vec![(0, 1)], vec![(1, 1)]],
+    };
+    ok.check(&p).unwrap();
+    assert_eq!(ok.times(&p), vec![3.0, 3.0]);
+    for bad in [
+        vec![vec![(0, 1), (1, 2)], vec![]],
+        vec![vec![(0, 2)], vec![(1, 1)]],
+        vec![vec![(0, 1)], vec![]],
+        vec![vec![(0, 1)], vec![(1, 1), (1, 1)]],
+        vec![vec![(0, 1)]],
+    ] {
+        assert!(Routes { tours: bad }.check(&p).is_err());
+    }
+}
