@@ -103,8 +103,12 @@ impl From<String> for BenchError {
     }
 }
 
-fn input(e: cellplan_solve::ReadError) -> BenchError {
-    BenchError::Input(e)
+/// An instance as read.
+enum Instance {
+    /// A (generalized) TSP.
+    Route(Gtsp),
+    /// A set cover.
+    Cover(cellplan_solve::SetCover),
 }
 
 /// Runs the benchmark; returns the rows or what went wrong.
@@ -126,32 +130,30 @@ pub fn run(args: &BenchArgs) -> Result<Vec<Row>, BenchError> {
             .map(|s| s.to_string_lossy().into_owned())
             .unwrap_or_default();
         let optimum = optimum_for(file, &name);
+        // Read once; only the solving is timed.
+        let instance = match args.kind {
+            Kind::Tsp => Instance::Route(Gtsp::tsp(read_tsplib(file).map_err(BenchError::Input)?.costs)),
+            Kind::Gtsp => Instance::Route(read_gtsplib(file).map_err(BenchError::Input)?.gtsp),
+            Kind::Setcover => Instance::Cover(read_orlib_setcover(file).map_err(BenchError::Input)?),
+        };
         let mut costs = Vec::new();
         let mut proven = false;
         let start = Instant::now();
         for seed in 0..args.runs.max(1) {
-            let (cost, exact) = match args.kind {
-                Kind::Tsp => {
-                    let inst = read_tsplib(file).map_err(input)?;
-                    route(&Gtsp::tsp(inst.costs), method, limit, seed)?
-                }
-                Kind::Gtsp => {
-                    let inst = read_gtsplib(file).map_err(input)?;
-                    route(&inst.gtsp, method, limit, seed)?
-                }
-                Kind::Setcover => {
-                    let sc = read_orlib_setcover(file).map_err(input)?;
+            let (cost, exact) = match &instance {
+                Instance::Route(p) => route(p, method, limit, seed)?,
+                Instance::Cover(sc) => {
                     let cover = match method {
                         Method::Exact => setcover::exact(
-                            &sc,
+                            sc,
                             &setcover::ExactLimits {
                                 time_limit: Some(limit),
                                 ..setcover::ExactLimits::default()
                             },
                         ),
-                        Method::Greedy => setcover::greedy(&sc),
+                        Method::Greedy => setcover::greedy(sc),
                         Method::Penalty => setcover::penalty_method(
-                            &sc,
+                            sc,
                             &setcover::PenaltyParams {
                                 seed,
                                 ..setcover::PenaltyParams::default()

@@ -249,18 +249,10 @@ fn run_gen_tasks(args: &GenTasksArgs) -> Result<(), Failure> {
 
 fn run_bench(args: &bench::BenchArgs) -> Result<(), Failure> {
     let rows = bench::run(args).map_err(|e| match e {
-        bench::BenchError::Input(e) => {
-            // The reader's message starts with `path:line: `; keep only what follows.
-            let text = e.to_string();
-            let prefix = match e.line() {
-                Some(l) => format!("{}:{l}: ", e.path().display()),
-                None => format!("{}: ", e.path().display()),
-            };
-            let message = text.strip_prefix(&prefix).unwrap_or(&text).to_string();
-            Failure::Input(Box::new(InputError::at_line(e.path(), e.line(), message).hint(
-                "give TSPLIB (.tsp), GTSPLIB (.gtsp) or OR-Library set-cover files of the kind named",
-            )))
-        }
+        bench::BenchError::Input(e) => Failure::Input(Box::new(
+            InputError::at_line(e.path(), e.line(), e.detail())
+                .hint("give TSPLIB (.tsp), GTSPLIB (.gtsp) or OR-Library set-cover files of the kind named"),
+        )),
         bench::BenchError::Usage(m) => Failure::Other(m),
     })?;
     if args.json {

@@ -70,6 +70,18 @@ impl ReadError {
     }
 }
 
+impl ReadError {
+    /// What is wrong, without the file and line (for callers that show those themselves).
+    pub fn detail(&self) -> String {
+        match self {
+            ReadError::Io { source, .. } => format!("cannot read the file: {source}"),
+            ReadError::Syntax { message, .. }
+            | ReadError::Unsupported { message, .. }
+            | ReadError::Invalid { message, .. } => message.clone(),
+        }
+    }
+}
+
 fn location(path: &Path, line: &Option<usize>) -> String {
     match line {
         Some(l) => format!("{}:{l}", path.display()),

@@ -2,7 +2,7 @@
 //! collision world, and refuse anything inconsistent with an error that names file and line.
 use super::pose::pose_from_spec;
 use super::robot::{BodyFrame, IkKind, Robot, RobotId, Scratch, Tool};
-use super::self_pairs::{SelfPairs, adjacent, cached_self_pairs, geometry_key};
+use super::self_pairs::{SelfPairs, cached_self_pairs, geometry_key, non_adjacent_pairs};
 use super::spec::{CellSpec, OpwSpec, PoseSpec, ProcessSpec, ShapeEntry};
 use super::tasks::read_tasks;
 use super::{Cell, Object, Process, Source};
@@ -253,11 +253,8 @@ pub fn load(path: &Path, opts: &LoadOptions) -> Result<Cell, InputError> {
         robot.body_poses(&robot.home, &mut scratch);
         let entry = &spec.robots[i];
         let home_span = entry.get_ref().home.as_ref().map_or(entry.span(), |h| h.span());
-        let adjacent = adjacent(robot);
-        let n = robot.bodies.len();
-        let self_contact = (0..n)
-            .flat_map(|a| (a + 1..n).map(move |b| (a, b)))
-            .filter(|p| !adjacent.contains(p))
+        let self_contact = non_adjacent_pairs(robot)
+            .into_iter()
             .find(|&(a, b)| world.bodies_within(robot.group, a, b, &scratch.bodies, 0.0))
             .map(|(a, b)| BodyContact::SelfPair(a, b));
         if let Some(contact) = world

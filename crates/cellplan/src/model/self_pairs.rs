@@ -24,9 +24,20 @@ pub struct SelfPairs {
     pub pairs: Vec<(usize, usize)>,
 }
 
+/// Every body pair `(i, j)`, `i < j`, that is not adjacent in the chain: the pairs that can be
+/// checked for self-collision at all.
+pub fn non_adjacent_pairs(robot: &Robot) -> Vec<(usize, usize)> {
+    let n = robot.bodies.len();
+    let adjacent = adjacent(robot);
+    (0..n)
+        .flat_map(|i| (i + 1..n).map(move |j| (i, j)))
+        .filter(|p| !adjacent.contains(p))
+        .collect()
+}
+
 /// Bodies adjacent in the chain: `a` is the nearest body up the chain from `b` (links without
 /// geometry are skipped over).
-pub fn adjacent(robot: &Robot) -> Vec<(usize, usize)> {
+fn adjacent(robot: &Robot) -> Vec<(usize, usize)> {
     let chain = &robot.model.chain;
     let tip = chain.links.len() - 1;
     let body_of_link = |l: usize| robot.bodies.iter().position(|b| *b == BodyFrame::Link(l));
@@ -56,12 +67,7 @@ pub fn adjacent(robot: &Robot) -> Vec<(usize, usize)> {
 
 /// Samples `samples` random configurations (seeded) and returns the pairs to check.
 pub fn sample_self_pairs(robot: &Robot, world: &CollisionWorld, samples: usize, seed: u64) -> SelfPairs {
-    let n = robot.bodies.len();
-    let adjacent = adjacent(robot);
-    let candidates: Vec<(usize, usize)> = (0..n)
-        .flat_map(|i| (i + 1..n).map(move |j| (i, j)))
-        .filter(|p| !adjacent.contains(p))
-        .collect();
+    let candidates = non_adjacent_pairs(robot);
     let chain = &robot.model.chain;
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let configs: Vec<Vec<f64>> = (0..samples)
