@@ -1,0 +1,1 @@
+//! Collision-free joint-space path planning (filled in by the planning work).

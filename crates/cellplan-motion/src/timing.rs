@@ -1,0 +1,1 @@
+//! Move-time bounds and time parameterisation (filled in by the timing work).
