@@ -1,15 +1,18 @@
 //! Readers for the standard benchmark formats: TSPLIB ([`read_tsplib`]), GTSPLIB
-//! ([`read_gtsplib`]) and OR-Library set cover ([`read_orlib_setcover`]). Each has a `parse_*`
-//! twin that reads from a string. Errors name the file and line and say what was expected.
+//! ([`read_gtsplib`]), OR-Library set cover ([`read_orlib_setcover`]) and cellplan's own
+//! min-max format ([`read_minmax`], written by [`write_minmax`]). Each has a `parse_*` twin that
+//! reads from a string. Errors name the file and line and say what was expected.
 use std::path::{Path, PathBuf};
 
 use crate::error::ReadError;
 
 mod gtsplib;
+mod minmax;
 mod orlib;
 mod tsplib;
 
 pub use gtsplib::{GtspInstance, parse_gtsplib, read_gtsplib};
+pub use minmax::{MinMaxInstance, parse_minmax, read_minmax, read_minmax_instance, write_minmax};
 pub use orlib::{parse_orlib_setcover, read_orlib_setcover};
 pub use tsplib::{TsplibInstance, parse_optima, parse_tsplib, read_optima, read_tsplib};
 
