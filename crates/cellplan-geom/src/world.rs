@@ -430,6 +430,80 @@ impl CollisionWorld {
         best
     }
 
+    /// Smallest distance from the bodies of `g` that are **not** exempt (see
+    /// [`CollisionWorld::set_static_exempt`]) to the static scene, capped at `cap`: the result
+    /// is `min(true distance, cap)` (0 when touching), for distance-based motion checks.
+    ///
+    /// The cap prunes the search (objects, BVH nodes and triangles whose box is at least `cap`
+    /// away are skipped), so a small cap is much faster than
+    /// [`CollisionWorld::min_distance_to_static`], which also measures exempt bodies. A
+    /// non-finite pose of a non-exempt body gives 0 (when the scene has an object); a NaN or
+    /// negative cap counts as 0.
+    pub fn group_static_distance(&self, g: GroupId, poses: &[Pose], cap: f64) -> f64 {
+        let group = self.group(g);
+        debug_assert_eq!(poses.len(), group.bodies.len(), "one pose per body");
+        let mut best = sanitize_margin(cap);
+        for (i, (body, pose)) in group.bodies.iter().zip(poses).enumerate() {
+            if group.exempt[i] {
+                continue;
+            }
+            let placed = match place(body, pose) {
+                Placement::Empty => continue,
+                Placement::Invalid => {
+                    if self.first_solid_static().is_some() {
+                        return 0.0;
+                    }
+                    continue;
+                }
+                Placement::At(p) => p,
+            };
+            for s in &self.statics {
+                let Some(shape) = s.shape.as_deref() else {
+                    continue;
+                };
+                if aabb_distance(&placed.aabb, &s.aabb) >= best {
+                    continue;
+                }
+                if let Some(d) = static_distance(s, shape, &placed, best) {
+                    best = d;
+                    if best <= 0.0 {
+                        return 0.0;
+                    }
+                }
+            }
+        }
+        best
+    }
+
+    /// Smallest distance between the checked self pairs of `g` (see
+    /// [`CollisionWorld::set_self_pairs`]), capped at `cap`: `min(true distance, cap)`, 0 when
+    /// a pair touches or a pose is not finite. `cap` (at least 0) when no pair is checked.
+    pub fn group_self_distance(&self, g: GroupId, poses: &[Pose], cap: f64) -> f64 {
+        let group = self.group(g);
+        debug_assert_eq!(poses.len(), group.bodies.len(), "one pose per body");
+        let mut best = sanitize_margin(cap);
+        for &(i, j) in &group.self_pairs {
+            let (Some(pa), Some(pb)) = (poses.get(i), poses.get(j)) else {
+                continue;
+            };
+            let (a, b) = match (place(&group.bodies[i], pa), place(&group.bodies[j], pb)) {
+                (Placement::Empty, _) | (_, Placement::Empty) => continue,
+                (Placement::Invalid, _) | (_, Placement::Invalid) => return 0.0,
+                (Placement::At(a), Placement::At(b)) => (a, b),
+            };
+            if aabb_distance(&a.aabb, &b.aabb) >= best {
+                continue;
+            }
+            if let Some(d) = convex_distance(&a.pose.inv_mul(&b.pose), a.support, b.support, best) {
+                best = d;
+                if best <= 0.0 {
+                    return 0.0;
+                }
+            }
+        }
+        best
+    }
+
     /// First static object hit by the ray `origin + t·dir`, `0 ≤ t ≤ max_distance`.
     ///
     /// `dir` need not be unit length: it is normalised, and the distance is in metres. Boxes,

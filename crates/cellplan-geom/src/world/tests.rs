@@ -696,3 +696,101 @@ fn hull_pairs_agree_with_parry() {
         "{contacts} of {checked}"
     );
 }
+
+#[test]
+fn capped_static_distance_skips_exempt_bodies() {
+    let mut w = CollisionWorld::new();
+    w.add_static("floor", &cube(0.5), at(0.0, 0.0, -0.5));
+    w.add_static("wall", &cube(0.5), at(3.0, 0.0, 0.5));
+    let g = w.add_group(
+        "r",
+        vec![
+            body("base", vec![(cube(0.1), Pose::IDENTITY)]),
+            body("arm", vec![(cube(0.1), Pose::IDENTITY)]),
+        ],
+    );
+    // The base sits 0.05 above the floor; the arm is beside the floor (x = 2) and 0.4 from the wall.
+    let p = [at(0.0, 0.0, 0.15), at(2.0, 0.0, 0.4)];
+    assert!((w.group_static_distance(g, &p, 10.0) - 0.05).abs() < 1e-9);
+    assert!((w.min_distance_to_static(g, &p) - 0.05).abs() < 1e-9);
+    w.set_static_exempt(g, &[0]);
+    assert!((w.group_static_distance(g, &p, 10.0) - 0.4).abs() < 1e-9);
+    // The cap caps; a zero, negative or NaN cap gives 0.
+    assert_eq!(w.group_static_distance(g, &p, 0.2), 0.2);
+    assert!((w.group_static_distance(g, &p, 0.41) - 0.4).abs() < 1e-9);
+    assert_eq!(w.group_static_distance(g, &p, -1.0), 0.0);
+    assert_eq!(w.group_static_distance(g, &p, f64::NAN), 0.0);
+    // The existing query still measures every body.
+    assert!((w.min_distance_to_static(g, &p) - 0.05).abs() < 1e-9);
+    // Touching gives 0, a non-finite pose of a moving body gives 0.
+    assert_eq!(w.group_static_distance(g, &[p[0], at(2.45, 0.0, 0.4)], 1.0), 0.0);
+    let bad = Pose::from_translation(DVec3::new(f64::NAN, 0.0, 0.0));
+    assert_eq!(w.group_static_distance(g, &[p[0], bad], 1.0), 0.0);
+}
+
+#[test]
+fn capped_self_distance_over_checked_pairs() {
+    let mut w = CollisionWorld::new();
+    let g = w.add_group(
+        "r",
+        (0..3)
+            .map(|i| body(&format!("l{i}"), vec![(cube(0.1), Pose::IDENTITY)]))
+            .collect(),
+    );
+    // Gaps: (0, 1) 0.3, (1, 2) 0.6, (0, 2) 1.1.
+    let poses = [at(0.0, 0.0, 0.0), at(0.5, 0.0, 0.0), at(1.3, 0.0, 0.0)];
+    // No pair checked: the cap.
+    assert_eq!(w.group_self_distance(g, &poses, 0.7), 0.7);
+    w.set_self_pairs(g, vec![(0, 2), (1, 2)]);
+    assert!((w.group_self_distance(g, &poses, 10.0) - 0.6).abs() < 1e-9);
+    assert_eq!(w.group_self_distance(g, &poses, 0.5), 0.5);
+    w.set_self_pairs(g, vec![(0, 2)]);
+    assert!((w.group_self_distance(g, &poses, 10.0) - 1.1).abs() < 1e-9);
+    // An overlapping unchecked pair (0, 1) is not seen; a checked one gives 0.
+    let touching = [at(0.0, 0.0, 0.0), at(0.05, 0.0, 0.0), at(1.3, 0.0, 0.0)];
+    assert!((w.group_self_distance(g, &touching, 10.0) - 1.1).abs() < 1e-9);
+    w.set_self_pairs(g, vec![(0, 1), (0, 2)]);
+    assert_eq!(w.group_self_distance(g, &touching, 10.0), 0.0);
+    let bad = Pose::from_translation(DVec3::new(f64::INFINITY, 0.0, 0.0));
+    assert_eq!(w.group_self_distance(g, &[poses[0], poses[1], bad], 10.0), 0.0);
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(200))]
+
+    /// The capped queries give `min(exact distance, cap)`, against a primitive or the sheet mesh
+    /// (statics) and between two bodies (self pairs).
+    #[test]
+    fn capped_distances_are_min_of_distance_and_cap(
+        a in arb_shape(), b in arb_shape(), pa in arb_pose(), pb in arb_pose(),
+        cap in 0.0..3.0f64, use_sheet in any::<bool>()
+    ) {
+        let (w, g) = if use_sheet {
+            let mut w = CollisionWorld::new();
+            w.add_static("sheet", &ShapeSpec::Mesh(Arc::new(sheet())), pa);
+            let g = w.add_group("robot", vec![body("b", vec![(b.clone(), Pose::IDENTITY)])]);
+            (w, g)
+        } else {
+            one_on_one(&a, pa, &b)
+        };
+        let d = w.min_distance_to_static(g, &[pb]);
+        let capped = w.group_static_distance(g, &[pb], cap);
+        prop_assert!((capped - d.min(cap)).abs() < 1e-6, "{} vs min({}, {})", capped, d, cap);
+
+        let mut s = CollisionWorld::new();
+        s.add_static("a", &a, pa);
+        let g2 = s.add_group(
+            "pair",
+            vec![
+                body("a", vec![(a.clone(), Pose::IDENTITY)]),
+                body("b", vec![(b.clone(), Pose::IDENTITY)]),
+            ],
+        );
+        s.set_self_pairs(g2, vec![(0, 1)]);
+        let self_d = s.group_self_distance(g2, &[pa, pb], cap);
+        let (wa, ga) = one_on_one(&a, pa, &b);
+        let exact = wa.min_distance_to_static(ga, &[pb]);
+        // Body `a` is a convex hull of `a`, the static `a` is exact: equal for these primitives.
+        prop_assert!((self_d - exact.min(cap)).abs() < 1e-6, "{} vs min({}, {})", self_d, exact, cap);
+    }
+}
