@@ -1,0 +1,309 @@
+use super::*;
+use proptest::prelude::*;
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+/// A point robot among disc (ball) obstacles: clearance = distance to the nearest disc surface
+/// minus the margin. The point moves exactly as far as the joint segment is long, which the
+/// unit radii bound (the 1-norm bounds the 2-norm).
+struct Discs {
+    discs: Vec<(Vec<f64>, f64)>,
+    margin: f64,
+    calls: AtomicUsize,
+}
+
+impl Discs {
+    fn new(discs: Vec<(Vec<f64>, f64)>, margin: f64) -> Self {
+        Discs {
+            discs,
+            margin,
+            calls: AtomicUsize::new(0),
+        }
+    }
+}
+
+impl StateValidity for Discs {
+    fn clearance(&self, q: &[f64]) -> f64 {
+        self.calls.fetch_add(1, Ordering::Relaxed);
+        self.discs
+            .iter()
+            .map(|(c, r)| {
+                let d2: f64 = c.iter().zip(q).map(|(a, b)| (a - b) * (a - b)).sum();
+                d2.sqrt() - r
+            })
+            .fold(f64::INFINITY, f64::min)
+            - self.margin
+    }
+}
+
+fn square(n: usize, size: f64) -> JointSpace {
+    JointSpace::new(vec![0.0; n], vec![size; n], vec![1.0; n])
+}
+
+/// A wall of discs along x = 5 from y = 0 up to y = 8 in the square [0, 10]²: the way from
+/// the left to the right goes around its top.
+fn wall() -> Discs {
+    let discs = (0..=20).map(|k| (vec![5.0, 0.4 * k as f64], 0.3)).collect();
+    Discs::new(discs, 0.05)
+}
+
+/// Every edge sampled every `step` (in the 2-norm) is valid.
+fn brute_force_valid(v: &dyn StateValidity, waypoints: &[Vec<f64>], step: f64) -> bool {
+    let space = square(waypoints[0].len(), 1.0);
+    let mut q = Vec::new();
+    waypoints.windows(2).all(|w| {
+        let len = w[0]
+            .iter()
+            .zip(&w[1])
+            .map(|(a, b)| (a - b) * (a - b))
+            .sum::<f64>()
+            .sqrt();
+        let n = (len / step).ceil().max(1.0) as usize;
+        (0..=n).all(|k| {
+            space.interpolate(&w[0], &w[1], k as f64 / n as f64, &mut q);
+            v.clearance(&q) > 0.0
+        })
+    })
+}
+
+fn settings(seed: u64) -> PlanSettings {
+    PlanSettings {
+        seed,
+        ..PlanSettings::default()
+    }
+}
+
+#[test]
+fn straight_when_clear() {
+    let space = square(2, 10.0);
+    let v = wall();
+    let path = plan_leg(&space, &v, &[1.0, 9.5], &[9.0, 9.5], &settings(1)).unwrap();
+    assert!(path.straight);
+    assert_eq!(path.waypoints, vec![vec![1.0, 9.5], vec![9.0, 9.5]]);
+    assert_eq!(path.samples, 0);
+    assert_eq!(path.validity_calls, v.calls.load(Ordering::Relaxed));
+    assert!(brute_force_valid(&v, &path.waypoints, 1e-3));
+    let direct = Straight
+        .plan(&space, &v, &[1.0, 9.5], &[9.0, 9.5], &settings(1))
+        .unwrap();
+    assert_eq!(direct.waypoints.len(), 2);
+}
+
+#[test]
+fn around_the_wall() {
+    let space = square(2, 10.0);
+    let v = wall();
+    let (start, goal) = ([1.0, 1.0], [9.0, 1.0]);
+    assert!(matches!(
+        Straight.plan(&space, &v, &start, &goal, &settings(0)),
+        Err(PlanError::NoPath { samples: 0, .. })
+    ));
+    for seed in 0..10 {
+        let raw = RrtConnect
+            .plan(&space, &v, &start, &goal, &settings(seed))
+            .unwrap();
+        assert!(!raw.straight && raw.samples > 0);
+        assert_eq!(raw.waypoints.first().unwrap(), &start.to_vec());
+        assert_eq!(raw.waypoints.last().unwrap(), &goal.to_vec());
+        assert!(brute_force_valid(&v, &raw.waypoints, 1e-3), "seed {seed}");
+        let leg = plan_leg(&space, &v, &start, &goal, &settings(seed)).unwrap();
+        assert!(!leg.straight);
+        assert!(brute_force_valid(&v, &leg.waypoints, 1e-3), "seed {seed}");
+        // It goes over the top of the wall (y > 8.3) and is not much longer than needed.
+        assert!(leg.waypoints.iter().any(|q| q[1] > 8.3));
+        let shortest = 2.0 * ((4.0f64).powi(2) + (7.35f64).powi(2)).sqrt();
+        assert!(leg.length(&space) < 1.3 * shortest, "{}", leg.length(&space));
+        assert!(leg.length(&space) <= raw.length(&space) + 1e-9);
+    }
+}
+
+#[test]
+fn invalid_ends_are_refused() {
+    let space = square(2, 10.0);
+    let v = wall();
+    let s = settings(0);
+    for planner in [&Straight as &dyn Planner, &RrtConnect] {
+        assert!(matches!(
+            planner.plan(&space, &v, &[5.0, 2.0], &[9.0, 1.0], &s),
+            Err(PlanError::StartInvalid { clearance }) if clearance < 0.0
+        ));
+        assert!(matches!(
+            planner.plan(&space, &v, &[1.0, 1.0], &[5.0, 8.2], &s),
+            Err(PlanError::GoalInvalid { .. })
+        ));
+        // Outside the joint limits.
+        assert!(matches!(
+            planner.plan(&space, &v, &[-1.0, 1.0], &[9.0, 1.0], &s),
+            Err(PlanError::StartInvalid { clearance }) if clearance == f64::NEG_INFINITY
+        ));
+        assert!(matches!(
+            planner.plan(&space, &v, &[1.0, 1.0], &[9.0, f64::NAN], &s),
+            Err(PlanError::GoalInvalid { .. })
+        ));
+    }
+    // Within the margin of a disc: invalid too.
+    assert!(matches!(
+        plan_leg(&space, &v, &[5.0, 8.32], &[9.0, 1.0], &s),
+        Err(PlanError::StartInvalid { .. })
+    ));
+    assert!(
+        PlanError::NoPath {
+            samples: 3,
+            validity_calls: 7
+        }
+        .to_string()
+        .contains("3 samples")
+    );
+}
+
+#[test]
+fn enclosed_goal_gives_no_path() {
+    let space = square(2, 10.0);
+    // A ring of discs around (8, 8).
+    let discs = (0..40)
+        .map(|k| {
+            let a = k as f64 / 40.0 * std::f64::consts::TAU;
+            (vec![8.0 + 1.5 * a.cos(), 8.0 + 1.5 * a.sin()], 0.2)
+        })
+        .collect();
+    let v = Discs::new(discs, 0.01);
+    let s = PlanSettings {
+        max_samples: 300,
+        ..settings(3)
+    };
+    match plan_leg(&space, &v, &[1.0, 1.0], &[8.0, 8.0], &s) {
+        Err(PlanError::NoPath {
+            samples,
+            validity_calls,
+        }) => {
+            assert_eq!(samples, 300);
+            assert!(validity_calls > 300);
+        }
+        other => panic!("{other:?}"),
+    }
+    let s = PlanSettings {
+        time_limit: Duration::ZERO,
+        ..settings(3)
+    };
+    assert!(matches!(
+        RrtConnect.plan(&space, &v, &[1.0, 1.0], &[8.0, 8.0], &s),
+        Err(PlanError::NoPath { samples: 0, .. })
+    ));
+}
+
+#[test]
+fn deterministic_for_a_seed_in_3d() {
+    let space = square(3, 4.0);
+    // A slab of balls at z = 2 with one hole near a corner.
+    let mut discs = Vec::new();
+    for i in 0..=10 {
+        for j in 0..=10 {
+            if i >= 9 && j >= 9 {
+                continue;
+            }
+            discs.push((vec![0.4 * i as f64, 0.4 * j as f64, 2.0], 0.3));
+        }
+    }
+    let v = Discs::new(discs, 0.0);
+    let (start, goal) = ([1.0, 1.0, 0.5], [1.0, 1.0, 3.5]);
+    let a = plan_leg(&space, &v, &start, &goal, &settings(42)).unwrap();
+    let b = plan_leg(&space, &v, &start, &goal, &settings(42)).unwrap();
+    assert_eq!(a, b);
+    assert!(!a.straight);
+    assert!(brute_force_valid(&v, &a.waypoints, 1e-3));
+    // It goes through the hole.
+    assert!(
+        a.waypoints
+            .windows(2)
+            .any(|w| (w[0][2] - 2.0) * (w[1][2] - 2.0) <= 0.0)
+    );
+    let c = plan_leg(&space, &v, &start, &goal, &settings(43)).unwrap();
+    assert!(brute_force_valid(&v, &c.waypoints, 1e-3));
+}
+
+#[test]
+fn segment_check_steps_by_clearance() {
+    let space = square(2, 10.0);
+    let v = Discs::new(vec![(vec![5.0, 5.0], 1.0)], 0.0);
+    // Far from the disc: few calls; grazing it: more; through it: invalid.
+    let far = check_segment(&space, &v, &[0.0, 0.0], &[10.0, 0.0], 1e-4);
+    assert!(far.valid && far.calls <= 6, "{far:?}");
+    let near = check_segment(&space, &v, &[0.0, 3.9], &[10.0, 3.9], 1e-4);
+    assert!(near.valid && near.calls > far.calls, "{near:?}");
+    let through = check_segment(&space, &v, &[0.0, 5.0], &[10.0, 5.0], 1e-4);
+    assert!(!through.valid);
+    // Weighted radii: a joint with a large radius is stepped finely.
+    let heavy = JointSpace::new(vec![0.0; 2], vec![10.0; 2], vec![100.0, 1.0]);
+    let fine = check_segment(&heavy, &v, &[0.0, 0.0], &[10.0, 0.0], 1e-4);
+    assert!(fine.valid && fine.calls > far.calls);
+    // A zero-length segment at a valid point.
+    let point = check_segment(&space, &v, &[1.0, 1.0], &[1.0, 1.0], 1e-4);
+    assert_eq!(
+        point,
+        SegmentCheck {
+            valid: true,
+            calls: 2
+        }
+    );
+}
+
+#[test]
+fn shortcut_never_lengthens_and_stays_valid() {
+    let space = square(2, 10.0);
+    let v = wall();
+    for seed in 0..20 {
+        let raw = RrtConnect
+            .plan(&space, &v, &[1.0, 1.0], &[9.0, 1.0], &settings(seed))
+            .unwrap();
+        let before = path_length(&space, &raw.waypoints);
+        let mut path = raw.waypoints.clone();
+        let mut last = before;
+        // Post-processing in several rounds, each never longer than the last.
+        for round in 0..3 {
+            let s = PlanSettings {
+                shortcut_iterations: 20,
+                ..settings(seed * 10 + round)
+            };
+            shortcut(&space, &v, &mut path, &s);
+            let now = path_length(&space, &path);
+            assert!(now <= last + 1e-9, "seed {seed}: {now} > {last}");
+            assert!(brute_force_valid(&v, &path, 1e-3), "seed {seed}");
+            assert_eq!(path.first(), raw.waypoints.first());
+            assert_eq!(path.last(), raw.waypoints.last());
+            last = now;
+        }
+        assert!(last < before || raw.waypoints.len() <= 3);
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(300))]
+
+    /// The conservative check never accepts a segment in which a dense sampling finds a
+    /// contact, in 2-D and 3-D, with unit or larger radii.
+    #[test]
+    fn conservative_check_never_accepts_a_colliding_segment(
+        dim in 2usize..=3,
+        discs in prop::collection::vec(
+            (prop::collection::vec(0.0..4.0f64, 3), 0.05..0.8f64), 1..6),
+        a in prop::collection::vec(0.0..4.0f64, 3),
+        b in prop::collection::vec(0.0..4.0f64, 3),
+        margin in 0.0..0.1f64,
+        radius_scale in 1.0..3.0f64,
+    ) {
+        let discs: Vec<(Vec<f64>, f64)> =
+            discs.into_iter().map(|(c, r)| (c[..dim].to_vec(), r)).collect();
+        let v = Discs::new(discs, margin);
+        let space = JointSpace::new(vec![0.0; dim], vec![4.0; dim], vec![radius_scale; dim]);
+        let (a, b) = (&a[..dim], &b[..dim]);
+        let check = check_segment(&space, &v, a, b, 1e-4);
+        if check.valid {
+            let n = 20_000;
+            let mut q = Vec::new();
+            for k in 0..=n {
+                space.interpolate(a, b, k as f64 / n as f64, &mut q);
+                prop_assert!(v.clearance(&q) > 0.0, "contact at {:?}", q);
+            }
+        }
+        prop_assert!(check.calls >= 1);
+    }
+}
