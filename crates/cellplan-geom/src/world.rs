@@ -443,32 +443,48 @@ impl CollisionWorld {
         let group = self.group(g);
         debug_assert_eq!(poses.len(), group.bodies.len(), "one pose per body");
         let mut best = sanitize_margin(cap);
-        for (i, (body, pose)) in group.bodies.iter().zip(poses).enumerate() {
-            if group.exempt[i] {
+        for i in 0..group.bodies.len().min(poses.len()) {
+            if !group.exempt[i] {
+                best = self.body_static_distance(g, i, poses, best);
+                if best <= 0.0 {
+                    return 0.0;
+                }
+            }
+        }
+        best
+    }
+
+    /// Distance from body `i` of `g` (at `poses[i]`) to the static scene, capped at `cap`:
+    /// `min(true distance, cap)`, 0 when touching or at a non-finite pose (when the scene has
+    /// an object). Exemption is not consulted. A NaN or negative cap counts as 0; a missing
+    /// pose or a body without shapes gives the cap.
+    pub fn body_static_distance(&self, g: GroupId, i: usize, poses: &[Pose], cap: f64) -> f64 {
+        let mut best = sanitize_margin(cap);
+        let (Some(body), Some(pose)) = (self.group(g).bodies.get(i), poses.get(i)) else {
+            return best;
+        };
+        let placed = match place(body, pose) {
+            Placement::Empty => return best,
+            Placement::Invalid => {
+                return if self.first_solid_static().is_some() {
+                    0.0
+                } else {
+                    best
+                };
+            }
+            Placement::At(p) => p,
+        };
+        for s in &self.statics {
+            let Some(shape) = s.shape.as_deref() else {
+                continue;
+            };
+            if aabb_distance(&placed.aabb, &s.aabb) >= best {
                 continue;
             }
-            let placed = match place(body, pose) {
-                Placement::Empty => continue,
-                Placement::Invalid => {
-                    if self.first_solid_static().is_some() {
-                        return 0.0;
-                    }
-                    continue;
-                }
-                Placement::At(p) => p,
-            };
-            for s in &self.statics {
-                let Some(shape) = s.shape.as_deref() else {
-                    continue;
-                };
-                if aabb_distance(&placed.aabb, &s.aabb) >= best {
-                    continue;
-                }
-                if let Some(d) = static_distance(s, shape, &placed, best) {
-                    best = d;
-                    if best <= 0.0 {
-                        return 0.0;
-                    }
+            if let Some(d) = static_distance(s, shape, &placed, best) {
+                best = d;
+                if best <= 0.0 {
+                    return 0.0;
                 }
             }
         }
@@ -483,25 +499,40 @@ impl CollisionWorld {
         debug_assert_eq!(poses.len(), group.bodies.len(), "one pose per body");
         let mut best = sanitize_margin(cap);
         for &(i, j) in &group.self_pairs {
-            let (Some(pa), Some(pb)) = (poses.get(i), poses.get(j)) else {
-                continue;
-            };
-            let (a, b) = match (place(&group.bodies[i], pa), place(&group.bodies[j], pb)) {
-                (Placement::Empty, _) | (_, Placement::Empty) => continue,
-                (Placement::Invalid, _) | (_, Placement::Invalid) => return 0.0,
-                (Placement::At(a), Placement::At(b)) => (a, b),
-            };
-            if aabb_distance(&a.aabb, &b.aabb) >= best {
-                continue;
-            }
-            if let Some(d) = convex_distance(&a.pose.inv_mul(&b.pose), a.support, b.support, best) {
-                best = d;
-                if best <= 0.0 {
-                    return 0.0;
-                }
+            best = self.pair_distance(g, i, j, poses, best);
+            if best <= 0.0 {
+                return 0.0;
             }
         }
         best
+    }
+
+    /// Distance between bodies `i` and `j` of `g` (whether or not the pair is checked), capped
+    /// at `cap`: `min(true distance, cap)`, 0 when they touch or a pose is not finite. The cap
+    /// (at least 0) when `i == j`, a body has no shapes or a pose is missing.
+    pub fn pair_distance(&self, g: GroupId, i: usize, j: usize, poses: &[Pose], cap: f64) -> f64 {
+        let group = self.group(g);
+        let best = sanitize_margin(cap);
+        let (Some(ba), Some(bb), Some(pa), Some(pb)) = (
+            group.bodies.get(i),
+            group.bodies.get(j),
+            poses.get(i),
+            poses.get(j),
+        ) else {
+            return best;
+        };
+        if i == j {
+            return best;
+        }
+        let (a, b) = match (place(ba, pa), place(bb, pb)) {
+            (Placement::Empty, _) | (_, Placement::Empty) => return best,
+            (Placement::Invalid, _) | (_, Placement::Invalid) => return 0.0,
+            (Placement::At(a), Placement::At(b)) => (a, b),
+        };
+        if aabb_distance(&a.aabb, &b.aabb) >= best {
+            return best;
+        }
+        convex_distance(&a.pose.inv_mul(&b.pose), a.support, b.support, best).unwrap_or(best)
     }
 
     /// First static object hit by the ray `origin + t·dir`, `0 ≤ t ≤ max_distance`.

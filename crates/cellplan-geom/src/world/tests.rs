@@ -726,6 +726,12 @@ fn capped_static_distance_skips_exempt_bodies() {
     assert_eq!(w.group_static_distance(g, &[p[0], at(2.45, 0.0, 0.4)], 1.0), 0.0);
     let bad = Pose::from_translation(DVec3::new(f64::NAN, 0.0, 0.0));
     assert_eq!(w.group_static_distance(g, &[p[0], bad], 1.0), 0.0);
+    // Per body, exemption not consulted.
+    assert!((w.body_static_distance(g, 0, &p, 10.0) - 0.05).abs() < 1e-9);
+    assert!((w.body_static_distance(g, 1, &p, 10.0) - 0.4).abs() < 1e-9);
+    assert_eq!(w.body_static_distance(g, 1, &p, 0.1), 0.1);
+    assert_eq!(w.body_static_distance(g, 1, &[p[0], bad], 1.0), 0.0);
+    assert_eq!(w.body_static_distance(g, 5, &p, 1.0), 1.0);
 }
 
 #[test]
@@ -753,6 +759,13 @@ fn capped_self_distance_over_checked_pairs() {
     assert_eq!(w.group_self_distance(g, &touching, 10.0), 0.0);
     let bad = Pose::from_translation(DVec3::new(f64::INFINITY, 0.0, 0.0));
     assert_eq!(w.group_self_distance(g, &[poses[0], poses[1], bad], 10.0), 0.0);
+    // One pair, checked or not.
+    assert!((w.pair_distance(g, 1, 2, &poses, 10.0) - 0.6).abs() < 1e-9);
+    assert!((w.pair_distance(g, 2, 1, &poses, 10.0) - 0.6).abs() < 1e-9);
+    assert_eq!(w.pair_distance(g, 1, 2, &poses, 0.5), 0.5);
+    assert_eq!(w.pair_distance(g, 0, 1, &touching, 10.0), 0.0);
+    assert_eq!(w.pair_distance(g, 1, 1, &poses, 10.0), 10.0);
+    assert_eq!(w.pair_distance(g, 0, 2, &[poses[0], poses[1], bad], 10.0), 0.0);
 }
 
 proptest! {
