@@ -15,9 +15,13 @@
 //! `|s' − s|·L < c(q(s))` is valid: [`check_segment`] walks from both ends, each step as long
 //! as the clearance just measured allows, until the two walks meet. Steps therefore shrink
 //! near obstacles and grow in free space; a clearance below
-//! [`PlanSettings::min_clearance`] counts as a contact (so the walk always ends).
+//! [`PlanSettings::min_clearance`] counts as a contact (so the walk always ends). A checker
+//! may split its clearance by the joints that can reduce each part
+//! ([`StateValidity::clearances`]): the step is then the smallest `c_k / L_k`, `L_k` summing
+//! only over the joints of part `k`.
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
+use std::ops::Range;
 use std::time::{Duration, Instant};
 use thiserror::Error;
 
@@ -118,16 +122,44 @@ impl JointSpace {
     }
 }
 
+/// One clearance with the joints whose motion can reduce it (see
+/// [`StateValidity::clearances`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Clearance {
+    /// How far (m) the points involved may move relative to each other; `<= 0`: invalid.
+    pub distance: f64,
+    /// The joints (indices, clipped to the space) whose motion can reduce it: along a segment
+    /// the points involved move relative to each other by at most
+    /// `Σ_{j in joints} radii[j]·|Δq_j|`.
+    pub joints: Range<usize>,
+}
+
 /// Whether a configuration is valid, as a clearance.
 pub trait StateValidity: Sync {
     /// A lower bound on how far (m) every point of every moving body may move from its place
     /// at `q` before the state can become invalid: the distance to every obstacle (static
-    /// scene, and half the distance of checked self pairs, since both bodies move) minus the
-    /// required margin. `<= 0` (or NaN) means invalid. Implementations may cap the value
-    /// (return `min(d, cap)`) for speed: a smaller value is always safe.
+    /// scene and checked self pairs) minus the required margin. `<= 0` (or NaN) means invalid.
+    /// Implementations may cap the value (return `min(d, cap)`) for speed: a smaller value is
+    /// always safe.
     fn clearance(&self, q: &[f64]) -> f64;
+
+    /// The same, finer: several clearances into `out` (cleared first), each with the range of
+    /// joints that can reduce it — on a serial chain, a body on link `k` is moved only by
+    /// joints up to `k`, and two bodies of the chain move relative to each other only by the
+    /// joints between them. The segment check steps by the smallest `distance / bound over
+    /// joints`, which allows long steps when the only tight clearance is one that few joints
+    /// change (a tool near the wrist it hangs on). The smallest distance must not exceed
+    /// [`StateValidity::clearance`]. Default: that one clearance, over every joint.
+    fn clearances(&self, q: &[f64], out: &mut Vec<Clearance>) {
+        out.clear();
+        out.push(Clearance {
+            distance: self.clearance(q),
+            joints: 0..usize::MAX,
+        });
+    }
 }
 
+/// A plain function or closure of `q` is a validity checker (its value is the clearance).
 impl<F: Fn(&[f64]) -> f64 + Sync> StateValidity for F {
     fn clearance(&self, q: &[f64]) -> f64 {
         self(q)
@@ -154,57 +186,69 @@ pub fn check_segment(
     min_clearance: f64,
 ) -> SegmentCheck {
     let mut calls = 0;
-    let valid = segment_valid(space, validity, a, None, b, None, min_clearance, &mut calls).is_some();
+    let valid = segment_valid(space, validity, a, b, min_clearance, &mut calls);
     SegmentCheck { valid, calls }
 }
 
-/// The walk of [`check_segment`], with clearances at the ends if already known; returns the
-/// clearance at `b` when the segment is valid.
-#[allow(clippy::too_many_arguments)]
+/// The walk of [`check_segment`]; counts the clearance calls into `calls`.
 fn segment_valid(
     space: &JointSpace,
     validity: &dyn StateValidity,
     a: &[f64],
-    ca: Option<f64>,
     b: &[f64],
-    cb: Option<f64>,
     min_clearance: f64,
     calls: &mut usize,
-) -> Option<f64> {
+) -> bool {
     let floor = min_clearance.max(1e-9);
-    let mut measure = |q: &[f64]| {
+    let n = space.dim().min(a.len()).min(b.len());
+    // Bound of each joint over the whole segment, and prefix sums for the ranges.
+    let mut prefix = Vec::with_capacity(n + 1);
+    prefix.push(0.0);
+    for j in 0..n {
+        let r = space.radii.get(j).copied().unwrap_or(f64::INFINITY);
+        let d = (a[j] - b[j]).abs();
+        let term = if d == 0.0 { 0.0 } else { r * d };
+        prefix.push(prefix[j] + term);
+    }
+    if !prefix[n].is_finite() {
+        return false;
+    }
+    let mut buf = Vec::new();
+    // The parameter interval around a sample proven valid, or `None` for a contact.
+    let mut measure = |q: &[f64]| -> Option<f64> {
         *calls += 1;
-        let c = validity.clearance(q);
-        // NaN fails the comparison and so counts as a contact.
-        (c >= floor).then_some(c)
+        validity.clearances(q, &mut buf);
+        let mut step = f64::INFINITY;
+        for c in &buf {
+            // NaN fails the comparison and so counts as a contact.
+            if c.distance.is_nan() || c.distance < floor {
+                return None;
+            }
+            let (lo, hi) = (c.joints.start.min(n), c.joints.end.min(n));
+            let bound = if hi > lo { prefix[hi] - prefix[lo] } else { 0.0 };
+            if bound > 0.0 {
+                step = step.min(c.distance / bound * STEP_SAFETY);
+            }
+        }
+        Some(step)
     };
-    let ca = match ca {
-        Some(c) if c >= floor => c,
-        Some(_) => return None,
-        None => measure(a)?,
+    let Some(step_a) = measure(a) else {
+        return false;
     };
-    let cb = match cb {
-        Some(c) if c >= floor => c,
-        Some(_) => return None,
-        None => measure(b)?,
+    let Some(step_b) = measure(b) else {
+        return false;
     };
-    let bound = space.cartesian_bound(a, b);
-    if !bound.is_finite() {
-        return None;
-    }
-    if bound <= 0.0 {
-        return Some(cb);
-    }
     // [0, lo) and (hi, 1] are proven valid.
-    let mut lo = ca / bound * STEP_SAFETY;
-    let mut hi = 1.0 - cb / bound * STEP_SAFETY;
-    let mut q = Vec::with_capacity(a.len());
+    let mut lo = step_a;
+    let mut hi = 1.0 - step_b;
+    let mut q = Vec::with_capacity(n);
     let mut from_a = true;
     while lo < hi {
         let s = if from_a { lo } else { hi };
         space.interpolate(a, b, s, &mut q);
-        let c = measure(&q)?;
-        let step = c / bound * STEP_SAFETY;
+        let Some(step) = measure(&q) else {
+            return false;
+        };
         if from_a {
             lo = s + step;
         } else {
@@ -212,7 +256,7 @@ fn segment_valid(
         }
         from_a = !from_a;
     }
-    Some(cb)
+    true
 }
 
 /// Limits and knobs of a planning query.
@@ -308,14 +352,14 @@ pub trait Planner {
     ) -> Result<PlannedPath, PlanError>;
 }
 
-/// Checks both ends; returns their clearances and the calls made.
+/// Checks both ends (two clearance calls).
 fn check_ends(
     space: &JointSpace,
     validity: &dyn StateValidity,
     start: &[f64],
     goal: &[f64],
     settings: &PlanSettings,
-) -> Result<(f64, f64), PlanError> {
+) -> Result<(), PlanError> {
     let floor = settings.min_clearance.max(1e-9);
     let measure = |q: &[f64]| {
         if space.contains(q) {
@@ -332,7 +376,7 @@ fn check_ends(
     if cg.is_nan() || cg < floor {
         return Err(PlanError::GoalInvalid { clearance: cg });
     }
-    Ok((cs, cg))
+    Ok(())
 }
 
 /// Only the direct segment.
@@ -352,19 +396,9 @@ impl Planner for Straight {
         goal: &[f64],
         settings: &PlanSettings,
     ) -> Result<PlannedPath, PlanError> {
-        let (cs, cg) = check_ends(space, validity, start, goal, settings)?;
+        check_ends(space, validity, start, goal, settings)?;
         let mut calls = 2;
-        let ok = segment_valid(
-            space,
-            validity,
-            start,
-            Some(cs),
-            goal,
-            Some(cg),
-            settings.min_clearance,
-            &mut calls,
-        )
-        .is_some();
+        let ok = segment_valid(space, validity, start, goal, settings.min_clearance, &mut calls);
         if ok {
             Ok(PlannedPath {
                 waypoints: vec![start.to_vec(), goal.to_vec()],
@@ -390,15 +424,13 @@ pub struct RrtConnect;
 struct Tree {
     nodes: Vec<Vec<f64>>,
     parent: Vec<usize>,
-    clearance: Vec<f64>,
 }
 
 impl Tree {
-    fn new(root: &[f64], clearance: f64) -> Self {
+    fn new(root: &[f64]) -> Self {
         Tree {
             nodes: vec![root.to_vec()],
             parent: vec![usize::MAX],
-            clearance: vec![clearance],
         }
     }
 
@@ -451,21 +483,18 @@ impl Search<'_> {
             self.space.interpolate(near, target, self.range / d, &mut q);
             (q, false)
         };
-        let Some(c) = segment_valid(
+        if !segment_valid(
             self.space,
             self.validity,
             near,
-            Some(tree.clearance[from]),
             &q_new,
-            None,
             self.min_clearance,
             &mut self.calls,
-        ) else {
+        ) {
             return Extend::Trapped;
-        };
+        }
         tree.nodes.push(q_new);
         tree.parent.push(from);
-        tree.clearance.push(c);
         let i = tree.nodes.len() - 1;
         if reached {
             Extend::Reached(i)
@@ -506,7 +535,7 @@ impl Planner for RrtConnect {
         settings: &PlanSettings,
     ) -> Result<PlannedPath, PlanError> {
         let began = Instant::now();
-        let (cs, cg) = check_ends(space, validity, start, goal, settings)?;
+        check_ends(space, validity, start, goal, settings)?;
         let range = if settings.range > 0.0 {
             settings.range
         } else {
@@ -521,7 +550,7 @@ impl Planner for RrtConnect {
         };
         let mut rng = ChaCha8Rng::seed_from_u64(settings.seed);
         // trees[0] grows from the start, trees[1] from the goal; `a` is the one extended.
-        let mut trees = [Tree::new(start, cs), Tree::new(goal, cg)];
+        let mut trees = [Tree::new(start), Tree::new(goal)];
         let mut a = 0;
         let mut samples = 0;
         let mut q_rand = Vec::with_capacity(space.dim());

@@ -307,3 +307,45 @@ proptest! {
         prop_assert!(check.calls >= 1);
     }
 }
+
+/// A constant tight clearance that only joint 1 can reduce (a tool beside the wrist that
+/// carries it), and a point robot on joint 0 far from anything.
+struct TightWrist;
+
+impl StateValidity for TightWrist {
+    fn clearance(&self, _q: &[f64]) -> f64 {
+        0.01
+    }
+    fn clearances(&self, _q: &[f64], out: &mut Vec<Clearance>) {
+        out.clear();
+        out.push(Clearance {
+            distance: 0.01,
+            joints: 1..2,
+        });
+        out.push(Clearance {
+            distance: 1.0,
+            joints: 0..2,
+        });
+    }
+}
+
+fn tight(_: &[f64]) -> f64 {
+    0.01
+}
+
+#[test]
+fn structured_clearances_step_by_the_joints_that_matter() {
+    let space = square(2, 10.0);
+    // Joint 0 moves 10, joint 1 does not: the tight clearance cannot shrink.
+    let fine = check_segment(&space, &tight, &[0.0, 1.0], &[10.0, 1.0], 1e-4);
+    let coarse = check_segment(&space, &TightWrist, &[0.0, 1.0], &[10.0, 1.0], 1e-4);
+    assert!(fine.valid && coarse.valid);
+    assert!(fine.calls > 900, "{fine:?}");
+    assert!(coarse.calls < 15, "{coarse:?}");
+    // Joint 1 moving by 1: steps of 0.01.
+    let wrist = check_segment(&space, &TightWrist, &[0.0, 1.0], &[0.0, 2.0], 1e-4);
+    assert!(wrist.valid && wrist.calls > 90, "{wrist:?}");
+    // A clearance below the floor is a contact whatever its joints.
+    let floor = check_segment(&space, &TightWrist, &[0.0, 1.0], &[1.0, 1.0], 0.02);
+    assert!(!floor.valid);
+}
