@@ -99,7 +99,15 @@ fn solve_bounded(p: &Gtsp, mut upper: f64) -> Result<Exact, HeldKarpError> {
             );
             // The bound is a tour's cost, so some path meets it; without one, search unbounded.
             let (cost, path) = found
-                .or_else(|| run(&p.clusters, &c, &|v| c(s, v), &|v| p.costs.get(v, end), f64::INFINITY))
+                .or_else(|| {
+                    run(
+                        &p.clusters,
+                        &c,
+                        &|v| c(s, v),
+                        &|v| p.costs.get(v, end),
+                        f64::INFINITY,
+                    )
+                })
                 .ok_or(HeldKarpError::Empty)?;
             Ok(Exact {
                 tour: Tour { nodes: path },
@@ -123,7 +131,13 @@ fn solve_bounded(p: &Gtsp, mut upper: f64) -> Result<Exact, HeldKarpError> {
                 let found = if rest.is_empty() {
                     Some((p.costs.get(s, s), Vec::new()))
                 } else {
-                    run(&rest, &c, &|v| c(s, v), &|v| p.costs.get(v, s), upper - p.service[s])
+                    run(
+                        &rest,
+                        &c,
+                        &|v| c(s, v),
+                        &|v| p.costs.get(v, s),
+                        upper - p.service[s],
+                    )
                 };
                 let Some((cost, path)) = found else { continue };
                 let cost = cost + p.service[s];
@@ -259,10 +273,15 @@ fn run(
     let mut value = vec![f64::INFINITY; at];
     // Bit r of `alive[s]`: some value of cluster r in subset s is finite.
     let mut alive = vec![0u32; full + 1];
-    let mut rest_bound = vec![0.0f64; full + 1];
-    for s in 0..=full {
-        rest_bound[s] = (0..k).filter(|&q| s & (1 << q) == 0).map(|q| in_min[q]).sum::<f64>() + leave_min;
-    }
+    let rest_bound: Vec<f64> = (0..=full)
+        .map(|s| {
+            (0..k)
+                .filter(|&q| s & (1 << q) == 0)
+                .map(|q| in_min[q])
+                .sum::<f64>()
+                + leave_min
+        })
+        .collect();
     let pos = |s: usize, q: usize, j: usize| offset[s] + count[s & ((1 << q) - 1)] + j;
 
     let mut layer_begin = 0;
@@ -309,10 +328,8 @@ fn run(
                                 }
                                 let len = first[r + 1] - first[r];
                                 if live & (1 << r) != 0 {
-                                    best = best.min(min_plus(
-                                        &done[base..base + len],
-                                        &col[first[r]..first[r + 1]],
-                                    ));
+                                    best = best
+                                        .min(min_plus(&done[base..base + len], &col[first[r]..first[r + 1]]));
                                 }
                                 base += len;
                             }
@@ -521,8 +538,16 @@ mod tests {
                 // The tightest valid bound (the optimum itself) and a loose one.
                 for upper in [free.cost, free.cost * 1.05] {
                     let pruned = solve_bounded(&p, upper).unwrap();
-                    assert!((pruned.cost - free.cost).abs() < 1e-9, "seed {seed}: {} vs {}", pruned.cost, free.cost);
-                    assert_eq!(pruned.tour, free.tour, "seed {seed}: same tour whatever the bound");
+                    assert!(
+                        (pruned.cost - free.cost).abs() < 1e-9,
+                        "seed {seed}: {} vs {}",
+                        pruned.cost,
+                        free.cost
+                    );
+                    assert_eq!(
+                        pruned.tour, free.tour,
+                        "seed {seed}: same tour whatever the bound"
+                    );
                     p.check(&pruned.tour).unwrap();
                 }
             }

@@ -1,6 +1,7 @@
 //! Iterated local search: construct, improve, then repeatedly kick the accepted tour with a
 //! local double bridge (swap two adjacent segments of random lengths), improve, and accept the
-//! result if it is no worse.
+//! result if it is no worse than the current tour by more than a random threshold (see
+//! [`ACCEPT`]); the best tour seen is kept.
 use std::time::Instant;
 
 use rand::{RngExt, SeedableRng};
