@@ -238,3 +238,37 @@ fn validation_rejects_bad_problems() {
         assert!(Routes { tours: bad }.check(&p).is_err());
     }
 }
+
+#[test]
+fn lower_bound_is_below_every_solution_and_tight_on_one_task() {
+    for seed in 0..6 {
+        let p = generate(3, 20, (1, 4), seed);
+        let lb = lower_bound(&p);
+        assert!(lb > 0.0);
+        for method in [
+            MinMaxMethod::Ils,
+            MinMaxMethod::Algorithm1,
+            MinMaxMethod::Proximity,
+        ] {
+            let sol = solve(
+                &p,
+                &MinMaxParams {
+                    method,
+                    seed,
+                    max_iterations: Some(30),
+                    ..MinMaxParams::default()
+                },
+            );
+            assert!(
+                lb <= sol.makespan + 1e-9,
+                "seed {seed} {method:?}: bound {lb} above {}",
+                sol.makespan
+            );
+        }
+    }
+    // One vehicle, one task with one node: the bound is the route itself.
+    let costs = CostMatrix::from_fn(2, |i, j| if i == j { 0.0 } else { 1.0 + i as f64 });
+    let v = Vehicle::new(costs, 0, 1, vec![vec![1]]).unwrap();
+    let p = MinMaxProblem::new(vec![v], 1, vec![0.5], None).unwrap();
+    assert!((lower_bound(&p) - (1.0 + 0.5 + 2.0)).abs() < 1e-12);
+}
