@@ -8,6 +8,7 @@
 //!   its own trapezoidal or triangular profile, the slowest joint sets the time). It is a lower
 //!   bound of the time of *any* motion between the two configurations, collision-free or not,
 //!   and is what tour costs (paper 000, eq. 8–9) should be measured in.
+//!   [`move_trajectory`] realises it (joints synchronised in time, not on a straight line).
 //!   [`move_time_instant`] is paper 000's assumption 2 (every joint reaches its maximum
 //!   velocity at once): `max_j |Δq_j| / v_j`, never more than [`move_time`].
 //! - [`Trajectory`] is a sequence of [`Piece`]s of constant joint acceleration, so position,
@@ -25,6 +26,6 @@ mod trajectory;
 
 pub use check::{LimitViolation, check_limits, check_position_limits};
 pub use error::TimingError;
-pub use limits::{Limits, joint_min_time, move_time, move_time_instant};
+pub use limits::{Limits, joint_min_time, move_time, move_time_instant, move_trajectory};
 pub use path::{Blend, BlendedPath, TimedPath, time_path_blended, time_path_exact};
 pub use trajectory::{Piece, Trajectory};

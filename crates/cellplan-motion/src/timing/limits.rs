@@ -1,6 +1,6 @@
 //! Per-joint limits and point-to-point move times.
 
-use super::TimingError;
+use super::{Piece, TimingError, Trajectory};
 
 /// Per-joint velocity (rad/s or m/s) and acceleration (rad/s² or m/s²) limits, each finite
 /// and > 0. Build with [`Limits::new`] (validated) or [`Limits::uniform`]; the fields are public
@@ -111,6 +111,91 @@ pub fn move_time_instant(a: &[f64], b: &[f64], limits: &Limits) -> f64 {
         .fold(0.0, f64::max)
 }
 
+/// A trajectory realising [`move_time`]: every joint follows its own trapezoidal (or, for the
+/// slowest, possibly triangular) profile at full acceleration, with its cruise velocity lowered
+/// so that all joints start and stop together after exactly `move_time(a, b, limits)`. The
+/// joints are synchronised in time but the path is in general *not* the straight line from
+/// `a` to `b` (use [`time_path_exact`](super::time_path_exact) for that); it stays within the
+/// box spanned by `a` and `b`, since each joint moves monotonically. Panics if `a`, `b` and
+/// `limits` differ in length.
+///
+/// ```
+/// use cellplan_motion::timing::{Limits, check_limits, move_time, move_trajectory};
+/// let l = Limits::new(vec![1.0, 2.0], vec![2.0, 1.0]).unwrap();
+/// let (a, b) = ([0.0, 0.0], [2.0, -1.0]);
+/// let t = move_trajectory(&a, &b, &l);
+/// assert_eq!(t.duration(), move_time(&a, &b, &l));
+/// assert!(check_limits(&t, &l, 1e-9).is_ok());
+/// ```
+pub fn move_trajectory(a: &[f64], b: &[f64], limits: &Limits) -> Trajectory {
+    let total = move_time(a, b, limits);
+    if total <= 0.0 {
+        return Trajectory::dwell(a, 0.0);
+    }
+    // Per joint: signed distance, acceleration, cruise velocity and acceleration time.
+    let joints: Vec<(f64, f64, f64, f64)> = (0..a.len())
+        .map(|j| {
+            let d = b[j] - a[j];
+            let acc = limits.acceleration[j];
+            if d == 0.0 {
+                return (0.0, 0.0, 0.0, 0.0);
+            }
+            // v²/acc − v·T + |d| = 0, smaller root (numerically stable form).
+            let disc = (acc * acc * total * total - 4.0 * acc * d.abs()).max(0.0).sqrt();
+            let v = (2.0 * acc * d.abs() / (acc * total + disc)).min(limits.velocity[j]);
+            (d, acc, v, (v / acc).min(0.5 * total))
+        })
+        .collect();
+    let eval = |j: usize, t: f64| -> (f64, f64) {
+        let (d, acc, v, ta) = joints[j];
+        let sgn = d.signum();
+        let (s, sd) = if d == 0.0 {
+            (0.0, 0.0)
+        } else if t <= ta {
+            (0.5 * acc * t * t, acc * t)
+        } else if t <= total - ta {
+            (0.5 * acc * ta * ta + v * (t - ta), v)
+        } else {
+            let r = total - t;
+            (d.abs() - 0.5 * acc * r * r, acc * r)
+        };
+        (a[j] + sgn * s, sgn * sd)
+    };
+    let mut times = vec![0.0, total];
+    for &(d, _, _, ta) in &joints {
+        if d != 0.0 {
+            times.extend([ta, total - ta]);
+        }
+    }
+    times.sort_by(f64::total_cmp);
+    times.dedup_by(|x, y| (*x - *y).abs() <= 1e-12 * total);
+    let mut pieces = Vec::with_capacity(times.len());
+    for w in times.windows(2) {
+        let (t0, t1) = (w[0], w[1]);
+        let mid = 0.5 * (t0 + t1);
+        let (position, velocity) = (0..a.len()).map(|j| eval(j, t0)).unzip();
+        let acceleration = joints
+            .iter()
+            .map(|&(d, acc, _, ta)| {
+                if d == 0.0 || (mid > ta && mid < total - ta) {
+                    0.0
+                } else if mid <= ta {
+                    d.signum() * acc
+                } else {
+                    -d.signum() * acc
+                }
+            })
+            .collect();
+        pieces.push(Piece {
+            duration: t1 - t0,
+            position,
+            velocity,
+            acceleration,
+        });
+    }
+    Trajectory::from_pieces_unchecked(pieces)
+}
+
 fn check_dims(a: &[f64], b: &[f64], limits: &Limits) {
     assert!(
         a.len() == limits.dof() && b.len() == limits.dof(),
@@ -174,6 +259,29 @@ mod tests {
         assert!((move_time(&a, &b2, &l) - 4.0).abs() < 1e-12);
         // symmetric
         assert_eq!(move_time(&a, &b2, &l), move_time(&b2, &a, &l));
+    }
+
+    #[test]
+    fn move_trajectory_realises_move_time() {
+        let l = Limits::new(vec![1.0, 3.0, 0.5, 2.0], vec![2.0, 1.0, 10.0, 4.0]).unwrap();
+        let a = [0.0, 1.0, -1.0, 0.3];
+        for b in [
+            [2.0, 1.5, -1.0, 0.2],
+            [0.1, 5.0, -2.0, -3.0],
+            [0.0, 1.0, -1.0, 0.3],
+        ] {
+            let t = move_trajectory(&a, &b, &l);
+            assert!((t.duration() - move_time(&a, &b, &l)).abs() < 1e-12);
+            assert!(super::super::check_limits(&t, &l, 1e-9).is_ok());
+            assert!(t.end_position().iter().zip(&b).all(|(x, y)| (x - y).abs() < 1e-9));
+            assert!(t.velocity(t.duration()).iter().all(|v| v.abs() < 1e-9));
+            // monotone per joint: within the box of a and b
+            for (_, q) in t.sample(0.01) {
+                for j in 0..4 {
+                    assert!(q[j] >= a[j].min(b[j]) - 1e-12 && q[j] <= a[j].max(b[j]) + 1e-12);
+                }
+            }
+        }
     }
 
     #[test]

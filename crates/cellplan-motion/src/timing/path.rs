@@ -48,8 +48,10 @@ pub struct Blend {
     /// Distance (Euclidean, joint units) from the corner at which the blend leaves the incoming
     /// segment and joins the outgoing one.
     pub radius: f64,
-    /// Per joint, the largest distance between the blended position and the corner polyline
-    /// (reached at the middle of the blend, where it equals `|Δv_j|·duration/8`).
+    /// Per joint, the largest difference between the blended position and the point of the
+    /// corner polyline crossed at constant `speed` at the same time (reached at the middle of
+    /// the blend, where it equals `|Δv_j|·duration/8`); the distance from the blend to the
+    /// polyline is no larger.
     pub deviation: Vec<f64>,
 }
 

@@ -1,4 +1,4 @@
-use super::super::{check_limits, move_time, move_time_instant};
+use super::super::{check_limits, move_time, move_time_instant, move_trajectory};
 use super::*;
 use proptest::prelude::*;
 
@@ -205,13 +205,19 @@ proptest! {
     #![proptest_config(ProptestConfig::with_cases(300))]
 
     #[test]
-    fn instant_is_optimistic((l, path, _) in limits_and_path()) {
+    fn instant_is_optimistic_and_move_time_is_reached((l, path, _) in limits_and_path()) {
         let (a, b) = (&path[0], &path[path.len() - 1]);
         let mi = move_time_instant(a, b, &l);
         let mt = move_time(a, b, &l);
         prop_assert!(mi <= mt);
         let max_va = l.velocity.iter().zip(&l.acceleration).map(|(v, a)| v / a).fold(0.0, f64::max);
         prop_assert!(mt <= mi + max_va + 1e-12);
+        // move_trajectory realises move_time within the limits
+        let t = move_trajectory(a, b, &l);
+        prop_assert!((t.duration() - mt).abs() <= 1e-12 * (1.0 + mt));
+        prop_assert!(check_limits(&t, &l, 1e-9).is_ok(), "{:?}", check_limits(&t, &l, 1e-9));
+        prop_assert!(close(&t.end_position(), b, 1e-9));
+        prop_assert!(close(&t.velocity(t.duration()), &vec![0.0; l.dof()], 1e-9));
     }
 
     #[test]
