@@ -374,10 +374,10 @@ pub fn lower_bound(p: &MinMaxProblem) -> f64 {
     }
     let mut best: f64 = 0.0;
     let mut total = 0.0;
-    for t in 0..p.tasks {
+    for (t, service) in p.service.iter().enumerate() {
         let who = p.capable(t);
         let cheapest = who.iter().map(|&v| entry[v][t]).fold(f64::INFINITY, f64::min);
-        total += p.service[t] + cheapest;
+        total += service + cheapest;
     }
     total += (0..m).map(|v| ret[v]).fold(f64::INFINITY, f64::min);
     best = best.max(total / m as f64);
