@@ -13,6 +13,7 @@ pub mod candidates;
 pub mod error;
 pub mod io;
 pub mod model;
+pub mod motion;
 pub mod process;
 pub mod report;
 pub mod taskgen;
