@@ -1,7 +1,10 @@
 //! `cellplan bench`: the combinatorial solvers on standard instance files, against the known
-//! optima found in a `solutions` file beside each instance (`name : value` lines).
-use cellplan_solve::io::{read_gtsplib, read_optima, read_orlib_setcover, read_tsplib};
-use cellplan_solve::{Gtsp, gtsp, held_karp, setcover};
+//! optima found in a `solutions` file beside each instance (`name : value` lines); and min-max
+//! routing on cellplan's own format (docs/minmax-format.md), against its BEST_KNOWN line.
+use cellplan_solve::io::{
+    read_gtsplib, read_minmax_instance, read_optima, read_orlib_setcover, read_tsplib, write_minmax,
+};
+use cellplan_solve::{Gtsp, gtsp, held_karp, minmax, setcover};
 use clap::{Args, ValueEnum};
 use serde::Serialize;
 use std::path::{Path, PathBuf};
@@ -16,6 +19,8 @@ pub enum Kind {
     Gtsp,
     /// OR-Library set cover.
     Setcover,
+    /// cellplan min-max multi-vehicle routing with alternatives (docs/minmax-format.md).
+    Minmax,
 }
 
 /// Solver method.
@@ -29,6 +34,10 @@ pub enum Method {
     Greedy,
     /// Paper 000's penalty/auxiliary-function set cover.
     Penalty,
+    /// Min-max: paper 000's Algorithm 1 generalised to m vehicles.
+    Algorithm1,
+    /// Min-max: every task to the vehicle whose depot is nearest.
+    Proximity,
 }
 
 #[derive(Args)]
@@ -37,7 +46,7 @@ pub struct BenchArgs {
     #[arg(value_enum)]
     kind: Kind,
     /// Instance files.
-    #[arg(required = true)]
+    #[arg(required_unless_present = "generate")]
     files: Vec<PathBuf>,
     /// Time limit per run, in seconds.
     #[arg(long, default_value_t = 1.0)]
@@ -45,12 +54,35 @@ pub struct BenchArgs {
     /// Runs per instance (seeds 0, 1, ...).
     #[arg(long, default_value_t = 1)]
     runs: u64,
-    /// Method (default: ils for tsp/gtsp, exact for setcover).
+    /// Method (default: ils for tsp/gtsp/minmax, exact for setcover; minmax also takes
+    /// algorithm1 and proximity).
     #[arg(long, value_enum)]
     method: Option<Method>,
     /// Print JSON (a list of objects with instance, cost, mean_cost, optimum, gap_percent, time_s).
     #[arg(long)]
     pub json: bool,
+    /// Min-max only: write a random inspection-shaped instance (`minmax::generate`) to `--out`
+    /// instead of benchmarking.
+    #[arg(long, conflicts_with = "files", requires_all = ["vehicles", "tasks", "out"])]
+    pub generate: bool,
+    /// With `--generate`: number of vehicles (robots).
+    #[arg(long, requires = "generate")]
+    vehicles: Option<usize>,
+    /// With `--generate`: number of tasks.
+    #[arg(long, requires = "generate")]
+    tasks: Option<usize>,
+    /// With `--generate`: nodes per (robot, reachable task), an inclusive range `LO..HI`.
+    #[arg(long, requires = "generate", default_value = "1..4", value_name = "LO..HI")]
+    alternatives: String,
+    /// With `--generate`: the seed.
+    #[arg(long, requires = "generate", default_value_t = 1)]
+    seed: u64,
+    /// With `--generate`: round costs and service times to this many decimals (smaller files).
+    #[arg(long, requires = "generate", default_value_t = 4)]
+    decimals: u32,
+    /// With `--generate`: the file to write (atomically).
+    #[arg(long, short, requires = "generate", value_name = "FILE")]
+    out: Option<PathBuf>,
 }
 
 /// One instance's result.
@@ -65,6 +97,15 @@ pub struct Row {
     time_s: f64,
     runs: u64,
     proven_optimal: bool,
+    /// Min-max: the total route time of the best-makespan run.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    total: Option<f64>,
+    /// Min-max: number of vehicles.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    vehicles: Option<usize>,
+    /// Min-max: number of tasks.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    tasks: Option<usize>,
 }
 
 fn optimum_for(file: &Path, name: &str) -> Option<f64> {
@@ -95,6 +136,8 @@ pub enum BenchError {
     Input(cellplan_solve::ReadError),
     /// Arguments that do not fit together.
     Usage(String),
+    /// A solver returned an invalid solution (a bug), or the output could not be written.
+    Failed(String),
 }
 
 impl From<String> for BenchError {
@@ -119,10 +162,19 @@ pub fn run(args: &BenchArgs) -> Result<Vec<Row>, BenchError> {
         ));
     }
     let limit = Duration::from_secs_f64(args.time_limit);
+    if args.kind == Kind::Minmax {
+        return run_minmax(args, limit);
+    }
     let method = args.method.unwrap_or(match args.kind {
-        Kind::Tsp | Kind::Gtsp => Method::Ils,
+        Kind::Tsp | Kind::Gtsp | Kind::Minmax => Method::Ils,
         Kind::Setcover => Method::Exact,
     });
+    if matches!(method, Method::Algorithm1 | Method::Proximity) {
+        return Err(BenchError::Usage(format!(
+            "method {} is for minmax",
+            format!("{method:?}").to_lowercase()
+        )));
+    }
     let mut rows = Vec::new();
     for file in &args.files {
         let name = file
@@ -135,6 +187,7 @@ pub fn run(args: &BenchArgs) -> Result<Vec<Row>, BenchError> {
             Kind::Tsp => Instance::Route(Gtsp::tsp(read_tsplib(file).map_err(BenchError::Input)?.costs)),
             Kind::Gtsp => Instance::Route(read_gtsplib(file).map_err(BenchError::Input)?.gtsp),
             Kind::Setcover => Instance::Cover(read_orlib_setcover(file).map_err(BenchError::Input)?),
+            Kind::Minmax => unreachable!("min-max is benchmarked by run_minmax"),
         };
         let mut costs = Vec::new();
         let mut proven = false;
@@ -159,8 +212,11 @@ pub fn run(args: &BenchArgs) -> Result<Vec<Row>, BenchError> {
                                 ..setcover::PenaltyParams::default()
                             },
                         ),
-                        Method::Ils => {
-                            return Err(BenchError::Usage("method ils is for tsp and gtsp".into()));
+                        other => {
+                            return Err(BenchError::Usage(format!(
+                                "method {} is not for set cover",
+                                format!("{other:?}").to_lowercase()
+                            )));
                         }
                     };
                     (cover.cost, cover.proven_optimal)
@@ -181,9 +237,136 @@ pub fn run(args: &BenchArgs) -> Result<Vec<Row>, BenchError> {
             time_s: start.elapsed().as_secs_f64() / costs.len() as f64,
             runs: costs.len() as u64,
             proven_optimal: proven,
+            total: None,
+            vehicles: None,
+            tasks: None,
         });
     }
     Ok(rows)
+}
+
+fn stem(file: &Path) -> String {
+    file.file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default()
+}
+
+/// `cellplan bench minmax FILE...`: every run's routes are checked before they are reported.
+fn run_minmax(args: &BenchArgs, limit: Duration) -> Result<Vec<Row>, BenchError> {
+    let method = args.method.unwrap_or(Method::Ils);
+    let mm = match method {
+        Method::Ils => minmax::MinMaxMethod::Ils,
+        Method::Algorithm1 => minmax::MinMaxMethod::Algorithm1,
+        Method::Proximity => minmax::MinMaxMethod::Proximity,
+        other => {
+            return Err(BenchError::Usage(format!(
+                "method {} is not for minmax; use ils, algorithm1 or proximity",
+                format!("{other:?}").to_lowercase()
+            )));
+        }
+    };
+    let mut rows = Vec::new();
+    for file in &args.files {
+        let inst = read_minmax_instance(file).map_err(BenchError::Input)?;
+        let p = &inst.problem;
+        let mut runs: Vec<(f64, f64)> = Vec::new();
+        let start = Instant::now();
+        for seed in 0..args.runs.max(1) {
+            let params = minmax::MinMaxParams {
+                time_limit: limit,
+                seed,
+                max_iterations: None,
+                method: mm,
+            };
+            let sol = minmax::solve(p, &params);
+            sol.routes.check(p).map_err(|e| {
+                BenchError::Failed(format!(
+                    "{}: the {method:?} solution of seed {seed} is invalid: {e}",
+                    file.display()
+                ))
+            })?;
+            let makespan = sol.routes.makespan(p);
+            if (makespan - sol.makespan).abs() > 1e-9 * makespan.max(1.0) {
+                return Err(BenchError::Failed(format!(
+                    "{}: seed {seed} reports makespan {} but its routes take {makespan}",
+                    file.display(),
+                    sol.makespan
+                )));
+            }
+            runs.push((makespan, sol.routes.times(p).iter().sum()));
+        }
+        let elapsed = start.elapsed().as_secs_f64();
+        let (best, total) =
+            runs.iter().copied().fold(
+                (f64::INFINITY, f64::INFINITY),
+                |a, b| if b.0 < a.0 { b } else { a },
+            );
+        let mean = runs.iter().map(|r| r.0).sum::<f64>() / runs.len() as f64;
+        let optimum = inst.best_known;
+        rows.push(Row {
+            instance: stem(file),
+            method: format!("{method:?}").to_lowercase(),
+            cost: best,
+            mean_cost: mean,
+            optimum,
+            gap_percent: optimum.map(|o| if o > 0.0 { 100.0 * (best - o) / o } else { 0.0 }),
+            time_s: elapsed / runs.len() as f64,
+            runs: runs.len() as u64,
+            proven_optimal: false,
+            total: Some(total),
+            vehicles: Some(p.vehicles.len()),
+            tasks: Some(p.tasks),
+        });
+    }
+    Ok(rows)
+}
+
+/// `cellplan bench minmax --generate`: writes the instance atomically; returns what was written.
+pub fn generate(args: &BenchArgs) -> Result<String, BenchError> {
+    if args.kind != Kind::Minmax {
+        return Err(BenchError::Usage("`--generate` is for minmax only".into()));
+    }
+    let (Some(m), Some(n), Some(out)) = (args.vehicles, args.tasks, &args.out) else {
+        return Err(BenchError::Usage(
+            "`--generate` needs --vehicles, --tasks and --out".into(),
+        ));
+    };
+    let range = args
+        .alternatives
+        .split_once("..=")
+        .or_else(|| args.alternatives.split_once(".."));
+    let (lo, hi) = match range.map(|(a, b)| (a.trim().parse::<usize>(), b.trim().parse::<usize>())) {
+        Some((Ok(lo), Ok(hi))) if lo >= 1 && lo <= hi => (lo, hi),
+        _ => {
+            return Err(BenchError::Usage(format!(
+                "`--alternatives {}`: expected an inclusive range LO..HI with 1 <= LO <= HI, e.g. 10..40",
+                args.alternatives
+            )));
+        }
+    };
+    if m == 0 {
+        return Err(BenchError::Usage("`--vehicles` must be at least 1".into()));
+    }
+    let mut p = minmax::generate(m, n, (lo, hi), args.seed);
+    let scale = 10f64.powi(args.decimals.min(12) as i32);
+    let round = |x: f64| (x * scale).round() / scale;
+    for v in &mut p.vehicles {
+        let k = v.costs.n();
+        let data = v.costs.data().iter().map(|&c| round(c)).collect();
+        v.costs = cellplan_solve::CostMatrix::new(k, data).map_err(BenchError::Failed)?;
+    }
+    p.service.iter_mut().for_each(|s| *s = round(*s));
+    p.validate().map_err(BenchError::Failed)?;
+    let mut buf = Vec::new();
+    write_minmax(&p, &stem(out), &mut buf).map_err(|e| BenchError::Failed(e.to_string()))?;
+    cellplan::io::write_atomic(out, &buf)
+        .map_err(|e| BenchError::Failed(format!("cannot write {}: {e}", out.display())))?;
+    let nodes: usize = p.vehicles.iter().map(|v| v.costs.n()).sum();
+    Ok(format!(
+        "wrote {}: {m} vehicles, {n} tasks, {nodes} nodes in all, {} bytes",
+        out.display(),
+        buf.len()
+    ))
 }
 
 /// The rows as a table.
@@ -194,7 +377,7 @@ pub fn render(rows: &[Row]) -> String {
     );
     for r in rows {
         s.push_str(&format!(
-            "{:<14} {:<8} {:>12.1} {:>12.1} {:>12} {:>8} {:>8.3}{}\n",
+            "{:<14} {:<8} {:>12.prec$} {:>12.prec$} {:>12} {:>8} {:>8.3}{}{}\n",
             r.instance,
             r.method,
             r.cost,
@@ -202,7 +385,9 @@ pub fn render(rows: &[Row]) -> String {
             r.optimum.map_or("-".into(), |o| format!("{o:.0}")),
             r.gap_percent.map_or("-".into(), |g| format!("{g:.3}")),
             r.time_s,
-            if r.proven_optimal { "  proven" } else { "" }
+            if r.proven_optimal { "  proven" } else { "" },
+            r.total.map_or(String::new(), |t| format!("  total {t:.3}")),
+            prec = if r.total.is_some() { 3 } else { 1 }
         ));
     }
     if !rows.is_empty() {

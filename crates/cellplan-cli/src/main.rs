@@ -248,13 +248,20 @@ fn run_gen_tasks(args: &GenTasksArgs) -> Result<(), Failure> {
 }
 
 fn run_bench(args: &bench::BenchArgs) -> Result<(), Failure> {
-    let rows = bench::run(args).map_err(|e| match e {
+    let failure = |e| match e {
         bench::BenchError::Input(e) => Failure::Input(Box::new(
-            InputError::at_line(e.path(), e.line(), e.detail())
-                .hint("give TSPLIB (.tsp), GTSPLIB (.gtsp) or OR-Library set-cover files of the kind named"),
+            InputError::at_line(e.path(), e.line(), e.detail()).hint(
+                "give TSPLIB (.tsp), GTSPLIB (.gtsp), OR-Library set-cover or cellplan min-max \
+                 (docs/minmax-format.md) files of the kind named",
+            ),
         )),
-        bench::BenchError::Usage(m) => Failure::Other(m),
-    })?;
+        bench::BenchError::Usage(m) | bench::BenchError::Failed(m) => Failure::Other(m),
+    };
+    if args.generate {
+        eprintln!("{}", bench::generate(args).map_err(failure)?);
+        return Ok(());
+    }
+    let rows = bench::run(args).map_err(failure)?;
     if args.json {
         println!(
             "{}",
