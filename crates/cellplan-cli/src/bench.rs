@@ -28,6 +28,8 @@ pub enum Kind {
 pub enum Method {
     /// Iterated local search (tsp, gtsp).
     Ils,
+    /// Paper 003's enhanced genetic algorithm (tsp, gtsp).
+    Ga,
     /// Exact: Held–Karp for tsp/gtsp, branch and bound for set cover.
     Exact,
     /// Greedy set cover.
@@ -115,11 +117,16 @@ fn optimum_for(file: &Path, name: &str) -> Option<f64> {
 
 fn route(p: &Gtsp, method: Method, limit: Duration, seed: u64) -> Result<(f64, bool), String> {
     match method {
-        Method::Ils => {
+        Method::Ils | Method::Ga => {
             let params = gtsp::GtspParams {
                 time_limit: limit,
                 seed,
                 max_iterations: None,
+                method: if method == Method::Ga {
+                    gtsp::GtspMethod::Ga
+                } else {
+                    gtsp::GtspMethod::Ils
+                },
             };
             Ok((gtsp::solve(p, &params).cost, false))
         }

@@ -17,7 +17,7 @@ pub mod problem;
 pub use error::ReadError;
 pub use problem::{CostMatrix, Gtsp, SetCover, Tour};
 pub mod gtsp;
-pub use gtsp::{GtspParams, Solution, solve as solve_gtsp};
+pub use gtsp::{GtspMethod, GtspParams, Solution, solve as solve_gtsp};
 
 pub mod setcover;
 pub use setcover::Cover;

@@ -4,7 +4,7 @@ use std::path::{Path, PathBuf};
 use std::time::Duration;
 
 use cellplan_solve::io::{read_gtsplib, read_optima, read_tsplib};
-use cellplan_solve::{Gtsp, GtspParams, solve_gtsp};
+use cellplan_solve::{Gtsp, GtspMethod, GtspParams, solve_gtsp};
 
 fn bench(sub: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -17,6 +17,7 @@ fn params(iters: usize, seed: u64) -> GtspParams {
         time_limit: Duration::from_secs(3600),
         seed,
         max_iterations: Some(iters),
+        method: GtspMethod::Ils,
     }
 }
 
@@ -60,4 +61,52 @@ fn gtsp_39rat195_feasible_and_near_best_known() {
     let sol = solve_gtsp(&d, &params(200, 3));
     d.check(&sol.tour).unwrap();
     assert_eq!(sol.cost, d.tour_cost(&sol.tour));
+}
+
+#[test]
+fn ga_burma14_reaches_optimum_and_is_deterministic() {
+    let inst = read_tsplib(bench("tsplib/burma14.tsp")).unwrap();
+    let optima = read_optima(bench("tsplib/solutions")).unwrap();
+    let g = Gtsp::tsp(inst.costs);
+    let ga = |seed| {
+        solve_gtsp(
+            &g,
+            &GtspParams {
+                method: GtspMethod::Ga,
+                ..params(500, seed)
+            },
+        )
+    };
+    let sol = ga(1);
+    g.check(&sol.tour).unwrap();
+    assert_eq!(sol.cost, g.tour_cost(&sol.tour));
+    assert_eq!(sol.iterations, 500);
+    assert_eq!(sol.cost, optima["burma14"]);
+    assert_eq!(ga(1), sol);
+}
+
+#[test]
+fn ga_39rat195_feasible_with_and_without_depots() {
+    let g = read_gtsplib(bench("gtsplib/39rat195.gtsp")).unwrap().gtsp;
+    let ga = |p: &Gtsp| {
+        let sol = solve_gtsp(
+            p,
+            &GtspParams {
+                method: GtspMethod::Ga,
+                ..params(30, 2)
+            },
+        );
+        p.check(&sol.tour).unwrap();
+        assert_eq!(sol.cost, p.tour_cost(&sol.tour));
+        sol
+    };
+    let closed = ga(&g);
+    assert_eq!(closed.tour.nodes.len(), 39);
+    let mut clusters = g.clusters.clone();
+    let (s, e) = (clusters[0].remove(0), clusters[0].remove(0));
+    let d = Gtsp::new(g.costs.clone(), clusters)
+        .unwrap()
+        .with_depots(Some(s), Some(e))
+        .unwrap();
+    assert_eq!(ga(&d).tour.nodes.len(), 39);
 }

@@ -2,7 +2,8 @@
 //! construction over clusters, the layer pass (the best node per cluster for a fixed cluster
 //! order, by DP), 2-opt and Or-opt on neighbour lists with node re-choice, and iterated local
 //! search with local double-bridge kicks. Deterministic for a seed and `max_iterations`; the time
-//! limit only cuts the search short.
+//! limit only cuts the search short. [`GtspMethod::Ga`] selects paper 003's enhanced genetic
+//! algorithm instead (module `ga`).
 //!
 //! Internally a tour is an array of *items*: the clusters in visiting order and, when the problem
 //! has depots, a fixed pseudo-cluster at position 0 standing for "start … end" (arcs into it go
@@ -12,21 +13,39 @@ use std::time::{Duration, Instant};
 use crate::problem::{Gtsp, Tour};
 
 mod construct;
+mod ga;
 mod ils;
 mod layer;
 mod or_opt;
 mod search;
 mod two_opt;
 
+/// Which GTSP heuristic [`solve`] runs.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum GtspMethod {
+    /// The default: iterated local search (nearest-neighbour construction, layer pass, 2-opt,
+    /// Or-opt, double-bridge kicks); `iterations` counts kicks.
+    #[default]
+    Ils,
+    /// Paper 003's enhanced genetic algorithm (§3.3, Algorithm 5): random-key-like integer
+    /// encoding by sub-segments, elite/non-elite two-point crossover, heuristic mutation and the
+    /// paper's max/min gene exchange ("2-opt"); population 100, 10 elite, `P_c` = 0.9,
+    /// `P_m` = 1.0, 3 mutated genes. `iterations` counts generations (`max_iterations` = `T_iter`).
+    Ga,
+}
+
 /// Parameters of [`solve`].
 #[derive(Clone, Debug, PartialEq)]
 pub struct GtspParams {
     /// Stop after this much wall-clock time (checked between iterations).
     pub time_limit: Duration,
-    /// Seed of the random kicks.
+    /// Seed of the random kicks (ILS) or of the GA.
     pub seed: u64,
-    /// Stop after this many kicks (the result then depends only on the instance and the seed).
+    /// Stop after this many kicks (ILS) or generations (GA); the result then depends only on the
+    /// instance and the seed.
     pub max_iterations: Option<usize>,
+    /// The heuristic (default [`GtspMethod::Ils`]).
+    pub method: GtspMethod,
 }
 
 impl Default for GtspParams {
@@ -35,6 +54,7 @@ impl Default for GtspParams {
             time_limit: Duration::from_secs(1),
             seed: 0,
             max_iterations: None,
+            method: GtspMethod::Ils,
         }
     }
 }
@@ -46,7 +66,7 @@ pub struct Solution {
     pub tour: Tour,
     /// Its cost.
     pub cost: f64,
-    /// Iterated-local-search kicks made.
+    /// Iterated-local-search kicks made (ILS) or generations run (GA).
     pub iterations: usize,
 }
 
@@ -57,6 +77,15 @@ pub(crate) const EPS: f64 = 1e-7;
 /// → end (back to start when `end` is `None`); without, it is a closed cycle.
 pub fn solve(p: &Gtsp, params: &GtspParams) -> Solution {
     let deadline = Instant::now() + params.time_limit;
+    if params.method == GtspMethod::Ga {
+        let (tour, iterations) = ga::run(p, params, deadline);
+        let cost = p.tour_cost(&tour);
+        return Solution {
+            tour,
+            cost,
+            iterations,
+        };
+    }
     let inst = Inst::new(p);
     let (st, iterations) = ils::run(&inst, params, deadline);
     let tour = inst.tour_of(&st);
@@ -276,6 +305,7 @@ pub(crate) mod tests {
             time_limit: Duration::from_secs(3600),
             seed,
             max_iterations: Some(iters),
+            method: GtspMethod::Ils,
         };
         let sol = solve(p, &params);
         p.check(&sol.tour).unwrap();

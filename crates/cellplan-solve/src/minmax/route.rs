@@ -87,6 +87,7 @@ pub(crate) fn optimise(p: &MinMaxProblem, v: usize, tour: &[Visit], seed: u64, i
             time_limit: Duration::from_secs(3600),
             seed,
             max_iterations: Some(iters),
+            method: gtsp::GtspMethod::Ils,
         },
     );
     let cand: Vec<Visit> = sol.tour.nodes.iter().map(|&i| (task_of[i], nodes[i])).collect();
