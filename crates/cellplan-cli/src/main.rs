@@ -4,6 +4,7 @@
 //! 3 the cell is valid but some task no robot can do (the report says which and why);
 //! 1 anything else.
 mod bench;
+mod plan_cmd;
 
 use cellplan::report::{check, svg};
 use cellplan::taskgen::{GenOptions, sample_tasks};
@@ -32,6 +33,8 @@ struct Cli {
 enum Command {
     /// Load and validate a cell, find every task's candidates per robot, report reachability.
     Check(CheckArgs),
+    /// Plan the cell: allocation, order, collision-free timed motion per robot; writes the plan.
+    Plan(plan_cmd::PlanArgs),
     /// Generate inputs for building cells.
     #[command(subcommand)]
     Gen(GenCommand),
@@ -286,6 +289,7 @@ fn main() -> ExitCode {
     }
     let result = match &cli.command {
         Command::Check(a) => run_check(a),
+        Command::Plan(a) => plan_cmd::run(a),
         Command::Gen(GenCommand::Tasks(a)) => run_gen_tasks(a),
         Command::Bench(a) => run_bench(a),
     };

@@ -14,6 +14,7 @@ pub mod error;
 pub mod io;
 pub mod model;
 pub mod motion;
+pub mod plan;
 pub mod process;
 pub mod report;
 pub mod taskgen;

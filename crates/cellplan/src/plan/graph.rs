@@ -1,0 +1,128 @@
+//! Per-robot graphs: the robot's home and every candidate of every task it can do, with the
+//! lower-bound move times between them (paper 000 eq. 3 with the move model of the settings).
+use crate::candidates::CandidateTable;
+use crate::model::robot::Robot;
+use crate::model::tasks::TaskId;
+use cellplan_motion::timing::{Limits, move_time, move_time_instant};
+use cellplan_solve::CostMatrix;
+
+/// How the time of a move between two configurations is estimated before it is planned.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum MoveModel {
+    /// Synchronised trapezoidal/triangular profiles under the velocity and acceleration
+    /// limits: a lower bound of any real move.
+    Trapezoid,
+    /// Paper 000's assumption 2: maximum velocity reached at once (max_j |Δq_j| / v_j).
+    Instant,
+}
+
+/// One robot's nodes: node 0 is home, the others are candidates.
+#[derive(Clone, Debug)]
+pub struct RobotGraph {
+    /// Configurations, node 0 the home.
+    pub q: Vec<Vec<f64>>,
+    /// For nodes ≥ 1: the task and the index of the candidate in the table.
+    pub node_task: Vec<Option<(TaskId, usize)>>,
+    /// For every task of the cell, this robot's nodes for it (empty when it cannot do it).
+    pub alternatives: Vec<Vec<usize>>,
+    /// Lower-bound move times between nodes (s).
+    pub costs: CostMatrix,
+    /// The joint limits used for timing.
+    pub limits: Limits,
+}
+
+/// The joint limits of a robot.
+pub fn limits_of(robot: &Robot) -> Limits {
+    Limits::new(robot.max_velocity.clone(), robot.max_acceleration.clone())
+        .expect("the loader checks velocity and acceleration limits")
+}
+
+/// At most `k` of the configurations `qs` (their indices, ascending): the half nearest to
+/// `home` in move time (the natural arm postures, which short tours use), then the rest by
+/// farthest-point sampling in move time (different postures, for detours and for
+/// coordination). A task × robot pair has hundreds of candidates (poses × IK branches × ±2π
+/// turns), far more than sequencing needs; the kept ones span them.
+pub fn select(qs: &[&[f64]], home: &[f64], k: usize, limits: &Limits) -> Vec<usize> {
+    if qs.len() <= k {
+        return (0..qs.len()).collect();
+    }
+    let mut order: Vec<(f64, usize)> = qs
+        .iter()
+        .enumerate()
+        .map(|(i, q)| (move_time(home, q, limits), i))
+        .collect();
+    order.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+    let near = k.div_ceil(2);
+    let mut chosen: Vec<usize> = order[..near].iter().map(|x| x.1).collect();
+    let mut dist: Vec<f64> = qs
+        .iter()
+        .map(|q| {
+            chosen
+                .iter()
+                .map(|&c| move_time(qs[c], q, limits))
+                .fold(f64::INFINITY, f64::min)
+        })
+        .collect();
+    while chosen.len() < k {
+        let (far, d) =
+            dist.iter().enumerate().fold(
+                (0, f64::NEG_INFINITY),
+                |best, (i, &d)| if d > best.1 { (i, d) } else { best },
+            );
+        if d <= 0.0 {
+            break;
+        }
+        chosen.push(far);
+        for (i, q) in qs.iter().enumerate() {
+            dist[i] = dist[i].min(move_time(qs[far], q, limits));
+        }
+    }
+    chosen.sort_unstable();
+    chosen
+}
+
+impl RobotGraph {
+    /// The graph of `robot` over the candidates of `table`, at most `per_task` per task (see
+    /// [`select`]).
+    pub fn new(robot: &Robot, table: &CandidateTable, model: MoveModel, per_task: usize) -> Self {
+        let limits = limits_of(robot);
+        let time = match model {
+            MoveModel::Trapezoid => move_time,
+            MoveModel::Instant => move_time_instant,
+        };
+        let mut q = vec![robot.home.clone()];
+        let mut node_task = vec![None];
+        let mut alternatives = vec![Vec::new(); table.table.len()];
+        for (t, row) in table.table.iter().enumerate() {
+            let cands = &row[robot.id.0].candidates;
+            let all: Vec<&[f64]> = cands.iter().map(|c| c.q.as_slice()).collect();
+            for c in select(&all, &robot.home, per_task, &limits) {
+                alternatives[t].push(q.len());
+                q.push(cands[c].q.clone());
+                node_task.push(Some((TaskId(t), c)));
+            }
+        }
+        let costs = CostMatrix::from_fn(
+            q.len(),
+            |i, j| if i == j { 0.0 } else { time(&q[i], &q[j], &limits) },
+        );
+        RobotGraph {
+            q,
+            node_task,
+            alternatives,
+            costs,
+            limits,
+        }
+    }
+
+    /// Number of nodes.
+    pub fn len(&self) -> usize {
+        self.q.len()
+    }
+
+    /// Whether there is only the home.
+    pub fn is_empty(&self) -> bool {
+        self.q.len() <= 1
+    }
+}

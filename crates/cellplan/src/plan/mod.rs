@@ -1,0 +1,231 @@
+//! `cellplan plan`: allocation, sequencing, collision-free motion and timing (paper 000 §3–§4.1,
+//! with paper 002's lazy path costs). Stages, each a function of plain data:
+//!
+//! 1. [`graph`]: per robot, home and candidates with lower-bound move times between them;
+//! 2. [`allocate`]: which robot measures which MP (proximity, local-robust, balanced);
+//! 3. [`sequence`]: per robot, the order and candidates as a GTSP, legs planned lazily;
+//! 4. timing: every leg timed under the joint limits, a dwell for each measurement;
+//! 5. [`output`]: the [`output::Plan`] document.
+pub mod allocate;
+pub mod graph;
+pub mod output;
+pub mod sequence;
+
+pub use allocate::{Allocation, CoverMethod};
+pub use graph::MoveModel;
+pub use output::Plan;
+
+use crate::Cell;
+use crate::candidates::CandidateTable;
+use crate::model::tasks::TaskId;
+use cellplan_motion::plan::PlanSettings as MotionSettings;
+use cellplan_motion::timing::{Trajectory, time_path_exact};
+use graph::RobotGraph;
+use rayon::prelude::*;
+use std::time::{Duration, Instant};
+
+/// Knobs of a planning run.
+#[derive(Clone, Debug)]
+pub struct PlanSettings {
+    /// Allocation strategy.
+    pub allocation: Allocation,
+    /// Set-cover method of the local-robust strategy.
+    pub cover: CoverMethod,
+    /// Move-time model of the lower-bound costs.
+    pub move_model: MoveModel,
+    /// Seed of every random choice.
+    pub seed: u64,
+    /// Budget of the search stages (allocation search and lazy sequencing); they also stop
+    /// after fixed iteration counts, so the plan only depends on the budget when it cuts.
+    pub time_limit: Duration,
+    /// ε of eq. 4 (m): MPs closer than this may form a local robust set.
+    pub local_set_radius: f64,
+    /// Kicks of the balanced strategy's min-max search.
+    pub balanced_iterations: usize,
+    /// Candidates kept per task and robot for sequencing (see [`graph::select`]).
+    pub alternatives: usize,
+    /// Settings of every leg's path planner (its seed is derived per leg).
+    pub motion: MotionSettings,
+    /// Time step of the trajectory samples written to the plan (s).
+    pub sample_dt: f64,
+}
+
+impl Default for PlanSettings {
+    fn default() -> Self {
+        PlanSettings {
+            allocation: Allocation::Balanced,
+            cover: CoverMethod::Penalty,
+            move_model: MoveModel::Trapezoid,
+            seed: 0,
+            time_limit: Duration::from_secs(30),
+            local_set_radius: 0.3,
+            balanced_iterations: 300,
+            alternatives: 24,
+            motion: MotionSettings {
+                time_limit: Duration::from_secs(30),
+                ..MotionSettings::default()
+            },
+            sample_dt: 0.02,
+        }
+    }
+}
+
+/// Why no plan.
+#[derive(Debug, Clone, thiserror::Error)]
+pub enum PlanError {
+    /// The cell's constraints admit no allocation (e.g. task caps too small).
+    #[error("{0}")]
+    Infeasible(String),
+    /// A leg has no collision-free path.
+    #[error("{0}")]
+    NoPath(String),
+    /// Timing failed (should not happen on a planner's path).
+    #[error("timing: {0}")]
+    Timing(String),
+}
+
+/// The stages, for progress reports.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Stage {
+    /// Lower-bound move times between candidates.
+    Costs,
+    /// Allocation.
+    Allocation,
+    /// Sequencing with lazy motion planning.
+    Sequencing,
+    /// Time parameterisation and assembly.
+    Timing,
+}
+
+impl Stage {
+    /// Name in reports and in `compute_s`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Stage::Costs => "costs",
+            Stage::Allocation => "allocation",
+            Stage::Sequencing => "sequencing_motion",
+            Stage::Timing => "timing",
+        }
+    }
+}
+
+/// One robot's timed result, before it is written out.
+#[derive(Clone, Debug)]
+pub struct RobotResult {
+    /// The sequence with its legs.
+    pub sequence: sequence::Sequence,
+    /// The whole trajectory, home to home, with the dwells.
+    pub trajectory: Trajectory,
+    /// (arrive, depart) times at each visited node, in order.
+    pub visits: Vec<(f64, f64)>,
+    /// Time moving (s).
+    pub motion: f64,
+    /// Time measuring (s).
+    pub measuring: f64,
+}
+
+/// Everything a run produced.
+#[derive(Clone, Debug)]
+pub struct Outcome {
+    /// Per robot graphs.
+    pub graphs: Vec<RobotGraph>,
+    /// The allocation.
+    pub allocated: allocate::Allocated,
+    /// Per robot results.
+    pub robots: Vec<RobotResult>,
+    /// Seconds per stage, in stage order.
+    pub compute: Vec<(Stage, f64)>,
+}
+
+/// Plan `cell` from its candidate table. `progress` is told when each stage starts.
+pub fn plan(
+    cell: &Cell,
+    table: &CandidateTable,
+    settings: &PlanSettings,
+    progress: &(dyn Fn(Stage) + Sync),
+) -> Result<Outcome, PlanError> {
+    let started = Instant::now();
+    let deadline = started + settings.time_limit;
+    let mut compute = Vec::new();
+    let mut lap = Instant::now();
+    let mut tick = |stage: Stage, compute: &mut Vec<(Stage, f64)>| {
+        compute.push((stage, lap.elapsed().as_secs_f64()));
+        lap = Instant::now();
+    };
+
+    progress(Stage::Costs);
+    let graphs: Vec<RobotGraph> = cell
+        .robots
+        .par_iter()
+        .map(|r| RobotGraph::new(r, table, settings.move_model, settings.alternatives))
+        .collect();
+    tick(Stage::Costs, &mut compute);
+
+    progress(Stage::Allocation);
+    let allocated = allocate::allocate(cell, table, &graphs, settings)?;
+    tick(Stage::Allocation, &mut compute);
+
+    progress(Stage::Sequencing);
+    let sequences: Vec<sequence::Sequence> = cell
+        .robots
+        .par_iter()
+        .zip(&graphs)
+        .zip(&allocated.tasks)
+        .map(|((robot, graph), tasks)| sequence::sequence(cell, robot, graph, tasks, settings, deadline))
+        .collect::<Result<_, _>>()?;
+    tick(Stage::Sequencing, &mut compute);
+
+    progress(Stage::Timing);
+    let measure = cell.optical().measure_time;
+    let mut robots = Vec::with_capacity(sequences.len());
+    for (seq, graph) in sequences.into_iter().zip(&graphs) {
+        robots.push(assemble(seq, graph, measure)?);
+    }
+    tick(Stage::Timing, &mut compute);
+    Ok(Outcome {
+        graphs,
+        allocated,
+        robots,
+        compute,
+    })
+}
+
+/// Time every leg and put legs and dwells on one trajectory.
+fn assemble(seq: sequence::Sequence, graph: &RobotGraph, measure: f64) -> Result<RobotResult, PlanError> {
+    let mut parts = Vec::with_capacity(2 * seq.legs.len());
+    let mut visits = Vec::with_capacity(seq.nodes.len());
+    let (mut t, mut motion, mut measuring) = (0.0, 0.0, 0.0);
+    for (i, leg) in seq.legs.iter().enumerate() {
+        let timed =
+            time_path_exact(&leg.waypoints, &graph.limits).map_err(|e| PlanError::Timing(e.to_string()))?;
+        let d = timed.trajectory.duration();
+        t += d;
+        motion += d;
+        parts.push(timed.trajectory);
+        if let Some(&node) = seq.nodes.get(i) {
+            visits.push((t, t + measure));
+            parts.push(Trajectory::dwell(&graph.q[node], measure));
+            t += measure;
+            measuring += measure;
+        }
+    }
+    let trajectory = Trajectory::concat(&parts).map_err(|e| PlanError::Timing(e.to_string()))?;
+    Ok(RobotResult {
+        sequence: seq,
+        trajectory,
+        visits,
+        motion,
+        measuring,
+    })
+}
+
+/// The tasks of a robot in visiting order.
+pub fn visited_tasks(outcome: &Outcome, robot: usize) -> Vec<TaskId> {
+    let g = &outcome.graphs[robot];
+    outcome.robots[robot]
+        .sequence
+        .nodes
+        .iter()
+        .filter_map(|&n| g.node_task[n].map(|(t, _)| t))
+        .collect()
+}

@@ -1,0 +1,235 @@
+//! Sequencing with lazy path costs (paper 002 §2.1): each robot's tasks as a GTSP over its
+//! candidates, home → tasks → home, first on the lower-bound move times; the legs the sequence
+//! uses are planned (collision-free path, timed under the limits) and their real times replace
+//! the bounds; re-sequence until the sequence uses only planned legs, or the budget ends.
+use super::graph::RobotGraph;
+use super::{PlanError, PlanSettings};
+use crate::Cell;
+use crate::model::robot::Robot;
+use crate::model::tasks::TaskId;
+use cellplan_motion::plan::PlanSettings as MotionSettings;
+use cellplan_motion::timing::time_path_exact;
+use cellplan_solve::{CostMatrix, Gtsp, GtspParams};
+use rayon::prelude::*;
+use std::collections::BTreeMap;
+use std::time::{Duration, Instant};
+
+/// A planned leg between two nodes of a robot graph.
+#[derive(Clone, Debug)]
+pub struct Leg {
+    /// The collision-free joint path (waypoints, straight segments between them).
+    pub waypoints: Vec<Vec<f64>>,
+    /// Time to drive it from rest to rest under the limits (s).
+    pub duration: f64,
+    /// Whether it is the direct segment.
+    pub straight: bool,
+    /// Random samples a sampling planner drew for it.
+    pub samples: usize,
+}
+
+/// One robot's sequence.
+#[derive(Clone, Debug, Default)]
+pub struct Sequence {
+    /// Nodes visited in order (home excluded).
+    pub nodes: Vec<usize>,
+    /// Legs: home → first, …, last → home (one leg home → home when there are no tasks).
+    pub legs: Vec<Leg>,
+    /// Sequencing rounds.
+    pub rounds: usize,
+    /// Legs planned (each pair once).
+    pub legs_planned: usize,
+    /// Of those, legs that needed the sampling planner.
+    pub legs_sampled: usize,
+    /// Legs for which no path was found (their nodes were avoided).
+    pub legs_failed: usize,
+}
+
+/// Kicks of the GTSP heuristic per sequencing round (fixed, for determinism).
+const GTSP_ITERATIONS: usize = 400;
+/// Sequencing rounds at most.
+const MAX_ROUNDS: usize = 12;
+/// Cost of a leg no path was found for: large enough never to be chosen when another exists.
+const NO_PATH: f64 = 1e6;
+
+type Planned = BTreeMap<(usize, usize), Result<Leg, String>>;
+
+/// Sequence `tasks` for `robot` with lazily planned legs.
+pub fn sequence(
+    cell: &Cell,
+    robot: &Robot,
+    graph: &RobotGraph,
+    tasks: &[TaskId],
+    settings: &PlanSettings,
+    deadline: Instant,
+) -> Result<Sequence, PlanError> {
+    let measure = cell.optical().measure_time;
+    let mut planned: Planned = BTreeMap::new();
+    let mut out = Sequence::default();
+    let mut nodes: Vec<usize>;
+    loop {
+        out.rounds += 1;
+        nodes = solve_order(graph, tasks, &planned, measure, settings.seed ^ robot.id.0 as u64);
+        let legs = legs_of(&nodes);
+        let new: Vec<(usize, usize)> = legs
+            .iter()
+            .copied()
+            .filter(|&(a, b)| !planned.contains_key(&key(a, b)))
+            .map(|(a, b)| key(a, b))
+            .collect::<std::collections::BTreeSet<_>>()
+            .into_iter()
+            .collect();
+        if new.is_empty() {
+            break;
+        }
+        let results: Vec<((usize, usize), Result<Leg, String>)> = new
+            .par_iter()
+            .map(|&(a, b)| ((a, b), plan_leg(cell, robot, graph, a, b, settings)))
+            .collect();
+        for (k, r) in results {
+            match &r {
+                Ok(leg) => {
+                    out.legs_planned += 1;
+                    out.legs_sampled += usize::from(!leg.straight);
+                }
+                Err(_) => out.legs_failed += 1,
+            }
+            planned.insert(k, r);
+        }
+        if out.rounds >= MAX_ROUNDS || Instant::now() >= deadline {
+            // Keep this order; every leg of it is planned now.
+            break;
+        }
+    }
+    let mut legs = Vec::new();
+    for (a, b) in legs_of(&nodes) {
+        let leg = match planned.get(&key(a, b)) {
+            Some(Ok(leg)) => leg.clone(),
+            Some(Err(e)) => {
+                return Err(PlanError::NoPath(format!(
+                    "robot {}: no collision-free path from {} to {}: {e}",
+                    robot.name,
+                    node_name(cell, graph, a),
+                    node_name(cell, graph, b)
+                )));
+            }
+            None => unreachable!("every leg of the final order is planned"),
+        };
+        legs.push(if (a, b) == key(a, b) { leg } else { reversed(leg) });
+    }
+    out.nodes = nodes;
+    out.legs = legs;
+    Ok(out)
+}
+
+fn key(a: usize, b: usize) -> (usize, usize) {
+    (a.min(b), a.max(b))
+}
+
+fn reversed(mut leg: Leg) -> Leg {
+    leg.waypoints.reverse();
+    leg
+}
+
+fn legs_of(nodes: &[usize]) -> Vec<(usize, usize)> {
+    let mut out = Vec::with_capacity(nodes.len() + 1);
+    let mut prev = 0;
+    for &n in nodes {
+        out.push((prev, n));
+        prev = n;
+    }
+    out.push((prev, 0));
+    out
+}
+
+/// A readable name for a node: "home" or "MP <id> (candidate c)".
+pub fn node_name(cell: &Cell, graph: &RobotGraph, node: usize) -> String {
+    match graph.node_task[node] {
+        None => "home".to_string(),
+        Some((t, c)) => format!("MP {} (candidate {c})", cell.tasks[t.0].name),
+    }
+}
+
+/// The best order (GTSP over the tasks' candidates) under the current costs: planned legs at
+/// their real time, the others at their lower bound.
+fn solve_order(
+    graph: &RobotGraph,
+    tasks: &[TaskId],
+    planned: &Planned,
+    measure: f64,
+    seed: u64,
+) -> Vec<usize> {
+    if tasks.is_empty() {
+        return Vec::new();
+    }
+    let mut local = vec![0usize];
+    let mut clusters = Vec::with_capacity(tasks.len());
+    for t in tasks {
+        let mut cl = Vec::new();
+        for &n in &graph.alternatives[t.0] {
+            cl.push(local.len());
+            local.push(n);
+        }
+        clusters.push(cl);
+    }
+    let cost = |a: usize, b: usize| match planned.get(&key(a, b)) {
+        Some(Ok(leg)) => leg.duration,
+        Some(Err(_)) => NO_PATH,
+        None => graph.costs.get(a, b),
+    };
+    let costs = CostMatrix::from_fn(
+        local.len(),
+        |i, j| if i == j { 0.0 } else { cost(local[i], local[j]) },
+    );
+    let service = (0..local.len())
+        .map(|i| if i == 0 { 0.0 } else { measure })
+        .collect();
+    let g = Gtsp::new(costs, clusters)
+        .and_then(|g| g.with_depots(Some(0), None))
+        .and_then(|g| g.with_service(service))
+        .expect("every allocated task has candidates");
+    let sol = cellplan_solve::solve_gtsp(
+        &g,
+        &GtspParams {
+            time_limit: Duration::from_secs(600),
+            seed,
+            max_iterations: Some(GTSP_ITERATIONS),
+            ..GtspParams::default()
+        },
+    );
+    sol.tour.nodes.iter().map(|&i| local[i]).collect()
+}
+
+fn plan_leg(
+    cell: &Cell,
+    robot: &Robot,
+    graph: &RobotGraph,
+    a: usize,
+    b: usize,
+    settings: &PlanSettings,
+) -> Result<Leg, String> {
+    let motion = MotionSettings {
+        seed: leg_seed(settings.seed, robot.id.0, a, b),
+        ..settings.motion.clone()
+    };
+    let path =
+        crate::motion::plan_leg(cell, robot, &graph.q[a], &graph.q[b], &motion).map_err(|e| e.to_string())?;
+    let timed = time_path_exact(&path.waypoints, &graph.limits).map_err(|e| e.to_string())?;
+    Ok(Leg {
+        waypoints: path.waypoints,
+        duration: timed.trajectory.duration(),
+        straight: path.straight,
+        samples: path.samples,
+    })
+}
+
+/// A seed per leg, so that a leg's path does not depend on which thread plans it or when.
+fn leg_seed(seed: u64, robot: usize, a: usize, b: usize) -> u64 {
+    let mut h = 0xcbf2_9ce4_8422_2325u64;
+    for x in [seed, robot as u64, a as u64, b as u64] {
+        for byte in x.to_le_bytes() {
+            h ^= u64::from(byte);
+            h = h.wrapping_mul(0x0100_0000_01b3);
+        }
+    }
+    h
+}
