@@ -97,7 +97,10 @@ fn main() {
                 let time = (0..6).map(|k| (a[k] - b[k]).abs() / SPEED[k]).fold(0.0, f64::max);
                 let effort: f64 = (0..6).map(|k| (a[k] - b[k]).powi(2)).sum::<f64>().sqrt();
                 // Hundredths, as TSPLIB weights are integers.
-                format!("{}", ((30.0 * time + 5.0 * effort + weld_cost[j]) * 100.0).round() as i64)
+                format!(
+                    "{}",
+                    ((30.0 * time + 5.0 * effort + weld_cost[j]) * 100.0).round() as i64
+                )
             })
             .collect();
         println!("{}", row.join(" "));
