@@ -222,3 +222,35 @@ fn blocked_leg_is_solved_by_rrt_connect() {
         path.validity_calls
     );
 }
+
+#[test]
+fn accepted_segments_pass_the_dense_recheck() {
+    let f = fixture();
+    let cell = &f.cell;
+    let mut rng = ChaCha8Rng::seed_from_u64(3);
+    let s = PlanSettings::default();
+    let (mut accepted, mut refused) = (0, 0);
+    for robot in &cell.robots {
+        let space = joint_space(cell, robot);
+        let v = RobotValidity::new(cell, robot, margin(cell));
+        // From home or a candidate to a random valid configuration.
+        let mut starts = vec![robot.home.clone()];
+        starts.extend(f.candidates[robot.id.0].iter().take(4).cloned());
+        for a in &starts {
+            for _ in 0..6 {
+                let b = random_q(robot, &mut rng);
+                if v.clearance(&b) <= s.min_clearance || v.clearance(a) <= s.min_clearance {
+                    continue;
+                }
+                let check = cellplan_motion::plan::check_segment(&space, &v, a, &b, s.min_clearance);
+                if check.valid {
+                    dense_contact_free(cell, robot, &[a.clone(), b]).unwrap();
+                    accepted += 1;
+                } else {
+                    refused += 1;
+                }
+            }
+        }
+    }
+    assert!(accepted >= 5 && refused >= 5, "{accepted} {refused}");
+}
