@@ -44,8 +44,14 @@ pub struct PlanSettings {
     pub balanced_iterations: usize,
     /// Candidates kept per task and robot for sequencing (see [`graph::select`]).
     pub alternatives: usize,
-    /// Settings of every leg's path planner (its seed is derived per leg).
+    /// Settings of every leg's path planner (its seed is derived per leg); its shortcut
+    /// iterations apply while the lazy loop ranks orders.
     pub motion: MotionSettings,
+    /// Shortcut iterations for the sampled legs of the final orders.
+    pub final_shortcut_iterations: usize,
+    /// Sample budget for legs of the final orders that the lazy rounds' budget
+    /// (`motion.max_samples`) did not solve.
+    pub final_max_samples: usize,
     /// Time step of the trajectory samples written to the plan (s).
     pub sample_dt: f64,
 }
@@ -63,8 +69,12 @@ impl Default for PlanSettings {
             alternatives: 24,
             motion: MotionSettings {
                 time_limit: Duration::from_secs(30),
+                shortcut_iterations: 10,
+                max_samples: 200,
                 ..MotionSettings::default()
             },
+            final_shortcut_iterations: 100,
+            final_max_samples: 20_000,
             sample_dt: 0.02,
         }
     }

@@ -25,6 +25,10 @@ pub struct Leg {
     pub straight: bool,
     /// Random samples a sampling planner drew for it.
     pub samples: usize,
+    /// Validity (clearance) calls spent on it.
+    pub validity_calls: usize,
+    /// Seconds spent planning it (one thread).
+    pub compute_s: f64,
 }
 
 /// One robot's sequence.
@@ -99,6 +103,54 @@ pub fn sequence(
             // Keep this order; every leg of it is planned now.
             break;
         }
+    }
+    // Legs of the final order the quick planner gave up on get the full search budget.
+    let retry: Vec<(usize, usize)> = legs_of(&nodes)
+        .into_iter()
+        .map(|(a, b)| key(a, b))
+        .filter(|k| matches!(planned.get(k), Some(Err(_))))
+        .collect::<std::collections::BTreeSet<_>>()
+        .into_iter()
+        .collect();
+    let retried: Vec<((usize, usize), Result<Leg, String>)> = retry
+        .par_iter()
+        .map(|&(a, b)| {
+            let full = PlanSettings {
+                motion: MotionSettings {
+                    max_samples: settings.final_max_samples,
+                    ..settings.motion.clone()
+                },
+                ..settings.clone()
+            };
+            ((a, b), plan_leg(cell, robot, graph, a, b, &full))
+        })
+        .collect();
+    for (k, r) in retried {
+        if r.is_ok() {
+            out.legs_failed -= 1;
+            out.legs_planned += 1;
+            out.legs_sampled += 1;
+        }
+        planned.insert(k, r);
+    }
+    // The final order's sampled legs get the full shortcutting (the lazy rounds used a few
+    // iterations per leg, enough to rank orders).
+    let finals: Vec<(usize, usize)> = legs_of(&nodes)
+        .into_iter()
+        .map(|(a, b)| key(a, b))
+        .filter(|k| matches!(planned.get(k), Some(Ok(leg)) if !leg.straight))
+        .collect::<std::collections::BTreeSet<_>>()
+        .into_iter()
+        .collect();
+    let polished: Vec<((usize, usize), Leg)> = finals
+        .par_iter()
+        .filter_map(|k| match planned.get(k) {
+            Some(Ok(leg)) => Some((*k, polish(cell, robot, graph, k, leg.clone(), settings))),
+            _ => None,
+        })
+        .collect();
+    for (k, leg) in polished {
+        planned.insert(k, Ok(leg));
     }
     let mut legs = Vec::new();
     for (a, b) in legs_of(&nodes) {
@@ -199,6 +251,33 @@ fn solve_order(
     sol.tour.nodes.iter().map(|&i| local[i]).collect()
 }
 
+/// Shortcut a sampled leg with the full iteration count; keep it if it is faster.
+fn polish(
+    cell: &Cell,
+    robot: &Robot,
+    graph: &RobotGraph,
+    k: &(usize, usize),
+    mut leg: Leg,
+    settings: &PlanSettings,
+) -> Leg {
+    let space = crate::motion::joint_space(cell, robot);
+    let validity = crate::motion::RobotValidity::new(cell, robot, cell.optical().clearance);
+    let motion = MotionSettings {
+        seed: leg_seed(settings.seed, robot.id.0, k.0, k.1) ^ 1,
+        shortcut_iterations: settings.final_shortcut_iterations,
+        ..settings.motion.clone()
+    };
+    let mut waypoints = leg.waypoints.clone();
+    cellplan_motion::plan::shortcut(&space, &validity, &mut waypoints, &motion);
+    if let Ok(timed) = time_path_exact(&waypoints, &graph.limits)
+        && timed.trajectory.duration() < leg.duration
+    {
+        leg.duration = timed.trajectory.duration();
+        leg.waypoints = waypoints;
+    }
+    leg
+}
+
 fn plan_leg(
     cell: &Cell,
     robot: &Robot,
@@ -207,6 +286,7 @@ fn plan_leg(
     b: usize,
     settings: &PlanSettings,
 ) -> Result<Leg, String> {
+    let started = Instant::now();
     let motion = MotionSettings {
         seed: leg_seed(settings.seed, robot.id.0, a, b),
         ..settings.motion.clone()
@@ -219,6 +299,8 @@ fn plan_leg(
         duration: timed.trajectory.duration(),
         straight: path.straight,
         samples: path.samples,
+        validity_calls: path.validity_calls,
+        compute_s: started.elapsed().as_secs_f64(),
     })
 }
 

@@ -1,0 +1,242 @@
+//! `cellplan plan` through the library on a reduced copy of the two-robot example (its first 8
+//! MPs): every plan is re-checked here, independently of the planner — every MP measured
+//! exactly once at a pose that meets the probe constraints, every leg re-sampled finely (joint
+//! steps of 1 mrad) against the static scene at the margin, joint position, velocity and
+//! acceleration limits from the written samples, the document's totals recomputed.
+use cellplan::candidates::{CandidateTable, generate};
+use cellplan::model::load::load;
+use cellplan::model::robot::Scratch;
+use cellplan::plan::{self, Allocation, PlanSettings, output};
+use cellplan::{Cell, LoadOptions, TaskId};
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::sync::OnceLock;
+
+/// The two-robot example with only its first `n` MPs, written to a temporary folder.
+fn small_cell(n: usize) -> PathBuf {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../..")
+        .canonicalize()
+        .unwrap();
+    let example = root.join("examples/autobody-2r");
+    let dir = std::env::temp_dir().join(format!("cellplan-plan-test-{}-{n}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let text = std::fs::read_to_string(example.join("cell.toml")).unwrap();
+    let text = text
+        .replace("../../data", &root.join("data").display().to_string())
+        .replace("name = \"autobody-2r\"", "name = \"autobody-2r-small\"");
+    std::fs::write(dir.join("cell.toml"), text).unwrap();
+    let tasks = std::fs::read_to_string(example.join("tasks.csv")).unwrap();
+    let mut lines = tasks.lines().filter(|l| !l.starts_with('#'));
+    let mut out = String::new();
+    for l in lines.by_ref().take(n + 1) {
+        out += l;
+        out += "\n";
+    }
+    std::fs::write(dir.join("tasks.csv"), out).unwrap();
+    dir.join("cell.toml")
+}
+
+struct Fixture {
+    cell: Cell,
+    table: CandidateTable,
+}
+
+fn fixture() -> &'static Fixture {
+    static F: OnceLock<Fixture> = OnceLock::new();
+    F.get_or_init(|| {
+        let cell = load(&small_cell(8), &LoadOptions::default()).expect("the reduced cell loads");
+        let table = generate(&cell);
+        Fixture { cell, table }
+    })
+}
+
+fn settings(allocation: Allocation) -> PlanSettings {
+    PlanSettings {
+        allocation,
+        alternatives: 8,
+        balanced_iterations: 60,
+        ..PlanSettings::default()
+    }
+}
+
+fn make(allocation: Allocation) -> output::Plan {
+    let f = fixture();
+    let s = settings(allocation);
+    let outcome = plan::plan(&f.cell, &f.table, &s, &|_| {}).expect("the reduced cell plans");
+    let doc = output::build(&f.cell, &f.table, &outcome, &s, 0.0, 0.0);
+    // The document survives its own JSON.
+    let text = serde_json::to_string(&doc).unwrap();
+    let back: output::Plan = serde_json::from_str(&text).unwrap();
+    assert_eq!(serde_json::to_string(&back).unwrap(), text);
+    check_plan(&f.cell, &doc);
+    doc
+}
+
+/// The independent re-check of a plan.
+fn check_plan(cell: &Cell, doc: &output::Plan) {
+    let process = cell.optical();
+    assert_eq!(doc.format, output::FORMAT);
+    assert_eq!(doc.robots.len(), cell.robots.len());
+    let by_name: BTreeMap<&str, usize> = cell.tasks.iter().map(|t| (t.name.as_str(), t.id.0)).collect();
+    let mut measured = vec![0usize; cell.tasks.len()];
+    let mut scratch = Scratch::default();
+    let mut times = Vec::new();
+    for (robot, rp) in cell.robots.iter().zip(&doc.robots) {
+        assert_eq!(rp.name, robot.name);
+        assert!(rp.tasks.len() <= process.task_cap, "{} over its cap", rp.name);
+        for v in &rp.tasks {
+            let t = &cell.tasks[by_name[v.task.as_str()]];
+            measured[t.id.0] += 1;
+            assert!(robot.within_limits(&v.q));
+            let tcp = robot.tcp_pose(&v.q);
+            assert!((tcp.translation - glam::DVec3::from(v.tcp.xyz)).length() < 1e-6);
+            let angle = process
+                .measurement(t, &tcp)
+                .unwrap_or_else(|r| panic!("{} does not measure {} from its pose: {r:?}", rp.name, v.task));
+            assert!((angle - v.view_angle_rad).abs() < 1e-6);
+            robot.body_poses(&v.q, &mut scratch);
+            assert!(
+                robot
+                    .contact_at(&cell.world, &scratch, process.clearance - 1e-6)
+                    .is_none()
+            );
+            assert!(v.depart_s - v.arrive_s >= process.measure_time - 1e-9);
+        }
+        // Legs: chained home → … → home, re-sampled at 1 mrad per joint step.
+        assert_eq!(rp.legs.len(), rp.tasks.len() + 1);
+        let mut at = rp.home.clone();
+        for (i, leg) in rp.legs.iter().enumerate() {
+            let to = rp.tasks.get(i).map_or(&rp.home, |v| &v.q);
+            assert!(
+                dist(&leg.waypoints[0], &at) < 1e-9,
+                "{} leg {i} starts elsewhere",
+                rp.name
+            );
+            assert!(
+                dist(leg.waypoints.last().unwrap(), to) < 1e-9,
+                "{} leg {i} ends elsewhere",
+                rp.name
+            );
+            for w in leg.waypoints.windows(2) {
+                let steps = (dist(&w[0], &w[1]) / 1e-3).ceil().max(1.0) as usize;
+                for s in 0..=steps {
+                    let f = s as f64 / steps as f64;
+                    let q: Vec<f64> = w[0].iter().zip(&w[1]).map(|(a, b)| a + f * (b - a)).collect();
+                    assert!(
+                        robot.within_limits(&q),
+                        "{} leg {i} leaves the joint limits",
+                        rp.name
+                    );
+                    robot.body_poses(&q, &mut scratch);
+                    assert!(
+                        robot
+                            .contact_at(&cell.world, &scratch, process.clearance - 1e-6)
+                            .is_none(),
+                        "{} leg {i} ({} → {}) comes closer than the clearance at {q:?}",
+                        rp.name,
+                        leg.from,
+                        leg.to
+                    );
+                }
+            }
+            at = to.clone();
+        }
+        // Samples: within limits; finite differences bound the mean velocity and acceleration.
+        let tr = &rp.trajectory;
+        assert!(tr.first().unwrap().t.abs() < 1e-12);
+        assert!((tr.last().unwrap().t - rp.total_s).abs() < 1e-9);
+        assert!(dist(&tr.first().unwrap().q, &rp.home) < 1e-9);
+        assert!(dist(&tr.last().unwrap().q, &rp.home) < 1e-9);
+        for s in tr {
+            assert!(robot.within_limits(&s.q));
+        }
+        for w in tr.windows(3) {
+            let (h1, h2) = (w[1].t - w[0].t, w[2].t - w[1].t);
+            for j in 0..robot.dof() {
+                let v = (w[1].q[j] - w[0].q[j]) / h1;
+                assert!(
+                    v.abs() <= robot.max_velocity[j] * (1.0 + 1e-6),
+                    "{} joint {j} too fast",
+                    rp.name
+                );
+                if (h1 - h2).abs() < 1e-9 {
+                    let a = (w[2].q[j] - 2.0 * w[1].q[j] + w[0].q[j]) / (h1 * h1);
+                    assert!(
+                        a.abs() <= robot.max_acceleration[j] * (1.0 + 1e-6),
+                        "{} joint {j} accelerates too hard",
+                        rp.name
+                    );
+                }
+            }
+        }
+        times.push(rp.total_s);
+    }
+    // Every measurable MP exactly once; the others listed as unmeasured.
+    let unmeasured: Vec<&str> = doc.unmeasured.iter().map(|u| u.task.as_str()).collect();
+    for t in &cell.tasks {
+        let want = usize::from(!unmeasured.contains(&t.name.as_str()));
+        assert_eq!(
+            measured[t.id.0], want,
+            "MP {} measured {} times",
+            t.name, measured[t.id.0]
+        );
+    }
+    let cycle = times.iter().copied().fold(0.0, f64::max);
+    assert!((doc.cycle_time_s - cycle).abs() < 1e-9);
+    let spread = cycle - times.iter().copied().fold(f64::INFINITY, f64::min);
+    assert!((doc.delta_t_s - spread).abs() < 1e-9);
+    assert!(doc.lower_bound_s > 0.0 && doc.lower_bound_s <= doc.cycle_time_s + 1e-9);
+}
+
+fn dist(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| (x - y).powi(2)).sum::<f64>().sqrt()
+}
+
+#[test]
+fn every_strategy_gives_a_plan_that_rechecks_clean() {
+    let f = fixture();
+    let prox = make(Allocation::Proximity);
+    // Proximity: every MP with the nearest robot able to measure it (the caps do not bind here).
+    for (r, rp) in prox.robots.iter().enumerate() {
+        for v in &rp.tasks {
+            let t = f.cell.tasks.iter().find(|t| t.name == v.task).unwrap();
+            let d = |i: usize| (f.cell.robots[i].base.translation - t.position).length();
+            for other in f.table.robots_for(t.id) {
+                assert!(
+                    d(r) <= d(other.0) + 1e-12,
+                    "MP {} is not with its nearest robot",
+                    v.task
+                );
+            }
+        }
+    }
+    let robust = make(Allocation::LocalRobust);
+    assert!(robust.stats.local_sets_built >= robust.stats.local_sets_chosen);
+    let balanced = make(Allocation::Balanced);
+    for doc in [&prox, &robust, &balanced] {
+        assert!(doc.stats.legs_planned >= doc.robots.iter().map(|r| r.legs.len()).sum::<usize>() / 2);
+    }
+}
+
+#[test]
+fn the_plan_does_not_depend_on_the_thread_count() {
+    let f = fixture();
+    let s = settings(Allocation::Balanced);
+    let run = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| {
+            let outcome = plan::plan(&f.cell, &f.table, &s, &|_| {}).unwrap();
+            let mut doc = output::build(&f.cell, &f.table, &outcome, &s, 0.0, 0.0);
+            doc.compute_s = output::ComputeTimes::default();
+            doc
+        })
+    };
+    let one = run(1);
+    check_plan(&f.cell, &one);
+    assert_eq!(one, run(2));
+    let _ = TaskId(0);
+}
