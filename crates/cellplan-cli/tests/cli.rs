@@ -870,3 +870,89 @@ fn bench_minmax_refuses_a_malformed_instance() {
     assert!(stderr.contains("bad.txt:14"), "{stderr}");
     assert!(stderr.contains("out of range"), "{stderr}");
 }
+
+#[test]
+fn plan_writes_a_plan_and_a_stable_summary() {
+    let dir = scratch("plan");
+    small_cell(&dir);
+    let cell = dir.join("cell.toml");
+    let out_dir = dir.join("out");
+    let out = cellplan(
+        &[
+            "plan",
+            cell.to_str().unwrap(),
+            "-o",
+            out_dir.to_str().unwrap(),
+            "--json",
+        ],
+        &dir,
+    );
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let summary: Value = serde_json::from_slice(&out.stdout).unwrap();
+    for key in [
+        "cycle_time_s",
+        "delta_t_s",
+        "lower_bound_s",
+        "robots",
+        "unmeasured",
+        "compute_s",
+    ] {
+        assert!(summary.get(key).is_some(), "summary lacks {key}");
+    }
+    let robots = summary["robots"].as_array().unwrap();
+    assert_eq!(robots.len(), 1);
+    assert_eq!(robots[0]["name"], "R1");
+    assert_eq!(robots[0]["tasks"], 3);
+    let cycle = summary["cycle_time_s"].as_f64().unwrap();
+    assert!(cycle >= summary["lower_bound_s"].as_f64().unwrap() - 1e-9);
+    assert!((robots[0]["total_s"].as_f64().unwrap() - cycle).abs() < 1e-9);
+    // Three measurements at the default 1.5 s, plus motion.
+    assert!(cycle > 4.5);
+    let plan: Value = serde_json::from_slice(&std::fs::read(out_dir.join("plan.json")).unwrap()).unwrap();
+    assert_eq!(plan["format"], "cellplan-plan");
+    assert_eq!(plan["version"], 1);
+    assert_eq!(plan["robots"][0]["tasks"].as_array().unwrap().len(), 3);
+    assert_eq!(plan["robots"][0]["legs"].as_array().unwrap().len(), 4);
+    // The same seed gives the same plan, whatever the thread count.
+    let again = dir.join("again");
+    let out = cellplan(
+        &[
+            "--threads",
+            "1",
+            "plan",
+            cell.to_str().unwrap(),
+            "-o",
+            again.to_str().unwrap(),
+            "-q",
+        ],
+        &dir,
+    );
+    assert!(out.status.success());
+    let second: Value = serde_json::from_slice(&std::fs::read(again.join("plan.json")).unwrap()).unwrap();
+    assert_eq!(plan["robots"], second["robots"]);
+}
+
+#[test]
+fn plan_refuses_caps_that_cannot_hold_the_tasks() {
+    let dir = scratch("plan-cap");
+    let (cell, _) = small_cell(&dir);
+    std::fs::write(
+        dir.join("cell.toml"),
+        cell.replace("baseline = 100", "baseline = 100\ntask_cap = 2"),
+    )
+    .unwrap();
+    let out_dir = dir.join("out");
+    let out = cellplan(
+        &[
+            "plan",
+            dir.join("cell.toml").to_str().unwrap(),
+            "-o",
+            out_dir.to_str().unwrap(),
+        ],
+        &dir,
+    );
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("cell.toml") && err.contains("task_cap"), "{err}");
+    assert!(!out_dir.join("plan.json").exists());
+}
