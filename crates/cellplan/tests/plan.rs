@@ -240,3 +240,49 @@ fn the_plan_does_not_depend_on_the_thread_count() {
     assert_eq!(one, run(2));
     let _ = TaskId(0);
 }
+
+/// Every key the schema requires is in a written plan, at every level.
+#[test]
+fn written_plans_have_every_key_the_schema_requires() {
+    let schema: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("../../docs/plan.schema.json"))
+            .unwrap(),
+    )
+    .unwrap();
+    let f = fixture();
+    let s = PlanSettings {
+        allocation: Allocation::Proximity,
+        ..settings(Allocation::Proximity)
+    };
+    let outcome = plan::plan(&f.cell, &f.table, &s, &|_| {}).unwrap();
+    let doc = serde_json::to_value(output::build(&f.cell, &f.table, &outcome, &s, 0.0, 0.0)).unwrap();
+    fn required(schema: &serde_json::Value, value: &serde_json::Value, root: &serde_json::Value, at: &str) {
+        let schema = match schema.get("$ref").and_then(|r| r.as_str()) {
+            Some(r) => root.pointer(r.trim_start_matches('#')).unwrap(),
+            None => schema,
+        };
+        if let Some(keys) = schema.get("required").and_then(|r| r.as_array()) {
+            for k in keys {
+                let k = k.as_str().unwrap();
+                assert!(value.get(k).is_some(), "{at} lacks `{k}`");
+            }
+        }
+        if let (Some(props), Some(obj)) = (
+            schema.get("properties").and_then(|p| p.as_object()),
+            value.as_object(),
+        ) {
+            for (k, sub) in props {
+                if let Some(v) = obj.get(k) {
+                    required(sub, v, root, &format!("{at}.{k}"));
+                }
+            }
+        }
+        if let (Some(items), Some(arr)) = (schema.get("items"), value.as_array()) {
+            for (i, v) in arr.iter().enumerate() {
+                required(items, v, root, &format!("{at}[{i}]"));
+            }
+        }
+    }
+    required(&schema, &doc, &schema, "plan");
+    assert_eq!(doc["version"], schema["properties"]["version"]["const"]);
+}
