@@ -32,6 +32,12 @@ pub struct PlanArgs {
     /// ε of paper 000 eq. 4 in metres: MPs closer than this may share a local robust set.
     #[arg(long, value_name = "M", default_value_t = 0.3)]
     local_set_radius: f64,
+    /// Most sequencing rounds of the lazy loop per robot (each plans the legs its order uses).
+    #[arg(long, value_name = "N", default_value_t = PlanSettings::default().lazy_rounds)]
+    lazy_rounds: usize,
+    /// Re-allocations of `balanced` on the leg times learnt while sequencing.
+    #[arg(long, value_name = "N", default_value_t = PlanSettings::default().reallocation_rounds)]
+    reallocation_rounds: usize,
     /// No progress output and no table.
     #[arg(long, short)]
     quiet: bool,
@@ -143,6 +149,8 @@ pub fn run(args: &PlanArgs) -> Result<(), Failure> {
         seed: args.seed,
         time_limit: Duration::from_secs_f64(args.time_limit),
         local_set_radius: args.local_set_radius,
+        lazy_rounds: args.lazy_rounds.max(1),
+        reallocation_rounds: args.reallocation_rounds,
         ..PlanSettings::default()
     };
     let progress = {

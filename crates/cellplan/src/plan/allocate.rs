@@ -56,12 +56,15 @@ pub struct Allocated {
     pub lower_bound: f64,
 }
 
-/// Allocate the measurable tasks of `cell` to its robots.
+/// Allocate the measurable tasks of `cell` to its robots. `costs`, when given, replaces each
+/// robot's lower-bound matrix in the balanced strategy's routing (the lower bound reported
+/// stays the one of the lower-bound costs).
 pub fn allocate(
     cell: &Cell,
     table: &CandidateTable,
     graphs: &[RobotGraph],
     settings: &PlanSettings,
+    costs: Option<&[CostMatrix]>,
 ) -> Result<Allocated, PlanError> {
     let process = cell.optical();
     let m = cell.robots.len();
@@ -99,6 +102,16 @@ pub fn allocate(
             local_sets = local_robust(cell, &capable, settings, &mut tasks)?;
         }
         Allocation::Balanced => {
+            let problem = match costs {
+                Some(c) => {
+                    let mut p = problem.0.clone();
+                    for (v, m) in p.vehicles.iter_mut().zip(c) {
+                        v.costs = m.clone();
+                    }
+                    (p, problem.1)
+                }
+                None => problem,
+            };
             let sol = minmax::solve(
                 &problem.0,
                 &MinMaxParams {
@@ -213,8 +226,10 @@ fn local_robust(
             })
             .collect();
         built += sets.len();
-        // Step 3: the cover model (eq. 5); c_j is the set's running time once sorted: its
-        // measuring time and its shortest open path at the nominal TCP speed.
+        // Step 3: the cover model (eq. 5). The paper asks for the fewest sets and weighs a set
+        // by its running time once sorted (its measuring time and shortest open path at the
+        // nominal TCP speed); c_j = 1 + time_j / (1 + Σ time) keeps the count first and the
+        // time as the tie-break (with c_j = time alone, singletons would always win).
         let row_of: BTreeMap<usize, usize> = members.iter().enumerate().map(|(r, &t)| (t, r)).collect();
         let mut covers = vec![Vec::new(); members.len()];
         for (c, set) in sets.iter().enumerate() {
@@ -225,13 +240,15 @@ fn local_robust(
         for row in &mut covers {
             row.sort_unstable();
         }
-        let costs: Vec<f64> = sets
+        let times: Vec<f64> = sets
             .iter()
             .map(|s| {
                 let pts: Vec<DVec3> = s.iter().map(|&t| cell.tasks[t].position).collect();
                 s.len() as f64 * process.measure_time + open_path(&pts, settings.seed) / NOMINAL_TCP_SPEED
             })
             .collect();
+        let sum: f64 = times.iter().sum();
+        let costs: Vec<f64> = times.iter().map(|t| 1.0 + t / (1.0 + sum)).collect();
         let sc = SetCover {
             rows: members.len(),
             columns: sets.len(),

@@ -20,6 +20,7 @@ use crate::candidates::CandidateTable;
 use crate::model::tasks::TaskId;
 use cellplan_motion::plan::PlanSettings as MotionSettings;
 use cellplan_motion::timing::{Trajectory, time_path_exact};
+use cellplan_solve::CostMatrix;
 use graph::RobotGraph;
 use rayon::prelude::*;
 use std::time::{Duration, Instant};
@@ -42,6 +43,13 @@ pub struct PlanSettings {
     pub local_set_radius: f64,
     /// Kicks of the balanced strategy's min-max search.
     pub balanced_iterations: usize,
+    /// Re-allocations of the balanced strategy on the costs learnt while sequencing.
+    pub reallocation_rounds: usize,
+    /// Most sequencing rounds of the lazy loop per robot.
+    pub lazy_rounds: usize,
+    /// The lazy loop stops when no order can beat the best fully planned one by more than
+    /// this fraction (its optimistic cost, with unplanned legs at their bound, is not lower).
+    pub lazy_tolerance: f64,
     /// Candidates kept per task and robot for sequencing (see [`graph::select`]).
     pub alternatives: usize,
     /// Settings of every leg's path planner (its seed is derived per leg); its shortcut
@@ -67,13 +75,16 @@ impl Default for PlanSettings {
             local_set_radius: 0.3,
             balanced_iterations: 300,
             alternatives: 24,
+            lazy_rounds: 4,
+            reallocation_rounds: 1,
+            lazy_tolerance: 0.01,
             motion: MotionSettings {
                 time_limit: Duration::from_secs(30),
                 shortcut_iterations: 10,
-                max_samples: 200,
+                max_samples: 60,
                 ..MotionSettings::default()
             },
-            final_shortcut_iterations: 100,
+            final_shortcut_iterations: 40,
             final_max_samples: 20_000,
             sample_dt: 0.02,
         }
@@ -172,17 +183,85 @@ pub fn plan(
     tick(Stage::Costs, &mut compute);
 
     progress(Stage::Allocation);
-    let allocated = allocate::allocate(cell, table, &graphs, settings)?;
+    let mut allocated = allocate::allocate(cell, table, &graphs, settings, None)?;
     tick(Stage::Allocation, &mut compute);
 
     progress(Stage::Sequencing);
-    let sequences: Vec<sequence::Sequence> = cell
-        .robots
-        .par_iter()
+    let mut planned: Vec<sequence::Planned> = vec![Default::default(); cell.robots.len()];
+    let mut counts = vec![(0usize, 0usize, 0usize); cell.robots.len()];
+    let mut sequences = sequence_all(
+        cell,
+        &graphs,
+        &allocated.tasks,
+        settings,
+        deadline,
+        &mut planned,
+        &mut counts,
+    )?;
+    if settings.allocation == Allocation::Balanced {
+        // Re-allocate on what is known now: planned legs at their real time (paper 002's lazy
+        // costs, one level up); keep the better plan.
+        let measure = cell.optical().measure_time;
+        let makespan = |seqs: &[sequence::Sequence], planned: &[sequence::Planned]| {
+            seqs.iter()
+                .enumerate()
+                .map(|(r, s)| sequence::order_cost(&graphs[r], &planned[r], &s.nodes, measure))
+                .fold(0.0, f64::max)
+        };
+        // The nearest-robot allocation is tried too, so that ours is never worse than the
+        // baseline on the real times.
+        let proximity = allocate::allocate(
+            cell,
+            table,
+            &graphs,
+            &PlanSettings {
+                allocation: Allocation::Proximity,
+                ..settings.clone()
+            },
+            None,
+        )?;
+        let mut tried = vec![allocated.tasks.clone()];
+        for round in 0..=settings.reallocation_rounds {
+            if Instant::now() >= deadline {
+                break;
+            }
+            let next = if round == 0 {
+                proximity.tasks.clone()
+            } else {
+                let mixed: Vec<CostMatrix> = graphs
+                    .iter()
+                    .zip(&planned)
+                    .map(|(g, p)| mixed_costs(g, p))
+                    .collect();
+                allocate::allocate(cell, table, &graphs, settings, Some(&mixed))?.tasks
+            };
+            if tried.contains(&next) {
+                continue;
+            }
+            tried.push(next.clone());
+            let seqs = sequence_all(
+                cell,
+                &graphs,
+                &next,
+                settings,
+                deadline,
+                &mut planned,
+                &mut counts,
+            )?;
+            if makespan(&seqs, &planned) < makespan(&sequences, &planned) - 1e-9 {
+                sequences = seqs;
+                allocated.tasks = next;
+            }
+        }
+    }
+    for (s, c) in sequences.iter_mut().zip(&counts) {
+        (s.legs_planned, s.legs_sampled, s.legs_failed) = *c;
+    }
+    sequences
+        .par_iter_mut()
+        .zip(&cell.robots)
         .zip(&graphs)
-        .zip(&allocated.tasks)
-        .map(|((robot, graph), tasks)| sequence::sequence(cell, robot, graph, tasks, settings, deadline))
-        .collect::<Result<_, _>>()?;
+        .for_each(|((seq, robot), graph)| sequence::polish(cell, robot, graph, seq, settings));
     tick(Stage::Sequencing, &mut compute);
 
     progress(Stage::Timing);
@@ -198,6 +277,50 @@ pub fn plan(
         robots,
         compute,
     })
+}
+
+/// Sequence every robot's tasks (in parallel), reusing and extending each robot's planned legs;
+/// `counts` accumulates (planned, sampled, failed) legs per robot.
+fn sequence_all(
+    cell: &Cell,
+    graphs: &[RobotGraph],
+    tasks: &[Vec<TaskId>],
+    settings: &PlanSettings,
+    deadline: Instant,
+    planned: &mut [sequence::Planned],
+    counts: &mut [(usize, usize, usize)],
+) -> Result<Vec<sequence::Sequence>, PlanError> {
+    let seqs: Vec<sequence::Sequence> = cell
+        .robots
+        .par_iter()
+        .zip(graphs)
+        .zip(tasks)
+        .zip(planned.par_iter_mut())
+        .map(|(((robot, graph), tasks), planned)| {
+            sequence::sequence(cell, robot, graph, tasks, settings, deadline, planned)
+        })
+        .collect::<Result<_, _>>()?;
+    for (s, c) in seqs.iter().zip(counts.iter_mut()) {
+        c.0 += s.legs_planned;
+        c.1 += s.legs_sampled;
+        c.2 += s.legs_failed;
+    }
+    Ok(seqs)
+}
+
+/// A robot's costs with its planned legs at their real time (failed ones prohibitive).
+fn mixed_costs(graph: &RobotGraph, planned: &sequence::Planned) -> CostMatrix {
+    let n = graph.len();
+    let mut data = graph.costs.data().to_vec();
+    for (&(a, b), leg) in planned {
+        let c = match leg {
+            Ok(l) => l.duration,
+            Err(_) => sequence::NO_PATH,
+        };
+        data[a * n + b] = c;
+        data[b * n + a] = c;
+    }
+    CostMatrix::new(n, data).expect("same size as the graph")
 }
 
 /// Time every leg and put legs and dwells on one trajectory.

@@ -50,12 +50,11 @@ pub struct Sequence {
 
 /// Kicks of the GTSP heuristic per sequencing round (fixed, for determinism).
 const GTSP_ITERATIONS: usize = 400;
-/// Sequencing rounds at most.
-const MAX_ROUNDS: usize = 12;
 /// Cost of a leg no path was found for: large enough never to be chosen when another exists.
-const NO_PATH: f64 = 1e6;
+pub const NO_PATH: f64 = 1e6;
 
-type Planned = BTreeMap<(usize, usize), Result<Leg, String>>;
+/// Legs planned so far for one robot, by unordered node pair (a < b), or why none was found.
+pub type Planned = BTreeMap<(usize, usize), Result<Leg, String>>;
 
 /// Sequence `tasks` for `robot` with lazily planned legs.
 pub fn sequence(
@@ -65,24 +64,37 @@ pub fn sequence(
     tasks: &[TaskId],
     settings: &PlanSettings,
     deadline: Instant,
+    planned: &mut Planned,
 ) -> Result<Sequence, PlanError> {
     let measure = cell.optical().measure_time;
-    let mut planned: Planned = BTreeMap::new();
     let mut out = Sequence::default();
+    // The best order whose every leg is planned, with its real time.
+    let mut best: Option<(f64, Vec<usize>)> = None;
     let mut nodes: Vec<usize>;
     loop {
         out.rounds += 1;
-        nodes = solve_order(graph, tasks, &planned, measure, settings.seed ^ robot.id.0 as u64);
-        let legs = legs_of(&nodes);
-        let new: Vec<(usize, usize)> = legs
-            .iter()
-            .copied()
-            .filter(|&(a, b)| !planned.contains_key(&key(a, b)))
+        nodes = solve_order(graph, tasks, planned, measure, settings.seed ^ robot.id.0 as u64);
+        let optimistic = order_cost(graph, planned, &nodes, measure);
+        // No order can beat the best real one by more than the tolerance: stop.
+        if let Some((b, order)) = &best
+            && optimistic >= b * (1.0 - settings.lazy_tolerance)
+        {
+            nodes = order.clone();
+            break;
+        }
+        let new: Vec<(usize, usize)> = legs_of(&nodes)
+            .into_iter()
             .map(|(a, b)| key(a, b))
+            .filter(|k| !planned.contains_key(k))
             .collect::<std::collections::BTreeSet<_>>()
             .into_iter()
             .collect();
         if new.is_empty() {
+            // Its cost is real already, and the sequencer found nothing cheaper.
+            if best.as_ref().is_none_or(|(b, _)| optimistic < *b) {
+                best = Some((optimistic, nodes.clone()));
+            }
+            nodes = best.as_ref().map(|b| b.1.clone()).unwrap_or_default();
             break;
         }
         let results: Vec<((usize, usize), Result<Leg, String>)> = new
@@ -99,8 +111,12 @@ pub fn sequence(
             }
             planned.insert(k, r);
         }
-        if out.rounds >= MAX_ROUNDS || Instant::now() >= deadline {
-            // Keep this order; every leg of it is planned now.
+        let real = order_cost(graph, planned, &nodes, measure);
+        if best.as_ref().is_none_or(|(b, _)| real < *b) {
+            best = Some((real, nodes.clone()));
+        }
+        if out.rounds >= settings.lazy_rounds || Instant::now() >= deadline {
+            nodes = best.as_ref().map(|b| b.1.clone()).unwrap_or_default();
             break;
         }
     }
@@ -133,25 +149,6 @@ pub fn sequence(
         }
         planned.insert(k, r);
     }
-    // The final order's sampled legs get the full shortcutting (the lazy rounds used a few
-    // iterations per leg, enough to rank orders).
-    let finals: Vec<(usize, usize)> = legs_of(&nodes)
-        .into_iter()
-        .map(|(a, b)| key(a, b))
-        .filter(|k| matches!(planned.get(k), Some(Ok(leg)) if !leg.straight))
-        .collect::<std::collections::BTreeSet<_>>()
-        .into_iter()
-        .collect();
-    let polished: Vec<((usize, usize), Leg)> = finals
-        .par_iter()
-        .filter_map(|k| match planned.get(k) {
-            Some(Ok(leg)) => Some((*k, polish(cell, robot, graph, k, leg.clone(), settings))),
-            _ => None,
-        })
-        .collect();
-    for (k, leg) in polished {
-        planned.insert(k, Ok(leg));
-    }
     let mut legs = Vec::new();
     for (a, b) in legs_of(&nodes) {
         let leg = match planned.get(&key(a, b)) {
@@ -173,7 +170,37 @@ pub fn sequence(
     Ok(out)
 }
 
-fn key(a: usize, b: usize) -> (usize, usize) {
+/// Give the sampled legs of a final sequence the full shortcutting (the lazy rounds used a few
+/// iterations per leg, enough to rank orders); a leg is replaced only when it gets faster.
+pub fn polish(cell: &Cell, robot: &Robot, graph: &RobotGraph, seq: &mut Sequence, settings: &PlanSettings) {
+    let mut prev = 0usize;
+    let ends: Vec<(usize, usize)> = seq
+        .nodes
+        .iter()
+        .chain(std::iter::once(&0))
+        .map(|&n| {
+            let e = (prev, n);
+            prev = n;
+            e
+        })
+        .collect();
+    let polished: Vec<Option<Leg>> = seq
+        .legs
+        .par_iter()
+        .zip(&ends)
+        .map(|(leg, &(a, b))| {
+            (!leg.straight).then(|| polish_leg(cell, robot, graph, &key(a, b), leg.clone(), settings))
+        })
+        .collect();
+    for (leg, p) in seq.legs.iter_mut().zip(polished) {
+        if let Some(p) = p {
+            *leg = p;
+        }
+    }
+}
+
+/// The unordered key of a leg between nodes `a` and `b`.
+pub fn key(a: usize, b: usize) -> (usize, usize) {
     (a.min(b), a.max(b))
 }
 
@@ -199,6 +226,19 @@ pub fn node_name(cell: &Cell, graph: &RobotGraph, node: usize) -> String {
         None => "home".to_string(),
         Some((t, c)) => format!("MP {} (candidate {c})", cell.tasks[t.0].name),
     }
+}
+
+/// Time of an order under the current costs (planned legs real, the others their bound).
+pub fn order_cost(graph: &RobotGraph, planned: &Planned, nodes: &[usize], measure: f64) -> f64 {
+    legs_of(nodes)
+        .into_iter()
+        .map(|(a, b)| match planned.get(&key(a, b)) {
+            Some(Ok(leg)) => leg.duration,
+            Some(Err(_)) => NO_PATH,
+            None => graph.costs.get(a, b),
+        })
+        .sum::<f64>()
+        + measure * nodes.len() as f64
 }
 
 /// The best order (GTSP over the tasks' candidates) under the current costs: planned legs at
@@ -252,7 +292,7 @@ fn solve_order(
 }
 
 /// Shortcut a sampled leg with the full iteration count; keep it if it is faster.
-fn polish(
+fn polish_leg(
     cell: &Cell,
     robot: &Robot,
     graph: &RobotGraph,
