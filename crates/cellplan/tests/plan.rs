@@ -286,3 +286,96 @@ fn written_plans_have_every_key_the_schema_requires() {
     required(&schema, &doc, &schema, "plan");
     assert_eq!(doc["version"], schema["properties"]["version"]["const"]);
 }
+
+/// Two robots 2 m apart facing a box, four MPs close together on its top, all nearer to R1
+/// and measurable by both: proximity gives all four to R1; local robust sets group them
+/// (closer than ε, same normal) and Algorithm 1 gives the set to R1 (the shorter tour from its
+/// base); the balanced min-max splits them two and two (four measurements on one robot take
+/// 6 s, two take 3 s).
+#[test]
+fn allocation_strategies_give_the_known_answers_on_a_hand_made_cell() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../..")
+        .canonicalize()
+        .unwrap();
+    let fanuc = root.join("data/robots/fanuc_r2000ic");
+    let dir = std::env::temp_dir().join(format!("cellplan-plan-known-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let robot = |name: &str, y: i32| {
+        format!(
+            r#"
+[[robots]]
+name = "{name}"
+urdf = "{f}/urdf/r2000ic125l.urdf"
+packages = {{ fanuc_r2000ic_support = "{f}/fanuc_r2000ic_support" }}
+opw = "{f}/fanuc_r2000ic_support/config/opw_parameters_r2000ic125l.yaml"
+base = {{ xyz = [0, {y}, 0] }}
+home = [0, -30, 0, 0, -60, 0]
+tool = "probe"
+"#,
+            f = fanuc.display()
+        )
+    };
+    let cell = format!(
+        r#"name = "known"
+units = {{ length = "mm", angle = "deg" }}
+
+[process]
+kind = "optical-inspection"
+standoff = 250
+stripe_length = 60
+baseline = 100
+
+[tools.probe]
+tcp = {{ xyz = [0, 0, 300] }}
+
+[[tools.probe.shape]]
+box = [180, 120, 220]
+pose = {{ xyz = [45, 0, 190] }}
+{}{}
+[[objects]]
+name = "part"
+box = [600, 600, 600]
+pose = {{ xyz = [1900, 0, 300] }}
+
+[tasks]
+file = "tasks.csv"
+"#,
+        robot("R1", 1000),
+        robot("R2", -1000)
+    );
+    std::fs::write(dir.join("cell.toml"), cell).unwrap();
+    std::fs::write(
+        dir.join("tasks.csv"),
+        "id,x,y,z,nx,ny,nz\nA,1800,150,600,0,0,1\nB,1900,150,600,0,0,1\nC,1800,250,600,0,0,1\nD,1900,250,600,0,0,1\n",
+    )
+    .unwrap();
+    let cell = load(&dir.join("cell.toml"), &LoadOptions::default()).expect("the hand-made cell loads");
+    let table = generate(&cell);
+    for t in 0..4 {
+        assert_eq!(table.robots_for(TaskId(t)).len(), 2, "both robots measure MP {t}");
+    }
+    let graphs: Vec<_> = cell
+        .robots
+        .iter()
+        .map(|r| plan::graph::RobotGraph::new(r, &table, plan::MoveModel::Trapezoid, 8))
+        .collect();
+    let counts = |a: Allocation| {
+        let s = settings(a);
+        let got = plan::allocate::allocate(&cell, &table, &graphs, &s, None).unwrap();
+        got.tasks.iter().map(Vec::len).collect::<Vec<_>>()
+    };
+    assert_eq!(counts(Allocation::Proximity), vec![4, 0]);
+    assert_eq!(counts(Allocation::LocalRobust), vec![4, 0]);
+    assert_eq!(counts(Allocation::Balanced), vec![2, 2]);
+    // And the plans of all three recheck clean.
+    for a in [
+        Allocation::Proximity,
+        Allocation::LocalRobust,
+        Allocation::Balanced,
+    ] {
+        let s = settings(a);
+        let outcome = plan::plan(&cell, &table, &s, &|_| {}).unwrap();
+        check_plan(&cell, &output::build(&cell, &table, &outcome, &s, 0.0, 0.0));
+    }
+}
