@@ -2,9 +2,11 @@
 //!
 //! Exit codes: 0 done; 2 bad input (the message names file, line and a fix; nothing written);
 //! 3 the cell is valid but some task no robot can do (the report says which and why);
+//! 4 `verify` found the plan violates something (each violation is printed);
 //! 1 anything else.
 mod bench;
 mod plan_cmd;
+mod verify_cmd;
 
 use cellplan::report::{check, svg};
 use cellplan::taskgen::{GenOptions, sample_tasks};
@@ -35,6 +37,8 @@ enum Command {
     Check(CheckArgs),
     /// Plan the cell: allocation, order, collision-free timed motion per robot; writes the plan.
     Plan(plan_cmd::PlanArgs),
+    /// Check a plan independently: MPs, probe poses, limits, clearances, robot–robot, totals.
+    Verify(verify_cmd::VerifyArgs),
     /// Generate inputs for building cells.
     #[command(subcommand)]
     Gen(GenCommand),
@@ -153,6 +157,8 @@ fn parse_direction(s: &str) -> Result<DVec3, String> {
 enum Failure {
     Input(Box<InputError>),
     Infeasible,
+    /// `verify` found violations.
+    Rejected,
     Other(String),
 }
 
@@ -290,6 +296,7 @@ fn main() -> ExitCode {
     let result = match &cli.command {
         Command::Check(a) => run_check(a),
         Command::Plan(a) => plan_cmd::run(a),
+        Command::Verify(a) => verify_cmd::run(a),
         Command::Gen(GenCommand::Tasks(a)) => run_gen_tasks(a),
         Command::Bench(a) => run_bench(a),
     };
@@ -300,6 +307,7 @@ fn main() -> ExitCode {
             ExitCode::from(2)
         }
         Err(Failure::Infeasible) => ExitCode::from(3),
+        Err(Failure::Rejected) => ExitCode::from(4),
         Err(Failure::Other(m)) => {
             eprintln!("error: {m}");
             ExitCode::from(1)

@@ -930,6 +930,50 @@ fn plan_writes_a_plan_and_a_stable_summary() {
     assert!(out.status.success());
     let second: Value = serde_json::from_slice(&std::fs::read(again.join("plan.json")).unwrap()).unwrap();
     assert_eq!(plan["robots"], second["robots"]);
+    // The verifier accepts it (one robot: nothing to coordinate) ...
+    let plan_file = out_dir.join("plan.json");
+    let out = cellplan(
+        &[
+            "verify",
+            plan_file.to_str().unwrap(),
+            cell.to_str().unwrap(),
+            "--json",
+        ],
+        &dir,
+    );
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stdout));
+    let verdict: Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(verdict["ok"], true);
+    assert!(verdict["violations"].as_array().unwrap().is_empty());
+    // ... and rejects it with an MP removed and the cycle time fudged (exit 4, both named).
+    let mut broken = plan.clone();
+    broken["robots"][0]["tasks"].as_array_mut().unwrap().remove(0);
+    broken["cycle_time_s"] = Value::from(1.0);
+    let bad = dir.join("broken.json");
+    std::fs::write(&bad, serde_json::to_string(&broken).unwrap()).unwrap();
+    let out = cellplan(
+        &["verify", bad.to_str().unwrap(), cell.to_str().unwrap(), "--json"],
+        &dir,
+    );
+    assert_eq!(out.status.code(), Some(4));
+    let verdict: Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(verdict["ok"], false);
+    let kinds: Vec<&str> = verdict["violations"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v["kind"].as_str().unwrap())
+        .collect();
+    assert!(
+        kinds.contains(&"missing-task") && kinds.contains(&"totals"),
+        "{kinds:?}"
+    );
+    // Not a plan: exit 2 naming the file and line.
+    std::fs::write(&bad, "{\n  \"format\": 3\n").unwrap();
+    let out = cellplan(&["verify", bad.to_str().unwrap(), cell.to_str().unwrap()], &dir);
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("broken.json") && err.contains("help:"), "{err}");
 }
 
 #[test]

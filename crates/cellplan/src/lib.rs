@@ -18,6 +18,7 @@ pub mod plan;
 pub mod process;
 pub mod report;
 pub mod taskgen;
+pub mod verify;
 
 pub use candidates::{Candidate, CandidateTable};
 pub use error::InputError;

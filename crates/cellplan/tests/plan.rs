@@ -7,6 +7,7 @@ use cellplan::candidates::{CandidateTable, generate};
 use cellplan::model::load::load;
 use cellplan::model::robot::Scratch;
 use cellplan::plan::{self, Allocation, PlanSettings, output};
+use cellplan::verify::{VerifySettings, ViolationKind, verify};
 use cellplan::{Cell, LoadOptions, TaskId};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -70,7 +71,19 @@ fn make(allocation: Allocation) -> output::Plan {
     let back: output::Plan = serde_json::from_str(&text).unwrap();
     assert_eq!(serde_json::to_string(&back).unwrap(), text);
     check_plan(&f.cell, &doc);
+    verified(&f.cell, &doc);
     doc
+}
+
+/// The verifier accepts the plan, robot–robot clearance aside (coordination is a later stage).
+fn verified(cell: &Cell, doc: &output::Plan) {
+    let settings = VerifySettings {
+        robot_robot: false,
+        ..VerifySettings::default()
+    };
+    let report = verify(cell, doc, &settings);
+    assert!(report.ok, "{:#?}", report.violations);
+    assert!(report.configurations_checked > 0);
 }
 
 /// The independent re-check of a plan.
@@ -376,6 +389,70 @@ file = "tasks.csv"
     ] {
         let s = settings(a);
         let outcome = plan::plan(&cell, &table, &s, &|_| {}).unwrap();
-        check_plan(&cell, &output::build(&cell, &table, &outcome, &s, 0.0, 0.0));
+        let doc = output::build(&cell, &table, &outcome, &s, 0.0, 0.0);
+        check_plan(&cell, &doc);
+        verified(&cell, &doc);
     }
+}
+
+/// Faults injected into a good plan are each caught by the verifier.
+#[test]
+fn the_verifier_catches_injected_faults() {
+    let f = fixture();
+    let s = settings(Allocation::Balanced);
+    let outcome = plan::plan(&f.cell, &f.table, &s, &|_| {}).unwrap();
+    let good = output::build(&f.cell, &f.table, &outcome, &s, 0.0, 0.0);
+    let quiet = VerifySettings {
+        robot_robot: false,
+        ..VerifySettings::default()
+    };
+    assert!(verify(&f.cell, &good, &quiet).ok);
+    let kinds = |doc: &output::Plan| -> Vec<ViolationKind> {
+        verify(&f.cell, doc, &quiet)
+            .violations
+            .iter()
+            .map(|v| v.kind)
+            .collect()
+    };
+    let busy = good.robots.iter().position(|r| !r.tasks.is_empty()).unwrap();
+    // A skipped MP.
+    let mut skipped = good.clone();
+    skipped.robots[busy].tasks.remove(0);
+    assert!(kinds(&skipped).contains(&ViolationKind::MissingTask));
+    // A joint-limit breach in the trajectory.
+    let mut breach = good.clone();
+    let n = breach.robots[busy].trajectory.len();
+    breach.robots[busy].trajectory[n / 2].q[0] = 10.0;
+    let k = kinds(&breach);
+    assert!(
+        k.contains(&ViolationKind::JointLimit) && k.contains(&ViolationKind::Velocity),
+        "{k:?}"
+    );
+    // A measuring pose turned away from its MP.
+    let mut turned = good.clone();
+    turned.robots[busy].tasks[0].q[4] += 0.5; // tilt the wrist: the beam leaves the view cone
+    assert!(kinds(&turned).contains(&ViolationKind::ProbeConstraint));
+    // A cycle time that does not match.
+    let mut fudged = good.clone();
+    fudged.cycle_time_s -= 1.0;
+    assert!(kinds(&fudged).contains(&ViolationKind::Totals));
+    // A leg waypoint pushed into the part: the home-to-first-MP leg detoured through the car.
+    let mut through = good.clone();
+    let leg = &mut through.robots[busy].legs[0];
+    let mid: Vec<f64> = leg.waypoints[0]
+        .iter()
+        .zip(leg.waypoints.last().unwrap())
+        .map(|(a, b)| 0.5 * (a + b))
+        .collect();
+    let mut into = mid.clone();
+    into[1] += 0.9; // lean far forward, into the car
+    leg.waypoints.insert(1, into);
+    let k = kinds(&through);
+    assert!(
+        k.iter().any(|k| matches!(
+            k,
+            ViolationKind::StaticClearance | ViolationKind::SelfCollision | ViolationKind::JointLimit
+        )),
+        "{k:?}"
+    );
 }

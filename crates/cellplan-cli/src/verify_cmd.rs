@@ -1,0 +1,76 @@
+//! `cellplan verify`: the independent check of a plan.
+use crate::Failure;
+use cellplan::verify::{VerifySettings, verify};
+use cellplan::{InputError, LoadOptions, plan::output::Plan};
+use clap::Args;
+use std::path::PathBuf;
+
+#[derive(Args)]
+pub struct VerifyArgs {
+    /// The plan (plan.json written by `cellplan plan`).
+    plan: PathBuf,
+    /// The cell file it was made for.
+    cell: PathBuf,
+    /// Print the verdict as JSON (stable keys: ok, violations).
+    #[arg(long)]
+    json: bool,
+    /// Skip the robot–robot clearance check (for plans not coordinated yet).
+    #[arg(long)]
+    no_robot_robot: bool,
+    /// Time step of the robot–robot check (s).
+    #[arg(long, value_name = "S", default_value_t = VerifySettings::default().time_step)]
+    time_step: f64,
+}
+
+pub fn run(args: &VerifyArgs) -> Result<(), Failure> {
+    if !(args.time_step.is_finite() && args.time_step > 0.0) {
+        return Err(Failure::Other(
+            "--time-step must be a positive number of seconds".into(),
+        ));
+    }
+    let text = std::fs::read_to_string(&args.plan).map_err(|e| {
+        Failure::Input(Box::new(
+            InputError::new(&args.plan, format!("cannot read the plan: {e}"))
+                .hint("give the plan.json that `cellplan plan` wrote"),
+        ))
+    })?;
+    let plan: Plan = serde_json::from_str(&text).map_err(|e| {
+        Failure::Input(Box::new(
+            InputError::at_line(&args.plan, Some(e.line()), format!("not a cellplan plan: {e}"))
+                .hint("give the plan.json that `cellplan plan` wrote (docs/plan-format.md)"),
+        ))
+    })?;
+    let cell = cellplan::model::load::load(&args.cell, &LoadOptions::default())?;
+    let settings = VerifySettings {
+        robot_robot: !args.no_robot_robot,
+        time_step: args.time_step,
+        ..VerifySettings::default()
+    };
+    let report = verify(&cell, &plan, &settings);
+    if args.json {
+        println!(
+            "{}",
+            serde_json::to_string_pretty(&report).map_err(|e| Failure::Other(e.to_string()))?
+        );
+    } else {
+        for v in &report.violations {
+            let who = match (&v.robot, &v.other) {
+                (Some(a), Some(b)) => format!("{a} & {b}"),
+                (Some(a), None) => a.clone(),
+                _ => "-".into(),
+            };
+            let when = v.time_s.map_or(String::new(), |t| format!(" at {t:.2} s"));
+            let task = v.task.as_ref().map_or(String::new(), |t| format!(" MP {t}"));
+            println!("{:?} {who}{when}{task}: {}", v.kind, v.detail);
+        }
+        println!(
+            "{}: {} violation(s); cycle time {:.2} s, Δt {:.2} s (recomputed); {} configurations checked",
+            if report.ok { "ok" } else { "NOT OK" },
+            report.violations.len(),
+            report.cycle_time_s,
+            report.delta_t_s,
+            report.configurations_checked
+        );
+    }
+    if report.ok { Ok(()) } else { Err(Failure::Rejected) }
+}
