@@ -315,17 +315,15 @@ pub fn verify(cell: &Cell, plan: &Plan, settings: &VerifySettings) -> Report {
                     let f = s as f64 / steps as f64;
                     let q: Vec<f64> = w[0].iter().zip(&w[1]).map(|(a, b)| a + f * (b - a)).collect();
                     checked += 1;
-                    if let Some(v) = config_violation(cell, robot, &q, clearance, &mut scratch) {
-                        if !reported {
-                            out.push(violation(
-                                v.0,
-                                &rp.name,
-                                Some(leg.start_s),
-                                None,
-                                format!("on leg {} → {}: {}", leg.from, leg.to, v.1),
-                            ));
-                            reported = true;
-                        }
+                    if !reported && let Some(v) = config_violation(cell, robot, &q, clearance, &mut scratch) {
+                        out.push(violation(
+                            v.0,
+                            &rp.name,
+                            Some(leg.start_s),
+                            None,
+                            format!("on leg {} → {}: {}", leg.from, leg.to, v.1),
+                        ));
+                        reported = true;
                     }
                 }
             }
