@@ -178,17 +178,22 @@ fn spinner(show: bool, message: &str) -> indicatif::ProgressBar {
     pb
 }
 
+/// Loader options from the cache flags shared by the commands that load a cell.
+fn load_options(no_cache: bool, cache_dir: &Option<PathBuf>) -> LoadOptions {
+    LoadOptions {
+        cache_dir: if no_cache {
+            None
+        } else {
+            cache_dir.clone().or_else(LoadOptions::default_cache_dir)
+        },
+        ..LoadOptions::default()
+    }
+}
+
 fn run_check(args: &CheckArgs) -> Result<(), Failure> {
     let start = Instant::now();
     let show = !args.quiet && !args.json;
-    let opts = LoadOptions {
-        cache_dir: if args.no_cache {
-            None
-        } else {
-            args.cache_dir.clone().or_else(LoadOptions::default_cache_dir)
-        },
-        ..LoadOptions::default()
-    };
+    let opts = load_options(args.no_cache, &args.cache_dir);
     let pb = spinner(show, "loading the cell");
     let cell = cellplan::model::load::load(&args.cell, &opts)?;
     pb.set_message(format!(

@@ -1,7 +1,7 @@
 //! `cellplan plan`: the main job.
-use crate::{Failure, spinner};
+use crate::{Failure, load_options, spinner};
 use cellplan::plan::{self, Allocation, CoverMethod, MoveModel, PlanError, PlanSettings, Stage, output};
-use cellplan::{InputError, LoadOptions, candidates, io::write_atomic, report::check};
+use cellplan::{InputError, candidates, io::write_atomic, report::check};
 use clap::{Args, ValueEnum};
 use serde::Serialize;
 use std::path::PathBuf;
@@ -109,14 +109,7 @@ pub fn run(args: &PlanArgs) -> Result<(), Failure> {
         ));
     }
     let show = !args.quiet && !args.json;
-    let opts = LoadOptions {
-        cache_dir: if args.no_cache {
-            None
-        } else {
-            args.cache_dir.clone().or_else(LoadOptions::default_cache_dir)
-        },
-        ..LoadOptions::default()
-    };
+    let opts = load_options(args.no_cache, &args.cache_dir);
     let pb = spinner(show, "loading the cell");
     let cell = cellplan::model::load::load(&args.cell, &opts)?;
     let load_s = start.elapsed().as_secs_f64();

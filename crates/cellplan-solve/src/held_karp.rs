@@ -154,7 +154,7 @@ fn solve_bounded(p: &Gtsp, mut upper: f64) -> Result<Exact, HeldKarpError> {
             match best {
                 Some(b) => Ok(b),
                 // Only when the bound was wrong (it never is: it is a tour's cost); stay exact.
-                None if upper.is_finite() => solve_unbounded(p),
+                None if upper.is_finite() => solve_bounded(p, f64::INFINITY),
                 None => Err(HeldKarpError::Empty),
             }
         }
@@ -174,36 +174,6 @@ fn upper_bound(p: &Gtsp, states: u128) -> f64 {
         ..Default::default()
     };
     crate::gtsp::solve(p, &params).cost
-}
-
-fn solve_unbounded(p: &Gtsp) -> Result<Exact, HeldKarpError> {
-    let c = |u: usize, v: usize| p.costs.get(u, v) + p.service[v];
-    let first = (0..p.clusters.len())
-        .min_by_key(|&k| (p.clusters[k].len(), k))
-        .unwrap_or(0);
-    let rest: Vec<Vec<usize>> = p
-        .clusters
-        .iter()
-        .enumerate()
-        .filter(|&(k, _)| k != first)
-        .map(|(_, v)| v.clone())
-        .collect();
-    let mut best: Option<Exact> = None;
-    for &s in &p.clusters[first] {
-        let Some((cost, path)) = run(&rest, &c, &|v| c(s, v), &|v| p.costs.get(v, s), f64::INFINITY) else {
-            continue;
-        };
-        let cost = cost + p.service[s];
-        if best.as_ref().is_none_or(|b| cost < b.cost) {
-            let mut nodes = vec![s];
-            nodes.extend(path);
-            best = Some(Exact {
-                tour: Tour { nodes },
-                cost,
-            });
-        }
-    }
-    best.ok_or(HeldKarpError::Empty)
 }
 
 /// The DP over `clusters`: cheapest path entering with `from(v)`, visiting one node per
