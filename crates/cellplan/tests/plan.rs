@@ -57,6 +57,8 @@ fn settings(allocation: Allocation) -> PlanSettings {
         allocation,
         alternatives: 8,
         balanced_iterations: 60,
+        // Never cut by the clock: the plan must depend only on the input and the seed.
+        time_limit: std::time::Duration::from_secs(3600),
         ..PlanSettings::default()
     }
 }
