@@ -458,3 +458,25 @@ fn the_verifier_catches_injected_faults() {
         "{k:?}"
     );
 }
+
+/// The two bundled example cells, whole, with the default settings: the plans re-check clean.
+#[test]
+fn both_example_cells_plan_and_recheck_clean() {
+    for name in ["autobody-2r", "autobody-4r"] {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("../../examples/{name}/cell.toml"));
+        let cell = load(&path, &LoadOptions::default()).expect("the example loads");
+        let table = generate(&cell);
+        let s = PlanSettings {
+            time_limit: std::time::Duration::from_secs(3600),
+            ..PlanSettings::default()
+        };
+        let outcome = plan::plan(&cell, &table, &s, &|_| {}).expect("the example plans");
+        let doc = output::build(&cell, &table, &outcome, &s, 0.0, 0.0);
+        assert!(
+            doc.unmeasured.is_empty(),
+            "{name}: every MP of the examples is measurable"
+        );
+        check_plan(&cell, &doc);
+        verified(&cell, &doc);
+    }
+}
