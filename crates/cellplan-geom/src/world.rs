@@ -401,30 +401,10 @@ impl CollisionWorld {
         let group = self.group(g);
         debug_assert_eq!(poses.len(), group.bodies.len(), "one pose per body");
         let mut best = f64::INFINITY;
-        for (body, pose) in group.bodies.iter().zip(poses) {
-            let placed = match place(body, pose) {
-                Placement::Empty => continue,
-                Placement::Invalid => {
-                    if self.first_solid_static().is_some() {
-                        return 0.0;
-                    }
-                    continue;
-                }
-                Placement::At(p) => p,
-            };
-            for s in &self.statics {
-                let Some(shape) = s.shape.as_deref() else {
-                    continue;
-                };
-                if aabb_distance(&placed.aabb, &s.aabb) >= best {
-                    continue;
-                }
-                if let Some(d) = static_distance(s, shape, &placed, best) {
-                    best = d;
-                    if best <= 0.0 {
-                        return 0.0;
-                    }
-                }
+        for i in 0..group.bodies.len().min(poses.len()) {
+            best = self.body_static_distance(g, i, poses, best);
+            if best <= 0.0 {
+                return 0.0;
             }
         }
         best
