@@ -31,6 +31,7 @@ use parry3d_f64::partitioning::TraversalAction;
 use parry3d_f64::query::gjk::{self, CsoPoint, GJKResult, VoronoiSimplex};
 use parry3d_f64::query::{self, Ray, RayCast};
 use parry3d_f64::shape::{Shape, SharedShape, SupportMap, TriMesh, Triangle};
+use std::cell::{Cell, RefCell};
 
 /// Index of a static object in a [`CollisionWorld`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -836,6 +837,28 @@ impl AxisCache {
             .any(|&(d, limit)| d.dot(c) + d.abs().dot(e) < limit)
     }
 
+    /// The largest gap `limit − max(axis · vertex)` over the cached axes (−∞ when empty): with
+    /// limits that are the convex shape's lowest projections, a lower bound on the distance
+    /// from the triangle to the shape.
+    #[inline]
+    fn triangle_gap(&self, t: &Triangle) -> f64 {
+        self.axes[..self.len]
+            .iter()
+            .map(|&(d, limit)| limit - d.dot(t.a).max(d.dot(t.b)).max(d.dot(t.c)))
+            .fold(f64::NEG_INFINITY, f64::max)
+    }
+
+    /// [`AxisCache::triangle_gap`] for everything inside the box `mins..maxs`.
+    #[inline]
+    fn box_gap(&self, mins: DVec3, maxs: DVec3) -> f64 {
+        let c = (mins + maxs) * 0.5;
+        let e = (maxs - mins) * 0.5;
+        self.axes[..self.len]
+            .iter()
+            .map(|&(d, limit)| limit - (d.dot(c) + d.abs().dot(e)))
+            .fold(f64::NEG_INFINITY, f64::max)
+    }
+
     fn push(&mut self, dir: DVec3, limit: f64) {
         self.axes[self.next] = (dir, limit);
         self.next = (self.next + 1) % self.axes.len();
@@ -854,17 +877,88 @@ fn static_distance(s: &StaticObject, shape: &dyn Shape, b: &Placed, best: f64) -
     if let Some(c) = shape.as_support_map() {
         convex_distance(&pos12, c, b.support, best)
     } else if let Some(mesh) = shape.as_trimesh() {
-        let query = support_aabb(b.support, &pos12);
-        mesh.bvh()
-            .find_best(
-                best,
-                |node, _| aabb_distance(&query, &Aabb::new(node.mins(), node.maxs())),
-                |i, best| convex_distance(&pos12, &mesh.triangle(i), b.support, best),
-            )
-            .map(|(_, d)| d)
+        mesh_distance(&pos12, mesh, b.support, best)
     } else {
         let d = query::distance(&s.pose, shape, &b.pose, b.shape).map_or(0.0, |d| d.distance);
         (d < best).then_some(d.max(0.0))
+    }
+}
+
+/// Exact distance between a triangle mesh (frame 1) and a convex shape (at `pos12` in the
+/// mesh's frame), 0 when they touch, if below `best`; `None` otherwise.
+///
+/// The BVH is searched nearest box first. Every axis that separated a triangle from the
+/// convex shape (the GJK witness direction, or the direction that proved a triangle beyond
+/// `best`) is cached with the shape's lowest projection on it: the gap along such an axis is
+/// a lower bound on the distance of any other triangle or BVH node, usually a tight one for
+/// the neighbours of the nearest triangle, so most of them are dismissed without GJK.
+fn mesh_distance(pos12: &Pose, mesh: &TriMesh, convex: &dyn SupportMap, best: f64) -> Option<f64> {
+    let query = support_aabb(convex, pos12);
+    let cache = RefCell::new(AxisCache::default());
+    let convex = Recording {
+        inner: convex,
+        last: Cell::new((DVec3::ZERO, DVec3::ZERO)),
+    };
+    // Caches `dir` (pointing from the triangle towards the shape) with the shape's lowest
+    // projection on it; GJK's last support query was usually that very one.
+    let remember = |dir: DVec3| {
+        let (asked, point) = convex.last.get();
+        let point = if asked == -dir {
+            point
+        } else {
+            convex.support_point(pos12, -dir)
+        };
+        cache.borrow_mut().push(dir, dir.dot(point));
+    };
+    mesh.bvh()
+        .find_best(
+            best,
+            |node, _| {
+                let (lo, hi) = (node.mins(), node.maxs());
+                aabb_distance(&query, &Aabb::new(lo, hi)).max(cache.borrow().box_gap(lo, hi))
+            },
+            |i, best| {
+                let t = mesh.triangle(i);
+                if cache.borrow().triangle_gap(&t) >= best {
+                    return None;
+                }
+                match convex_gjk(pos12, &t, &convex, best, true, None) {
+                    GJKResult::ClosestPoints(p1, p2, _) => {
+                        let d = (p2 - p1).length();
+                        if d > 0.0 {
+                            remember((p2 - p1) / d);
+                        }
+                        (d < best).then_some(d)
+                    }
+                    GJKResult::Intersection => Some(0.0),
+                    GJKResult::NoIntersection(dir) => {
+                        remember(dir);
+                        None
+                    }
+                    GJKResult::Proximity(_) => None,
+                }
+            },
+        )
+        .map(|(_, d)| d)
+}
+
+/// A support map that remembers its last world-frame query `(direction, support point)`.
+struct Recording<'a> {
+    inner: &'a dyn SupportMap,
+    last: Cell<(DVec3, DVec3)>,
+}
+
+impl SupportMap for Recording<'_> {
+    #[inline]
+    fn local_support_point(&self, dir: DVec3) -> DVec3 {
+        self.inner.local_support_point(dir)
+    }
+
+    #[inline]
+    fn support_point(&self, transform: &Pose, dir: DVec3) -> DVec3 {
+        let p = self.inner.support_point(transform, dir);
+        self.last.set((dir, p));
+        p
     }
 }
 
