@@ -12,10 +12,10 @@
 //! move). A [`JointSpace`] carries per-joint radii such that along a straight joint-space
 //! segment from `a` to `b` no point moves more than `Σ_j radii[j]·|a_j − b_j|`. So around a
 //! sample at parameter `s` of a segment whose whole bound is `L`, every parameter `s'` with
-//! `|s' − s|·L < c(q(s))` is valid: [`check_segment`] walks from both ends, each step as long
-//! as the clearance just measured allows, until the two walks meet. Steps therefore shrink
-//! near obstacles and grow in free space; a clearance below
-//! [`PlanSettings::min_clearance`] counts as a contact (so the walk always ends). A checker
+//! `|s' − s|·L < c(q(s))` is valid: [`check_segment`] covers the segment with such intervals,
+//! placing each new sample where its interval should about touch the covered part, until no
+//! gap is left. Samples therefore crowd near obstacles and spread in free space; a clearance below
+//! [`PlanSettings::min_clearance`] counts as a contact (so the check always ends). A checker
 //! may split its clearance by the joints that can reduce each part
 //! ([`StateValidity::clearances`]): the step is then the smallest `c_k / L_k`, `L_k` summing
 //! only over the joints of part `k`.
@@ -157,6 +157,36 @@ pub trait StateValidity: Sync {
             joints: 0..usize::MAX,
         });
     }
+
+    /// The radius, in segment parameter, of the piece of a segment around `q` proven valid:
+    /// `min_k distance_k / bound(joints_k)` over [`StateValidity::clearances`], at most
+    /// `limit`; `None` when some distance is below `floor` (or NaN). `bound(joints)` is the
+    /// Cartesian displacement bound of those joints over the whole segment (0 when they do not
+    /// move). The segment check calls this; an implementation may override it to skip work
+    /// the answer does not need — a distance query capped at `step · bound` (the step found so
+    /// far) answers as well as an exact one. The result must not exceed the default's.
+    fn segment_step(
+        &self,
+        q: &[f64],
+        bound: &dyn Fn(&Range<usize>) -> f64,
+        floor: f64,
+        limit: f64,
+    ) -> Option<f64> {
+        let mut buf = Vec::new();
+        self.clearances(q, &mut buf);
+        let mut step = limit;
+        for c in &buf {
+            // NaN fails the comparison and so counts as a contact.
+            if c.distance.is_nan() || c.distance < floor {
+                return None;
+            }
+            let b = bound(&c.joints);
+            if b > 0.0 {
+                step = step.min(c.distance / b);
+            }
+        }
+        Some(step)
+    }
 }
 
 /// A plain function or closure of `q` is a validity checker (its value is the clearance).
@@ -190,7 +220,15 @@ pub fn check_segment(
     SegmentCheck { valid, calls }
 }
 
-/// The walk of [`check_segment`]; counts the clearance calls into `calls`.
+/// The check of [`check_segment`]; counts the clearance calls into `calls`.
+///
+/// The segment is covered by parameter intervals proven valid, one around each sample (its
+/// radius from [`StateValidity::segment_step`]). Gaps between covered pieces are kept in a
+/// first-in first-out list; a gap wider than two of its ends' radii is entered one radius
+/// past its left end (where, the radius being 1-Lipschitz in the parameter, the new ball
+/// about touches the covered piece: each sample covers about twice its radius, where a walk
+/// would cover one), a narrower gap is sampled in its middle. The check ends at the first
+/// contact or when no gap is left.
 fn segment_valid(
     space: &JointSpace,
     validity: &dyn StateValidity,
@@ -213,48 +251,43 @@ fn segment_valid(
     if !prefix[n].is_finite() {
         return false;
     }
-    let mut buf = Vec::new();
-    // The parameter interval around a sample proven valid, or `None` for a contact.
-    let mut measure = |q: &[f64]| -> Option<f64> {
+    let bound = |joints: &Range<usize>| {
+        let (lo, hi) = (joints.start.min(n), joints.end.min(n));
+        if hi > lo { prefix[hi] - prefix[lo] } else { 0.0 }
+    };
+    let mut measure = |q: &[f64], limit: f64| -> Option<f64> {
         *calls += 1;
-        validity.clearances(q, &mut buf);
-        let mut step = f64::INFINITY;
-        for c in &buf {
-            // NaN fails the comparison and so counts as a contact.
-            if c.distance.is_nan() || c.distance < floor {
-                return None;
-            }
-            let (lo, hi) = (c.joints.start.min(n), c.joints.end.min(n));
-            let bound = if hi > lo { prefix[hi] - prefix[lo] } else { 0.0 };
-            if bound > 0.0 {
-                step = step.min(c.distance / bound * STEP_SAFETY);
-            }
-        }
-        Some(step)
+        validity
+            .segment_step(q, &bound, floor, limit)
+            .map(|r| r * STEP_SAFETY)
     };
-    let Some(step_a) = measure(a) else {
+    let Some(ra) = measure(a, 1.0) else {
         return false;
     };
-    let Some(step_b) = measure(b) else {
+    let Some(rb) = measure(b, 1.0) else {
         return false;
     };
-    // [0, lo) and (hi, 1] are proven valid.
-    let mut lo = step_a;
-    let mut hi = 1.0 - step_b;
+    // Gaps (left end, its radius, right end, its radius).
+    let mut gaps = std::collections::VecDeque::from([(0.0, ra, 1.0, rb)]);
     let mut q = Vec::with_capacity(n);
-    let mut from_a = true;
-    while lo < hi {
-        let s = if from_a { lo } else { hi };
+    while let Some((s0, r0, s1, r1)) = gaps.pop_front() {
+        let (lo, hi) = (s0 + r0, s1 - r1);
+        if lo >= hi {
+            continue;
+        }
+        let guess = r0.min(r1);
+        let s = if hi - lo <= 2.0 * guess {
+            0.5 * (lo + hi)
+        } else {
+            lo + guess
+        };
         space.interpolate(a, b, s, &mut q);
-        let Some(step) = measure(&q) else {
+        // A radius beyond the farther end of the gap is of no use.
+        let Some(r) = measure(&q, (s - s0).max(s1 - s)) else {
             return false;
         };
-        if from_a {
-            lo = s + step;
-        } else {
-            hi = s - step;
-        }
-        from_a = !from_a;
+        gaps.push_back((s0, r0, s, r));
+        gaps.push_back((s, r, s1, r1));
     }
     true
 }

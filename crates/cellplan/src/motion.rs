@@ -221,6 +221,126 @@ impl StateValidity for RobotValidity<'_> {
             }
         });
     }
+
+    /// As the default, with every distance query capped where it stops mattering (see
+    /// `capped_part`): bodies from the tool inwards (the tool is the usual tightest part, and
+    /// its step then caps the others' queries), then the self pairs.
+    fn segment_step(
+        &self,
+        q: &[f64],
+        bound: &dyn Fn(&Range<usize>) -> f64,
+        floor: f64,
+        limit: f64,
+    ) -> Option<f64> {
+        if !self.robot.within_limits(q) {
+            return None;
+        }
+        SCRATCH.with_borrow_mut(|scratch| {
+            self.robot.body_poses(q, scratch);
+            let world = &self.cell.world;
+            let g = self.robot.group;
+            let margin = self.margin.max(0.0);
+            let mut step = limit;
+            let take = |c: f64, b: f64, step: &mut f64| {
+                if c.is_nan() || c < floor {
+                    return false;
+                }
+                if b > 0.0 {
+                    *step = step.min(c / b);
+                }
+                true
+            };
+            for (i, joints) in self.moving.iter().rev() {
+                let b = bound(joints);
+                let query = |cap: f64| world.body_static_distance(g, *i, &scratch.bodies, cap);
+                let c = self.capped_part(query, margin, b, step, floor);
+                if !take(c, b, &mut step) {
+                    return None;
+                }
+            }
+            for (i, j, joints) in &self.pairs {
+                let b = bound(joints);
+                let query = |cap: f64| world.pair_distance(g, *i, *j, &scratch.bodies, cap);
+                let c = self.capped_part(query, 0.0, b, step, floor);
+                if !take(c, b, &mut step) {
+                    return None;
+                }
+            }
+            Some(step)
+        })
+    }
+}
+
+impl RobotValidity<'_> {
+    /// The clearance of `q` from the static scene alone (minus the margin, capped at
+    /// [`Self::cap`]); negative infinity outside the joint limits.
+    pub fn static_clearance(&self, q: &[f64]) -> f64 {
+        if !self.robot.within_limits(q) {
+            return f64::NEG_INFINITY;
+        }
+        SCRATCH.with_borrow_mut(|scratch| {
+            self.robot.body_poses(q, scratch);
+            let margin = self.margin.max(0.0);
+            self.moving
+                .iter()
+                .map(|(i, _)| {
+                    self.cell.world.body_static_distance(
+                        self.robot.group,
+                        *i,
+                        &scratch.bodies,
+                        self.cap + margin,
+                    ) - margin
+                        - DISTANCE_SLACK
+                })
+                .fold(f64::INFINITY, f64::min)
+        })
+    }
+
+    /// The smallest distance between the robot's checked self pairs at `q` (capped at
+    /// [`Self::cap`]); negative infinity outside the joint limits.
+    pub fn self_clearance(&self, q: &[f64]) -> f64 {
+        if !self.robot.within_limits(q) {
+            return f64::NEG_INFINITY;
+        }
+        SCRATCH.with_borrow_mut(|scratch| {
+            self.robot.body_poses(q, scratch);
+            self.pairs
+                .iter()
+                .map(|(i, j, _)| {
+                    self.cell
+                        .world
+                        .pair_distance(self.robot.group, *i, *j, &scratch.bodies, self.cap)
+                        - DISTANCE_SLACK
+                })
+                .fold(self.cap, f64::min)
+        })
+    }
+
+    /// The distance query of one part, capped just where the answer stops mattering: the step
+    /// found so far times the part's bound (or the floor when the part cannot move), and at
+    /// most [`Self::cap`]. Returns the part's clearance (capped likewise).
+    fn capped_part(
+        &self,
+        query: impl FnOnce(f64) -> f64,
+        offset: f64,
+        bound: f64,
+        step: f64,
+        floor: f64,
+    ) -> f64 {
+        let wanted = if bound > 0.0 {
+            (step * bound).min(self.cap).max(floor)
+        } else {
+            floor
+        };
+        let cap = wanted + offset + DISTANCE_SLACK;
+        let d = query(cap);
+        // At the cap, the answer is `wanted` itself (subtracting back could round below it).
+        if d >= cap {
+            wanted
+        } else {
+            d - offset - DISTANCE_SLACK
+        }
+    }
 }
 
 /// One leg of `robot` from `from` to `to`, keeping the process clearance from the static

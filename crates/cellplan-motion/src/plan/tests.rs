@@ -340,11 +340,12 @@ fn structured_clearances_step_by_the_joints_that_matter() {
     let fine = check_segment(&space, &tight, &[0.0, 1.0], &[10.0, 1.0], 1e-4);
     let coarse = check_segment(&space, &TightWrist, &[0.0, 1.0], &[10.0, 1.0], 1e-4);
     assert!(fine.valid && coarse.valid);
-    assert!(fine.calls > 900, "{fine:?}");
+    // Each sample proves at most 0.01 / 10 of the parameter either side: at least 500 samples.
+    assert!(fine.calls >= 500, "{fine:?}");
     assert!(coarse.calls < 15, "{coarse:?}");
-    // Joint 1 moving by 1: steps of 0.01.
+    // Joint 1 moving by 1: each sample proves 0.01 either side, at least 50 samples.
     let wrist = check_segment(&space, &TightWrist, &[0.0, 1.0], &[0.0, 2.0], 1e-4);
-    assert!(wrist.valid && wrist.calls > 90, "{wrist:?}");
+    assert!(wrist.valid && wrist.calls >= 50, "{wrist:?}");
     // A clearance below the floor is a contact whatever its joints.
     let floor = check_segment(&space, &TightWrist, &[0.0, 1.0], &[1.0, 1.0], 0.02);
     assert!(!floor.valid);
