@@ -222,20 +222,67 @@ fn kick(p: &MinMaxProblem, st: &mut St, rng: &mut ChaCha8Rng, k: usize) {
     }
 }
 
+/// Independent search chains. Each runs its share of the kicks from the same start with its
+/// own seed, on its own thread when there is one; the best chain wins (ties to the first), so
+/// the result does not depend on the thread count.
+const CHAINS: usize = 2;
+
 /// The ILS; returns the best tours found.
 pub(crate) fn run(p: &MinMaxProblem, params: &MinMaxParams) -> Vec<Vec<Visit>> {
+    use rayon::prelude::*;
     let start = Instant::now();
     let a = St::new(p, construct::proximity(p, params.seed));
     let b = St::new(p, construct::algorithm1(p, params.seed));
-    let mut cur = if cmp_report(p, &b.times, &a.times) == Ordering::Less {
+    let first = if cmp_report(p, &b.times, &a.times) == Ordering::Less {
         b
     } else {
         a
     };
+    let per_chain = params.max_iterations.map(|n| n.div_ceil(CHAINS));
+    let chains: Vec<(St, u64)> = (0..CHAINS)
+        .into_par_iter()
+        .map(|c| {
+            let seed = params
+                .seed
+                .wrapping_add((c as u64).wrapping_mul(0xA076_1D64_78BD_642F));
+            chain(p, params, start, first.clone(), seed, per_chain)
+        })
+        .collect();
+    let (best, seed) = chains
+        .into_iter()
+        .reduce(|x, y| {
+            if cmp_report(p, &y.0.times, &x.0.times) == Ordering::Less {
+                y
+            } else {
+                x
+            }
+        })
+        .expect("at least one chain");
+    let mut polished = best.clone();
+    for v in 0..polished.tours.len() {
+        polished.tours[v] = optimise(p, v, &polished.tours[v], seed.wrapping_add(v as u64), FINAL_ITERS);
+        polished.times[v] = p.route_time(v, &polished.tours[v]);
+    }
+    if cmp_report(p, &polished.times, &best.times) == Ordering::Greater {
+        polished = best;
+    }
+    polished.tours
+}
+
+/// One chain: descents and kicks from `cur` for at most `max_iter` kicks (and the time
+/// limit); the best state and the last GTSP seed.
+fn chain(
+    p: &MinMaxProblem,
+    params: &MinMaxParams,
+    start: Instant,
+    mut cur: St,
+    seed: u64,
+    max_iter: Option<usize>,
+) -> (St, u64) {
     let mut best = cur.clone();
-    let mut rng = ChaCha8Rng::seed_from_u64(params.seed);
-    let mut seed = params.seed.wrapping_mul(0x9E37_79B9_7F4A_7C15);
-    let max_iter = params.max_iterations.unwrap_or(usize::MAX);
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let mut seed = seed.wrapping_mul(0x9E37_79B9_7F4A_7C15);
+    let max_iter = max_iter.unwrap_or(usize::MAX);
     let mut stale = 0;
     let mut iter = 0;
     loop {
@@ -260,13 +307,5 @@ pub(crate) fn run(p: &MinMaxProblem, params: &MinMaxParams) -> Vec<Vec<Visit>> {
             kick(p, &mut cur, &mut rng, k);
         }
     }
-    let mut polished = best.clone();
-    for v in 0..polished.tours.len() {
-        polished.tours[v] = optimise(p, v, &polished.tours[v], seed.wrapping_add(v as u64), FINAL_ITERS);
-        polished.times[v] = p.route_time(v, &polished.tours[v]);
-    }
-    if cmp_report(p, &polished.times, &best.times) == Ordering::Greater {
-        polished = best;
-    }
-    polished.tours
+    (best, seed)
 }
