@@ -32,10 +32,13 @@ pub struct PlanArgs {
     /// ε of paper 000 eq. 4 in metres: MPs closer than this may share a local robust set.
     #[arg(long, value_name = "M", default_value_t = 0.3)]
     local_set_radius: f64,
-    /// Most sequencing rounds of the lazy loop per robot (each plans the legs its order uses).
+    /// Most sequencing rounds of the lazy loop per robot (each plans the legs its order uses;
+    /// twice as many while the best order still needs a leg the quick planner gave up on).
     #[arg(long, value_name = "N", default_value_t = PlanSettings::default().lazy_rounds)]
     lazy_rounds: usize,
-    /// Re-allocations of `balanced` on the leg times learnt while sequencing.
+    /// Re-allocations of `balanced` on the leg times learnt while sequencing (each costs about
+    /// an allocation and a sequencing; an alternative that cannot beat the plan so far is
+    /// dropped after one GTSP per robot).
     #[arg(long, value_name = "N", default_value_t = PlanSettings::default().reallocation_rounds)]
     reallocation_rounds: usize,
     /// No progress output and no table.

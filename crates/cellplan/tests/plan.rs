@@ -373,7 +373,7 @@ file = "tasks.csv"
     let graphs: Vec<_> = cell
         .robots
         .iter()
-        .map(|r| plan::graph::RobotGraph::new(r, &table, plan::MoveModel::Trapezoid, 8))
+        .map(|r| plan::graph::RobotGraph::new(&cell, r, &table, plan::MoveModel::Trapezoid, 8, 0.02))
         .collect();
     let counts = |a: Allocation| {
         let s = settings(a);

@@ -1,8 +1,10 @@
 //! Per-robot graphs: the robot's home and every candidate of every task it can do, with the
 //! lower-bound move times between them (paper 000 eq. 3 with the move model of the settings).
+use crate::Cell;
 use crate::candidates::CandidateTable;
 use crate::model::robot::Robot;
 use crate::model::tasks::TaskId;
+use crate::motion::RobotValidity;
 use cellplan_motion::timing::{Limits, move_time, move_time_instant};
 use cellplan_solve::CostMatrix;
 
@@ -43,18 +45,39 @@ pub fn limits_of(robot: &Robot) -> Limits {
 /// farthest-point sampling in move time (different postures, for detours and for
 /// coordination). A task × robot pair has hundreds of candidates (poses × IK branches × ±2π
 /// turns), far more than sequencing needs; the kept ones span them.
-pub fn select(qs: &[&[f64]], home: &[f64], k: usize, limits: &Limits) -> Vec<usize> {
-    if qs.len() <= k {
-        return (0..qs.len()).collect();
-    }
+///
+/// `roomy(i)` says whether configuration `i` keeps a comfortable distance from the scene; it
+/// is asked only of configurations about to be chosen, and one that is not roomy is passed
+/// over while roomy ones remain (then the others fill up to `k`). A pose with a millimetre to
+/// spare is valid, but every leg out of it starts in a crevice — slow to plan, and fragile
+/// against the cell's real tolerances.
+pub fn select(
+    qs: &[&[f64]],
+    home: &[f64],
+    k: usize,
+    limits: &Limits,
+    roomy: &dyn Fn(usize) -> bool,
+) -> Vec<usize> {
     let mut order: Vec<(f64, usize)> = qs
         .iter()
         .enumerate()
         .map(|(i, q)| (move_time(home, q, limits), i))
         .collect();
     order.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
-    let near = k.div_ceil(2);
-    let mut chosen: Vec<usize> = order[..near].iter().map(|x| x.1).collect();
+    // Roominess, asked lazily.
+    let mut known: Vec<Option<bool>> = vec![None; qs.len()];
+    let ask = |known: &mut Vec<Option<bool>>, i: usize| *known[i].get_or_insert_with(|| roomy(i));
+    let near = k.div_ceil(2).min(qs.len());
+    let mut chosen: Vec<usize> = Vec::with_capacity(k);
+    for &(_, i) in &order {
+        if chosen.len() == near {
+            break;
+        }
+        if ask(&mut known, i) {
+            chosen.push(i);
+        }
+    }
+    // Farthest-point sampling over the roomy ones; then, if short, over the rest.
     let mut dist: Vec<f64> = qs
         .iter()
         .map(|q| {
@@ -64,18 +87,39 @@ pub fn select(qs: &[&[f64]], home: &[f64], k: usize, limits: &Limits) -> Vec<usi
                 .fold(f64::INFINITY, f64::min)
         })
         .collect();
-    while chosen.len() < k {
-        let (far, d) =
-            dist.iter().enumerate().fold(
-                (0, f64::NEG_INFINITY),
-                |best, (i, &d)| if d > best.1 { (i, d) } else { best },
-            );
-        if d <= 0.0 {
-            break;
+    let mut passed = vec![false; qs.len()];
+    for &c in &chosen {
+        passed[c] = true;
+    }
+    for strict in [true, false] {
+        if !strict {
+            passed.iter_mut().zip(&known).for_each(|(p, r)| {
+                if *r == Some(false) {
+                    *p = false;
+                }
+            });
+            for &c in &chosen {
+                passed[c] = true;
+            }
         }
-        chosen.push(far);
-        for (i, q) in qs.iter().enumerate() {
-            dist[i] = dist[i].min(move_time(qs[far], q, limits));
+        while chosen.len() < k.min(qs.len()) {
+            let (far, d) = dist.iter().enumerate().filter(|&(i, _)| !passed[i]).fold(
+                (usize::MAX, f64::NEG_INFINITY),
+                |best, (i, &d)| {
+                    if d > best.1 { (i, d) } else { best }
+                },
+            );
+            if far == usize::MAX || d <= 0.0 {
+                break;
+            }
+            passed[far] = true;
+            if strict && !ask(&mut known, far) {
+                continue;
+            }
+            chosen.push(far);
+            for (i, q) in qs.iter().enumerate() {
+                dist[i] = dist[i].min(move_time(qs[far], q, limits));
+            }
         }
     }
     chosen.sort_unstable();
@@ -84,8 +128,21 @@ pub fn select(qs: &[&[f64]], home: &[f64], k: usize, limits: &Limits) -> Vec<usi
 
 impl RobotGraph {
     /// The graph of `robot` over the candidates of `table`, at most `per_task` per task (see
-    /// [`select`]).
-    pub fn new(robot: &Robot, table: &CandidateTable, model: MoveModel, per_task: usize) -> Self {
+    /// [`select`]), preferring candidates at least `roomy` (m) farther from the static scene
+    /// than the process clearance asks, whose self pairs are that far apart too (or as far
+    /// as at home, if less).
+    pub fn new(
+        cell: &Cell,
+        robot: &Robot,
+        table: &CandidateTable,
+        model: MoveModel,
+        per_task: usize,
+        roomy: f64,
+    ) -> Self {
+        let validity = RobotValidity::new(cell, robot, cell.optical().clearance);
+        // Some self pairs are close by construction (a tool beside its wrist): what is roomy
+        // for them is what they have at home, if less.
+        let self_roomy = roomy.min(validity.self_clearance(&robot.home));
         let limits = limits_of(robot);
         let time = match model {
             MoveModel::Trapezoid => move_time,
@@ -97,7 +154,12 @@ impl RobotGraph {
         for (t, row) in table.table.iter().enumerate() {
             let cands = &row[robot.id.0].candidates;
             let all: Vec<&[f64]> = cands.iter().map(|c| c.q.as_slice()).collect();
-            for c in select(&all, &robot.home, per_task, &limits) {
+            let roomy = |i: usize| {
+                roomy <= 0.0
+                    || (validity.static_clearance(all[i]) >= roomy
+                        && validity.self_clearance(all[i]) >= self_roomy)
+            };
+            for c in select(&all, &robot.home, per_task, &limits, &roomy) {
                 alternatives[t].push(q.len());
                 q.push(cands[c].q.clone());
                 node_task.push(Some((TaskId(t), c)));

@@ -45,13 +45,17 @@ pub struct PlanSettings {
     pub balanced_iterations: usize,
     /// Re-allocations of the balanced strategy on the costs learnt while sequencing.
     pub reallocation_rounds: usize,
-    /// Most sequencing rounds of the lazy loop per robot.
+    /// Most sequencing rounds of the lazy loop per robot (twice that while its best order
+    /// still needs a leg the quick planner gave up on).
     pub lazy_rounds: usize,
     /// The lazy loop stops when no order can beat the best fully planned one by more than
     /// this fraction (its optimistic cost, with unplanned legs at their bound, is not lower).
     pub lazy_tolerance: f64,
     /// Candidates kept per task and robot for sequencing (see [`graph::select`]).
     pub alternatives: usize,
+    /// Candidates with at least this much more clearance (m) than the process asks are kept
+    /// first (see [`graph::select`]); 0 keeps them regardless.
+    pub roomy: f64,
     /// Settings of every leg's path planner (its seed is derived per leg); its shortcut
     /// iterations apply while the lazy loop ranks orders.
     pub motion: MotionSettings,
@@ -73,10 +77,11 @@ impl Default for PlanSettings {
             seed: 0,
             time_limit: Duration::from_secs(30),
             local_set_radius: 0.3,
-            balanced_iterations: 300,
+            balanced_iterations: 200,
             alternatives: 24,
+            roomy: 0.02,
             lazy_rounds: 4,
-            reallocation_rounds: 1,
+            reallocation_rounds: 0,
             lazy_tolerance: 0.01,
             motion: MotionSettings {
                 time_limit: Duration::from_secs(30),
@@ -178,7 +183,16 @@ pub fn plan(
     let graphs: Vec<RobotGraph> = cell
         .robots
         .par_iter()
-        .map(|r| RobotGraph::new(r, table, settings.move_model, settings.alternatives))
+        .map(|r| {
+            RobotGraph::new(
+                cell,
+                r,
+                table,
+                settings.move_model,
+                settings.alternatives,
+                settings.roomy,
+            )
+        })
         .collect();
     tick(Stage::Costs, &mut compute);
 
@@ -195,12 +209,16 @@ pub fn plan(
         &allocated.tasks,
         settings,
         deadline,
+        f64::INFINITY,
         &mut planned,
         &mut counts,
-    )?;
+    )?
+    .expect("no bar, so never beaten");
     if settings.allocation == Allocation::Balanced {
         // Re-allocate on what is known now: planned legs at their real time (paper 002's lazy
-        // costs, one level up); keep the better plan.
+        // costs, one level up); keep the better plan. An alternative is sequenced only as long
+        // as its robots' optimistic times stay below the best real makespan (the lazy bar), so
+        // one that cannot win costs a sequencing round, not its legs.
         let measure = cell.optical().measure_time;
         let makespan = |seqs: &[sequence::Sequence], planned: &[sequence::Planned]| {
             seqs.iter()
@@ -239,15 +257,20 @@ pub fn plan(
                 continue;
             }
             tried.push(next.clone());
-            let seqs = sequence_all(
+            let bar = makespan(&sequences, &planned) - 1e-9;
+            let Some(seqs) = sequence_all(
                 cell,
                 &graphs,
                 &next,
                 settings,
                 deadline,
+                bar,
                 &mut planned,
                 &mut counts,
-            )?;
+            )?
+            else {
+                continue;
+            };
             if makespan(&seqs, &planned) < makespan(&sequences, &planned) - 1e-9 {
                 sequences = seqs;
                 allocated.tasks = next;
@@ -280,16 +303,36 @@ pub fn plan(
 }
 
 /// Sequence every robot's tasks (in parallel), reusing and extending each robot's planned legs;
-/// `counts` accumulates (planned, sampled, failed) legs per robot.
+/// `counts` accumulates (planned, sampled, failed) legs per robot. `None` when some robot's
+/// time cannot get below `bar` (see [`sequence::sequence`]): every robot first finds its best
+/// order on the current costs, and only when all of them are below the bar are legs planned.
+#[allow(clippy::too_many_arguments)]
 fn sequence_all(
     cell: &Cell,
     graphs: &[RobotGraph],
     tasks: &[Vec<TaskId>],
     settings: &PlanSettings,
     deadline: Instant,
+    bar: f64,
     planned: &mut [sequence::Planned],
     counts: &mut [(usize, usize, usize)],
-) -> Result<Vec<sequence::Sequence>, PlanError> {
+) -> Result<Option<Vec<sequence::Sequence>>, PlanError> {
+    if bar.is_finite() {
+        let measure = cell.optical().measure_time;
+        let hopeless = cell
+            .robots
+            .par_iter()
+            .zip(graphs)
+            .zip(tasks)
+            .zip(planned.par_iter())
+            .any(|(((robot, graph), tasks), planned)| {
+                sequence::optimistic_time(graph, tasks, planned, measure, settings.seed ^ robot.id.0 as u64)
+                    >= bar
+            });
+        if hopeless {
+            return Ok(None);
+        }
+    }
     let seqs: Vec<sequence::Sequence> = cell
         .robots
         .par_iter()
@@ -297,7 +340,7 @@ fn sequence_all(
         .zip(tasks)
         .zip(planned.par_iter_mut())
         .map(|(((robot, graph), tasks), planned)| {
-            sequence::sequence(cell, robot, graph, tasks, settings, deadline, planned)
+            sequence::sequence(cell, robot, graph, tasks, settings, deadline, bar, planned)
         })
         .collect::<Result<_, _>>()?;
     for (s, c) in seqs.iter().zip(counts.iter_mut()) {
@@ -305,7 +348,7 @@ fn sequence_all(
         c.1 += s.legs_sampled;
         c.2 += s.legs_failed;
     }
-    Ok(seqs)
+    Ok((!seqs.iter().any(|s| s.beaten)).then_some(seqs))
 }
 
 /// A robot's costs with its planned legs at their real time (failed ones prohibitive).

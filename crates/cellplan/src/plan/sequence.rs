@@ -46,10 +46,15 @@ pub struct Sequence {
     pub legs_sampled: usize,
     /// Legs for which no path was found (their nodes were avoided).
     pub legs_failed: usize,
+    /// The search stopped because no order could finish below the bar it was given: `nodes`
+    /// and `legs` are empty (the counts still say what was planned).
+    pub beaten: bool,
 }
 
 /// Kicks of the GTSP heuristic per sequencing round (fixed, for determinism).
 const GTSP_ITERATIONS: usize = 400;
+/// The lazy loop may run this many times its rounds while its best order needs a failed leg.
+const STUCK_ROUNDS_FACTOR: usize = 2;
 /// Cost of a leg no path was found for: large enough never to be chosen when another exists.
 pub const NO_PATH: f64 = 1e6;
 
@@ -57,6 +62,12 @@ pub const NO_PATH: f64 = 1e6;
 pub type Planned = BTreeMap<(usize, usize), Result<Leg, String>>;
 
 /// Sequence `tasks` for `robot` with lazily planned legs.
+///
+/// `bar` (s) is the time to beat: as soon as the best order the sequencer finds under the
+/// current costs (planned legs real, the others at their lower bound) takes at least `bar`,
+/// the search stops and returns a sequence marked [`Sequence::beaten`]. The legs planned until
+/// then stay in `planned`. Pass `f64::INFINITY` to always finish.
+#[allow(clippy::too_many_arguments)]
 pub fn sequence(
     cell: &Cell,
     robot: &Robot,
@@ -64,6 +75,7 @@ pub fn sequence(
     tasks: &[TaskId],
     settings: &PlanSettings,
     deadline: Instant,
+    bar: f64,
     planned: &mut Planned,
 ) -> Result<Sequence, PlanError> {
     let measure = cell.optical().measure_time;
@@ -75,6 +87,10 @@ pub fn sequence(
         out.rounds += 1;
         nodes = solve_order(graph, tasks, planned, measure, settings.seed ^ robot.id.0 as u64);
         let optimistic = order_cost(graph, planned, &nodes, measure);
+        if optimistic >= bar {
+            out.beaten = true;
+            return Ok(out);
+        }
         // No order can beat the best real one by more than the tolerance: stop.
         if let Some((b, order)) = &best
             && optimistic >= b * (1.0 - settings.lazy_tolerance)
@@ -115,7 +131,15 @@ pub fn sequence(
         if best.as_ref().is_none_or(|(b, _)| real < *b) {
             best = Some((real, nodes.clone()));
         }
-        if out.rounds >= settings.lazy_rounds || Instant::now() >= deadline {
+        // While the best planned order still needs a leg the quick planner gave up on, more
+        // rounds (each a GTSP and a few legs) are cheaper than the full-budget retry below.
+        let stuck = best.as_ref().is_some_and(|(b, _)| *b >= NO_PATH);
+        let rounds = if stuck {
+            STUCK_ROUNDS_FACTOR * settings.lazy_rounds
+        } else {
+            settings.lazy_rounds
+        };
+        if out.rounds >= rounds || Instant::now() >= deadline {
             nodes = best.as_ref().map(|b| b.1.clone()).unwrap_or_default();
             break;
         }
@@ -239,6 +263,19 @@ pub fn order_cost(graph: &RobotGraph, planned: &Planned, nodes: &[usize], measur
         })
         .sum::<f64>()
         + measure * nodes.len() as f64
+}
+
+/// The time of the best order the sequencer finds for `tasks` under the current costs (planned
+/// legs real, the others at their lower bound): what [`sequence`]'s first round starts from.
+pub fn optimistic_time(
+    graph: &RobotGraph,
+    tasks: &[TaskId],
+    planned: &Planned,
+    measure: f64,
+    seed: u64,
+) -> f64 {
+    let nodes = solve_order(graph, tasks, planned, measure, seed);
+    order_cost(graph, planned, &nodes, measure)
 }
 
 /// The best order (GTSP over the tasks' candidates) under the current costs: planned legs at
