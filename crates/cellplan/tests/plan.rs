@@ -480,3 +480,59 @@ fn both_example_cells_plan_and_recheck_clean() {
         verified(&cell, &doc);
     }
 }
+
+/// The lazy bar: a robot whose best order cannot finish below the bar stops before planning a
+/// leg; with no bar it finishes, and its real time is what the bar is measured against.
+#[test]
+fn sequencing_against_a_bar_stops_before_planning() {
+    let f = fixture();
+    let s = settings(Allocation::Balanced);
+    let robot = &f.cell.robots[0];
+    let graph =
+        plan::graph::RobotGraph::new(&f.cell, robot, &f.table, plan::MoveModel::Trapezoid, 8, s.roomy);
+    let tasks: Vec<TaskId> = (0..f.cell.tasks.len())
+        .map(TaskId)
+        .filter(|&t| !graph.alternatives[t.0].is_empty())
+        .take(3)
+        .collect();
+    assert_eq!(tasks.len(), 3, "the robot measures at least three MPs");
+    let deadline = std::time::Instant::now() + std::time::Duration::from_secs(3600);
+    let measure = f.cell.optical().measure_time;
+    // Three measurements alone take longer than this bar.
+    let bar = 3.0 * measure - 1e-3;
+    let mut planned = plan::sequence::Planned::new();
+    let beaten =
+        plan::sequence::sequence(&f.cell, robot, &graph, &tasks, &s, deadline, bar, &mut planned).unwrap();
+    assert!(beaten.beaten && beaten.nodes.is_empty() && beaten.legs.is_empty());
+    assert!(planned.is_empty(), "no leg planned for a hopeless allocation");
+    let done = plan::sequence::sequence(
+        &f.cell,
+        robot,
+        &graph,
+        &tasks,
+        &s,
+        deadline,
+        f64::INFINITY,
+        &mut planned,
+    )
+    .unwrap();
+    assert!(!done.beaten);
+    assert_eq!(done.nodes.len(), 3);
+    assert_eq!(done.legs.len(), 4);
+    let real = plan::sequence::order_cost(&graph, &planned, &done.nodes, measure);
+    assert!(real < plan::sequence::NO_PATH && real > 3.0 * measure);
+    // A bar just above the real time does not stop it.
+    let mut again = planned.clone();
+    let kept = plan::sequence::sequence(
+        &f.cell,
+        robot,
+        &graph,
+        &tasks,
+        &s,
+        deadline,
+        real + 1.0,
+        &mut again,
+    )
+    .unwrap();
+    assert!(!kept.beaten);
+}
