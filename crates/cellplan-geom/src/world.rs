@@ -820,21 +820,32 @@ struct AxisCache {
     next: usize,
 }
 
+/// The highest projection of a triangle on `d`.
+#[inline]
+fn triangle_top(d: DVec3, t: &Triangle) -> f64 {
+    d.dot(t.a).max(d.dot(t.b)).max(d.dot(t.c))
+}
+
+/// The highest projection on `d` of the box with centre `c` and half extents `e`.
+#[inline]
+fn box_top(d: DVec3, c: DVec3, e: DVec3) -> f64 {
+    d.dot(c) + d.abs().dot(e)
+}
+
 impl AxisCache {
     #[inline]
     fn separates(&self, t: &Triangle) -> bool {
         self.axes[..self.len]
             .iter()
-            .any(|&(d, limit)| d.dot(t.a).max(d.dot(t.b)).max(d.dot(t.c)) < limit)
+            .any(|&(d, limit)| triangle_top(d, t) < limit)
     }
 
     #[inline]
     fn separates_box(&self, mins: DVec3, maxs: DVec3) -> bool {
-        let c = (mins + maxs) * 0.5;
-        let e = (maxs - mins) * 0.5;
+        let (c, e) = ((mins + maxs) * 0.5, (maxs - mins) * 0.5);
         self.axes[..self.len]
             .iter()
-            .any(|&(d, limit)| d.dot(c) + d.abs().dot(e) < limit)
+            .any(|&(d, limit)| box_top(d, c, e) < limit)
     }
 
     /// The largest gap `limit − max(axis · vertex)` over the cached axes (−∞ when empty): with
@@ -844,18 +855,17 @@ impl AxisCache {
     fn triangle_gap(&self, t: &Triangle) -> f64 {
         self.axes[..self.len]
             .iter()
-            .map(|&(d, limit)| limit - d.dot(t.a).max(d.dot(t.b)).max(d.dot(t.c)))
+            .map(|&(d, limit)| limit - triangle_top(d, t))
             .fold(f64::NEG_INFINITY, f64::max)
     }
 
     /// [`AxisCache::triangle_gap`] for everything inside the box `mins..maxs`.
     #[inline]
     fn box_gap(&self, mins: DVec3, maxs: DVec3) -> f64 {
-        let c = (mins + maxs) * 0.5;
-        let e = (maxs - mins) * 0.5;
+        let (c, e) = ((mins + maxs) * 0.5, (maxs - mins) * 0.5);
         self.axes[..self.len]
             .iter()
-            .map(|&(d, limit)| limit - (d.dot(c) + d.abs().dot(e)))
+            .map(|&(d, limit)| limit - box_top(d, c, e))
             .fold(f64::NEG_INFINITY, f64::max)
     }
 

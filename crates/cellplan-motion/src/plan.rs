@@ -172,21 +172,33 @@ pub trait StateValidity: Sync {
         floor: f64,
         limit: f64,
     ) -> Option<f64> {
-        let mut buf = Vec::new();
-        self.clearances(q, &mut buf);
-        let mut step = limit;
-        for c in &buf {
-            // NaN fails the comparison and so counts as a contact.
-            if c.distance.is_nan() || c.distance < floor {
-                return None;
-            }
-            let b = bound(&c.joints);
-            if b > 0.0 {
-                step = step.min(c.distance / b);
-            }
+        // One buffer per thread, taken out while in use (so a nested call gets its own).
+        thread_local! {
+            static BUF: std::cell::Cell<Vec<Clearance>> = const { std::cell::Cell::new(Vec::new()) };
         }
-        Some(step)
+        let mut buf = BUF.take();
+        self.clearances(q, &mut buf);
+        let step = buf.iter().try_fold(limit, |step, c| {
+            narrow_step(step, c.distance, bound(&c.joints), floor)
+        });
+        BUF.set(buf);
+        step
     }
+}
+
+/// One part's say in [`StateValidity::segment_step`]: `None` when its clearance `distance` is
+/// below `floor` (or NaN), else `step` shortened to `distance / bound` if that is shorter
+/// (a part whose joints do not move, `bound` 0, only has to be valid).
+pub fn narrow_step(step: f64, distance: f64, bound: f64, floor: f64) -> Option<f64> {
+    // NaN fails the comparison and so counts as a contact.
+    if distance.is_nan() || distance < floor {
+        return None;
+    }
+    Some(if bound > 0.0 {
+        step.min(distance / bound)
+    } else {
+        step
+    })
 }
 
 /// A plain function or closure of `q` is a validity checker (its value is the clearance).

@@ -14,7 +14,7 @@ use crate::model::Cell;
 use crate::model::robot::{BodyFrame, Robot, Scratch};
 use cellplan_kin::JointKind;
 use cellplan_motion::plan::{
-    self, Clearance, JointSpace, PlanError, PlanSettings, PlannedPath, StateValidity,
+    self, Clearance, JointSpace, PlanError, PlanSettings, PlannedPath, StateValidity, narrow_step,
 };
 use std::cell::RefCell;
 use std::ops::Range;
@@ -241,30 +241,15 @@ impl StateValidity for RobotValidity<'_> {
             let g = self.robot.group;
             let margin = self.margin.max(0.0);
             let mut step = limit;
-            let take = |c: f64, b: f64, step: &mut f64| {
-                if c.is_nan() || c < floor {
-                    return false;
-                }
-                if b > 0.0 {
-                    *step = step.min(c / b);
-                }
-                true
-            };
             for (i, joints) in self.moving.iter().rev() {
                 let b = bound(joints);
                 let query = |cap: f64| world.body_static_distance(g, *i, &scratch.bodies, cap);
-                let c = self.capped_part(query, margin, b, step, floor);
-                if !take(c, b, &mut step) {
-                    return None;
-                }
+                step = narrow_step(step, self.capped_part(query, margin, b, step, floor), b, floor)?;
             }
             for (i, j, joints) in &self.pairs {
                 let b = bound(joints);
                 let query = |cap: f64| world.pair_distance(g, *i, *j, &scratch.bodies, cap);
-                let c = self.capped_part(query, 0.0, b, step, floor);
-                if !take(c, b, &mut step) {
-                    return None;
-                }
+                step = narrow_step(step, self.capped_part(query, 0.0, b, step, floor), b, floor)?;
             }
             Some(step)
         })
@@ -272,47 +257,19 @@ impl StateValidity for RobotValidity<'_> {
 }
 
 impl RobotValidity<'_> {
-    /// The clearance of `q` from the static scene alone (minus the margin, capped at
-    /// [`Self::cap`]); negative infinity outside the joint limits.
-    pub fn static_clearance(&self, q: &[f64]) -> f64 {
+    /// The clearance of `q` from the static scene (minus the margin) and the smallest distance
+    /// between its checked self pairs, each capped at [`Self::cap`] (the parts of
+    /// [`StateValidity::clearances`], split); both negative infinity outside the joint limits.
+    pub fn scene_and_self_clearance(&self, q: &[f64]) -> (f64, f64) {
         if !self.robot.within_limits(q) {
-            return f64::NEG_INFINITY;
+            return (f64::NEG_INFINITY, f64::NEG_INFINITY);
         }
-        SCRATCH.with_borrow_mut(|scratch| {
-            self.robot.body_poses(q, scratch);
-            let margin = self.margin.max(0.0);
-            self.moving
-                .iter()
-                .map(|(i, _)| {
-                    self.cell.world.body_static_distance(
-                        self.robot.group,
-                        *i,
-                        &scratch.bodies,
-                        self.cap + margin,
-                    ) - margin
-                        - DISTANCE_SLACK
-                })
-                .fold(f64::INFINITY, f64::min)
-        })
-    }
-
-    /// The smallest distance between the robot's checked self pairs at `q` (capped at
-    /// [`Self::cap`]); negative infinity outside the joint limits.
-    pub fn self_clearance(&self, q: &[f64]) -> f64 {
-        if !self.robot.within_limits(q) {
-            return f64::NEG_INFINITY;
-        }
-        SCRATCH.with_borrow_mut(|scratch| {
-            self.robot.body_poses(q, scratch);
-            self.pairs
-                .iter()
-                .map(|(i, j, _)| {
-                    self.cell
-                        .world
-                        .pair_distance(self.robot.group, *i, *j, &scratch.bodies, self.cap)
-                        - DISTANCE_SLACK
-                })
-                .fold(self.cap, f64::min)
+        CLEARANCES.with_borrow_mut(|out| {
+            self.clearances(q, out);
+            // `clearances` lists the moving bodies first, then the pairs.
+            let (scene, pairs) = out.split_at(self.moving.len());
+            let min = |parts: &[Clearance]| parts.iter().map(|c| c.distance).fold(self.cap, f64::min);
+            (min(scene), min(pairs))
         })
     }
 

@@ -500,39 +500,20 @@ fn sequencing_against_a_bar_stops_before_planning() {
     let measure = f.cell.optical().measure_time;
     // Three measurements alone take longer than this bar.
     let bar = 3.0 * measure - 1e-3;
+    let run = |bar: f64, planned: &mut plan::sequence::Planned| {
+        plan::sequence::sequence(&f.cell, robot, &graph, &tasks, &s, deadline, bar, None, planned).unwrap()
+    };
     let mut planned = plan::sequence::Planned::new();
-    let beaten =
-        plan::sequence::sequence(&f.cell, robot, &graph, &tasks, &s, deadline, bar, &mut planned).unwrap();
+    let beaten = run(bar, &mut planned);
     assert!(beaten.beaten && beaten.nodes.is_empty() && beaten.legs.is_empty());
     assert!(planned.is_empty(), "no leg planned for a hopeless allocation");
-    let done = plan::sequence::sequence(
-        &f.cell,
-        robot,
-        &graph,
-        &tasks,
-        &s,
-        deadline,
-        f64::INFINITY,
-        &mut planned,
-    )
-    .unwrap();
+    let done = run(f64::INFINITY, &mut planned);
     assert!(!done.beaten);
     assert_eq!(done.nodes.len(), 3);
     assert_eq!(done.legs.len(), 4);
     let real = plan::sequence::order_cost(&graph, &planned, &done.nodes, measure);
     assert!(real < plan::sequence::NO_PATH && real > 3.0 * measure);
     // A bar just above the real time does not stop it.
-    let mut again = planned.clone();
-    let kept = plan::sequence::sequence(
-        &f.cell,
-        robot,
-        &graph,
-        &tasks,
-        &s,
-        deadline,
-        real + 1.0,
-        &mut again,
-    )
-    .unwrap();
+    let kept = run(real + 1.0, &mut planned.clone());
     assert!(!kept.beaten);
 }

@@ -58,6 +58,9 @@ pub fn select(
     limits: &Limits,
     roomy: &dyn Fn(usize) -> bool,
 ) -> Vec<usize> {
+    if qs.len() <= k {
+        return (0..qs.len()).collect();
+    }
     let mut order: Vec<(f64, usize)> = qs
         .iter()
         .enumerate()
@@ -67,7 +70,7 @@ pub fn select(
     // Roominess, asked lazily.
     let mut known: Vec<Option<bool>> = vec![None; qs.len()];
     let ask = |known: &mut Vec<Option<bool>>, i: usize| *known[i].get_or_insert_with(|| roomy(i));
-    let near = k.div_ceil(2).min(qs.len());
+    let near = k.div_ceil(2);
     let mut chosen: Vec<usize> = Vec::with_capacity(k);
     for &(_, i) in &order {
         if chosen.len() == near {
@@ -87,22 +90,14 @@ pub fn select(
                 .fold(f64::INFINITY, f64::min)
         })
         .collect();
+    // Chosen, or passed over in this round.
     let mut passed = vec![false; qs.len()];
-    for &c in &chosen {
-        passed[c] = true;
-    }
     for strict in [true, false] {
-        if !strict {
-            passed.iter_mut().zip(&known).for_each(|(p, r)| {
-                if *r == Some(false) {
-                    *p = false;
-                }
-            });
-            for &c in &chosen {
-                passed[c] = true;
-            }
+        passed.fill(false);
+        for &c in &chosen {
+            passed[c] = true;
         }
-        while chosen.len() < k.min(qs.len()) {
+        while chosen.len() < k {
             let (far, d) = dist.iter().enumerate().filter(|&(i, _)| !passed[i]).fold(
                 (usize::MAX, f64::NEG_INFINITY),
                 |best, (i, &d)| {
@@ -142,7 +137,7 @@ impl RobotGraph {
         let validity = RobotValidity::new(cell, robot, cell.optical().clearance);
         // Some self pairs are close by construction (a tool beside its wrist): what is roomy
         // for them is what they have at home, if less.
-        let self_roomy = roomy.min(validity.self_clearance(&robot.home));
+        let self_roomy = roomy.min(validity.scene_and_self_clearance(&robot.home).1);
         let limits = limits_of(robot);
         let time = match model {
             MoveModel::Trapezoid => move_time,
@@ -155,9 +150,10 @@ impl RobotGraph {
             let cands = &row[robot.id.0].candidates;
             let all: Vec<&[f64]> = cands.iter().map(|c| c.q.as_slice()).collect();
             let roomy = |i: usize| {
-                roomy <= 0.0
-                    || (validity.static_clearance(all[i]) >= roomy
-                        && validity.self_clearance(all[i]) >= self_roomy)
+                roomy <= 0.0 || {
+                    let (scene, own) = validity.scene_and_self_clearance(all[i]);
+                    scene >= roomy && own >= self_roomy
+                }
             };
             for c in select(&all, &robot.home, per_task, &limits, &roomy) {
                 alternatives[t].push(q.len());

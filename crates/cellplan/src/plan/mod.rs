@@ -317,30 +317,43 @@ fn sequence_all(
     planned: &mut [sequence::Planned],
     counts: &mut [(usize, usize, usize)],
 ) -> Result<Option<Vec<sequence::Sequence>>, PlanError> {
-    if bar.is_finite() {
-        let measure = cell.optical().measure_time;
-        let hopeless = cell
+    // Every robot's first order, looked at before any robot plans a leg when there is a bar.
+    let measure = cell.optical().measure_time;
+    let firsts: Vec<Option<Vec<usize>>> = if bar.is_finite() {
+        let orders: Vec<(Vec<usize>, f64)> = cell
             .robots
             .par_iter()
             .zip(graphs)
             .zip(tasks)
             .zip(planned.par_iter())
-            .any(|(((robot, graph), tasks), planned)| {
-                sequence::optimistic_time(graph, tasks, planned, measure, settings.seed ^ robot.id.0 as u64)
-                    >= bar
-            });
-        if hopeless {
+            .map(|(((robot, graph), tasks), planned)| {
+                let order = sequence::best_order(
+                    graph,
+                    tasks,
+                    planned,
+                    measure,
+                    sequence::order_seed(settings, robot),
+                );
+                let time = sequence::order_cost(graph, planned, &order, measure);
+                (order, time)
+            })
+            .collect();
+        if orders.iter().any(|(_, time)| *time >= bar) {
             return Ok(None);
         }
-    }
+        orders.into_iter().map(|(order, _)| Some(order)).collect()
+    } else {
+        vec![None; graphs.len()]
+    };
     let seqs: Vec<sequence::Sequence> = cell
         .robots
         .par_iter()
         .zip(graphs)
         .zip(tasks)
+        .zip(firsts)
         .zip(planned.par_iter_mut())
-        .map(|(((robot, graph), tasks), planned)| {
-            sequence::sequence(cell, robot, graph, tasks, settings, deadline, bar, planned)
+        .map(|((((robot, graph), tasks), first), planned)| {
+            sequence::sequence(cell, robot, graph, tasks, settings, deadline, bar, first, planned)
         })
         .collect::<Result<_, _>>()?;
     for (s, c) in seqs.iter().zip(counts.iter_mut()) {

@@ -66,7 +66,9 @@ pub type Planned = BTreeMap<(usize, usize), Result<Leg, String>>;
 /// `bar` (s) is the time to beat: as soon as the best order the sequencer finds under the
 /// current costs (planned legs real, the others at their lower bound) takes at least `bar`,
 /// the search stops and returns a sequence marked [`Sequence::beaten`]. The legs planned until
-/// then stay in `planned`. Pass `f64::INFINITY` to always finish.
+/// then stay in `planned`. Pass `f64::INFINITY` to always finish. `first`, when given, is the
+/// first round's order, as [`best_order`] gives it for the same `planned` (already computed by
+/// a caller that looked before it leapt).
 #[allow(clippy::too_many_arguments)]
 pub fn sequence(
     cell: &Cell,
@@ -76,6 +78,7 @@ pub fn sequence(
     settings: &PlanSettings,
     deadline: Instant,
     bar: f64,
+    mut first: Option<Vec<usize>>,
     planned: &mut Planned,
 ) -> Result<Sequence, PlanError> {
     let measure = cell.optical().measure_time;
@@ -85,7 +88,10 @@ pub fn sequence(
     let mut nodes: Vec<usize>;
     loop {
         out.rounds += 1;
-        nodes = solve_order(graph, tasks, planned, measure, settings.seed ^ robot.id.0 as u64);
+        nodes = match first.take() {
+            Some(order) => order,
+            None => best_order(graph, tasks, planned, measure, order_seed(settings, robot)),
+        };
         let optimistic = order_cost(graph, planned, &nodes, measure);
         if optimistic >= bar {
             out.beaten = true;
@@ -265,22 +271,14 @@ pub fn order_cost(graph: &RobotGraph, planned: &Planned, nodes: &[usize], measur
         + measure * nodes.len() as f64
 }
 
-/// The time of the best order the sequencer finds for `tasks` under the current costs (planned
-/// legs real, the others at their lower bound): what [`sequence`]'s first round starts from.
-pub fn optimistic_time(
-    graph: &RobotGraph,
-    tasks: &[TaskId],
-    planned: &Planned,
-    measure: f64,
-    seed: u64,
-) -> f64 {
-    let nodes = solve_order(graph, tasks, planned, measure, seed);
-    order_cost(graph, planned, &nodes, measure)
+/// The seed of `robot`'s sequencing GTSPs.
+pub fn order_seed(settings: &PlanSettings, robot: &Robot) -> u64 {
+    settings.seed ^ robot.id.0 as u64
 }
 
 /// The best order (GTSP over the tasks' candidates) under the current costs: planned legs at
 /// their real time, the others at their lower bound.
-fn solve_order(
+pub fn best_order(
     graph: &RobotGraph,
     tasks: &[TaskId],
     planned: &Planned,
