@@ -1,6 +1,8 @@
 //! `cellplan plan`: the main job.
 use crate::{Failure, load_options, spinner};
+use cellplan::coord::{self, CoordSettings, Coordination};
 use cellplan::plan::{self, Allocation, CoverMethod, MoveModel, PlanError, PlanSettings, Stage, output};
+use cellplan::verify::{VerifySettings, verify};
 use cellplan::{InputError, candidates, io::write_atomic, report::check};
 use clap::{Args, ValueEnum};
 use serde::Serialize;
@@ -41,6 +43,13 @@ pub struct PlanArgs {
     /// dropped after one GTSP per robot).
     #[arg(long, value_name = "N", default_value_t = PlanSettings::default().reallocation_rounds)]
     reallocation_rounds: usize,
+    /// Coordination of the robots on the common clock (paper 000 §4.2 is `pose-perturbation`;
+    /// `none` leaves conflicts in, and the verifier then refuses the plan).
+    #[arg(long, value_enum, default_value_t = CoordinationArg::Best)]
+    coordination: CoordinationArg,
+    /// Write the plan even if `cellplan verify` rejects it.
+    #[arg(long)]
+    no_verify: bool,
     /// No progress output and no table.
     #[arg(long, short)]
     quiet: bool,
@@ -61,6 +70,27 @@ enum AllocationArg {
     Proximity,
     LocalRobust,
     Balanced,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+pub(crate) enum CoordinationArg {
+    None,
+    DelayStartup,
+    FixedPriority,
+    PosePerturbation,
+    Best,
+}
+
+impl From<CoordinationArg> for Coordination {
+    fn from(a: CoordinationArg) -> Self {
+        match a {
+            CoordinationArg::None => Coordination::None,
+            CoordinationArg::DelayStartup => Coordination::DelayStartup,
+            CoordinationArg::FixedPriority => Coordination::FixedPriority,
+            CoordinationArg::PosePerturbation => Coordination::PosePerturbation,
+            CoordinationArg::Best => Coordination::Best,
+        }
+    }
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -86,6 +116,8 @@ struct Summary<'a> {
     unmeasured: Vec<&'a str>,
     legs_planned: usize,
     legs_sampled: usize,
+    coordination: &'a output::CoordinationOut,
+    verified: bool,
     compute_s: f64,
     compute_stages_s: &'a output::ComputeTimes,
 }
@@ -96,6 +128,7 @@ struct RobotSummary<'a> {
     tasks: usize,
     motion_s: f64,
     measuring_s: f64,
+    waiting_s: f64,
     total_s: f64,
 }
 
@@ -160,13 +193,44 @@ pub fn run(args: &PlanArgs) -> Result<(), Failure> {
             })
         }
     };
-    let outcome = plan::plan(&cell, &table, &settings, &progress).map_err(|e| match e {
+    let failure = |e: PlanError| match e {
         PlanError::Infeasible(m) => Failure::Input(Box::new(
             InputError::new(&cell.path, m).hint("see [process] task_cap and balance_limit in the cell file"),
         )),
         other => Failure::Other(other.to_string()),
-    })?;
-    let mut doc = output::build(&cell, &table, &outcome, &settings, load_s, candidates_s);
+    };
+    let outcome = plan::plan(&cell, &table, &settings, &progress).map_err(failure)?;
+    pb.set_message("coordinating the robots on one clock");
+    let coord_settings = CoordSettings {
+        strategy: args.coordination.into(),
+        seed: args.seed,
+        ..CoordSettings::default()
+    };
+    let coordinated = coord::coordinate_outcome(&cell, &table, &outcome, &coord_settings).map_err(failure)?;
+    let mut doc = output::build(
+        &cell,
+        &table,
+        &outcome,
+        &coordinated,
+        &settings,
+        load_s,
+        candidates_s,
+    );
+    pb.set_message("verifying the plan");
+    let lap = Instant::now();
+    let report = verify(&cell, &doc, &VerifySettings::default());
+    doc.compute_s.verification = lap.elapsed().as_secs_f64();
+    doc.verified = report.ok;
+    if !report.ok && !args.no_verify {
+        pb.finish_and_clear();
+        for v in &report.violations {
+            eprintln!("{}", crate::verify_cmd::describe(v));
+        }
+        return Err(Failure::Other(format!(
+            "the plan failed verification ({} violation(s)) and was not written; --no-verify writes it anyway",
+            report.violations.len()
+        )));
+    }
     let dir = args
         .output
         .clone()
@@ -194,12 +258,15 @@ pub fn run(args: &PlanArgs) -> Result<(), Failure> {
                     tasks: r.tasks.len(),
                     motion_s: r.motion_s,
                     measuring_s: r.measuring_s,
+                    waiting_s: r.waiting_s,
                     total_s: r.total_s,
                 })
                 .collect(),
             unmeasured: doc.unmeasured.iter().map(|u| u.task.as_str()).collect(),
             legs_planned: doc.stats.legs_planned,
             legs_sampled: doc.stats.legs_sampled,
+            coordination: &doc.coordination,
+            verified: doc.verified,
             compute_s: doc.compute_s.total,
             compute_stages_s: &doc.compute_s,
         };
@@ -218,26 +285,49 @@ pub fn run(args: &PlanArgs) -> Result<(), Failure> {
 
 fn render(doc: &output::Plan) -> String {
     let mut s = format!(
-        "{} — allocation {}, seed {}\n\n",
+        "{} — allocation {}, coordination {}, seed {}\n\n",
         doc.cell,
         serde_json::to_value(doc.settings.allocation)
             .ok()
             .and_then(|v| v.as_str().map(String::from))
             .unwrap_or_default(),
+        doc.settings.coordination.name(),
         doc.settings.seed
     );
     s += &format!(
-        "{:<10} {:>6} {:>10} {:>12} {:>9}\n",
-        "robot", "MPs", "motion s", "measuring s", "total s"
+        "{:<10} {:>6} {:>10} {:>12} {:>10} {:>9}\n",
+        "robot", "MPs", "motion s", "measuring s", "waiting s", "total s"
     );
     for r in &doc.robots {
         s += &format!(
-            "{:<10} {:>6} {:>10.2} {:>12.2} {:>9.2}\n",
+            "{:<10} {:>6} {:>10.2} {:>12.2} {:>10.2} {:>9.2}\n",
             r.name,
             r.tasks.len(),
             r.motion_s,
             r.measuring_s,
+            r.waiting_s,
             r.total_s
+        );
+    }
+    let c = &doc.coordination;
+    s += &format!(
+        "\nconflicts before coordination {}, resolved {} ({} waits, {} poses changed); cycle time without coordination {:.2} s\n",
+        c.conflicts_before.len(),
+        c.conflicts_resolved,
+        c.waits,
+        c.poses_changed,
+        c.uncoordinated_cycle_time_s
+    );
+    for k in &c.conflicts_before {
+        s += &format!(
+            "  {:.2}–{:.2} s {} & {} (scenario {}): {}; {}\n",
+            k.start_s, k.end_s, k.robots[0], k.robots[1], k.scenario, k.activity[0], k.activity[1]
+        );
+    }
+    for k in &c.conflicts_after {
+        s += &format!(
+            "  NOT RESOLVED {:.2}–{:.2} s {} & {}: {}; {}\n",
+            k.start_s, k.end_s, k.robots[0], k.robots[1], k.activity[0], k.activity[1]
         );
     }
     s += &format!(
@@ -250,9 +340,22 @@ fn render(doc: &output::Plan) -> String {
     );
     let c = &doc.compute_s;
     s += &format!(
-        "compute: load {:.2} s, candidates {:.2} s, costs {:.2} s, allocation {:.2} s, sequencing+motion {:.2} s, timing {:.2} s, total {:.2} s\n",
-        c.load, c.candidates, c.costs, c.allocation, c.sequencing_motion, c.timing, c.total
+        "compute: load {:.2} s, candidates {:.2} s, costs {:.2} s, allocation {:.2} s, sequencing+motion {:.2} s, timing {:.2} s, coordination {:.2} s, verification {:.2} s, total {:.2} s\n",
+        c.load,
+        c.candidates,
+        c.costs,
+        c.allocation,
+        c.sequencing_motion,
+        c.timing,
+        c.coordination,
+        c.verification,
+        c.total
     );
+    s += if doc.verified {
+        "verified: every MP once, probe constraints, limits, clearance to the scene and between robots\n"
+    } else {
+        "NOT VERIFIED (written with --no-verify)\n"
+    };
     if !doc.unmeasured.is_empty() {
         s += "\nnot measured:\n";
         for u in &doc.unmeasured {

@@ -1,6 +1,6 @@
 //! `cellplan verify`: the independent check of a plan.
 use crate::Failure;
-use cellplan::verify::{VerifySettings, verify};
+use cellplan::verify::{VerifySettings, Violation, verify};
 use cellplan::{InputError, LoadOptions, plan::output::Plan};
 use clap::Args;
 use std::path::PathBuf;
@@ -54,14 +54,7 @@ pub fn run(args: &VerifyArgs) -> Result<(), Failure> {
         );
     } else {
         for v in &report.violations {
-            let who = match (&v.robot, &v.other) {
-                (Some(a), Some(b)) => format!("{a} & {b}"),
-                (Some(a), None) => a.clone(),
-                _ => "-".into(),
-            };
-            let when = v.time_s.map_or(String::new(), |t| format!(" at {t:.2} s"));
-            let task = v.task.as_ref().map_or(String::new(), |t| format!(" MP {t}"));
-            println!("{:?} {who}{when}{task}: {}", v.kind, v.detail);
+            println!("{}", describe(v));
         }
         println!(
             "{}: {} violation(s); cycle time {:.2} s, Δt {:.2} s (recomputed); {} configurations checked",
@@ -73,4 +66,16 @@ pub fn run(args: &VerifyArgs) -> Result<(), Failure> {
         );
     }
     if report.ok { Ok(()) } else { Err(Failure::Rejected) }
+}
+
+/// One violation on one line.
+pub fn describe(v: &Violation) -> String {
+    let who = match (&v.robot, &v.other) {
+        (Some(a), Some(b)) => format!("{a} & {b}"),
+        (Some(a), None) => a.clone(),
+        _ => "-".into(),
+    };
+    let when = v.time_s.map_or(String::new(), |t| format!(" at {t:.2} s"));
+    let task = v.task.as_ref().map_or(String::new(), |t| format!(" MP {t}"));
+    format!("{:?} {who}{when}{task}: {}", v.kind, v.detail)
 }

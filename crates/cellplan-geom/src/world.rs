@@ -380,6 +380,97 @@ impl CollisionWorld {
         None
     }
 
+    /// Distance from body `i` of `g` (at `poses[i]`) to every body of group `other` (at
+    /// `other_poses`), capped at `cap`: `min(true distance, cap)`, 0 when touching or at a
+    /// non-finite pose. A NaN or negative cap counts as 0; a missing pose or a body without
+    /// shapes gives the cap.
+    pub fn body_group_distance(
+        &self,
+        g: GroupId,
+        i: usize,
+        poses: &[Pose],
+        other: GroupId,
+        other_poses: &[Pose],
+        cap: f64,
+    ) -> f64 {
+        let mut best = sanitize_margin(cap);
+        let (Some(body), Some(pose)) = (self.group(g).bodies.get(i), poses.get(i)) else {
+            return best;
+        };
+        let pa = match place(body, pose) {
+            Placement::Empty => return best,
+            Placement::Invalid => return 0.0,
+            Placement::At(p) => p,
+        };
+        for (b, p) in self.group(other).bodies.iter().zip(other_poses) {
+            let pb = match place(b, p) {
+                Placement::Empty => continue,
+                Placement::Invalid => return 0.0,
+                Placement::At(p) => p,
+            };
+            if aabb_distance(&pa.aabb, &pb.aabb) >= best {
+                continue;
+            }
+            if let Some(d) = convex_distance(&pa.pose.inv_mul(&pb.pose), pa.support, pb.support, best) {
+                best = d;
+                if best <= 0.0 {
+                    return 0.0;
+                }
+            }
+        }
+        best
+    }
+
+    /// Smallest distance between any body of `a` (at `poses_a`) and any body of `b` (at
+    /// `poses_b`), capped at `cap`: `min(true distance, cap)`, 0 when two bodies touch or a pose
+    /// is not finite. Every pair is measured (an AABB test skips pairs at least the best
+    /// distance so far apart), so a small cap is fast. `a` and `b` should differ; for the same
+    /// group every pair `(i, j)`, `i < j`, is measured. A NaN or negative cap counts as 0.
+    pub fn group_group_distance(
+        &self,
+        a: GroupId,
+        poses_a: &[Pose],
+        b: GroupId,
+        poses_b: &[Pose],
+        cap: f64,
+    ) -> f64 {
+        let (ga, gb) = (self.group(a), self.group(b));
+        let mut best = sanitize_margin(cap);
+        let placed_b: Vec<Placement> = gb
+            .bodies
+            .iter()
+            .zip(poses_b)
+            .map(|(body, p)| place(body, p))
+            .collect();
+        for (i, (body, pose)) in ga.bodies.iter().zip(poses_a).enumerate() {
+            let pa = match place(body, pose) {
+                Placement::Empty => continue,
+                Placement::Invalid => return 0.0,
+                Placement::At(p) => p,
+            };
+            for (j, pb) in placed_b.iter().enumerate() {
+                if a == b && j <= i {
+                    continue;
+                }
+                let pb = match pb {
+                    Placement::Empty => continue,
+                    Placement::Invalid => return 0.0,
+                    Placement::At(p) => p,
+                };
+                if aabb_distance(&pa.aabb, &pb.aabb) >= best {
+                    continue;
+                }
+                if let Some(d) = convex_distance(&pa.pose.inv_mul(&pb.pose), pa.support, pb.support, best) {
+                    best = d;
+                    if best <= 0.0 {
+                        return 0.0;
+                    }
+                }
+            }
+        }
+        best
+    }
+
     /// Whether bodies `i` and `j` of group `g` are closer than `margin` (for pair sampling).
     ///
     /// Checks the pair regardless of the self-pair list. False when `i == j` or either index

@@ -4,7 +4,7 @@ use crate::model::robot::{BodyFrame, Robot, RobotId, Scratch};
 use crate::model::tasks::{Task, TaskId};
 use crate::process::optical::{OpticalProcess, ProbePose, Rejection};
 use crate::{Cell, Process};
-use cellplan_geom::{CollisionWorld, Pose};
+use cellplan_geom::{CollisionWorld, GroupId, Pose};
 use rayon::prelude::*;
 use serde::Serialize;
 use std::collections::BTreeMap;
@@ -83,7 +83,10 @@ pub fn generate(cell: &Cell) -> CandidateTable {
             let poses = process.sample_poses(task);
             cell.robots
                 .par_iter()
-                .map(|robot| optical_reach(process, &cell.world, robot, task, &poses))
+                .map(|robot| {
+                    let parked = parked_others(cell, robot);
+                    optical_reach(process, &cell.world, robot, task, &poses, &parked)
+                })
                 .collect()
         })
         .collect();
@@ -102,13 +105,31 @@ fn same_geometry(a: &[f64], b: &[f64]) -> bool {
     a.iter().zip(b).all(|(x, y)| (wrap(x - y)).abs() < 1e-9)
 }
 
-/// The candidates of one robot for one MP under the optical process.
+/// The other robots of the cell parked at home: (their body group, their body poses). A
+/// measuring pose that comes within the clearance of a parked robot is no candidate: every
+/// robot parks at home before and after its program, and a pose it cannot take while a
+/// neighbour is parked could only be timed around that neighbour's whole program.
+pub fn parked_others(cell: &crate::Cell, robot: &Robot) -> Vec<(GroupId, Vec<Pose>)> {
+    let mut scratch = Scratch::default();
+    cell.robots
+        .iter()
+        .filter(|r| r.id != robot.id)
+        .map(|r| {
+            r.body_poses(&r.home, &mut scratch);
+            (r.group, scratch.bodies.clone())
+        })
+        .collect()
+}
+
+/// The candidates of one robot for one MP under the optical process, clear of the `parked`
+/// robots (see [`parked_others`]).
 pub fn optical_reach(
     process: &OpticalProcess,
     world: &CollisionWorld,
     robot: &Robot,
     task: &Task,
     poses: &[ProbePose],
+    parked: &[(GroupId, Vec<Pose>)],
 ) -> Reach {
     let mut reach = Reach::default();
     let mut scratch = Scratch::default();
@@ -152,7 +173,8 @@ pub fn optical_reach(
             let verdict = match verdicts.iter().find(|(p, _)| same_geometry(p, q)) {
                 Some((_, v)) => *v,
                 None => {
-                    let v = check_configuration(process, world, robot, task, &pose.tcp, q, &mut scratch);
+                    let v =
+                        check_configuration(process, world, robot, task, &pose.tcp, q, parked, &mut scratch);
                     verdicts.push((q.clone(), v));
                     v
                 }
@@ -177,7 +199,9 @@ pub fn optical_reach(
     reach
 }
 
-/// Own-arm beam and collision checks of one configuration (the cheap rays first).
+/// Own-arm beam and collision checks of one configuration (the cheap rays first), then the
+/// parked robots.
+#[allow(clippy::too_many_arguments)]
 fn check_configuration(
     process: &OpticalProcess,
     world: &CollisionWorld,
@@ -185,6 +209,7 @@ fn check_configuration(
     task: &Task,
     tcp: &Pose,
     q: &[f64],
+    parked: &[(GroupId, Vec<Pose>)],
     scratch: &mut Scratch,
 ) -> Result<(), Rejection> {
     robot.body_poses(q, scratch);
@@ -200,6 +225,14 @@ fn check_configuration(
     }
     if robot.contact_at(world, scratch, process.clearance).is_some() {
         return Err(Rejection::Collision);
+    }
+    for (group, poses) in parked {
+        if world
+            .group_vs_group(robot.group, &scratch.bodies, *group, poses, process.clearance)
+            .is_some()
+        {
+            return Err(Rejection::Collision);
+        }
     }
     Ok(())
 }

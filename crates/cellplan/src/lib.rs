@@ -10,6 +10,7 @@
 #![allow(clippy::result_large_err)]
 
 pub mod candidates;
+pub mod coord;
 pub mod error;
 pub mod io;
 pub mod model;

@@ -137,6 +137,9 @@ pub struct RobotValidity<'a> {
     moving: Vec<(usize, Range<usize>)>,
     /// Checked self pairs with the joints between them.
     pairs: Vec<(usize, usize, Range<usize>)>,
+    /// The other robots parked at home (obstacles like the scene: see
+    /// [`crate::candidates::parked_others`]).
+    parked: Vec<(cellplan_geom::GroupId, Vec<cellplan_geom::Pose>)>,
 }
 
 impl<'a> RobotValidity<'a> {
@@ -179,7 +182,22 @@ impl<'a> RobotValidity<'a> {
             cap: DEFAULT_CLEARANCE_CAP,
             moving,
             pairs,
+            parked: crate::candidates::parked_others(cell, robot),
         }
+    }
+
+    /// Distance of body `i` (posed in `bodies`) to the scene and the parked robots, capped.
+    fn body_scene_distance(&self, i: usize, bodies: &[cellplan_geom::Pose], cap: f64) -> f64 {
+        let world = &self.cell.world;
+        let g = self.robot.group;
+        let mut d = world.body_static_distance(g, i, bodies, cap);
+        for (other, poses) in &self.parked {
+            if d <= 0.0 {
+                break;
+            }
+            d = world.body_group_distance(g, i, bodies, *other, poses, d);
+        }
+        d
     }
 }
 
@@ -206,7 +224,7 @@ impl StateValidity for RobotValidity<'_> {
             let g = self.robot.group;
             let margin = self.margin.max(0.0);
             for (i, joints) in &self.moving {
-                let d = world.body_static_distance(g, *i, &scratch.bodies, self.cap + margin);
+                let d = self.body_scene_distance(*i, &scratch.bodies, self.cap + margin);
                 out.push(Clearance {
                     distance: d - margin - DISTANCE_SLACK,
                     joints: joints.clone(),
@@ -243,7 +261,7 @@ impl StateValidity for RobotValidity<'_> {
             let mut step = limit;
             for (i, joints) in self.moving.iter().rev() {
                 let b = bound(joints);
-                let query = |cap: f64| world.body_static_distance(g, *i, &scratch.bodies, cap);
+                let query = |cap: f64| self.body_scene_distance(*i, &scratch.bodies, cap);
                 step = narrow_step(step, self.capped_part(query, margin, b, step, floor), b, floor)?;
             }
             for (i, j, joints) in &self.pairs {

@@ -4,6 +4,7 @@
 //! steps of 1 mrad) against the static scene at the margin, joint position, velocity and
 //! acceleration limits from the written samples, the document's totals recomputed.
 use cellplan::candidates::{CandidateTable, generate};
+use cellplan::coord::{self, CoordSettings};
 use cellplan::model::load::load;
 use cellplan::model::robot::Scratch;
 use cellplan::plan::{self, Allocation, PlanSettings, output};
@@ -67,7 +68,7 @@ fn make(allocation: Allocation) -> output::Plan {
     let f = fixture();
     let s = settings(allocation);
     let outcome = plan::plan(&f.cell, &f.table, &s, &|_| {}).expect("the reduced cell plans");
-    let doc = output::build(&f.cell, &f.table, &outcome, &s, 0.0, 0.0);
+    let doc = build(&f.cell, &f.table, &outcome, &s);
     // The document survives its own JSON.
     let text = serde_json::to_string(&doc).unwrap();
     let back: output::Plan = serde_json::from_str(&text).unwrap();
@@ -77,13 +78,16 @@ fn make(allocation: Allocation) -> output::Plan {
     doc
 }
 
-/// The verifier accepts the plan, robot–robot clearance aside (coordination is a later stage).
+/// The plan document of a run, coordinated by `best`.
+fn build(cell: &Cell, table: &CandidateTable, outcome: &plan::Outcome, s: &PlanSettings) -> output::Plan {
+    let c = coord::coordinate_outcome(cell, table, outcome, &CoordSettings::default())
+        .expect("coordination succeeds");
+    output::build(cell, table, outcome, &c, s, 0.0, 0.0)
+}
+
+/// The verifier accepts the plan, robot–robot clearance included.
 fn verified(cell: &Cell, doc: &output::Plan) {
-    let settings = VerifySettings {
-        robot_robot: false,
-        ..VerifySettings::default()
-    };
-    let report = verify(cell, doc, &settings);
+    let report = verify(cell, doc, &VerifySettings::default());
     assert!(report.ok, "{:#?}", report.violations);
     assert!(report.configurations_checked > 0);
 }
@@ -245,8 +249,9 @@ fn the_plan_does_not_depend_on_the_thread_count() {
             .unwrap();
         pool.install(|| {
             let outcome = plan::plan(&f.cell, &f.table, &s, &|_| {}).unwrap();
-            let mut doc = output::build(&f.cell, &f.table, &outcome, &s, 0.0, 0.0);
+            let mut doc = build(&f.cell, &f.table, &outcome, &s);
             doc.compute_s = output::ComputeTimes::default();
+            doc.coordination.compute_s = 0.0;
             doc
         })
     };
@@ -270,7 +275,7 @@ fn written_plans_have_every_key_the_schema_requires() {
         ..settings(Allocation::Proximity)
     };
     let outcome = plan::plan(&f.cell, &f.table, &s, &|_| {}).unwrap();
-    let doc = serde_json::to_value(output::build(&f.cell, &f.table, &outcome, &s, 0.0, 0.0)).unwrap();
+    let doc = serde_json::to_value(build(&f.cell, &f.table, &outcome, &s)).unwrap();
     fn required(schema: &serde_json::Value, value: &serde_json::Value, root: &serde_json::Value, at: &str) {
         let schema = match schema.get("$ref").and_then(|r| r.as_str()) {
             Some(r) => root.pointer(r.trim_start_matches('#')).unwrap(),
@@ -391,7 +396,7 @@ file = "tasks.csv"
     ] {
         let s = settings(a);
         let outcome = plan::plan(&cell, &table, &s, &|_| {}).unwrap();
-        let doc = output::build(&cell, &table, &outcome, &s, 0.0, 0.0);
+        let doc = build(&cell, &table, &outcome, &s);
         check_plan(&cell, &doc);
         verified(&cell, &doc);
     }
@@ -403,11 +408,8 @@ fn the_verifier_catches_injected_faults() {
     let f = fixture();
     let s = settings(Allocation::Balanced);
     let outcome = plan::plan(&f.cell, &f.table, &s, &|_| {}).unwrap();
-    let good = output::build(&f.cell, &f.table, &outcome, &s, 0.0, 0.0);
-    let quiet = VerifySettings {
-        robot_robot: false,
-        ..VerifySettings::default()
-    };
+    let good = build(&f.cell, &f.table, &outcome, &s);
+    let quiet = VerifySettings::default();
     assert!(verify(&f.cell, &good, &quiet).ok);
     let kinds = |doc: &output::Plan| -> Vec<ViolationKind> {
         verify(&f.cell, doc, &quiet)
@@ -471,7 +473,7 @@ fn both_example_cells_plan_and_recheck_clean() {
             ..PlanSettings::default()
         };
         let outcome = plan::plan(&cell, &table, &s, &|_| {}).expect("the example plans");
-        let doc = output::build(&cell, &table, &outcome, &s, 0.0, 0.0);
+        let doc = build(&cell, &table, &outcome, &s);
         assert!(
             doc.unmeasured.is_empty(),
             "{name}: every MP of the examples is measurable"

@@ -386,6 +386,34 @@ fn group_vs_group_pairs() {
 }
 
 #[test]
+fn group_group_distance_is_the_closest_pair() {
+    let (mut w, a) = three_boxes();
+    let b = w.add_group(
+        "other",
+        vec![
+            body("x", vec![(cube(0.5), Pose::IDENTITY)]),
+            body("y", vec![(ShapeSpec::Sphere { radius: 0.5 }, Pose::IDENTITY)]),
+        ],
+    );
+    let pa = [at(0.0, 0.0, 0.0), at(0.0, 3.0, 0.0), at(0.0, 6.0, 0.0)];
+    let pb = [at(10.0, 0.0, 0.0), at(1.2, 6.0, 0.0)];
+    let d = w.group_group_distance(a, &pa, b, &pb, 10.0);
+    assert!(d > 0.1 && d < 0.25, "{d}");
+    assert!((w.group_group_distance(b, &pb, a, &pa, 10.0) - d).abs() < 1e-9);
+    // The distance agrees with the margin test on both sides of it.
+    assert!(w.group_vs_group(a, &pa, b, &pb, d - 1e-6).is_none());
+    assert!(w.group_vs_group(a, &pa, b, &pb, d + 1e-6).is_some());
+    // Capped below the distance: the cap.
+    assert_eq!(w.group_group_distance(a, &pa, b, &pb, 0.05), 0.05);
+    // Touching: 0.
+    let pb = [at(0.0, 3.5, 0.0), at(0.0, 6.5, 0.0)];
+    assert_eq!(w.group_group_distance(a, &pa, b, &pb, 10.0), 0.0);
+    // A pose that is not finite counts as touching.
+    let pb = [at(f64::NAN, 0.0, 0.0), at(20.0, 0.0, 0.0)];
+    assert_eq!(w.group_group_distance(a, &pa, b, &pb, 10.0), 0.0);
+}
+
+#[test]
 fn ray_hits_group_bodies() {
     let (w, g) = three_boxes();
     let p = [at(2.0, 0.0, 0.0), at(5.0, 0.0, 0.0), at(0.0, 3.0, 0.0)];

@@ -105,6 +105,9 @@ pub enum PlanError {
     /// A leg has no collision-free path.
     #[error("{0}")]
     NoPath(String),
+    /// Coordination could not separate the robots.
+    #[error("coordination: {0}")]
+    Coordination(String),
     /// Timing failed (should not happen on a planner's path).
     #[error("timing: {0}")]
     Timing(String),

@@ -3,6 +3,7 @@
 use super::{Outcome, PlanSettings, Stage};
 use crate::Cell;
 use crate::candidates::CandidateTable;
+use crate::coord::{Activity, Conflict, Coordinated, Coordination, WaitReason};
 use crate::model::tasks::TaskId;
 use serde::{Deserialize, Serialize};
 
@@ -32,6 +33,13 @@ pub struct Plan {
     pub lower_bound_s: f64,
     /// `cycle_time_s / lower_bound_s`.
     pub ratio_to_lower_bound: f64,
+    /// Whether `cellplan verify` accepted the plan before it was written (false only when
+    /// written with `--no-verify`).
+    #[serde(default)]
+    pub verified: bool,
+    /// What coordination did.
+    #[serde(default)]
+    pub coordination: CoordinationOut,
     /// One entry per robot, in cell order.
     pub robots: Vec<RobotPlan>,
     /// MPs no robot can measure, with the reason.
@@ -67,6 +75,74 @@ pub struct SettingsOut {
     pub task_cap: usize,
     /// γ (s), if any.
     pub balance_limit_s: Option<f64>,
+    /// `none`, `delay-startup`, `fixed-priority`, `pose-perturbation` or `best`.
+    #[serde(default = "no_coordination")]
+    pub coordination: Coordination,
+}
+
+fn no_coordination() -> Coordination {
+    Coordination::None
+}
+
+/// What coordination did.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct CoordinationOut {
+    /// The strategy.
+    pub strategy: Coordination,
+    /// Cycle time of the programs before coordination (s): what the plan would take if the
+    /// robots could pass through each other.
+    pub uncoordinated_cycle_time_s: f64,
+    /// Conflicts of the programs before coordination.
+    pub conflicts_before: Vec<ConflictOut>,
+    /// Conflicts met and resolved (a resolution may meet new ones later on).
+    pub conflicts_resolved: usize,
+    /// Conflicts left (only with strategy `none`).
+    pub conflicts_after: Vec<ConflictOut>,
+    /// Waits added.
+    pub waits: usize,
+    /// Measuring poses changed.
+    pub poses_changed: usize,
+    /// Priority order (highest first), where the strategy uses one.
+    pub priority: Vec<String>,
+    /// Wall seconds.
+    pub compute_s: f64,
+}
+
+impl Default for CoordinationOut {
+    fn default() -> Self {
+        CoordinationOut {
+            strategy: Coordination::None,
+            uncoordinated_cycle_time_s: 0.0,
+            conflicts_before: Vec::new(),
+            conflicts_resolved: 0,
+            conflicts_after: Vec::new(),
+            waits: 0,
+            poses_changed: 0,
+            priority: Vec::new(),
+            compute_s: 0.0,
+        }
+    }
+}
+
+/// A robot–robot conflict.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct ConflictOut {
+    /// The two robots.
+    pub robots: [String; 2],
+    /// First time found closer than the clearance (s).
+    pub start_s: f64,
+    /// First time found clear again (s).
+    pub end_s: f64,
+    /// Paper 000's scenario: 1 both measuring, 2 moving between points.
+    pub scenario: u8,
+    /// What each robot was doing ("moving M3 → M7", "measuring M7", "waiting at M3").
+    pub activity: [String; 2],
+    /// The legs, as "from → to" ("" when measuring or waiting).
+    pub legs: [String; 2],
+    /// The MPs involved (the ends of each robot's leg, or the MP measured).
+    pub tasks: [Vec<String>; 2],
+    /// Probe positions at `start_s` (m).
+    pub probe_xyz: [[f64; 3]; 2],
 }
 
 /// One robot's part of the plan.
@@ -88,8 +164,14 @@ pub struct RobotPlan {
     pub motion_s: f64,
     /// Time measuring (s).
     pub measuring_s: f64,
+    /// Time standing still to let other robots pass (s).
+    #[serde(default)]
+    pub waiting_s: f64,
     /// `end_s − start_s` (s).
     pub total_s: f64,
+    /// Where and how long the robot waits.
+    #[serde(default)]
+    pub waits: Vec<WaitOut>,
     /// The legs: home → first MP, …, last MP → home.
     pub legs: Vec<LegOut>,
     /// The timed trajectory, sampled every `sample_dt_s` (and at its end), home to home.
@@ -109,10 +191,33 @@ pub struct Visit {
     pub tcp: PoseOut,
     /// Angle between the beam and the MP normal (rad).
     pub view_angle_rad: f64,
+    /// (Δw, Δp, Δr) (rad) when coordination perturbed the probe orientation of the candidate
+    /// (paper 000 §4.2); null otherwise.
+    #[serde(default)]
+    pub perturbation_rad: Option<[f64; 3]>,
     /// Arrival (start of the measurement) (s).
     pub arrive_s: f64,
     /// Departure (end of the measurement) (s).
     pub depart_s: f64,
+}
+
+/// A wait.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct WaitOut {
+    /// Index of the leg.
+    pub leg: usize,
+    /// Index of the waypoint of the leg where the robot stands (0: the leg's start).
+    pub waypoint: usize,
+    /// Where, for people ("home", "M3", "on the way M3 → M7").
+    pub at: String,
+    /// Start (s).
+    pub start_s: f64,
+    /// Duration (s).
+    pub duration_s: f64,
+    /// `startup`, `give-way` or `fallback`.
+    pub reason: String,
+    /// The robot it lets pass, if any.
+    pub for_robot: Option<String>,
 }
 
 /// A pose: position (m) and unit quaternion (x, y, z, w).
@@ -193,15 +298,22 @@ pub struct ComputeTimes {
     pub sequencing_motion: f64,
     /// Timing and assembly.
     pub timing: f64,
+    /// Coordination.
+    #[serde(default)]
+    pub coordination: f64,
+    /// The verifier.
+    #[serde(default)]
+    pub verification: f64,
     /// Everything, including writing.
     pub total: f64,
 }
 
-/// Build the document from a run.
+/// Build the document from a run and its coordination.
 pub fn build(
     cell: &Cell,
     table: &CandidateTable,
     outcome: &Outcome,
+    coordinated: &Coordinated,
     settings: &PlanSettings,
     load_s: f64,
     candidates_s: f64,
@@ -209,51 +321,67 @@ pub fn build(
     let process = cell.optical();
     let mut robots = Vec::with_capacity(cell.robots.len());
     for (r, robot) in cell.robots.iter().enumerate() {
-        let res = &outcome.robots[r];
-        let graph = &outcome.graphs[r];
-        let name_of = |node: usize| match graph.node_task[node] {
-            None => "home".to_string(),
-            Some((t, _)) => cell.tasks[t.0].name.clone(),
+        let prog = &coordinated.programs[r];
+        let timed = &coordinated.timed[r];
+        let name_of = |k: usize| -> String {
+            if k == 0 || k > prog.visits.len() {
+                "home".to_string()
+            } else {
+                cell.tasks[prog.visits[k - 1].task.0].name.clone()
+            }
         };
-        let tasks = res
-            .sequence
-            .nodes
+        let tasks = prog
+            .visits
             .iter()
-            .zip(&res.visits)
-            .map(|(&node, &(arrive, depart))| {
-                let (t, c) = graph.node_task[node].expect("visited nodes are candidates");
-                let cand = &table.get(t, robot.id).candidates[c];
-                Visit {
-                    task: cell.tasks[t.0].name.clone(),
-                    candidate: c,
-                    q: cand.q.clone(),
-                    tcp: pose_out(&cand.tcp),
-                    view_angle_rad: cand.view_angle,
-                    arrive_s: arrive,
-                    depart_s: depart,
-                }
+            .zip(&timed.visits)
+            .map(|(v, &(arrive, depart))| Visit {
+                task: cell.tasks[v.task.0].name.clone(),
+                candidate: v.candidate,
+                q: v.q.clone(),
+                tcp: pose_out(&v.tcp),
+                view_angle_rad: v.view_angle,
+                perturbation_rad: v.perturbation,
+                arrive_s: arrive,
+                depart_s: depart,
             })
             .collect();
-        let mut legs = Vec::with_capacity(res.sequence.legs.len());
-        let mut prev = 0usize;
-        let mut clock = 0.0;
-        for (i, leg) in res.sequence.legs.iter().enumerate() {
-            let to = res.sequence.nodes.get(i).copied().unwrap_or(0);
-            legs.push(LegOut {
-                from: name_of(prev),
-                to: name_of(to),
-                start_s: clock,
-                duration_s: leg.duration,
+        let legs = prog
+            .legs
+            .iter()
+            .enumerate()
+            .map(|(k, leg)| LegOut {
+                from: name_of(k),
+                to: name_of(k + 1),
+                start_s: timed.arrivals[k][0] + prog.wait_at(k, 0).map_or(0.0, |w| w.duration),
+                duration_s: leg.duration(),
                 straight: leg.straight,
                 waypoints: leg.waypoints.clone(),
-            });
-            clock += leg.duration;
-            if let Some(&(_, depart)) = res.visits.get(i) {
-                clock = depart;
-            }
-            prev = to;
-        }
-        let total = res.trajectory.duration();
+            })
+            .collect();
+        let waits = prog
+            .waits
+            .iter()
+            .zip(&timed.wait_starts)
+            .map(|(w, &start)| WaitOut {
+                leg: w.leg,
+                waypoint: w.waypoint,
+                at: if w.waypoint == 0 {
+                    name_of(w.leg)
+                } else {
+                    format!("on the way {} → {}", name_of(w.leg), name_of(w.leg + 1))
+                },
+                start_s: start,
+                duration_s: w.duration,
+                reason: match w.reason {
+                    WaitReason::Startup => "startup",
+                    WaitReason::GiveWay => "give-way",
+                    WaitReason::Fallback => "fallback",
+                }
+                .into(),
+                for_robot: w.for_robot.map(|o| cell.robots[o].name.clone()),
+            })
+            .collect();
+        let total = timed.end();
         robots.push(RobotPlan {
             name: robot.name.clone(),
             joints: robot.joint_names().into_iter().map(String::from).collect(),
@@ -261,11 +389,13 @@ pub fn build(
             tasks,
             start_s: 0.0,
             end_s: total,
-            motion_s: res.motion,
-            measuring_s: res.measuring,
+            motion_s: prog.motion(),
+            measuring_s: prog.measure * prog.visits.len() as f64,
+            waiting_s: prog.waiting(),
             total_s: total,
+            waits,
             legs,
-            trajectory: res
+            trajectory: timed
                 .trajectory
                 .sample(settings.sample_dt)
                 .into_iter()
@@ -292,6 +422,7 @@ pub fn build(
     let mut compute = ComputeTimes {
         load: load_s,
         candidates: candidates_s,
+        coordination: coordinated.compute_s,
         ..ComputeTimes::default()
     };
     for &(stage, s) in &outcome.compute {
@@ -302,8 +433,12 @@ pub fn build(
             Stage::Timing => compute.timing = s,
         }
     }
-    compute.total = load_s + candidates_s + outcome.compute.iter().map(|x| x.1).sum::<f64>();
+    compute.total =
+        load_s + candidates_s + outcome.compute.iter().map(|x| x.1).sum::<f64>() + coordinated.compute_s;
     let seqs = outcome.robots.iter().map(|r| &r.sequence);
+    let conflicts = |list: &[Conflict]| -> Vec<ConflictOut> {
+        list.iter().map(|c| conflict_out(cell, coordinated, c)).collect()
+    };
     Plan {
         format: FORMAT.to_string(),
         version: VERSION,
@@ -321,11 +456,28 @@ pub fn build(
             measure_time_s: process.measure_time,
             task_cap: process.task_cap,
             balance_limit_s: process.balance_limit,
+            coordination: coordinated.strategy,
         },
         cycle_time_s: cycle,
         delta_t_s: delta,
         lower_bound_s: lb,
         ratio_to_lower_bound: if lb > 0.0 { cycle / lb } else { 1.0 },
+        verified: false,
+        coordination: CoordinationOut {
+            strategy: coordinated.strategy,
+            uncoordinated_cycle_time_s: coordinated.uncoordinated_cycle,
+            conflicts_before: conflicts(&coordinated.before),
+            conflicts_resolved: coordinated.resolved,
+            conflicts_after: conflicts(&coordinated.after),
+            waits: coordinated.waits,
+            poses_changed: coordinated.poses_changed,
+            priority: coordinated
+                .priority
+                .iter()
+                .map(|&r| cell.robots[r].name.clone())
+                .collect(),
+            compute_s: coordinated.compute_s,
+        },
         robots,
         unmeasured,
         stats: Stats {
@@ -338,6 +490,57 @@ pub fn build(
             local_sets_chosen: outcome.allocated.local_sets.1,
         },
         compute_s: compute,
+    }
+}
+
+/// A conflict for the document.
+fn conflict_out(cell: &Cell, coordinated: &Coordinated, c: &Conflict) -> ConflictOut {
+    let robots = [c.robots.0, c.robots.1];
+    // Coordination keeps every robot's order of visits, so the final programs name them.
+    let progs = &coordinated.programs;
+    let one = |k: usize| {
+        let prog = &progs[robots[k]];
+        let name = |i: usize| -> String {
+            if i == 0 || i > prog.visits.len() {
+                "home".to_string()
+            } else {
+                cell.tasks[prog.visits[i - 1].task.0].name.clone()
+            }
+        };
+        let (leg, tasks) = match c.activity[k] {
+            Activity::Move { leg, .. } => (
+                format!("{} → {}", name(leg), name(leg + 1)),
+                [name(leg), name(leg + 1)]
+                    .into_iter()
+                    .filter(|n| n != "home")
+                    .collect(),
+            ),
+            Activity::Measure { visit } => (String::new(), vec![name(visit + 1)]),
+            Activity::Wait { leg, .. } => (
+                String::new(),
+                vec![name(leg)].into_iter().filter(|n| n != "home").collect(),
+            ),
+        };
+        (
+            crate::coord::timeline::activity_text(cell, prog, c.activity[k]),
+            leg,
+            tasks,
+        )
+    };
+    let (a0, l0, t0) = one(0);
+    let (a1, l1, t1) = one(1);
+    ConflictOut {
+        robots: [
+            cell.robots[robots[0]].name.clone(),
+            cell.robots[robots[1]].name.clone(),
+        ],
+        start_s: c.start,
+        end_s: c.end,
+        scenario: c.scenario.number(),
+        activity: [a0, a1],
+        legs: [l0, l1],
+        tasks: [t0, t1],
+        probe_xyz: [c.tcp[0].to_array(), c.tcp[1].to_array()],
     }
 }
 

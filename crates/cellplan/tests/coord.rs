@@ -1,0 +1,212 @@
+//! Coordination on a two-robot cell built so that the robots' paths cross: the bundled
+//! two-robot example with the second robot moved to 1 m from the first, and its first 8 MPs.
+//! Every strategy must give a plan the verifier accepts; the uncoordinated plan must be
+//! rejected, naming the conflict; injected faults must be caught.
+use cellplan::candidates::{CandidateTable, generate};
+use cellplan::coord::{self, CoordSettings, Coordination};
+use cellplan::model::load::load;
+use cellplan::plan::{self, Outcome, PlanSettings, output};
+use cellplan::verify::{VerifySettings, ViolationKind, verify};
+use cellplan::{Cell, LoadOptions};
+use std::path::{Path, PathBuf};
+use std::sync::OnceLock;
+
+fn crossing_cell() -> PathBuf {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../..")
+        .canonicalize()
+        .unwrap();
+    let example = root.join("examples/autobody-2r");
+    let dir = std::env::temp_dir().join(format!("cellplan-coord-test-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let text = std::fs::read_to_string(example.join("cell.toml"))
+        .unwrap()
+        .replace("../../data", &root.join("data").display().to_string())
+        .replace("name = \"autobody-2r\"", "name = \"crossing-2r\"")
+        .replace("xyz = [3100, 1100, 0]", "xyz = [3100, -100, 0]");
+    assert!(text.contains("[3100, -100, 0]"), "the second robot is moved");
+    std::fs::write(dir.join("cell.toml"), text).unwrap();
+    let tasks = std::fs::read_to_string(example.join("tasks.csv")).unwrap();
+    let keep: Vec<&str> = tasks.lines().filter(|l| !l.starts_with('#')).take(9).collect();
+    std::fs::write(dir.join("tasks.csv"), keep.join("\n") + "\n").unwrap();
+    dir.join("cell.toml")
+}
+
+struct Fixture {
+    cell: Cell,
+    table: CandidateTable,
+    settings: PlanSettings,
+    outcome: Outcome,
+}
+
+fn fixture() -> &'static Fixture {
+    static F: OnceLock<Fixture> = OnceLock::new();
+    F.get_or_init(|| {
+        let cell = load(&crossing_cell(), &LoadOptions::default()).expect("the crossing cell loads");
+        let table = generate(&cell);
+        let settings = PlanSettings {
+            alternatives: 8,
+            balanced_iterations: 60,
+            time_limit: std::time::Duration::from_secs(3600),
+            ..PlanSettings::default()
+        };
+        let outcome = plan::plan(&cell, &table, &settings, &|_| {}).expect("the crossing cell plans");
+        Fixture {
+            cell,
+            table,
+            settings,
+            outcome,
+        }
+    })
+}
+
+fn document(strategy: Coordination) -> (output::Plan, coord::Coordinated) {
+    let f = fixture();
+    let c = coord::coordinate_outcome(
+        &f.cell,
+        &f.table,
+        &f.outcome,
+        &CoordSettings {
+            strategy,
+            ..CoordSettings::default()
+        },
+    )
+    .unwrap_or_else(|e| panic!("{}: {e}", strategy.name()));
+    (
+        output::build(&f.cell, &f.table, &f.outcome, &c, &f.settings, 0.0, 0.0),
+        c,
+    )
+}
+
+#[test]
+fn the_uncoordinated_plan_has_a_conflict_and_the_verifier_names_it() {
+    let f = fixture();
+    let (doc, c) = document(Coordination::None);
+    assert!(!c.after.is_empty(), "the robots of this cell must meet");
+    let first = &doc.coordination.conflicts_after[0];
+    assert_eq!(first.robots, ["R1".to_string(), "R2".to_string()]);
+    assert!(first.end_s > first.start_s);
+    assert!(first.scenario == 1 || first.scenario == 2);
+    let report = verify(&f.cell, &doc, &VerifySettings::default());
+    assert!(!report.ok);
+    let rr: Vec<_> = report
+        .violations
+        .iter()
+        .filter(|v| v.kind == ViolationKind::RobotRobot)
+        .collect();
+    assert!(!rr.is_empty(), "{:#?}", report.violations);
+    assert_eq!(rr[0].robot.as_deref(), Some("R1"));
+    assert_eq!(rr[0].other.as_deref(), Some("R2"));
+    // The verifier sees the contact where the planner's search found it (within its step).
+    let t = rr[0].time_s.unwrap();
+    assert!(t <= first.end_s && t + 0.05 >= first.start_s, "{t} vs {first:?}");
+}
+
+#[test]
+fn every_strategy_gives_a_verified_conflict_free_plan() {
+    let f = fixture();
+    let (_, none) = document(Coordination::None);
+    let free = coord::cycle_and_delta(&none.timed).0;
+    for strategy in Coordination::RESOLVING {
+        let (doc, c) = document(strategy);
+        let report = verify(&f.cell, &doc, &VerifySettings::default());
+        assert!(report.ok, "{}: {:#?}", strategy.name(), report.violations);
+        assert!(!c.before.is_empty(), "{}", strategy.name());
+        assert!(c.after.is_empty());
+        assert!(c.resolved >= 1);
+        // Resolving costs time or nothing; never less than the robots passing through each other.
+        assert!(doc.cycle_time_s >= free - 1e-9, "{}", strategy.name());
+        // The waits are in the document where the strategy made them.
+        let waits: usize = doc.robots.iter().map(|r| r.waits.len()).sum();
+        assert_eq!(waits > 0, c.programs.iter().any(|p| !p.waits.is_empty()));
+        if strategy == Coordination::DelayStartup {
+            assert!(
+                doc.robots
+                    .iter()
+                    .flat_map(|r| &r.waits)
+                    .all(|w| w.leg == 0 && w.waypoint == 0)
+            );
+        }
+    }
+}
+
+#[test]
+fn best_is_no_worse_than_the_baselines_here() {
+    let cycle = |s: Coordination| document(s).0.cycle_time_s;
+    let best = cycle(Coordination::Best);
+    for s in [Coordination::DelayStartup, Coordination::FixedPriority] {
+        assert!(
+            best <= cycle(s) + 1e-9,
+            "best {best} vs {} {}",
+            s.name(),
+            cycle(s)
+        );
+    }
+}
+
+#[test]
+fn coordination_does_not_depend_on_the_thread_count() {
+    let run = |threads: usize| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap()
+            .install(|| {
+                let (mut doc, _) = document(Coordination::Best);
+                doc.compute_s = output::ComputeTimes::default();
+                doc.coordination.compute_s = 0.0;
+                doc
+            })
+    };
+    assert_eq!(run(1), run(2));
+}
+
+#[test]
+fn the_verifier_catches_injected_faults() {
+    let f = fixture();
+    let (good, _) = document(Coordination::FixedPriority);
+    let settings = VerifySettings::default();
+    assert!(verify(&f.cell, &good, &settings).ok);
+    let kinds = |doc: &output::Plan| -> Vec<ViolationKind> {
+        verify(&f.cell, doc, &settings)
+            .violations
+            .iter()
+            .map(|v| v.kind)
+            .collect()
+    };
+    // The cell as built differs from the plan: R2 stands 5 cm closer to R1. Where the plan
+    // passes the robots by each other with little room, they now meet.
+    let moved_path = crossing_cell().with_file_name("moved.toml");
+    let text = std::fs::read_to_string(crossing_cell())
+        .unwrap()
+        .replace("xyz = [3100, -100, 0]", "xyz = [3100, -150, 0]");
+    std::fs::write(&moved_path, text).unwrap();
+    let moved = load(&moved_path, &LoadOptions::default()).unwrap();
+    let k: Vec<ViolationKind> = verify(&moved, &good, &settings)
+        .violations
+        .iter()
+        .map(|v| v.kind)
+        .collect();
+    assert!(k.contains(&ViolationKind::RobotRobot), "{k:?}");
+    // A joint-limit breach.
+    let mut breach = good.clone();
+    let n = breach.robots[0].trajectory.len();
+    breach.robots[0].trajectory[n / 2].q[0] = 10.0;
+    assert!(kinds(&breach).contains(&ViolationKind::JointLimit));
+    // A skipped MP.
+    let mut skipped = good.clone();
+    let busy = skipped.robots.iter().position(|r| !r.tasks.is_empty()).unwrap();
+    skipped.robots[busy].tasks.remove(0);
+    assert!(kinds(&skipped).contains(&ViolationKind::MissingTask));
+    // A wait removed from the trajectory: the robots meet again.
+    let mut hurried = good.clone();
+    let (_, none) = document(Coordination::None);
+    let doc_none = output::build(&f.cell, &f.table, &f.outcome, &none, &f.settings, 0.0, 0.0);
+    for (r, rn) in hurried.robots.iter_mut().zip(&doc_none.robots) {
+        r.trajectory = rn.trajectory.clone();
+        r.total_s = rn.total_s;
+    }
+    hurried.cycle_time_s = doc_none.cycle_time_s;
+    hurried.delta_t_s = doc_none.delta_t_s;
+    assert!(kinds(&hurried).contains(&ViolationKind::RobotRobot));
+}
