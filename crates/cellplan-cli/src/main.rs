@@ -5,6 +5,7 @@
 //! 4 `verify` found the plan violates something (each violation is printed);
 //! 1 anything else.
 mod bench;
+mod compare_cmd;
 mod plan_cmd;
 mod verify_cmd;
 
@@ -39,6 +40,9 @@ enum Command {
     Plan(plan_cmd::PlanArgs),
     /// Check a plan independently: MPs, probe poses, limits, clearances, robot–robot, totals.
     Verify(verify_cmd::VerifyArgs),
+    /// Run every allocation × coordination strategy on a cell (paper 000 Table 3), or on
+    /// random MP sets drawn on its part (Table 4), and print the table.
+    Compare(compare_cmd::CompareArgs),
     /// Generate inputs for building cells.
     #[command(subcommand)]
     Gen(GenCommand),
@@ -302,6 +306,7 @@ fn main() -> ExitCode {
         Command::Check(a) => run_check(a),
         Command::Plan(a) => plan_cmd::run(a),
         Command::Verify(a) => verify_cmd::run(a),
+        Command::Compare(a) => compare_cmd::run(a),
         Command::Gen(GenCommand::Tasks(a)) => run_gen_tasks(a),
         Command::Bench(a) => run_bench(a),
     };

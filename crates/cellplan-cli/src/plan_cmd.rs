@@ -206,7 +206,30 @@ pub fn run(args: &PlanArgs) -> Result<(), Failure> {
         seed: args.seed,
         ..CoordSettings::default()
     };
-    let coordinated = coord::coordinate_outcome(&cell, &table, &outcome, &coord_settings).map_err(failure)?;
+    let mut coordinated =
+        coord::coordinate_outcome(&cell, &table, &outcome, &coord_settings).map_err(failure)?;
+    let (mut outcome, mut settings) = (outcome, settings);
+    if coord_settings.strategy == Coordination::Best && settings.allocation == Allocation::Balanced {
+        // Ours also coordinates the nearest-robot allocation (robots in their own zones meet
+        // less) and keeps whichever runs the shorter coordinated cycle.
+        pb.set_message("trying the proximity allocation against the coordinated plan");
+        let prox_settings = PlanSettings {
+            allocation: Allocation::Proximity,
+            ..settings.clone()
+        };
+        if let Ok(o) = plan::plan(&cell, &table, &prox_settings, &|_| {})
+            && let Ok(c) = coord::coordinate_outcome(&cell, &table, &o, &coord_settings)
+        {
+            let key = |c: &coord::Coordinated| coord::cycle_and_delta(&c.timed);
+            if key(&c) < key(&coordinated) {
+                let spent = coordinated.compute_s;
+                coordinated = c;
+                coordinated.compute_s += spent;
+                outcome = o;
+                settings = prox_settings;
+            }
+        }
+    }
     let mut doc = output::build(
         &cell,
         &table,

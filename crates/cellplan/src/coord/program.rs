@@ -272,7 +272,7 @@ impl Program {
 
     /// Total waiting (s).
     pub fn waiting(&self) -> f64 {
-        self.waits.iter().map(|w| w.duration).sum()
+        self.waits.iter().map(|w| w.duration).fold(0.0, |a, b| a + b)
     }
 
     /// Moving time (s).

@@ -1,0 +1,421 @@
+//! `cellplan compare`: allocation × coordination strategies on one cell (paper 000 Table 3),
+//! and over random MP sets drawn on the part (Table 4).
+use crate::{Failure, load_options, spinner};
+use cellplan::coord::{self, CoordSettings, Coordination};
+use cellplan::plan::{self, Allocation, PlanSettings, output};
+use cellplan::taskgen::{GenOptions, sample_tasks};
+use cellplan::verify::{VerifySettings, verify};
+use cellplan::{Cell, InputError, candidates, io::write_atomic};
+use cellplan_geom::ShapeSpec;
+use clap::Args;
+use serde::Serialize;
+use std::path::PathBuf;
+use std::time::{Duration, Instant};
+
+#[derive(Args)]
+pub struct CompareArgs {
+    /// The cell file (TOML).
+    cell: PathBuf,
+    /// Seed of the planners (and of the random MP sets).
+    #[arg(long, default_value_t = 0)]
+    seed: u64,
+    /// Instead of the cell's MPs, draw this many random MP sets on the part (as many MPs as
+    /// the cell has, in the region and facing of the cell's MPs) and report mean and spread.
+    #[arg(long, value_name = "K")]
+    random_tasks: Option<usize>,
+    /// Print JSON (stable keys: strategies[].allocation, coordination, cycle_time_s,
+    /// delta_t_s, conflicts_before, verified, compute_s).
+    #[arg(long)]
+    json: bool,
+    /// Also write the Markdown table and the JSON to this folder.
+    #[arg(short, long, value_name = "DIR")]
+    output: Option<PathBuf>,
+    /// No progress output.
+    #[arg(long, short)]
+    quiet: bool,
+}
+
+#[derive(Serialize, Clone)]
+struct Row {
+    case: usize,
+    allocation: String,
+    coordination: String,
+    robots: Vec<RobotTime>,
+    cycle_time_s: f64,
+    delta_t_s: f64,
+    lower_bound_s: f64,
+    uncoordinated_cycle_time_s: f64,
+    conflicts_before: usize,
+    conflicts_resolved: usize,
+    waits: usize,
+    waiting_s: f64,
+    poses_changed: usize,
+    verified: bool,
+    compute_s: f64,
+    coordination_compute_s: f64,
+    error: Option<String>,
+}
+
+#[derive(Serialize, Clone)]
+struct RobotTime {
+    name: String,
+    tasks: usize,
+    total_s: f64,
+}
+
+#[derive(Serialize)]
+struct Summary {
+    allocation: String,
+    coordination: String,
+    cases: usize,
+    solved: usize,
+    verified: usize,
+    cycle_time_mean_s: f64,
+    cycle_time_sd_s: f64,
+    delta_t_mean_s: f64,
+    delta_t_sd_s: f64,
+    compute_mean_s: f64,
+    coordination_compute_mean_s: f64,
+}
+
+#[derive(Serialize)]
+struct Report {
+    cell: String,
+    seed: u64,
+    random_tasks: Option<usize>,
+    strategies: Vec<Row>,
+    summary: Vec<Summary>,
+}
+
+const ALLOCATIONS: [Allocation; 3] = [
+    Allocation::Proximity,
+    Allocation::LocalRobust,
+    Allocation::Balanced,
+];
+
+fn allocation_name(a: Allocation) -> String {
+    serde_json::to_value(a)
+        .ok()
+        .and_then(|v| v.as_str().map(String::from))
+        .unwrap_or_default()
+}
+
+pub fn run(args: &CompareArgs) -> Result<(), Failure> {
+    let show = !args.quiet && !args.json;
+    let opts = load_options(false, &None);
+    let pb = spinner(show, "loading the cell");
+    let base = cellplan::model::load::load(&args.cell, &opts)?;
+    let cases = match args.random_tasks {
+        None => 1,
+        Some(0) => return Err(Failure::Other("--random-tasks must be at least 1".into())),
+        Some(k) => k,
+    };
+    let mut rows = Vec::new();
+    for case in 0..cases {
+        let mut cell = cellplan::model::load::load(&args.cell, &opts)?;
+        if args.random_tasks.is_some() {
+            cell.tasks = random_tasks(&base, args.seed + case as u64)?;
+        }
+        pb.set_message(format!("case {}/{cases}: candidates", case + 1));
+        let table = candidates::generate(&cell);
+        let mut best: Option<Row> = None;
+        for allocation in ALLOCATIONS {
+            pb.set_message(format!(
+                "case {}/{cases}: planning with {}",
+                case + 1,
+                allocation_name(allocation)
+            ));
+            let settings = PlanSettings {
+                allocation,
+                seed: args.seed,
+                time_limit: Duration::from_secs(3600),
+                ..PlanSettings::default()
+            };
+            let started = Instant::now();
+            let outcome = match plan::plan(&cell, &table, &settings, &|_| {}) {
+                Ok(o) => o,
+                Err(e) => {
+                    for c in Coordination::RESOLVING {
+                        rows.push(failed(case, allocation, c, e.to_string()));
+                    }
+                    continue;
+                }
+            };
+            let plan_s = started.elapsed().as_secs_f64();
+            for strategy in Coordination::RESOLVING {
+                pb.set_message(format!(
+                    "case {}/{cases}: {} + {}",
+                    case + 1,
+                    allocation_name(allocation),
+                    strategy.name()
+                ));
+                let cs = CoordSettings {
+                    strategy,
+                    seed: args.seed,
+                    ..CoordSettings::default()
+                };
+                let row = match coord::coordinate_outcome(&cell, &table, &outcome, &cs) {
+                    Ok(c) => {
+                        let doc = output::build(&cell, &table, &outcome, &c, &settings, 0.0, 0.0);
+                        let report = verify(&cell, &doc, &VerifySettings::default());
+                        row_of(case, &doc, report.ok, plan_s + c.compute_s, c.compute_s)
+                    }
+                    Err(e) => failed(case, allocation, strategy, e.to_string()),
+                };
+                if strategy == Coordination::Best
+                    && matches!(allocation, Allocation::Balanced | Allocation::Proximity)
+                    && row.error.is_none()
+                    && best
+                        .as_ref()
+                        .is_none_or(|b| (row.cycle_time_s, row.delta_t_s) < (b.cycle_time_s, b.delta_t_s))
+                {
+                    let mut b = row.clone();
+                    b.compute_s += best.as_ref().map_or(0.0, |x| x.compute_s);
+                    best = Some(b);
+                } else if strategy == Coordination::Best
+                    && let Some(b) = best.as_mut()
+                    && matches!(allocation, Allocation::Balanced | Allocation::Proximity)
+                {
+                    b.compute_s += row.compute_s;
+                }
+                rows.push(row);
+            }
+        }
+        // Ours, whole: `best` coordination over the balanced and the proximity allocations.
+        match best {
+            Some(mut b) => {
+                b.allocation = "balanced|proximity".into();
+                rows.push(b);
+            }
+            None => rows.push(Row {
+                allocation: "balanced|proximity".into(),
+                ..failed(case, Allocation::Balanced, Coordination::Best, "no plan".into())
+            }),
+        }
+    }
+    pb.finish_and_clear();
+    let summary = summarise(&rows);
+    let report = Report {
+        cell: base.name.clone(),
+        seed: args.seed,
+        random_tasks: args.random_tasks,
+        strategies: rows,
+        summary,
+    };
+    let json = serde_json::to_string_pretty(&report).map_err(|e| Failure::Other(e.to_string()))?;
+    let md = markdown(&report);
+    if let Some(dir) = &args.output {
+        std::fs::create_dir_all(dir)
+            .and_then(|()| write_atomic(&dir.join("compare.json"), json.as_bytes()))
+            .and_then(|()| write_atomic(&dir.join("compare.md"), md.as_bytes()))
+            .map_err(|e| Failure::Other(format!("cannot write to {}: {e}", dir.display())))?;
+    }
+    if args.json {
+        println!("{json}");
+    } else {
+        print!("{md}");
+    }
+    Ok(())
+}
+
+fn failed(case: usize, allocation: Allocation, coordination: Coordination, error: String) -> Row {
+    Row {
+        case,
+        allocation: allocation_name(allocation),
+        coordination: coordination.name().into(),
+        robots: Vec::new(),
+        cycle_time_s: f64::NAN,
+        delta_t_s: f64::NAN,
+        lower_bound_s: f64::NAN,
+        uncoordinated_cycle_time_s: f64::NAN,
+        conflicts_before: 0,
+        conflicts_resolved: 0,
+        waits: 0,
+        waiting_s: 0.0,
+        poses_changed: 0,
+        verified: false,
+        compute_s: 0.0,
+        coordination_compute_s: 0.0,
+        error: Some(error),
+    }
+}
+
+fn row_of(case: usize, doc: &output::Plan, verified: bool, compute_s: f64, coord_s: f64) -> Row {
+    Row {
+        case,
+        allocation: allocation_name(doc.settings.allocation),
+        coordination: doc.settings.coordination.name().into(),
+        robots: doc
+            .robots
+            .iter()
+            .map(|r| RobotTime {
+                name: r.name.clone(),
+                tasks: r.tasks.len(),
+                total_s: r.total_s,
+            })
+            .collect(),
+        cycle_time_s: doc.cycle_time_s,
+        delta_t_s: doc.delta_t_s,
+        lower_bound_s: doc.lower_bound_s,
+        uncoordinated_cycle_time_s: doc.coordination.uncoordinated_cycle_time_s,
+        conflicts_before: doc.coordination.conflicts_before.len(),
+        conflicts_resolved: doc.coordination.conflicts_resolved,
+        waits: doc.coordination.waits,
+        waiting_s: doc.robots.iter().map(|r| r.waiting_s).sum(),
+        poses_changed: doc.coordination.poses_changed,
+        verified,
+        compute_s,
+        coordination_compute_s: coord_s,
+        error: None,
+    }
+}
+
+fn summarise(rows: &[Row]) -> Vec<Summary> {
+    let mut keys: Vec<(String, String)> = Vec::new();
+    for r in rows {
+        let k = (r.allocation.clone(), r.coordination.clone());
+        if !keys.contains(&k) {
+            keys.push(k);
+        }
+    }
+    keys.into_iter()
+        .map(|(a, c)| {
+            let of: Vec<&Row> = rows
+                .iter()
+                .filter(|r| r.allocation == a && r.coordination == c)
+                .collect();
+            let ok: Vec<&Row> = of.iter().copied().filter(|r| r.error.is_none()).collect();
+            let stats = |f: &dyn Fn(&Row) -> f64| {
+                let n = ok.len() as f64;
+                if ok.is_empty() {
+                    return (f64::NAN, f64::NAN);
+                }
+                let mean = ok.iter().map(|r| f(r)).sum::<f64>() / n;
+                let var = ok.iter().map(|r| (f(r) - mean).powi(2)).sum::<f64>() / n;
+                (mean, var.sqrt())
+            };
+            let (cm, cs) = stats(&|r| r.cycle_time_s);
+            let (dm, ds) = stats(&|r| r.delta_t_s);
+            Summary {
+                allocation: a,
+                coordination: c,
+                cases: of.len(),
+                solved: ok.len(),
+                verified: ok.iter().filter(|r| r.verified).count(),
+                cycle_time_mean_s: cm,
+                cycle_time_sd_s: cs,
+                delta_t_mean_s: dm,
+                delta_t_sd_s: ds,
+                compute_mean_s: stats(&|r| r.compute_s).0,
+                coordination_compute_mean_s: stats(&|r| r.coordination_compute_s).0,
+            }
+        })
+        .collect()
+}
+
+fn markdown(report: &Report) -> String {
+    let mut s = format!(
+        "# {} — allocation × coordination (seed {})\n\n",
+        report.cell, report.seed
+    );
+    if report.random_tasks.is_none() {
+        let names: Vec<String> = report
+            .strategies
+            .iter()
+            .find(|r| !r.robots.is_empty())
+            .map(|r| r.robots.iter().map(|x| format!("{} s", x.name)).collect())
+            .unwrap_or_default();
+        s += &format!(
+            "| allocation | coordination | {} | cycle s | Δt s | uncoordinated s | lower bound s | conflicts | resolved | waits | waiting s | poses changed | verified | compute s | coordination s |\n",
+            names.join(" | ")
+        );
+        s += &format!("|{}\n", "---|".repeat(14 + names.len()));
+        for r in &report.strategies {
+            if let Some(e) = &r.error {
+                s += &format!("| {} | {} | failed: {e} |\n", r.allocation, r.coordination);
+                continue;
+            }
+            let times: Vec<String> = r.robots.iter().map(|x| format!("{:.2}", x.total_s)).collect();
+            s += &format!(
+                "| {} | {} | {} | {:.2} | {:.2} | {:.2} | {:.2} | {} | {} | {} | {:.2} | {} | {} | {:.2} | {:.2} |\n",
+                r.allocation,
+                r.coordination,
+                times.join(" | "),
+                r.cycle_time_s,
+                r.delta_t_s,
+                r.uncoordinated_cycle_time_s,
+                r.lower_bound_s,
+                r.conflicts_before,
+                r.conflicts_resolved,
+                r.waits,
+                r.waiting_s,
+                r.poses_changed,
+                if r.verified { "yes" } else { "NO" },
+                r.compute_s,
+                r.coordination_compute_s
+            );
+        }
+    } else {
+        s += &format!(
+            "{} random MP sets; mean ± standard deviation over the solved cases\n\n",
+            report.random_tasks.unwrap_or(0)
+        );
+        s += "| allocation | coordination | solved | verified | cycle s | Δt s | compute s | coordination s |\n|---|---|---|---|---|---|---|---|\n";
+        for m in &report.summary {
+            s += &format!(
+                "| {} | {} | {}/{} | {} | {:.2} ± {:.2} | {:.2} ± {:.2} | {:.2} | {:.2} |\n",
+                m.allocation,
+                m.coordination,
+                m.solved,
+                m.cases,
+                m.verified,
+                m.cycle_time_mean_s,
+                m.cycle_time_sd_s,
+                m.delta_t_mean_s,
+                m.delta_t_sd_s,
+                m.compute_mean_s,
+                m.coordination_compute_mean_s
+            );
+        }
+    }
+    s
+}
+
+/// As many random MPs as `cell` has, on its largest mesh object, in the box of its MPs (grown
+/// by 10 cm) and facing within 80° of their mean normal.
+fn random_tasks(cell: &Cell, seed: u64) -> Result<Vec<cellplan::Task>, Failure> {
+    let part = cell
+        .objects
+        .iter()
+        .filter_map(|o| match &o.shape {
+            ShapeSpec::Mesh(m) => Some((m.triangles.len(), m.transformed(&o.pose))),
+            _ => None,
+        })
+        .max_by_key(|x| x.0)
+        .map(|x| x.1)
+        .ok_or_else(|| {
+            Failure::Input(Box::new(
+                InputError::new(
+                    &cell.path,
+                    "--random-tasks needs a mesh object (the part) in the cell",
+                )
+                .hint("add the part as a mesh object"),
+            ))
+        })?;
+    let mut opts = GenOptions::new(cell.tasks.len(), seed);
+    let mut lo = cellplan_geom::DVec3::splat(f64::INFINITY);
+    let mut hi = cellplan_geom::DVec3::splat(f64::NEG_INFINITY);
+    let mut normal = cellplan_geom::DVec3::ZERO;
+    for t in &cell.tasks {
+        lo = lo.min(t.position);
+        hi = hi.max(t.position);
+        normal += t.normal;
+    }
+    for axis in 0..3 {
+        opts.region[axis] = (lo[axis] - 0.1, hi[axis] + 0.1);
+    }
+    if let Some(n) = normal.try_normalize() {
+        opts.facing = Some((n, 80f64.to_radians()));
+    }
+    sample_tasks(&part, &opts).map_err(|m| Failure::Other(format!("random MPs: {m}")))
+}
