@@ -93,13 +93,6 @@ const ALLOCATIONS: [Allocation; 3] = [
     Allocation::Balanced,
 ];
 
-fn allocation_name(a: Allocation) -> String {
-    serde_json::to_value(a)
-        .ok()
-        .and_then(|v| v.as_str().map(String::from))
-        .unwrap_or_default()
-}
-
 pub fn run(args: &CompareArgs) -> Result<(), Failure> {
     let show = !args.quiet && !args.json;
     let opts = load_options(false, &None);
@@ -118,12 +111,12 @@ pub fn run(args: &CompareArgs) -> Result<(), Failure> {
         }
         pb.set_message(format!("case {}/{cases}: candidates", case + 1));
         let table = candidates::generate(&cell);
-        let mut best: Option<Row> = None;
+        let mut ours: Vec<Row> = Vec::new();
         for allocation in ALLOCATIONS {
             pb.set_message(format!(
                 "case {}/{cases}: planning with {}",
                 case + 1,
-                allocation_name(allocation)
+                allocation.name()
             ));
             let settings = PlanSettings {
                 allocation,
@@ -146,7 +139,7 @@ pub fn run(args: &CompareArgs) -> Result<(), Failure> {
                 pb.set_message(format!(
                     "case {}/{cases}: {} + {}",
                     case + 1,
-                    allocation_name(allocation),
+                    allocation.name(),
                     strategy.name()
                 ));
                 let cs = CoordSettings {
@@ -165,26 +158,24 @@ pub fn run(args: &CompareArgs) -> Result<(), Failure> {
                 if strategy == Coordination::Best
                     && matches!(allocation, Allocation::Balanced | Allocation::Proximity)
                     && row.error.is_none()
-                    && best
-                        .as_ref()
-                        .is_none_or(|b| (row.cycle_time_s, row.delta_t_s) < (b.cycle_time_s, b.delta_t_s))
                 {
-                    let mut b = row.clone();
-                    b.compute_s += best.as_ref().map_or(0.0, |x| x.compute_s);
-                    best = Some(b);
-                } else if strategy == Coordination::Best
-                    && let Some(b) = best.as_mut()
-                    && matches!(allocation, Allocation::Balanced | Allocation::Proximity)
-                {
-                    b.compute_s += row.compute_s;
+                    ours.push(row.clone());
                 }
                 rows.push(row);
             }
         }
-        // Ours, whole: `best` coordination over the balanced and the proximity allocations.
+        // Ours, whole: `best` coordination over the balanced and the proximity allocations
+        // (compute: both runs).
+        let spent: f64 = ours.iter().map(|r| r.compute_s).sum();
+        let best = ours.into_iter().min_by(|a, b| {
+            (a.cycle_time_s, a.delta_t_s)
+                .partial_cmp(&(b.cycle_time_s, b.delta_t_s))
+                .unwrap_or(std::cmp::Ordering::Equal)
+        });
         match best {
             Some(mut b) => {
                 b.allocation = "balanced|proximity".into();
+                b.compute_s = spent;
                 rows.push(b);
             }
             None => rows.push(Row {
@@ -221,7 +212,7 @@ pub fn run(args: &CompareArgs) -> Result<(), Failure> {
 fn failed(case: usize, allocation: Allocation, coordination: Coordination, error: String) -> Row {
     Row {
         case,
-        allocation: allocation_name(allocation),
+        allocation: allocation.name().into(),
         coordination: coordination.name().into(),
         robots: Vec::new(),
         cycle_time_s: f64::NAN,
@@ -243,7 +234,7 @@ fn failed(case: usize, allocation: Allocation, coordination: Coordination, error
 fn row_of(case: usize, doc: &output::Plan, verified: bool, compute_s: f64, coord_s: f64) -> Row {
     Row {
         case,
-        allocation: allocation_name(doc.settings.allocation),
+        allocation: doc.settings.allocation.name().into(),
         coordination: doc.settings.coordination.name().into(),
         robots: doc
             .robots

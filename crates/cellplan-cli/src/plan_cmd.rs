@@ -310,10 +310,7 @@ fn render(doc: &output::Plan) -> String {
     let mut s = format!(
         "{} — allocation {}, coordination {}, seed {}\n\n",
         doc.cell,
-        serde_json::to_value(doc.settings.allocation)
-            .ok()
-            .and_then(|v| v.as_str().map(String::from))
-            .unwrap_or_default(),
+        doc.settings.allocation.name(),
         doc.settings.coordination.name(),
         doc.settings.seed
     );

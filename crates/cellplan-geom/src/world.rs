@@ -403,29 +403,22 @@ impl CollisionWorld {
             Placement::At(p) => p,
         };
         for (b, p) in self.group(other).bodies.iter().zip(other_poses) {
-            let pb = match place(b, p) {
-                Placement::Empty => continue,
+            match place(b, p) {
+                Placement::Empty => {}
                 Placement::Invalid => return 0.0,
-                Placement::At(p) => p,
-            };
-            if aabb_distance(&pa.aabb, &pb.aabb) >= best {
-                continue;
+                Placement::At(pb) => best = placed_distance(&pa, &pb, best),
             }
-            if let Some(d) = convex_distance(&pa.pose.inv_mul(&pb.pose), pa.support, pb.support, best) {
-                best = d;
-                if best <= 0.0 {
-                    return 0.0;
-                }
+            if best <= 0.0 {
+                return 0.0;
             }
         }
         best
     }
 
-    /// Smallest distance between any body of `a` (at `poses_a`) and any body of `b` (at
-    /// `poses_b`), capped at `cap`: `min(true distance, cap)`, 0 when two bodies touch or a pose
-    /// is not finite. Every pair is measured (an AABB test skips pairs at least the best
-    /// distance so far apart), so a small cap is fast. `a` and `b` should differ; for the same
-    /// group every pair `(i, j)`, `i < j`, is measured. A NaN or negative cap counts as 0.
+    /// Smallest distance between any body of `a` (at `poses_a`) and any body of another group
+    /// `b` (at `poses_b`), capped at `cap`: `min(true distance, cap)`, 0 when two bodies touch
+    /// or a pose is not finite (see [`CollisionWorld::body_group_distance`], body by body, each
+    /// capped at the best so far, so a small cap is fast). A NaN or negative cap counts as 0.
     pub fn group_group_distance(
         &self,
         a: GroupId,
@@ -434,38 +427,11 @@ impl CollisionWorld {
         poses_b: &[Pose],
         cap: f64,
     ) -> f64 {
-        let (ga, gb) = (self.group(a), self.group(b));
         let mut best = sanitize_margin(cap);
-        let placed_b: Vec<Placement> = gb
-            .bodies
-            .iter()
-            .zip(poses_b)
-            .map(|(body, p)| place(body, p))
-            .collect();
-        for (i, (body, pose)) in ga.bodies.iter().zip(poses_a).enumerate() {
-            let pa = match place(body, pose) {
-                Placement::Empty => continue,
-                Placement::Invalid => return 0.0,
-                Placement::At(p) => p,
-            };
-            for (j, pb) in placed_b.iter().enumerate() {
-                if a == b && j <= i {
-                    continue;
-                }
-                let pb = match pb {
-                    Placement::Empty => continue,
-                    Placement::Invalid => return 0.0,
-                    Placement::At(p) => p,
-                };
-                if aabb_distance(&pa.aabb, &pb.aabb) >= best {
-                    continue;
-                }
-                if let Some(d) = convex_distance(&pa.pose.inv_mul(&pb.pose), pa.support, pb.support, best) {
-                    best = d;
-                    if best <= 0.0 {
-                        return 0.0;
-                    }
-                }
+        for i in 0..self.group(a).bodies.len() {
+            best = self.body_group_distance(a, i, poses_a, b, poses_b, best);
+            if best <= 0.0 {
+                return 0.0;
             }
         }
         best
@@ -596,15 +562,11 @@ impl CollisionWorld {
         if i == j {
             return best;
         }
-        let (a, b) = match (place(ba, pa), place(bb, pb)) {
-            (Placement::Empty, _) | (_, Placement::Empty) => return best,
-            (Placement::Invalid, _) | (_, Placement::Invalid) => return 0.0,
-            (Placement::At(a), Placement::At(b)) => (a, b),
-        };
-        if aabb_distance(&a.aabb, &b.aabb) >= best {
-            return best;
+        match (place(ba, pa), place(bb, pb)) {
+            (Placement::Empty, _) | (_, Placement::Empty) => best,
+            (Placement::Invalid, _) | (_, Placement::Invalid) => 0.0,
+            (Placement::At(a), Placement::At(b)) => placed_distance(&a, &b, best),
         }
-        convex_distance(&a.pose.inv_mul(&b.pose), a.support, b.support, best).unwrap_or(best)
     }
 
     /// First static object hit by the ray `origin + t·dir`, `0 ≤ t ≤ max_distance`.
@@ -765,6 +727,14 @@ fn overlap(a: &Aabb, b: &Aabb) -> bool {
 #[inline]
 fn box_overlap(a: &Aabb, mins: DVec3, maxs: DVec3) -> bool {
     a.mins.cmple(maxs).all() && mins.cmple(a.maxs).all()
+}
+
+/// `min(distance between two placed bodies, best)` (0 when they touch); the AABB test first.
+fn placed_distance(a: &Placed, b: &Placed, best: f64) -> f64 {
+    if aabb_distance(&a.aabb, &b.aabb) >= best {
+        return best;
+    }
+    convex_distance(&a.pose.inv_mul(&b.pose), a.support, b.support, best).unwrap_or(best)
 }
 
 fn aabb_distance(a: &Aabb, b: &Aabb) -> f64 {

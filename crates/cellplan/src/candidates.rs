@@ -76,6 +76,7 @@ impl CandidateTable {
 /// the result does not depend on the thread count.
 pub fn generate(cell: &Cell) -> CandidateTable {
     let Process::Optical(process) = &cell.process;
+    let parked: Vec<_> = cell.robots.iter().map(|r| parked_others(cell, r)).collect();
     let table = cell
         .tasks
         .par_iter()
@@ -83,10 +84,8 @@ pub fn generate(cell: &Cell) -> CandidateTable {
             let poses = process.sample_poses(task);
             cell.robots
                 .par_iter()
-                .map(|robot| {
-                    let parked = parked_others(cell, robot);
-                    optical_reach(process, &cell.world, robot, task, &poses, &parked)
-                })
+                .zip(&parked)
+                .map(|(robot, parked)| optical_reach(process, &cell.world, robot, task, &poses, parked))
                 .collect()
         })
         .collect();
@@ -95,7 +94,7 @@ pub fn generate(cell: &Cell) -> CandidateTable {
 
 /// Wraps a joint value into (-π, π] so configurations differing by full turns compare equal
 /// (same geometry).
-fn wrap(a: f64) -> f64 {
+pub(crate) fn wrap(a: f64) -> f64 {
     let t = std::f64::consts::TAU;
     let w = a.rem_euclid(t);
     if w > std::f64::consts::PI { w - t } else { w }

@@ -141,6 +141,8 @@ pub(crate) struct Ctx<'a> {
     pub limits: Vec<Limits>,
     pub margin: f64,
     pub settings: &'a CoordSettings,
+    /// Per robot, the others parked at home (see [`crate::candidates::parked_others`]).
+    pub parked: Vec<Vec<(cellplan_geom::GroupId, Vec<cellplan_geom::Pose>)>>,
 }
 
 impl<'a> Ctx<'a> {
@@ -156,6 +158,11 @@ impl<'a> Ctx<'a> {
             limits: cell.robots.iter().map(limits_of).collect(),
             margin: cell.optical().clearance + REPLAY_SLACK,
             settings,
+            parked: cell
+                .robots
+                .iter()
+                .map(|r| crate::candidates::parked_others(cell, r))
+                .collect(),
         }
     }
 
@@ -163,8 +170,19 @@ impl<'a> Ctx<'a> {
         p.timed(&self.limits[p.robot])
     }
 
+    /// Robot `r` on the clock as `timed`.
+    pub fn mover<'b>(&'b self, r: usize, timed: &'b Timed) -> timeline::Mover<'b> {
+        timeline::Mover {
+            robot: &self.cell.robots[r],
+            timed,
+            radii: &self.radii[r],
+            limits: &self.limits[r],
+        }
+    }
+
     pub fn timeline<'b>(&'b self, timed: &'b [Timed]) -> Timeline<'b> {
-        Timeline::new(self.cell, timed, &self.radii, &self.limits, self.margin)
+        let movers = timed.iter().enumerate().map(|(r, t)| self.mover(r, t)).collect();
+        Timeline::new(self.cell, movers, self.margin)
     }
 
     /// Whether robot `x` (timed as `tx`) keeps clear of `others` in `[from, until]`.
@@ -177,19 +195,9 @@ impl<'a> Ctx<'a> {
         from: f64,
         until: f64,
     ) -> bool {
-        let mx = timeline::Mover {
-            robot: &self.cell.robots[x],
-            timed: tx,
-            radii: &self.radii[x],
-            limits: &self.limits[x],
-        };
+        let mx = self.mover(x, tx);
         others.iter().filter(|&&o| o != x).all(|&o| {
-            let mo = timeline::Mover {
-                robot: &self.cell.robots[o],
-                timed: &timed[o],
-                radii: &self.radii[o],
-                limits: &self.limits[o],
-            };
+            let mo = self.mover(o, &timed[o]);
             timeline::PairProbe::new(self.cell, &mx, &mo)
                 .first_contact(from, until, self.margin)
                 .is_none()
@@ -218,36 +226,9 @@ pub fn coordinate(
     let before = ctx.timeline(&timed).conflicts();
     let uncoordinated_cycle = cycle_and_delta(&timed).0;
     let cell_order: Vec<usize> = (0..programs.len()).collect();
-    let mut out = match settings.strategy {
-        Coordination::None => {
-            let after = before.clone();
-            Coordinated {
-                strategy: Coordination::None,
-                programs,
-                timed,
-                before: Vec::new(),
-                resolved: 0,
-                waits: 0,
-                poses_changed: 0,
-                priority: Vec::new(),
-                after,
-                uncoordinated_cycle,
-                compute_s: 0.0,
-            }
-        }
-        _ if before.is_empty() => Coordinated {
-            strategy: settings.strategy,
-            programs,
-            timed,
-            before: Vec::new(),
-            resolved: 0,
-            waits: 0,
-            poses_changed: 0,
-            priority: cell_order,
-            after: Vec::new(),
-            uncoordinated_cycle,
-            compute_s: 0.0,
-        },
+    let (programs, res, priority) = match settings.strategy {
+        Coordination::None => (programs, Resolution::default(), Vec::new()),
+        _ if before.is_empty() => (programs, Resolution::default(), cell_order),
         Coordination::DelayStartup | Coordination::FixedPriority | Coordination::PosePerturbation => {
             let mode = match settings.strategy {
                 Coordination::DelayStartup => Mode::DelayStartup,
@@ -255,22 +236,50 @@ pub fn coordinate(
                 _ => Mode::Perturb,
             };
             let mut progs = programs;
-            let s = resolve(&ctx, &mut progs, &rank_of(&cell_order), mode)?;
+            let res = resolve(&ctx, &mut progs, &rank_of(&cell_order), mode)?;
             let priority = if mode == Mode::Perturb {
                 Vec::new()
             } else {
                 cell_order
             };
-            finish(&ctx, progs, s.resolved, s.waits, s.poses_changed, priority)?
+            (progs, res, priority)
         }
         Coordination::Best => best(&ctx, programs)?,
     };
-    if settings.strategy != Coordination::None {
-        out.before = before;
+    let timed: Vec<Timed> = programs.iter().map(|p| ctx.timed(p)).collect::<Result<_, _>>()?;
+    // Whatever the strategy claims, the result is searched once more.
+    let after = if settings.strategy == Coordination::None {
+        before.clone()
+    } else if res.resolved == 0 {
+        Vec::new()
+    } else {
+        ctx.timeline(&timed).conflicts()
+    };
+    if settings.strategy != Coordination::None
+        && let Some(c) = after.first()
+    {
+        return Err(PlanError::Coordination(format!(
+            "robots {} and {} still meet at {:.2} s after coordination",
+            ctx.cell.robots[c.robots.0].name, ctx.cell.robots[c.robots.1].name, c.start
+        )));
     }
-    out.uncoordinated_cycle = uncoordinated_cycle;
-    out.compute_s = started.elapsed().as_secs_f64();
-    Ok(out)
+    Ok(Coordinated {
+        strategy: settings.strategy,
+        programs,
+        timed,
+        before: if settings.strategy == Coordination::None {
+            Vec::new()
+        } else {
+            before
+        },
+        resolved: res.resolved,
+        waits: res.waits,
+        poses_changed: res.poses_changed,
+        priority,
+        after,
+        uncoordinated_cycle,
+        compute_s: started.elapsed().as_secs_f64(),
+    })
 }
 
 /// Coordinate the programs of a planning run (see [`coordinate`]).
@@ -280,44 +289,8 @@ pub fn coordinate_outcome(
     outcome: &crate::plan::Outcome,
     settings: &CoordSettings,
 ) -> Result<Coordinated, PlanError> {
-    coordinate(
-        cell,
-        table,
-        Program::from_outcome(cell, table, outcome)?,
-        settings,
-    )
-}
-
-fn finish(
-    ctx: &Ctx,
-    programs: Vec<Program>,
-    resolved: usize,
-    waits: usize,
-    poses_changed: usize,
-    priority: Vec<usize>,
-) -> Result<Coordinated, PlanError> {
-    let timed: Vec<Timed> = programs.iter().map(|p| ctx.timed(p)).collect::<Result<_, _>>()?;
-    // Whatever the strategy claims, the result is searched once more.
-    let after = ctx.timeline(&timed).conflicts();
-    if let Some(c) = after.first() {
-        return Err(PlanError::Coordination(format!(
-            "robots {} and {} still meet at {:.2} s after coordination",
-            ctx.cell.robots[c.robots.0].name, ctx.cell.robots[c.robots.1].name, c.start
-        )));
-    }
-    Ok(Coordinated {
-        strategy: ctx.settings.strategy,
-        programs,
-        timed,
-        before: Vec::new(),
-        resolved,
-        waits,
-        poses_changed,
-        priority,
-        after,
-        uncoordinated_cycle: 0.0,
-        compute_s: 0.0,
-    })
+    let programs = outcome.robots.iter().map(|r| r.program.clone()).collect();
+    coordinate(cell, table, programs, settings)
 }
 
 /// Counts of a resolution.
@@ -375,6 +348,11 @@ pub(crate) fn resolve(
     let m = programs.len();
     let mut res = Resolution::default();
     let mut from = 0.0;
+    let (search, reason) = match mode {
+        Mode::DelayStartup => (WaitSearch::Startup(ctx.settings.delay_step), WaitReason::Startup),
+        Mode::Perturb => (WaitSearch::Shortest, WaitReason::Fallback),
+        _ => (WaitSearch::Shortest, WaitReason::GiveWay),
+    };
     while let Some((t, a, b)) = ctx.timeline(&timed).first_conflict(from) {
         from = t;
         res.resolved += 1;
@@ -400,42 +378,38 @@ pub(crate) fn resolve(
         let mut done = false;
         for (x, other) in [(lo, hi), (hi, lo)] {
             let others: Vec<usize> = (0..m).filter(|&r| r != x).collect();
-            let (search, reason) = match mode {
-                Mode::DelayStartup => (WaitSearch::Startup(ctx.settings.delay_step), WaitReason::Startup),
-                Mode::Perturb => (WaitSearch::Shortest, WaitReason::Fallback),
-                _ => (WaitSearch::Shortest, WaitReason::GiveWay),
-            };
-            let mut waited = programs[x].clone();
-            let waited = if add_wait(ctx, &mut waited, &timed, x, &others, t, other, reason, search)? {
-                let tw = ctx.timed(&waited)?;
-                Some((waited, tw))
-            } else {
-                None
-            };
             let reposed = match mode {
                 Mode::Perturb if x == lo => perturb::repose(ctx, &programs[x], &timed, x, &others, t, false)?,
                 Mode::GiveWayOrRepose => perturb::repose(ctx, &programs[x], &timed, x, &others, t, true)?,
                 _ => None,
             };
-            // The paper's robots do not stop: a perturbation wins whenever there is one.
+            // The paper's robots do not stop: a perturbation wins whenever there is one, and
+            // only without one is a wait looked for.
+            let waited = if mode == Mode::Perturb && reposed.is_some() {
+                None
+            } else {
+                let mut p = programs[x].clone();
+                if add_wait(ctx, &mut p, &timed, x, &others, t, other, reason, search)? {
+                    let tp = ctx.timed(&p)?;
+                    Some((p, tp))
+                } else {
+                    None
+                }
+            };
             let take_repose = match (&reposed, &waited) {
-                (Some(_), _) if mode == Mode::Perturb => true,
                 (Some(r), Some(w)) => r.1.end() < w.1.end() - 1e-9,
                 (Some(_), None) => true,
                 _ => false,
             };
-            if take_repose {
-                let (p, tp) = reposed.expect("checked");
+            let (change, counter) = if take_repose {
+                (reposed, &mut res.poses_changed)
+            } else {
+                (waited, &mut res.waits)
+            };
+            if let Some((p, tp)) = change {
                 programs[x] = p;
                 timed[x] = tp;
-                res.poses_changed += 1;
-                done = true;
-                break;
-            }
-            if let Some((p, tp)) = waited {
-                programs[x] = p;
-                timed[x] = tp;
-                res.waits += 1;
+                *counter += 1;
                 done = true;
                 break;
             }
@@ -575,7 +549,7 @@ type Scheduled = (f64, f64, Vec<Program>, Resolution);
 
 /// Our strategy: every priority order resolved by the shortest waits; the best orders again
 /// with other poses allowed; the shortest cycle time (then Δt) kept.
-fn best(ctx: &Ctx, programs: Vec<Program>) -> Result<Coordinated, PlanError> {
+fn best(ctx: &Ctx, programs: Vec<Program>) -> Result<(Vec<Program>, Resolution, Vec<usize>), PlanError> {
     let orders = priority_orders(&programs);
     let run = |order: &Vec<usize>, mode: Mode| -> Option<Scheduled> {
         let mut p = programs.clone();
@@ -596,33 +570,26 @@ fn best(ctx: &Ctx, programs: Vec<Program>) -> Result<Coordinated, PlanError> {
         .par_iter()
         .map(|&i| run(&orders[i], Mode::GiveWayOrRepose))
         .collect();
-    let mut results: Vec<(f64, f64, usize, Vec<Program>, Resolution)> = Vec::new();
-    for (k, r) in reposed.into_iter().enumerate() {
-        if let Some((c, d, p, res)) = r {
-            results.push((c, d, top[k], p, res));
-        }
+    // Each of the top orders with other poses, then with waits only.
+    let mut waits = waits;
+    let mut results: Vec<(Scheduled, usize)> = Vec::new();
+    for (&i, r) in top.iter().zip(reposed) {
+        results.extend(r.map(|r| (r, i)));
     }
-    for (i, r) in waits.into_iter().enumerate() {
-        if let Some((c, d, p, res)) = r
-            && top.contains(&i)
-        {
-            results.push((c, d, i, p, res));
-        }
+    for &i in &top {
+        results.extend(waits[i].take().map(|r| (r, i)));
     }
-    results.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.total_cmp(&b.1)).then(a.2.cmp(&b.2)));
-    let Some((_, _, i, progs, res)) = results.into_iter().next() else {
+    let Some(((_, _, progs, res), i)) = results.into_iter().min_by(|a, b| {
+        a.0.0
+            .total_cmp(&b.0.0)
+            .then(a.0.1.total_cmp(&b.0.1))
+            .then(a.1.cmp(&b.1))
+    }) else {
         return Err(PlanError::Coordination(
             "no priority order resolves every conflict (a robot stands in another's path at home)".into(),
         ));
     };
-    finish(
-        ctx,
-        progs,
-        res.resolved,
-        res.waits,
-        res.poses_changed,
-        orders[i].clone(),
-    )
+    Ok((progs, res, orders[i].clone()))
 }
 
 /// `rank[r]`: the position of robot `r` in `order`.

@@ -2,7 +2,7 @@
 //! them, and the same move with any other candidate pose (used by `best`).
 use super::Ctx;
 use super::program::{Activity, Program, ProgramLeg, Timed, VisitPose};
-use crate::candidates::optical_reach;
+use crate::candidates::{optical_reach, wrap};
 use crate::plan::PlanError;
 use crate::process::optical::ProbePose;
 use cellplan_geom::{DQuat, Pose};
@@ -42,12 +42,6 @@ fn wpr(q: DQuat) -> [f64; 3] {
     [w, p, r]
 }
 
-fn wrap(a: f64) -> f64 {
-    let t = std::f64::consts::TAU;
-    let w = a.rem_euclid(t);
-    if w > std::f64::consts::PI { w - t } else { w }
-}
-
 /// Other measuring poses of visit `v`: the orientation perturbed on the ±2-increment grid about
 /// w, p, r (position fixed), kept when the probe still measures the MP, IK reaches it within
 /// limits, the beams are clear and the robot is clear of the scene and itself; with
@@ -82,8 +76,14 @@ fn alternatives(ctx: &Ctx, program: &Program, v: usize, candidates: bool) -> Vec
         }
     }
     let limits = &ctx.limits[program.robot];
-    let parked = crate::candidates::parked_others(cell, robot);
-    let reach = optical_reach(cell.optical(), &cell.world, robot, task, &poses, &parked);
+    let reach = optical_reach(
+        cell.optical(),
+        &cell.world,
+        robot,
+        task,
+        &poses,
+        &ctx.parked[program.robot],
+    );
     let base = wpr(orig.tcp.rotation);
     let base_pert = orig.perturbation.unwrap_or([0.0; 3]);
     let mut perturbed: Vec<(f64, VisitPose)> = reach
@@ -96,18 +96,11 @@ fn alternatives(ctx: &Ctx, program: &Program, v: usize, candidates: bool) -> Vec
                 base_pert[1] + wrap(e[1] - base[1]),
                 base_pert[2] + wrap(e[2] - base[2]),
             ];
-            let cost = move_time(&orig.q, &c.q, limits);
-            (
-                cost,
-                VisitPose {
-                    task: orig.task,
-                    candidate: orig.candidate,
-                    q: c.q,
-                    tcp: c.tcp,
-                    view_angle: c.view_angle,
-                    perturbation: Some(d),
-                },
-            )
+            let pose = VisitPose {
+                perturbation: Some(d),
+                ..VisitPose::from_candidate(orig.task, orig.candidate, &c)
+            };
+            (move_time(&orig.q, &c.q, limits), pose)
         })
         .collect();
     perturbed.sort_by(|a, b| a.0.total_cmp(&b.0));
@@ -127,14 +120,7 @@ fn alternatives(ctx: &Ctx, program: &Program, v: usize, candidates: bool) -> Vec
             .map(|(c, cand)| {
                 (
                     move_time(&orig.q, &cand.q, limits),
-                    VisitPose {
-                        task: orig.task,
-                        candidate: c,
-                        q: cand.q.clone(),
-                        tcp: cand.tcp,
-                        view_angle: cand.view_angle,
-                        perturbation: None,
-                    },
+                    VisitPose::from_candidate(orig.task, c, cand),
                 )
             })
             .collect();

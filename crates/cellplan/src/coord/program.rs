@@ -5,11 +5,12 @@
 //! rest (as [`time_path_exact`] does for a whole polyline: it stops at every waypoint), so a
 //! wait at any waypoint changes nothing but the clock: the robot is at rest there anyway.
 use crate::Cell;
-use crate::candidates::CandidateTable;
+use crate::candidates::{Candidate, CandidateTable};
 use crate::model::robot::Robot;
 use crate::model::tasks::TaskId;
+use crate::plan::PlanError;
 use crate::plan::graph::RobotGraph;
-use crate::plan::{Outcome, PlanError};
+use crate::plan::sequence::Sequence;
 use cellplan_geom::Pose;
 use cellplan_motion::timing::{Limits, Trajectory, time_path_exact};
 
@@ -28,6 +29,20 @@ pub struct VisitPose {
     pub view_angle: f64,
     /// The (Δw, Δp, Δr) increments (rad) of paper 000 §4.2 when the orientation was perturbed.
     pub perturbation: Option<[f64; 3]>,
+}
+
+impl VisitPose {
+    /// Candidate `index` of the table, as it is.
+    pub fn from_candidate(task: TaskId, index: usize, c: &Candidate) -> Self {
+        VisitPose {
+            task,
+            candidate: index,
+            q: c.q.clone(),
+            tcp: c.tcp,
+            view_angle: c.view_angle,
+            perturbation: None,
+        }
+    }
 }
 
 /// One leg: a collision-free joint polyline.
@@ -203,56 +218,46 @@ pub fn segment_trajectory(a: &[f64], b: &[f64], limits: &Limits) -> Result<Traje
 }
 
 impl Program {
-    /// The programs of a planning run, one per robot, without waits.
-    pub fn from_outcome(
+    /// A robot's program from its final sequence, without waits: the sequence's candidates
+    /// as visits, every leg timed segment by segment.
+    pub fn from_sequence(
         cell: &Cell,
         table: &CandidateTable,
-        outcome: &Outcome,
-    ) -> Result<Vec<Program>, PlanError> {
-        cell.robots
+        robot: &Robot,
+        graph: &RobotGraph,
+        seq: &Sequence,
+    ) -> Result<Program, PlanError> {
+        let visits = seq
+            .nodes
             .iter()
-            .enumerate()
-            .map(|(r, robot)| {
-                let res = &outcome.robots[r];
-                let graph: &RobotGraph = &outcome.graphs[r];
-                let visits = res
-                    .sequence
-                    .nodes
-                    .iter()
-                    .map(|&node| {
-                        let (t, c) = graph.node_task[node].expect("visited nodes are candidates");
-                        let cand = &table.get(t, robot.id).candidates[c];
-                        VisitPose {
-                            task: t,
-                            candidate: c,
-                            q: cand.q.clone(),
-                            tcp: cand.tcp,
-                            view_angle: cand.view_angle,
-                            perturbation: None,
-                        }
-                    })
-                    .collect();
-                let legs = res
-                    .sequence
-                    .legs
-                    .iter()
-                    .map(|l| ProgramLeg::new(l.waypoints.clone(), l.straight, &graph.limits))
-                    .collect::<Result<_, _>>()?;
-                Ok(Program {
-                    robot: r,
-                    home: robot.home.clone(),
-                    legs,
-                    visits,
-                    waits: Vec::new(),
-                    measure: cell.optical().measure_time,
-                })
+            .map(|&node| {
+                let (t, c) = graph.node_task[node].expect("visited nodes are candidates");
+                VisitPose::from_candidate(t, c, &table.get(t, robot.id).candidates[c])
             })
-            .collect()
+            .collect();
+        let legs = seq
+            .legs
+            .iter()
+            .map(|l| ProgramLeg::new(l.waypoints.clone(), l.straight, &graph.limits))
+            .collect::<Result<_, _>>()?;
+        Ok(Program {
+            robot: robot.id.0,
+            home: robot.home.clone(),
+            legs,
+            visits,
+            waits: Vec::new(),
+            measure: cell.optical().measure_time,
+        })
     }
 
-    /// Where the robot is at waypoint `w` of leg `k`.
-    pub fn point(&self, k: usize, w: usize) -> &[f64] {
-        &self.legs[k].waypoints[w]
+    /// Name of stop `k` of the program: 0 and `visits.len() + 1` are "home", else the MP of
+    /// visit `k − 1` (leg `k` runs from stop `k` to stop `k + 1`).
+    pub fn stop_name(&self, cell: &Cell, k: usize) -> String {
+        if k == 0 || k > self.visits.len() {
+            "home".to_string()
+        } else {
+            cell.tasks[self.visits[k - 1].task.0].name.clone()
+        }
     }
 
     /// The wait at a waypoint, if any.
@@ -348,10 +353,5 @@ impl Program {
             wait_starts,
             arrivals,
         })
-    }
-
-    /// The robot this program belongs to.
-    pub fn robot_of<'a>(&self, cell: &'a Cell) -> &'a Robot {
-        &cell.robots[self.robot]
     }
 }

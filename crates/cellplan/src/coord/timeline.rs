@@ -64,8 +64,6 @@ pub struct PairProbe<'a> {
     b: &'a Mover<'a>,
     sa: Scratch,
     sb: Scratch,
-    /// Distance queries made.
-    pub queries: usize,
 }
 
 impl<'a> PairProbe<'a> {
@@ -77,7 +75,6 @@ impl<'a> PairProbe<'a> {
             b,
             sa: Scratch::default(),
             sb: Scratch::default(),
-            queries: 0,
         }
     }
 
@@ -87,7 +84,6 @@ impl<'a> PairProbe<'a> {
         let qb = self.b.timed.trajectory.position(t);
         self.a.robot.body_poses(&qa, &mut self.sa);
         self.b.robot.body_poses(&qb, &mut self.sb);
-        self.queries += 1;
         self.cell.world.group_group_distance(
             self.a.robot.group,
             &self.sa.bodies,
@@ -234,27 +230,8 @@ pub struct Timeline<'a> {
 }
 
 impl<'a> Timeline<'a> {
-    /// A timeline of `timed` programs (one per robot, cell order).
-    pub fn new(
-        cell: &'a Cell,
-        timed: &'a [Timed],
-        radii: &'a [Vec<f64>],
-        limits: &'a [Limits],
-        margin: f64,
-    ) -> Self {
-        let movers = cell
-            .robots
-            .iter()
-            .zip(timed)
-            .zip(radii)
-            .zip(limits)
-            .map(|(((robot, timed), radii), limits)| Mover {
-                robot,
-                timed,
-                radii,
-                limits,
-            })
-            .collect();
+    /// A timeline of robots on the clock, one mover per robot in cell order.
+    pub fn new(cell: &'a Cell, movers: Vec<Mover<'a>>, margin: f64) -> Self {
         Timeline { cell, movers, margin }
     }
 
@@ -296,40 +273,11 @@ impl<'a> Timeline<'a> {
         best
     }
 
-    /// First contact of robot `x` with any of `others` in `[from, until]`: (time, other).
-    pub fn first_conflict_of(
-        &self,
-        x: usize,
-        others: &[usize],
-        from: f64,
-        until: f64,
-    ) -> Option<(f64, usize)> {
-        let mut best: Option<(f64, usize)> = None;
-        for &o in others {
-            if o == x {
-                continue;
-            }
-            let limit = best.map_or(until, |b| b.0);
-            let mut probe = PairProbe::new(self.cell, &self.movers[x], &self.movers[o]);
-            if let Some(t) = probe.first_contact(from, limit, self.margin)
-                && best.is_none_or(|b| t < b.0)
-            {
-                best = Some((t, o));
-            }
-        }
-        best
-    }
-
     /// The conflict record of a contact interval.
     pub fn describe(&self, a: usize, b: usize, start: f64, end: f64) -> Conflict {
+        // Past its end a robot is home: `span_at` gives its last span, the leg home.
         let act = |r: usize| {
             let m = &self.movers[r];
-            if start >= m.timed.end() {
-                // Home after its program: the last span's activity would mislead; call it a
-                // wait at the end of the last leg.
-                let last = m.timed.spans.len() - 1;
-                return m.timed.spans[last].what;
-            }
             m.timed.spans[m.timed.span_at(start)].what
         };
         let tcp = |r: usize| {
@@ -355,13 +303,7 @@ impl<'a> Timeline<'a> {
 
 /// Describes an activity for people: "moving M3 → M7", "measuring M7", "waiting at M3".
 pub fn activity_text(cell: &Cell, program: &Program, a: Activity) -> String {
-    let name = |k: usize| -> String {
-        if k == 0 || k > program.visits.len() {
-            "home".into()
-        } else {
-            cell.tasks[program.visits[k - 1].task.0].name.clone()
-        }
-    };
+    let name = |k: usize| program.stop_name(cell, k);
     match a {
         Activity::Move { leg, .. } => format!("moving {} → {}", name(leg), name(leg + 1)),
         Activity::Measure { visit } => format!("measuring {}", name(visit + 1)),

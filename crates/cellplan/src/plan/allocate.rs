@@ -35,6 +35,17 @@ pub enum Allocation {
     Balanced,
 }
 
+impl Allocation {
+    /// Name as on the command line and in the plan document.
+    pub fn name(self) -> &'static str {
+        match self {
+            Allocation::Proximity => "proximity",
+            Allocation::LocalRobust => "local-robust",
+            Allocation::Balanced => "balanced",
+        }
+    }
+}
+
 /// How the local-robust strategy solves its set cover.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "kebab-case")]

@@ -17,9 +17,9 @@ pub use output::Plan;
 
 use crate::Cell;
 use crate::candidates::CandidateTable;
+use crate::coord::Program;
 use crate::model::tasks::TaskId;
 use cellplan_motion::plan::PlanSettings as MotionSettings;
-use cellplan_motion::timing::{Trajectory, time_path_exact};
 use cellplan_solve::CostMatrix;
 use graph::RobotGraph;
 use rayon::prelude::*;
@@ -138,19 +138,13 @@ impl Stage {
     }
 }
 
-/// One robot's timed result, before it is written out.
+/// One robot's result, before coordination.
 #[derive(Clone, Debug)]
 pub struct RobotResult {
     /// The sequence with its legs.
     pub sequence: sequence::Sequence,
-    /// The whole trajectory, home to home, with the dwells.
-    pub trajectory: Trajectory,
-    /// (arrive, depart) times at each visited node, in order.
-    pub visits: Vec<(f64, f64)>,
-    /// Time moving (s).
-    pub motion: f64,
-    /// Time measuring (s).
-    pub measuring: f64,
+    /// The sequence as a program: its measuring poses and its legs, timed (no waits yet).
+    pub program: Program,
 }
 
 /// Everything a run produced.
@@ -291,10 +285,10 @@ pub fn plan(
     tick(Stage::Sequencing, &mut compute);
 
     progress(Stage::Timing);
-    let measure = cell.optical().measure_time;
     let mut robots = Vec::with_capacity(sequences.len());
-    for (seq, graph) in sequences.into_iter().zip(&graphs) {
-        robots.push(assemble(seq, graph, measure)?);
+    for ((sequence, graph), robot) in sequences.into_iter().zip(&graphs).zip(&cell.robots) {
+        let program = Program::from_sequence(cell, table, robot, graph, &sequence)?;
+        robots.push(RobotResult { sequence, program });
     }
     tick(Stage::Timing, &mut compute);
     Ok(Outcome {
@@ -380,35 +374,6 @@ fn mixed_costs(graph: &RobotGraph, planned: &sequence::Planned) -> CostMatrix {
         data[b * n + a] = c;
     }
     CostMatrix::new(n, data).expect("same size as the graph")
-}
-
-/// Time every leg and put legs and dwells on one trajectory.
-fn assemble(seq: sequence::Sequence, graph: &RobotGraph, measure: f64) -> Result<RobotResult, PlanError> {
-    let mut parts = Vec::with_capacity(2 * seq.legs.len());
-    let mut visits = Vec::with_capacity(seq.nodes.len());
-    let (mut t, mut motion, mut measuring) = (0.0, 0.0, 0.0);
-    for (i, leg) in seq.legs.iter().enumerate() {
-        let timed =
-            time_path_exact(&leg.waypoints, &graph.limits).map_err(|e| PlanError::Timing(e.to_string()))?;
-        let d = timed.trajectory.duration();
-        t += d;
-        motion += d;
-        parts.push(timed.trajectory);
-        if let Some(&node) = seq.nodes.get(i) {
-            visits.push((t, t + measure));
-            parts.push(Trajectory::dwell(&graph.q[node], measure));
-            t += measure;
-            measuring += measure;
-        }
-    }
-    let trajectory = Trajectory::concat(&parts).map_err(|e| PlanError::Timing(e.to_string()))?;
-    Ok(RobotResult {
-        sequence: seq,
-        trajectory,
-        visits,
-        motion,
-        measuring,
-    })
 }
 
 /// The tasks of a robot in visiting order.

@@ -323,13 +323,7 @@ pub fn build(
     for (r, robot) in cell.robots.iter().enumerate() {
         let prog = &coordinated.programs[r];
         let timed = &coordinated.timed[r];
-        let name_of = |k: usize| -> String {
-            if k == 0 || k > prog.visits.len() {
-                "home".to_string()
-            } else {
-                cell.tasks[prog.visits[k - 1].task.0].name.clone()
-            }
-        };
+        let name_of = |k: usize| prog.stop_name(cell, k);
         let tasks = prog
             .visits
             .iter()
@@ -500,13 +494,7 @@ fn conflict_out(cell: &Cell, coordinated: &Coordinated, c: &Conflict) -> Conflic
     let progs = &coordinated.programs;
     let one = |k: usize| {
         let prog = &progs[robots[k]];
-        let name = |i: usize| -> String {
-            if i == 0 || i > prog.visits.len() {
-                "home".to_string()
-            } else {
-                cell.tasks[prog.visits[i - 1].task.0].name.clone()
-            }
-        };
+        let name = |i: usize| prog.stop_name(cell, i);
         let (leg, tasks) = match c.activity[k] {
             Activity::Move { leg, .. } => (
                 format!("{} → {}", name(leg), name(leg + 1)),
