@@ -174,12 +174,12 @@ pub fn run(args: &CompareArgs) -> Result<(), Failure> {
         });
         match best {
             Some(mut b) => {
-                b.allocation = "balanced|proximity".into();
+                b.allocation = "balanced+proximity".into();
                 b.compute_s = spent;
                 rows.push(b);
             }
             None => rows.push(Row {
-                allocation: "balanced|proximity".into(),
+                allocation: "balanced+proximity".into(),
                 ..failed(case, Allocation::Balanced, Coordination::Best, "no plan".into())
             }),
         }
