@@ -3,6 +3,8 @@
 use crate::{Failure, load_options, spinner};
 use cellplan::coord::{self, CoordSettings, Coordination};
 use cellplan::plan::{self, Allocation, PlanSettings, output};
+use cellplan::report::charts::StrategyBar;
+use cellplan::report::html::{CompareRow, compare_html};
 use cellplan::taskgen::{GenOptions, sample_tasks};
 use cellplan::verify::{VerifySettings, verify};
 use cellplan::{Cell, InputError, candidates, io::write_atomic};
@@ -199,6 +201,7 @@ pub fn run(args: &CompareArgs) -> Result<(), Failure> {
         std::fs::create_dir_all(dir)
             .and_then(|()| write_atomic(&dir.join("compare.json"), json.as_bytes()))
             .and_then(|()| write_atomic(&dir.join("compare.md"), md.as_bytes()))
+            .and_then(|()| write_atomic(&dir.join("compare.html"), html(&report).as_bytes()))
             .map_err(|e| Failure::Other(format!("cannot write to {}: {e}", dir.display())))?;
     }
     if args.json {
@@ -207,6 +210,123 @@ pub fn run(args: &CompareArgs) -> Result<(), Failure> {
         print!("{md}");
     }
     Ok(())
+}
+
+/// The comparison as an HTML page: the table and the bar chart of paper 000 Fig. 10.
+fn html(report: &Report) -> String {
+    let f2 = |v: f64| format!("{v:.2}");
+    let bound = report
+        .strategies
+        .iter()
+        .map(|r| r.lower_bound_s)
+        .find(|v| v.is_finite());
+    let (header, rows, bars): (Vec<String>, Vec<CompareRow>, Vec<StrategyBar>) = match report.random_tasks {
+        None => {
+            let names: Vec<String> = report
+                .strategies
+                .iter()
+                .find(|r| !r.robots.is_empty())
+                .map(|r| r.robots.iter().map(|x| format!("{} s", x.name)).collect())
+                .unwrap_or_default();
+            let mut header = vec!["allocation + coordination".to_string()];
+            header.extend(names);
+            header.extend(
+                ["cycle s", "Δt s", "uncoordinated s", "conflicts", "resolved", "waits", "poses changed", "verified", "compute s", "coordination s"]
+                    .map(String::from),
+            );
+            let label = |r: &Row| format!("{} + {}", r.allocation, r.coordination);
+            let ok = || report.strategies.iter().filter(|r| r.error.is_none());
+            let rows = report
+                .strategies
+                .iter()
+                .map(|r| {
+                    let mut cells = vec![label(r)];
+                    if let Some(e) = &r.error {
+                        cells.push(format!("failed: {e}"));
+                    } else {
+                        cells.extend(r.robots.iter().map(|x| f2(x.total_s)));
+                        cells.extend([
+                            f2(r.cycle_time_s),
+                            f2(r.delta_t_s),
+                            f2(r.uncoordinated_cycle_time_s),
+                            r.conflicts_before.to_string(),
+                            r.conflicts_resolved.to_string(),
+                            r.waits.to_string(),
+                            r.poses_changed.to_string(),
+                            if r.verified { "yes".into() } else { "NO".into() },
+                            f2(r.compute_s),
+                            f2(r.coordination_compute_s),
+                        ]);
+                    }
+                    CompareRow {
+                        cells,
+                        ours: r.allocation == "balanced+proximity",
+                    }
+                })
+                .collect();
+            let bars = ok()
+                .map(|r| StrategyBar {
+                    label: label(r),
+                    robots: r.robots.iter().map(|x| (x.name.clone(), x.total_s)).collect(),
+                    cycle_time_s: r.cycle_time_s,
+                    spread_s: None,
+                })
+                .collect();
+            (header, rows, bars)
+        }
+        Some(_) => {
+            let header = ["allocation + coordination", "solved", "verified", "cycle s (mean ± sd)", "Δt s (mean ± sd)", "compute s", "coordination s"]
+                .map(String::from)
+                .to_vec();
+            let label = |m: &Summary| format!("{} + {}", m.allocation, m.coordination);
+            let rows = report
+                .summary
+                .iter()
+                .map(|m| CompareRow {
+                    cells: vec![
+                        label(m),
+                        format!("{}/{}", m.solved, m.cases),
+                        m.verified.to_string(),
+                        format!("{:.2} ± {:.2}", m.cycle_time_mean_s, m.cycle_time_sd_s),
+                        format!("{:.2} ± {:.2}", m.delta_t_mean_s, m.delta_t_sd_s),
+                        f2(m.compute_mean_s),
+                        f2(m.coordination_compute_mean_s),
+                    ],
+                    ours: m.allocation == "balanced+proximity",
+                })
+                .collect();
+            let bars = report
+                .summary
+                .iter()
+                .filter(|m| m.cycle_time_mean_s.is_finite())
+                .map(|m| StrategyBar {
+                    label: label(m),
+                    robots: vec![("mean cycle".into(), m.cycle_time_mean_s)],
+                    cycle_time_s: m.cycle_time_mean_s,
+                    spread_s: Some(m.cycle_time_sd_s),
+                })
+                .collect();
+            (header, rows, bars)
+        }
+    };
+    let intro = match report.random_tasks {
+        None => format!(
+            "Every allocation × coordination strategy on cell {} (seed {}); every plan checked by cellplan verify. Bold: ours as `cellplan plan` runs it.",
+            report.cell, report.seed
+        ),
+        Some(k) => format!(
+            "{k} random MP sets drawn on the part of cell {} (seed {}), mean ± standard deviation over the solved sets (paper 000 Table 4).",
+            report.cell, report.seed
+        ),
+    };
+    compare_html(
+        &format!("cellplan compare — {}", report.cell),
+        &intro,
+        &header,
+        &rows,
+        &bars,
+        if report.random_tasks.is_none() { bound } else { None },
+    )
 }
 
 fn failed(case: usize, allocation: Allocation, coordination: Coordination, error: String) -> Row {

@@ -7,6 +7,7 @@
 mod bench;
 mod compare_cmd;
 mod plan_cmd;
+mod report_cmd;
 mod verify_cmd;
 
 use cellplan::report::{check, svg};
@@ -43,6 +44,12 @@ enum Command {
     /// Run every allocation × coordination strategy on a cell (paper 000 Table 3), or on
     /// random MP sets drawn on its part (Table 4), and print the table.
     Compare(compare_cmd::CompareArgs),
+    /// Write the self-contained HTML report of a plan: summary, Gantt chart, time–position
+    /// charts before and after coordination, and a 3D playback of the cell.
+    Report(report_cmd::ReportArgs),
+    /// Export a plan: binary glTF with the robots' motion as an animation, and/or per robot CSV
+    /// (time, joints, probe pose; program points) for post-processors.
+    Export(report_cmd::ExportArgs),
     /// Generate inputs for building cells.
     #[command(subcommand)]
     Gen(GenCommand),
@@ -307,6 +314,8 @@ fn main() -> ExitCode {
         Command::Plan(a) => plan_cmd::run(a),
         Command::Verify(a) => verify_cmd::run(a),
         Command::Compare(a) => compare_cmd::run(a),
+        Command::Report(a) => report_cmd::run_report(a),
+        Command::Export(a) => report_cmd::run_export(a),
         Command::Gen(GenCommand::Tasks(a)) => run_gen_tasks(a),
         Command::Bench(a) => run_bench(a),
     };

@@ -50,6 +50,9 @@ pub struct PlanArgs {
     /// Write the plan even if `cellplan verify` rejects it.
     #[arg(long)]
     no_verify: bool,
+    /// Do not write report.html (the HTML report) beside the plan.
+    #[arg(long)]
+    no_report: bool,
     /// No progress output and no table.
     #[arg(long, short)]
     quiet: bool,
@@ -108,6 +111,7 @@ enum MoveModelArg {
 #[derive(Serialize)]
 struct Summary<'a> {
     plan_file: String,
+    report_file: Option<String>,
     cycle_time_s: f64,
     delta_t_s: f64,
     lower_bound_s: f64,
@@ -264,11 +268,24 @@ pub fn run(args: &PlanArgs) -> Result<(), Failure> {
     std::fs::create_dir_all(&dir)
         .and_then(|()| write_atomic(&file, text.as_bytes()))
         .map_err(|e| Failure::Other(format!("cannot write {}: {e}", file.display())))?;
+    let report_file = dir.join("report.html");
+    if !args.no_report {
+        pb.set_message("writing the report");
+        crate::report_cmd::write_report(
+            &report_file,
+            &file,
+            &doc,
+            &cell,
+            Some(&report),
+            cellplan::report::scene::MESH_BUDGET,
+        )?;
+    }
     pb.finish_and_clear();
     cell.save_cache();
     if args.json {
         let summary = Summary {
             plan_file: file.display().to_string(),
+            report_file: (!args.no_report).then(|| report_file.display().to_string()),
             cycle_time_s: doc.cycle_time_s,
             delta_t_s: doc.delta_t_s,
             lower_bound_s: doc.lower_bound_s,
@@ -298,6 +315,9 @@ pub fn run(args: &PlanArgs) -> Result<(), Failure> {
     } else if !args.quiet {
         print!("{}", render(&doc));
         println!("plan written to {}", file.display());
+        if !args.no_report {
+            println!("report written to {}", report_file.display());
+        }
     }
     if doc.unmeasured.is_empty() {
         Ok(())

@@ -1,7 +1,7 @@
 //! `cellplan verify`: the independent check of a plan.
 use crate::Failure;
 use cellplan::verify::{VerifySettings, Violation, verify};
-use cellplan::{InputError, LoadOptions, plan::output::Plan};
+use cellplan::LoadOptions;
 use clap::Args;
 use std::path::PathBuf;
 
@@ -28,18 +28,7 @@ pub fn run(args: &VerifyArgs) -> Result<(), Failure> {
             "--time-step must be a positive number of seconds".into(),
         ));
     }
-    let text = std::fs::read_to_string(&args.plan).map_err(|e| {
-        Failure::Input(Box::new(
-            InputError::new(&args.plan, format!("cannot read the plan: {e}"))
-                .hint("give the plan.json that `cellplan plan` wrote"),
-        ))
-    })?;
-    let plan: Plan = serde_json::from_str(&text).map_err(|e| {
-        Failure::Input(Box::new(
-            InputError::at_line(&args.plan, Some(e.line()), format!("not a cellplan plan: {e}"))
-                .hint("give the plan.json that `cellplan plan` wrote (docs/plan-format.md)"),
-        ))
-    })?;
+    let plan = crate::report_cmd::read_plan(&args.plan)?;
     let cell = cellplan::model::load::load(&args.cell, &LoadOptions::default())?;
     let settings = VerifySettings {
         robot_robot: !args.no_robot_robot,

@@ -71,6 +71,101 @@ impl Mesh {
         (b - a).cross(c - a).normalize_or_zero()
     }
 
+    /// A copy with at most `max_triangles` triangles, by vertex clustering (Rossignac &
+    /// Borrel): the bounding box is cut into cubic cells, the vertices of a cell merge into
+    /// their mean, and triangles that collapse or repeat are dropped. The cell size is the
+    /// smallest (found by bisection on the number of cells along the longest side) that meets
+    /// the budget, so the result keeps as much detail as the budget allows. A mesh within the
+    /// budget is returned unchanged. Meant for drawing, not for collision.
+    pub fn decimated(&self, max_triangles: usize) -> Mesh {
+        if self.triangles.len() <= max_triangles {
+            return self.clone();
+        }
+        let Some((lo, hi)) = self.aabb() else {
+            return self.clone();
+        };
+        let longest = (hi - lo).max_element().max(f64::MIN_POSITIVE);
+        // More cells per side keep more triangles; the count is monotone enough to bisect on.
+        let (mut few, mut many) = (1usize, 2usize);
+        let mut best = self.clustered(lo, longest, 1);
+        loop {
+            let m = self.clustered(lo, longest, many);
+            if m.triangles.len() > max_triangles || many >= 1 << 16 {
+                break;
+            }
+            (few, best) = (many, m);
+            many *= 2;
+        }
+        while many - few > 1 {
+            let mid = (few + many) / 2;
+            let m = self.clustered(lo, longest, mid);
+            if m.triangles.len() <= max_triangles {
+                (few, best) = (mid, m);
+            } else {
+                many = mid;
+            }
+        }
+        best
+    }
+
+    /// Vertex clustering on a grid of `n` cells along the longest side (see [`Mesh::decimated`]).
+    fn clustered(&self, lo: DVec3, longest: f64, n: usize) -> Mesh {
+        let size = longest / n as f64;
+        let key = |v: DVec3| {
+            let c = ((v - lo) / size).floor();
+            let clamp = |x: f64| (x.max(0.0) as i64).min(n as i64);
+            (clamp(c.x), clamp(c.y), clamp(c.z))
+        };
+        let mut cells: HashMap<(i64, i64, i64), u32> = HashMap::new();
+        let mut sums: Vec<(DVec3, usize)> = Vec::new();
+        let index: Vec<u32> = self
+            .vertices
+            .iter()
+            .map(|&v| {
+                let next = sums.len() as u32;
+                let i = *cells.entry(key(v)).or_insert(next);
+                if i == next {
+                    sums.push((DVec3::ZERO, 0));
+                }
+                let s = &mut sums[i as usize];
+                s.0 += v;
+                s.1 += 1;
+                i
+            })
+            .collect();
+        let mut seen = std::collections::HashSet::new();
+        let mut triangles = Vec::new();
+        for t in &self.triangles {
+            let [a, b, c] = t.map(|k| index[k as usize]);
+            if a == b || b == c || a == c {
+                continue;
+            }
+            // The same triangle in either winding is drawn once (keyed by its sorted corners).
+            let mut sorted = [a, b, c];
+            sorted.sort_unstable();
+            if seen.insert(sorted) {
+                triangles.push([a, b, c]);
+            }
+        }
+        // Keep only the vertices some triangle still uses, in first-use order.
+        let mut remap = vec![u32::MAX; sums.len()];
+        let mut vertices = Vec::new();
+        for t in &mut triangles {
+            for k in t.iter_mut() {
+                if remap[*k as usize] == u32::MAX {
+                    remap[*k as usize] = vertices.len() as u32;
+                    let (sum, count) = sums[*k as usize];
+                    vertices.push(sum / count as f64);
+                }
+                *k = remap[*k as usize];
+            }
+        }
+        Mesh {
+            vertices,
+            triangles,
+        }
+    }
+
     /// The three corners of triangle `i`.
     ///
     /// # Panics
@@ -496,6 +591,46 @@ fn parse_err(path: &Path, line: Option<usize>, message: String) -> MeshError {
 mod tests {
     use super::*;
     use std::sync::atomic::{AtomicUsize, Ordering};
+
+    /// A flat square grid of `n` × `n` cells, two triangles each, on z = 0.
+    fn grid(n: u32) -> Mesh {
+        let mut m = Mesh::default();
+        for j in 0..=n {
+            for i in 0..=n {
+                m.vertices.push(DVec3::new(i as f64, j as f64, 0.0));
+            }
+        }
+        let at = |i: u32, j: u32| j * (n + 1) + i;
+        for j in 0..n {
+            for i in 0..n {
+                m.triangles.push([at(i, j), at(i + 1, j), at(i + 1, j + 1)]);
+                m.triangles.push([at(i, j), at(i + 1, j + 1), at(i, j + 1)]);
+            }
+        }
+        m
+    }
+
+    #[test]
+    fn decimation_meets_the_budget_and_keeps_the_shape() {
+        let m = grid(100);
+        assert_eq!(m.triangles.len(), 20_000);
+        let d = m.decimated(2_000);
+        assert!(d.triangles.len() <= 2_000, "{}", d.triangles.len());
+        // Bisection keeps as much as the budget allows: at least a quarter of it.
+        assert!(d.triangles.len() >= 500, "{}", d.triangles.len());
+        let (lo, hi) = d.aabb().unwrap();
+        assert!(lo.x < 2.0 && lo.y < 2.0 && hi.x > 98.0 && hi.y > 98.0);
+        assert!(d.vertices.iter().all(|v| v.z == 0.0));
+        // Every vertex is used and every triangle is proper and faces +z like the input.
+        let mut used = vec![false; d.vertices.len()];
+        for i in 0..d.triangles.len() {
+            d.triangles[i].iter().for_each(|&k| used[k as usize] = true);
+            assert!(d.triangle_normal(i).z > 0.99);
+        }
+        assert!(used.iter().all(|&u| u));
+        // Within budget: unchanged.
+        assert_eq!(m.decimated(20_000), m);
+    }
 
     /// Writes `bytes` to a fresh file named `*.{ext}` in the temp dir.
     fn temp_file(ext: &str, bytes: &[u8]) -> PathBuf {

@@ -12,6 +12,7 @@
 pub mod candidates;
 pub mod coord;
 pub mod error;
+pub mod export;
 pub mod io;
 pub mod model;
 pub mod motion;

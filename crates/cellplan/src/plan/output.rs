@@ -106,7 +106,25 @@ pub struct CoordinationOut {
     pub priority: Vec<String>,
     /// Wall seconds.
     pub compute_s: f64,
+    /// Each robot's probe (TCP) position over time as planned before coordination, for the
+    /// time–position chart of paper 000 Fig. 7 (the plan's own trajectories give Fig. 8).
+    #[serde(default)]
+    pub uncoordinated_probe: Vec<ProbeTrack>,
 }
+
+/// A robot's probe position sampled at a fixed step from time 0 to the end of its program.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct ProbeTrack {
+    /// Robot name.
+    pub robot: String,
+    /// Sampling step (s); the last sample is the end of the program.
+    pub dt_s: f64,
+    /// Positions (m), rounded to 0.1 mm.
+    pub xyz: Vec<[f64; 3]>,
+}
+
+/// Step of [`ProbeTrack`]s in plans.
+pub const PROBE_TRACK_DT: f64 = 0.1;
 
 impl Default for CoordinationOut {
     fn default() -> Self {
@@ -120,6 +138,7 @@ impl Default for CoordinationOut {
             poses_changed: 0,
             priority: Vec::new(),
             compute_s: 0.0,
+            uncoordinated_probe: Vec::new(),
         }
     }
 }
@@ -308,6 +327,36 @@ pub struct ComputeTimes {
     pub total: f64,
 }
 
+/// The probe tracks of the programs before coordination (see [`ProbeTrack`]).
+fn uncoordinated_probe(cell: &Cell, outcome: &Outcome) -> Vec<ProbeTrack> {
+    let round = |v: f64| (v * 1e4).round() / 1e4;
+    cell.robots
+        .iter()
+        .zip(&outcome.robots)
+        .map(|(robot, res)| {
+            let xyz = match res.program.timed(&super::graph::limits_of(robot)) {
+                Ok(timed) => {
+                    let end = timed.trajectory.duration();
+                    let steps = (end / PROBE_TRACK_DT).ceil() as usize;
+                    (0..=steps)
+                        .map(|k| {
+                            let t = (k as f64 * PROBE_TRACK_DT).min(end);
+                            let p = robot.tcp_pose(&timed.trajectory.position(t)).translation;
+                            [round(p.x), round(p.y), round(p.z)]
+                        })
+                        .collect()
+                }
+                Err(_) => Vec::new(),
+            };
+            ProbeTrack {
+                robot: robot.name.clone(),
+                dt_s: PROBE_TRACK_DT,
+                xyz,
+            }
+        })
+        .collect()
+}
+
 /// Build the document from a run and its coordination.
 pub fn build(
     cell: &Cell,
@@ -471,6 +520,7 @@ pub fn build(
                 .map(|&r| cell.robots[r].name.clone())
                 .collect(),
             compute_s: coordinated.compute_s,
+            uncoordinated_probe: uncoordinated_probe(cell, outcome),
         },
         robots,
         unmeasured,

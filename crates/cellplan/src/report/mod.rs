@@ -1,3 +1,7 @@
 //! Reports for people and machines.
+pub mod charts;
 pub mod check;
+pub mod html;
+pub mod playback;
+pub mod scene;
 pub mod svg;

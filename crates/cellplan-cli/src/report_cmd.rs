@@ -1,0 +1,187 @@
+//! `cellplan report` (the HTML page of a plan) and `cellplan export` (glTF, CSV).
+use crate::Failure;
+use cellplan::plan::output::Plan;
+use cellplan::report::html::{PlanReport, plan_html};
+use cellplan::report::scene::{MESH_BUDGET, Scene};
+use cellplan::verify::{self, VerifySettings};
+use cellplan::{Cell, InputError, LoadOptions, io::write_atomic};
+use clap::Args;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+#[derive(Args)]
+pub struct ReportArgs {
+    /// The plan (plan.json written by `cellplan plan`).
+    plan: PathBuf,
+    /// The cell file it was made for (default: the plan's `cell_file`).
+    cell: Option<PathBuf>,
+    /// Output file (default: report.html beside the plan).
+    #[arg(short, long, value_name = "FILE")]
+    output: Option<PathBuf>,
+    /// Do not run the verifier for the page (it then shows the plan's own `verified`).
+    #[arg(long)]
+    no_verify: bool,
+    /// Triangle budget per drawn mesh (larger meshes are decimated for drawing).
+    #[arg(long, default_value_t = MESH_BUDGET)]
+    mesh_budget: usize,
+}
+
+#[derive(Args)]
+pub struct ExportArgs {
+    /// The plan (plan.json written by `cellplan plan`).
+    plan: PathBuf,
+    /// The cell file it was made for (default: the plan's `cell_file`).
+    cell: Option<PathBuf>,
+    /// Write the cell and the robots' motion as binary glTF with an animation.
+    #[arg(long, value_name = "FILE")]
+    gltf: Option<PathBuf>,
+    /// Write per robot CSV files (trajectory samples and program points) into this folder.
+    #[arg(long, value_name = "DIR")]
+    csv: Option<PathBuf>,
+    /// Triangle budget per exported mesh (larger meshes are decimated).
+    #[arg(long, default_value_t = MESH_BUDGET)]
+    mesh_budget: usize,
+}
+
+/// Reads a plan document, with errors that name the file and line.
+pub fn read_plan(path: &Path) -> Result<Plan, Failure> {
+    let text = std::fs::read_to_string(path).map_err(|e| {
+        Failure::Input(Box::new(
+            InputError::new(path, format!("cannot read the plan: {e}"))
+                .hint("give the plan.json that `cellplan plan` wrote"),
+        ))
+    })?;
+    serde_json::from_str(&text).map_err(|e| {
+        Failure::Input(Box::new(
+            InputError::at_line(path, Some(e.line()), format!("not a cellplan plan: {e}"))
+                .hint("give the plan.json that `cellplan plan` wrote (docs/plan-format.md)"),
+        ))
+    })
+}
+
+/// The cell a plan was made for: `cell` when given, else the plan's `cell_file`.
+fn load_cell(plan_path: &Path, plan: &Plan, cell: &Option<PathBuf>) -> Result<Cell, Failure> {
+    let path = match cell {
+        Some(c) => c.clone(),
+        None => {
+            let p = PathBuf::from(&plan.cell_file);
+            if !p.exists() {
+                return Err(Failure::Input(Box::new(
+                    InputError::new(
+                        plan_path,
+                        format!("the plan's cell file {} is not there", plan.cell_file),
+                    )
+                    .hint("give the cell file as the second argument"),
+                )));
+            }
+            p
+        }
+    };
+    let cell = cellplan::model::load::load(&path, &LoadOptions::default())?;
+    if cell.name != plan.cell {
+        eprintln!(
+            "note: the plan was made for cell `{}`, {} is cell `{}`",
+            plan.cell,
+            path.display(),
+            cell.name
+        );
+    }
+    Ok(cell)
+}
+
+fn mismatch(plan_path: &Path) -> impl Fn(String) -> Failure + '_ {
+    move |m| {
+        Failure::Input(Box::new(
+            InputError::new(plan_path, m).hint("give the cell file the plan was made for"),
+        ))
+    }
+}
+
+/// Writes the HTML report of `plan` to `path`; returns the bytes written.
+pub fn write_report(
+    path: &Path,
+    plan_path: &Path,
+    plan: &Plan,
+    cell: &Cell,
+    verification: Option<&verify::Report>,
+    mesh_budget: usize,
+) -> Result<usize, Failure> {
+    let scene = Scene::new(cell, mesh_budget);
+    let name = plan_path.display().to_string();
+    let page = plan_html(&PlanReport {
+        plan,
+        cell,
+        scene: &scene,
+        verification,
+        plan_file: Some(&name),
+    })
+    .map_err(mismatch(plan_path))?;
+    write_atomic(path, page.as_bytes())
+        .map_err(|e| Failure::Other(format!("cannot write {}: {e}", path.display())))?;
+    Ok(page.len())
+}
+
+pub fn run_report(args: &ReportArgs) -> Result<(), Failure> {
+    let start = Instant::now();
+    let plan = read_plan(&args.plan)?;
+    let cell = load_cell(&args.plan, &plan, &args.cell)?;
+    let verdict = (!args.no_verify).then(|| verify::verify(&cell, &plan, &VerifySettings::default()));
+    let out = args.output.clone().unwrap_or_else(|| {
+        args.plan
+            .parent()
+            .unwrap_or(Path::new("."))
+            .join("report.html")
+    });
+    let bytes = write_report(
+        &out,
+        &args.plan,
+        &plan,
+        &cell,
+        verdict.as_ref(),
+        args.mesh_budget.max(12),
+    )?;
+    eprintln!(
+        "report written to {} ({:.2} MB, {:.2} s){}",
+        out.display(),
+        bytes as f64 / 1e6,
+        start.elapsed().as_secs_f64(),
+        match &verdict {
+            Some(v) if !v.ok => format!("; the plan has {} violation(s)", v.violations.len()),
+            _ => String::new(),
+        }
+    );
+    Ok(())
+}
+
+pub fn run_export(args: &ExportArgs) -> Result<(), Failure> {
+    if args.gltf.is_none() && args.csv.is_none() {
+        return Err(Failure::Other(
+            "nothing to export: give --gltf FILE and/or --csv DIR".into(),
+        ));
+    }
+    let plan = read_plan(&args.plan)?;
+    let cell = load_cell(&args.plan, &plan, &args.cell)?;
+    let scene = Scene::new(&cell, args.mesh_budget.max(12));
+    if let Some(path) = &args.gltf {
+        let start = Instant::now();
+        let bytes = cellplan::export::gltf::glb(&plan, &cell, &scene).map_err(mismatch(&args.plan))?;
+        write_atomic(path, &bytes)
+            .map_err(|e| Failure::Other(format!("cannot write {}: {e}", path.display())))?;
+        eprintln!(
+            "glTF written to {} ({:.2} MB, {:.2} s)",
+            path.display(),
+            bytes.len() as f64 / 1e6,
+            start.elapsed().as_secs_f64()
+        );
+    }
+    if let Some(dir) = &args.csv {
+        let files = cellplan::export::csv::files(&plan, &scene).map_err(mismatch(&args.plan))?;
+        for (name, text) in &files {
+            let path = dir.join(name);
+            write_atomic(&path, text.as_bytes())
+                .map_err(|e| Failure::Other(format!("cannot write {}: {e}", path.display())))?;
+        }
+        eprintln!("{} CSV files written to {}", files.len(), dir.display());
+    }
+    Ok(())
+}
