@@ -168,7 +168,7 @@ void main() {
   vec3 n = normalize(cross(dFdx(vW), dFdy(vW)));
   vec3 l = normalize(uEye - vW);
   float d = abs(dot(n, l));
-  o = vec4(uC * (0.32 + 0.68 * d), 1.0);
+  o = vec4(uC * (0.38 + 0.42 * d + 0.22 * abs(n.z)), 1.0);
 }`
   );
   const lineProg = program(
@@ -274,7 +274,7 @@ precision highp float; in vec3 vC; out vec4 o; void main() { o = vec4(vC, 1.0); 
   const cam = {
     az: hash.has('az') ? (+hash.get('az') * Math.PI) / 180 : D.camera_azimuth,
     el: hash.has('el') ? (+hash.get('el') * Math.PI) / 180 : 0.5,
-    dist: 2.2 * radius,
+    dist: 1.8 * radius,
     target: centre.slice(),
   };
   function eye() {
