@@ -231,8 +231,19 @@ fn html(report: &Report) -> String {
             let mut header = vec!["allocation + coordination".to_string()];
             header.extend(names);
             header.extend(
-                ["cycle s", "Δt s", "uncoordinated s", "conflicts", "resolved", "waits", "poses changed", "verified", "compute s", "coordination s"]
-                    .map(String::from),
+                [
+                    "cycle s",
+                    "Δt s",
+                    "uncoordinated s",
+                    "conflicts",
+                    "resolved",
+                    "waits",
+                    "poses changed",
+                    "verified",
+                    "compute s",
+                    "coordination s",
+                ]
+                .map(String::from),
             );
             let label = |r: &Row| format!("{} + {}", r.allocation, r.coordination);
             let ok = || report.strategies.iter().filter(|r| r.error.is_none());
@@ -275,9 +286,17 @@ fn html(report: &Report) -> String {
             (header, rows, bars)
         }
         Some(_) => {
-            let header = ["allocation + coordination", "solved", "verified", "cycle s (mean ± sd)", "Δt s (mean ± sd)", "compute s", "coordination s"]
-                .map(String::from)
-                .to_vec();
+            let header = [
+                "allocation + coordination",
+                "solved",
+                "verified",
+                "cycle s (mean ± sd)",
+                "Δt s (mean ± sd)",
+                "compute s",
+                "coordination s",
+            ]
+            .map(String::from)
+            .to_vec();
             let label = |m: &Summary| format!("{} + {}", m.allocation, m.coordination);
             let rows = report
                 .summary
@@ -325,7 +344,11 @@ fn html(report: &Report) -> String {
         &header,
         &rows,
         &bars,
-        if report.random_tasks.is_none() { bound } else { None },
+        if report.random_tasks.is_none() {
+            bound
+        } else {
+            None
+        },
     )
 }
 

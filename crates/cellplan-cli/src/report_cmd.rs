@@ -126,12 +126,10 @@ pub fn run_report(args: &ReportArgs) -> Result<(), Failure> {
     let plan = read_plan(&args.plan)?;
     let cell = load_cell(&args.plan, &plan, &args.cell)?;
     let verdict = (!args.no_verify).then(|| verify::verify(&cell, &plan, &VerifySettings::default()));
-    let out = args.output.clone().unwrap_or_else(|| {
-        args.plan
-            .parent()
-            .unwrap_or(Path::new("."))
-            .join("report.html")
-    });
+    let out = args
+        .output
+        .clone()
+        .unwrap_or_else(|| args.plan.parent().unwrap_or(Path::new(".")).join("report.html"));
     let bytes = write_report(
         &out,
         &args.plan,

@@ -1,7 +1,7 @@
 //! `cellplan verify`: the independent check of a plan.
 use crate::Failure;
-use cellplan::verify::{VerifySettings, Violation, verify};
 use cellplan::LoadOptions;
+use cellplan::verify::{VerifySettings, Violation, verify};
 use clap::Args;
 use std::path::PathBuf;
 

@@ -1000,3 +1000,113 @@ fn plan_refuses_caps_that_cannot_hold_the_tasks() {
     assert!(err.contains("cell.toml") && err.contains("task_cap"), "{err}");
     assert!(!out_dir.join("plan.json").exists());
 }
+
+#[test]
+fn plan_writes_a_report_and_export_writes_gltf_and_csv() {
+    let dir = scratch("report");
+    small_cell(&dir);
+    let cell = dir.join("cell.toml");
+    let out_dir = dir.join("out");
+    let out = cellplan(
+        &[
+            "plan",
+            cell.to_str().unwrap(),
+            "-o",
+            out_dir.to_str().unwrap(),
+            "--json",
+        ],
+        &dir,
+    );
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let summary: Value = serde_json::from_slice(&out.stdout).unwrap();
+    let report = out_dir.join("report.html");
+    assert_eq!(summary["report_file"], report.display().to_string());
+    let page = std::fs::read_to_string(&report).unwrap();
+    assert!(page.starts_with("<!DOCTYPE html>") && page.ends_with("</html>"));
+    for id in ["gantt", "timepos-after", "view", "cellplan-data"] {
+        assert!(page.contains(&format!("id=\"{id}\"")), "no #{id}");
+    }
+    // Self-contained: nothing fetched from elsewhere.
+    assert!(!page.contains("src=\"http") && !page.contains("href=\"http"));
+    let plan = out_dir.join("plan.json");
+
+    // `report` again, elsewhere, with the cell named.
+    let other = dir.join("again/page.html");
+    let out = cellplan(
+        &[
+            "report",
+            plan.to_str().unwrap(),
+            cell.to_str().unwrap(),
+            "-o",
+            other.to_str().unwrap(),
+        ],
+        &dir,
+    );
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("report written to"));
+    assert!(std::fs::read_to_string(&other).unwrap().contains("id=\"gantt\""));
+
+    // Exports.
+    let glb = dir.join("cell.glb");
+    let csv_dir = dir.join("csv");
+    let out = cellplan(
+        &[
+            "export",
+            plan.to_str().unwrap(),
+            cell.to_str().unwrap(),
+            "--gltf",
+            glb.to_str().unwrap(),
+            "--csv",
+            csv_dir.to_str().unwrap(),
+        ],
+        &dir,
+    );
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let bytes = std::fs::read(&glb).unwrap();
+    assert_eq!(&bytes[..4], b"glTF");
+    let traj = std::fs::read_to_string(csv_dir.join("R1-trajectory.csv")).unwrap();
+    assert!(traj.starts_with("t_s,joint_1,"), "{}", &traj[..60]);
+    let prog = std::fs::read_to_string(csv_dir.join("R1-program.csv")).unwrap();
+    assert_eq!(prog.lines().filter(|l| l.contains(",measure,")).count(), 3);
+
+    // Nothing asked: refused.
+    let out = cellplan(&["export", plan.to_str().unwrap(), cell.to_str().unwrap()], &dir);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--gltf"));
+    // Not a plan: exit 2 naming the file and line; nothing written.
+    let bad = dir.join("bad.json");
+    std::fs::write(&bad, "{\n  \"format\": [\n").unwrap();
+    let target = dir.join("bad.html");
+    let out = cellplan(
+        &[
+            "report",
+            bad.to_str().unwrap(),
+            cell.to_str().unwrap(),
+            "-o",
+            target.to_str().unwrap(),
+        ],
+        &dir,
+    );
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("bad.json") && err.contains("help:"), "{err}");
+    assert!(!target.exists());
+    // A plan for other robots: exit 2 naming the robot.
+    let mut doc: Value = serde_json::from_str(&std::fs::read_to_string(&plan).unwrap()).unwrap();
+    doc["robots"][0]["name"] = Value::from("R7");
+    std::fs::write(&bad, serde_json::to_string(&doc).unwrap()).unwrap();
+    let out = cellplan(
+        &[
+            "report",
+            bad.to_str().unwrap(),
+            cell.to_str().unwrap(),
+            "-o",
+            target.to_str().unwrap(),
+            "--no-verify",
+        ],
+        &dir,
+    );
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("R7"));
+    assert!(!target.exists());
+}

@@ -160,10 +160,7 @@ impl Mesh {
                 *k = remap[*k as usize];
             }
         }
-        Mesh {
-            vertices,
-            triangles,
-        }
+        Mesh { vertices, triangles }
     }
 
     /// The three corners of triangle `i`.

@@ -235,7 +235,10 @@ fn the_report_shows_the_plan_its_conflicts_and_its_waits() {
     let (doc, c) = document(Coordination::FixedPriority);
     let verdict = verify(&f.cell, &doc, &VerifySettings::default());
     assert!(verdict.ok, "{:?}", verdict.violations);
-    assert!(!c.before.is_empty() && c.waits > 0, "the crossing cell needs waits");
+    assert!(
+        !c.before.is_empty() && c.waits > 0,
+        "the crossing cell needs waits"
+    );
     let scene = Scene::new(&f.cell, MESH_BUDGET);
     let page = plan_html(&PlanReport {
         plan: &doc,
@@ -408,15 +411,11 @@ fn the_gltf_export_replays_the_plan() {
                 let q = &out[4 * k..4 * k + 4];
                 r = DQuat::from_xyzw(q[0] as f64, q[1] as f64, q[2] as f64, q[3] as f64);
             }
-            pose = pose * Pose::from_parts(t, r);
+            pose *= Pose::from_parts(t, r);
         }
         let tcp = (pose * robot.tool.tcp).translation;
         let want = robot.tcp_pose(&sample.q).translation;
-        assert!(
-            (tcp - want).length() < 1e-4,
-            "{}: {tcp} vs {want}",
-            rp.name
-        );
+        assert!((tcp - want).length() < 1e-4, "{}: {tcp} vs {want}", rp.name);
     }
 }
 
@@ -441,9 +440,15 @@ fn the_csv_export_carries_joints_probe_poses_and_the_program() {
         assert_eq!(header.len(), 1 + rp.joints.len() + 7 + 2);
         let records: Vec<csv::StringRecord> = rows.records().map(Result::unwrap).collect();
         assert_eq!(records.len(), rp.trajectory.len());
-        let measuring = records.iter().filter(|r| &r[header.len() - 2] == "measuring").count();
+        let measuring = records
+            .iter()
+            .filter(|r| &r[header.len() - 2] == "measuring")
+            .count();
         assert!(measuring > 0);
-        let waiting = records.iter().filter(|r| &r[header.len() - 2] == "waiting").count();
+        let waiting = records
+            .iter()
+            .filter(|r| &r[header.len() - 2] == "waiting")
+            .count();
         assert_eq!(waiting > 0, !rp.waits.is_empty());
         for (rec, s) in records.iter().zip(&rp.trajectory).step_by(17) {
             let num = |i: usize| rec[i].parse::<f64>().unwrap();

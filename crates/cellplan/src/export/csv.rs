@@ -24,7 +24,13 @@ pub fn files(plan: &Plan, scene: &Scene) -> Result<Vec<(String, String)>, String
 /// A robot name usable as a file name.
 fn safe(name: &str) -> String {
     name.chars()
-        .map(|c| if c.is_ascii_alphanumeric() || c == '-' || c == '_' { c } else { '_' })
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || c == '-' || c == '_' {
+                c
+            } else {
+                '_'
+            }
+        })
         .collect()
 }
 

@@ -146,8 +146,16 @@ pub fn gantt(plan: &Plan) -> String {
                 Doing::Measuring(k) => (colour(r), 1.0, format!("measuring {}", rp.tasks[k].task)),
                 Doing::Waiting(k) => {
                     let w = &rp.waits[k];
-                    let whom = w.for_robot.as_deref().map(|f| format!(" for {f}")).unwrap_or_default();
-                    (WAIT_COLOUR, 0.9, format!("waiting ({}){whom} at {}", w.reason, w.at))
+                    let whom = w
+                        .for_robot
+                        .as_deref()
+                        .map(|f| format!(" for {f}"))
+                        .unwrap_or_default();
+                    (
+                        WAIT_COLOUR,
+                        0.9,
+                        format!("waiting ({}){whom} at {}", w.reason, w.at),
+                    )
                 }
             };
             let _ = write!(
@@ -166,8 +174,16 @@ pub fn gantt(plan: &Plan) -> String {
         }
     }
     for (t, class, label) in [
-        (plan.cycle_time_s, "cycle", format!("cycle {:.2} s", plan.cycle_time_s)),
-        (plan.lower_bound_s, "bound", format!("lower bound {:.2} s", plan.lower_bound_s)),
+        (
+            plan.cycle_time_s,
+            "cycle",
+            format!("cycle {:.2} s", plan.cycle_time_s),
+        ),
+        (
+            plan.lower_bound_s,
+            "bound",
+            format!("lower bound {:.2} s", plan.lower_bound_s),
+        ),
     ] {
         if t > 0.0 && t <= x.d1 + 1e-9 {
             let px = x.at(t);
@@ -246,7 +262,9 @@ pub fn time_position(
     let (mut lo, mut hi) = tracks
         .iter()
         .flat_map(|t| t.points.iter().map(|p| p.1))
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| (a.min(v), b.max(v)));
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
+            (a.min(v), b.max(v))
+        });
     if !lo.is_finite() {
         (lo, hi) = (-1.0, 1.0);
     }

@@ -261,7 +261,12 @@ fn summary(page: &mut String, rep: &PlanReport) {
     let plan = rep.plan;
     page.push_str(r#"<section id="summary"><h2>Summary</h2><div class="figures">"#);
     figure(page, &format!("{:.2} s", plan.cycle_time_s), "cycle time", "");
-    figure(page, &format!("{:.2} s", plan.delta_t_s), "Δt (longest − shortest)", "");
+    figure(
+        page,
+        &format!("{:.2} s", plan.delta_t_s),
+        "Δt (longest − shortest)",
+        "",
+    );
     figure(
         page,
         &format!("{:.2} s", plan.lower_bound_s),
@@ -286,7 +291,10 @@ fn summary(page: &mut String, rep: &PlanReport) {
     );
     figure(
         page,
-        &format!("{} / {}", plan.coordination.waits, plan.coordination.poses_changed),
+        &format!(
+            "{} / {}",
+            plan.coordination.waits, plan.coordination.poses_changed
+        ),
         "waits / poses changed",
         "",
     );
@@ -388,7 +396,11 @@ fn details(page: &mut String, plan: &Plan) {
                 escape(&x.robots[1]),
                 x.start_s,
                 x.end_s,
-                if x.scenario == 1 { "1: both measuring" } else { "2: moving" },
+                if x.scenario == 1 {
+                    "1: both measuring"
+                } else {
+                    "2: moving"
+                },
                 escape(&x.robots[0]),
                 escape(&x.activity[0]),
                 escape(&x.robots[1]),
@@ -646,7 +658,11 @@ pub fn compare_html(
     for row in rows {
         page.push_str("<tr>");
         for (k, c) in row.cells.iter().enumerate() {
-            let text = if row.ours { format!("<b>{}</b>", escape(c)) } else { escape(c) };
+            let text = if row.ours {
+                format!("<b>{}</b>", escape(c))
+            } else {
+                escape(c)
+            };
             let _ = write!(
                 page,
                 "<td{}>{text}</td>",
