@@ -125,7 +125,11 @@ pub fn run_report(args: &ReportArgs) -> Result<(), Failure> {
     let start = Instant::now();
     let plan = read_plan(&args.plan)?;
     let cell = load_cell(&args.plan, &plan, &args.cell)?;
+    let load_s = start.elapsed().as_secs_f64();
+    let lap = Instant::now();
     let verdict = (!args.no_verify).then(|| verify::verify(&cell, &plan, &VerifySettings::default()));
+    let verify_s = lap.elapsed().as_secs_f64();
+    let lap = Instant::now();
     let out = args
         .output
         .clone()
@@ -139,10 +143,13 @@ pub fn run_report(args: &ReportArgs) -> Result<(), Failure> {
         args.mesh_budget.max(12),
     )?;
     eprintln!(
-        "report written to {} ({:.2} MB, {:.2} s){}",
+        "report written to {} ({:.2} MB; {:.2} s: reading plan and cell {:.2} s, verifying {:.2} s, page {:.2} s){}",
         out.display(),
         bytes as f64 / 1e6,
         start.elapsed().as_secs_f64(),
+        load_s,
+        verify_s,
+        lap.elapsed().as_secs_f64(),
         match &verdict {
             Some(v) if !v.ok => format!("; the plan has {} violation(s)", v.violations.len()),
             _ => String::new(),

@@ -1110,3 +1110,26 @@ fn plan_writes_a_report_and_export_writes_gltf_and_csv() {
     assert!(String::from_utf8_lossy(&out.stderr).contains("R7"));
     assert!(!target.exists());
 }
+
+#[test]
+fn compare_writes_its_table_and_bar_chart_as_html() {
+    let dir = scratch("compare");
+    small_cell(&dir);
+    let cell = dir.join("cell.toml");
+    let out_dir = dir.join("cmp");
+    let out = cellplan(
+        &["compare", cell.to_str().unwrap(), "-o", out_dir.to_str().unwrap(), "--json", "-q"],
+        &dir,
+    );
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let report: Value = serde_json::from_slice(&out.stdout).unwrap();
+    let rows = report["strategies"].as_array().unwrap();
+    let solved = rows.iter().filter(|r| r["error"].is_null()).count();
+    assert!(solved > 0);
+    let page = std::fs::read_to_string(out_dir.join("compare.html")).unwrap();
+    assert!(page.contains("id=\"strategy-bars\"") && page.contains("id=\"strategies\""));
+    // A bar per robot of every solved strategy (one robot here), a table row per strategy.
+    assert_eq!(page.matches("class=\"bar\"").count(), solved);
+    assert_eq!(page.matches("<tr><td").count(), rows.len());
+    assert!(page.contains("<b>balanced+proximity + best</b>"));
+}
