@@ -1118,7 +1118,14 @@ fn compare_writes_its_table_and_bar_chart_as_html() {
     let cell = dir.join("cell.toml");
     let out_dir = dir.join("cmp");
     let out = cellplan(
-        &["compare", cell.to_str().unwrap(), "-o", out_dir.to_str().unwrap(), "--json", "-q"],
+        &[
+            "compare",
+            cell.to_str().unwrap(),
+            "-o",
+            out_dir.to_str().unwrap(),
+            "--json",
+            "-q",
+        ],
         &dir,
     );
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));

@@ -3,7 +3,8 @@
 //! world, the probe's measurement model) and reads nothing but the plan document: every MP
 //! measured exactly once by a robot at a pose meeting the probe constraints; the joint paths of
 //! the legs re-sampled at the verifier's own resolution against the static scene and the
-//! robot itself; joint position, velocity and acceleration limits from the trajectory samples;
+//! robot itself; the trajectory walked forward along those joint paths (so the motion is the
+//! one checked); joint position, velocity and acceleration limits from the trajectory samples;
 //! robot–robot clearance over the whole timeline at the verifier's time step; the reported
 //! cycle time and Δt recomputed.
 use crate::Cell;
@@ -65,6 +66,10 @@ pub enum ViolationKind {
     SelfCollision,
     /// Two robots closer than the clearance.
     RobotRobot,
+    /// A trajectory that leaves its legs' joint paths (so the motion is not the one checked
+    /// against the scene), goes back along them, or covers more path between two samples than
+    /// the joint velocity limits allow.
+    OffPath,
     /// Legs, visits and trajectory that do not fit together (a gap, a jump, a robot not at its
     /// MP while measuring).
     Continuity,
@@ -433,6 +438,11 @@ pub fn verify(cell: &Cell, plan: &Plan, settings: &VerifySettings) -> Report {
                 }
             }
         }
+        if rp.legs.len() == rp.tasks.len() + 1
+            && let Some((t, detail)) = follow_legs(robot, rp, settings.limit_tolerance)
+        {
+            out.push(violation(ViolationKind::OffPath, &rp.name, Some(t), None, detail));
+        }
         // Every sample inside a measurement is at the measuring configuration.
         for v in &rp.tasks {
             let inside = tr
@@ -573,6 +583,100 @@ fn config_violation(
 }
 
 /// Position at `t` by linear interpolation of the samples (held before and after).
+/// Walks the trajectory forward along the legs' joint paths (home → MPs → home, straight
+/// joint segments between waypoints): each sample must lie on the path (within 1e-6 in every
+/// joint) at or after the previous sample's place, and the path covered between two samples
+/// must not exceed, joint by joint, what the velocity limit allows in their time. The first
+/// failure: its time and a sentence.
+fn follow_legs(robot: &Robot, rp: &RobotPlan, vtol: f64) -> Option<(f64, String)> {
+    const TOL: f64 = 1e-6;
+    let segments: Vec<(&[f64], &[f64], String)> = rp
+        .legs
+        .iter()
+        .flat_map(|leg| {
+            leg.waypoints.windows(2).map(move |w| {
+                (
+                    w[0].as_slice(),
+                    w[1].as_slice(),
+                    format!("{} → {}", leg.from, leg.to),
+                )
+            })
+        })
+        .collect();
+    if segments.is_empty() {
+        return None;
+    }
+    let dof = robot.dof();
+    // Place on a segment: the nearest point's parameter and its max-abs distance.
+    let place = |s: usize, q: &[f64]| -> (f64, f64) {
+        let (a, b, _) = &segments[s];
+        let (mut num, mut den) = (0.0, 0.0);
+        for j in 0..dof.min(q.len()) {
+            num += (q[j] - a[j]) * (b[j] - a[j]);
+            den += (b[j] - a[j]).powi(2);
+        }
+        let f = if den > 0.0 {
+            (num / den).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        let off = (0..dof.min(q.len()))
+            .map(|j| (q[j] - (a[j] + f * (b[j] - a[j]))).abs())
+            .fold(0.0, f64::max);
+        (f, off)
+    };
+    let (mut seg, mut frac) = (0usize, 0.0f64);
+    let mut prev_t = rp.trajectory.first()?.t;
+    for sample in &rp.trajectory {
+        // The first segment at or after the current place that holds the sample.
+        let found = (seg..segments.len()).find_map(|s| {
+            let (f, off) = place(s, &sample.q);
+            (off <= TOL && (s > seg || f >= frac - 1e-9)).then_some((s, f))
+        });
+        let Some((s, f)) = found else {
+            let behind = (0..seg).any(|s| place(s, &sample.q).1 <= TOL);
+            return Some((
+                sample.t,
+                if behind {
+                    format!(
+                        "the trajectory goes back along its path on leg {}",
+                        segments[seg].2
+                    )
+                } else {
+                    format!(
+                        "the trajectory leaves the joint path of leg {} (the motion checked against the scene)",
+                        segments[seg].2
+                    )
+                },
+            ));
+        };
+        // Path covered per joint from (seg, frac) to (s, f).
+        let h = sample.t - prev_t;
+        for j in 0..dof {
+            let len = |k: usize| (segments[k].1[j] - segments[k].0[j]).abs();
+            let covered = if s == seg {
+                (f - frac) * len(s)
+            } else {
+                (1.0 - frac) * len(seg) + (seg + 1..s).map(len).sum::<f64>() + f * len(s)
+            };
+            if covered > robot.max_velocity[j] * h * (1.0 + vtol) + TOL {
+                return Some((
+                    prev_t,
+                    format!(
+                        "joint {} covers {:.4} along the path in {:.3} s, more than its velocity limit allows ({:.4})",
+                        j + 1,
+                        covered,
+                        h,
+                        robot.max_velocity[j] * h
+                    ),
+                ));
+            }
+        }
+        (seg, frac, prev_t) = (s, f, sample.t);
+    }
+    None
+}
+
 fn position(tr: &[crate::plan::output::Sample], t: f64) -> Vec<f64> {
     let i = tr.partition_point(|s| s.t <= t);
     if i == 0 {

@@ -200,6 +200,26 @@ fn the_verifier_catches_injected_faults() {
     let busy = skipped.robots.iter().position(|r| !r.tasks.is_empty()).unwrap();
     skipped.robots[busy].tasks.remove(0);
     assert!(kinds(&skipped).contains(&ViolationKind::MissingTask));
+    // Legs that no longer describe the motion: a via point of a sampled leg dropped, so the
+    // trajectory leaves the joint path the scene was checked along.
+    let mut rerouted = good.clone();
+    let (r, l) = rerouted
+        .robots
+        .iter()
+        .enumerate()
+        .find_map(|(r, rp)| {
+            rp.legs
+                .iter()
+                .position(|l| l.waypoints.len() >= 3)
+                .map(|l| (r, l))
+        })
+        .expect("a leg with a via point");
+    rerouted.robots[r].legs[l].waypoints.remove(1);
+    assert!(
+        kinds(&rerouted).contains(&ViolationKind::OffPath),
+        "{:?}",
+        kinds(&rerouted)
+    );
     // A wait removed from the trajectory: the robots meet again.
     let mut hurried = good.clone();
     let (_, none) = document(Coordination::None);
