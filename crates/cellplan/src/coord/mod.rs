@@ -92,6 +92,10 @@ pub struct CoordSettings {
     pub perturb_evaluations: usize,
     /// Seed of the local path planner.
     pub seed: u64,
+    /// A cycle time to beat (s), from another plan of the same cell: `best` drops a priority
+    /// order as soon as its programs with waits end at or after it (waits only lengthen a
+    /// program, so it could not win), and fails when every order is dropped. `None`: no bar.
+    pub bar: Option<f64>,
 }
 
 impl Default for CoordSettings {
@@ -102,6 +106,7 @@ impl Default for CoordSettings {
             perturb_step: 4f64.to_radians(),
             perturb_evaluations: 12,
             seed: 0,
+            bar: None,
         }
     }
 }
@@ -353,7 +358,19 @@ pub(crate) fn resolve(
         Mode::Perturb => (WaitSearch::Shortest, WaitReason::Fallback),
         _ => (WaitSearch::Shortest, WaitReason::GiveWay),
     };
+    // Waits only lengthen programs: with waits alone, a plan that already ends at or after
+    // the bar cannot beat it.
+    let outrun = |timed: &[Timed]| {
+        mode == Mode::GiveWay
+            && ctx
+                .settings
+                .bar
+                .is_some_and(|bar| timed.iter().map(Timed::end).fold(0.0, f64::max) >= bar)
+    };
     while let Some((t, a, b)) = ctx.timeline(&timed).first_conflict(from) {
+        if outrun(&timed) {
+            return Err(PlanError::Coordination("no shorter than the bar".into()));
+        }
         from = t;
         res.resolved += 1;
         if res.resolved > MAX_RESOLUTIONS {
@@ -585,9 +602,12 @@ fn best(ctx: &Ctx, programs: Vec<Program>) -> Result<(Vec<Program>, Resolution, 
             .then(a.0.1.total_cmp(&b.0.1))
             .then(a.1.cmp(&b.1))
     }) else {
-        return Err(PlanError::Coordination(
-            "no priority order resolves every conflict (a robot stands in another's path at home)".into(),
-        ));
+        return Err(PlanError::Coordination(match ctx.settings.bar {
+            Some(bar) => format!("no priority order ends before the bar of {bar:.2} s"),
+            None => {
+                "no priority order resolves every conflict (a robot stands in another's path at home)".into()
+            }
+        }));
     };
     Ok((progs, res, orders[i].clone()))
 }
