@@ -222,12 +222,7 @@ fn html(report: &Report) -> String {
         .find(|v| v.is_finite());
     let (header, rows, bars): (Vec<String>, Vec<CompareRow>, Vec<StrategyBar>) = match report.random_tasks {
         None => {
-            let names: Vec<String> = report
-                .strategies
-                .iter()
-                .find(|r| !r.robots.is_empty())
-                .map(|r| r.robots.iter().map(|x| format!("{} s", x.name)).collect())
-                .unwrap_or_default();
+            let names = robot_columns(&report.strategies);
             let mut header = vec!["allocation + coordination".to_string()];
             header.extend(names);
             header.extend(
@@ -447,18 +442,21 @@ fn summarise(rows: &[Row]) -> Vec<Summary> {
         .collect()
 }
 
+/// Column names of the per robot times ("R1 s", ...), from the first solved row.
+fn robot_columns(rows: &[Row]) -> Vec<String> {
+    rows.iter()
+        .find(|r| !r.robots.is_empty())
+        .map(|r| r.robots.iter().map(|x| format!("{} s", x.name)).collect())
+        .unwrap_or_default()
+}
+
 fn markdown(report: &Report) -> String {
     let mut s = format!(
         "# {} — allocation × coordination (seed {})\n\n",
         report.cell, report.seed
     );
     if report.random_tasks.is_none() {
-        let names: Vec<String> = report
-            .strategies
-            .iter()
-            .find(|r| !r.robots.is_empty())
-            .map(|r| r.robots.iter().map(|x| format!("{} s", x.name)).collect())
-            .unwrap_or_default();
+        let names = robot_columns(&report.strategies);
         s += &format!(
             "| allocation | coordination | {} | cycle s | Δt s | uncoordinated s | lower bound s | conflicts | resolved | waits | waiting s | poses changed | verified | compute s | coordination s |\n",
             names.join(" | ")

@@ -88,6 +88,31 @@ fn trim(v: f64) -> String {
     s.trim_end_matches('0').trim_end_matches('.').to_string()
 }
 
+/// Ticks, labels and horizontal grid lines of a vertical value axis on the left, and its
+/// label turned along it.
+fn value_axis(s: &mut String, y: Axis, label: &str) {
+    let step = nice_step(y.d1 - y.d0, 6);
+    let mut v = (y.d0 / step).ceil() * step;
+    while v <= y.d1 + 1e-9 {
+        let py = y.at(v);
+        let _ = write!(
+            s,
+            r#"<line x1="{LEFT}" y1="{py:.1}" x2="{:.1}" y2="{py:.1}" class="grid"/><text x="{:.1}" y="{:.1}" class="tick" text-anchor="end">{}</text>"#,
+            WIDTH - RIGHT,
+            LEFT - 6.0,
+            py + 4.0,
+            trim(v)
+        );
+        v += step;
+    }
+    let _ = write!(
+        s,
+        r#"<text transform="translate(16 {:.1}) rotate(-90)" class="label" text-anchor="middle">{}</text>"#,
+        (y.p0 + y.p1) / 2.0,
+        escape(label)
+    );
+}
+
 /// The cursor line and the chart's time-mapping attributes.
 fn clock_attrs(x: Axis) -> String {
     format!(
@@ -292,26 +317,7 @@ pub fn time_position(
         escape(title)
     );
     time_axis(&mut s, x, top, top + plot_h);
-    let step = nice_step(y.d1 - y.d0, 6);
-    let mut v = (y.d0 / step).ceil() * step;
-    while v <= y.d1 {
-        let py = y.at(v);
-        let _ = write!(
-            s,
-            r#"<line x1="{LEFT}" y1="{py:.1}" x2="{:.1}" y2="{py:.1}" class="grid"/><text x="{:.1}" y="{:.1}" class="tick" text-anchor="end">{}</text>"#,
-            WIDTH - RIGHT,
-            LEFT - 6.0,
-            py + 4.0,
-            trim(v)
-        );
-        v += step;
-    }
-    let _ = write!(
-        s,
-        r#"<text transform="translate(16 {:.1}) rotate(-90)" class="label" text-anchor="middle">probe {} (m)</text>"#,
-        top + plot_h / 2.0,
-        escape(axis_name)
-    );
+    value_axis(&mut s, y, &format!("probe {} (m)", axis_name));
     // Marks under the lines.
     match marks {
         Marks::Conflicts(conflicts) => {
@@ -458,25 +464,7 @@ pub fn strategy_bars(bars: &[StrategyBar], bound: Option<f64>) -> String {
     let mut s = format!(
         r#"<svg id="strategy-bars" class="chart" viewBox="0 0 {WIDTH} {height:.0}" xmlns="http://www.w3.org/2000/svg" role="img" aria-label="time per robot and cycle time per strategy">"#
     );
-    let step = nice_step(t_max, 6);
-    let mut v = 0.0;
-    while v <= t_max {
-        let py = y.at(v);
-        let _ = write!(
-            s,
-            r#"<line x1="{LEFT}" y1="{py:.1}" x2="{:.1}" y2="{py:.1}" class="grid"/><text x="{:.1}" y="{:.1}" class="tick" text-anchor="end">{}</text>"#,
-            WIDTH - RIGHT,
-            LEFT - 6.0,
-            py + 4.0,
-            trim(v)
-        );
-        v += step;
-    }
-    let _ = write!(
-        s,
-        r#"<text transform="translate(16 {:.1}) rotate(-90)" class="label" text-anchor="middle">time (s)</text>"#,
-        top + plot_h / 2.0
-    );
+    value_axis(&mut s, y, "time (s)");
     let group = (WIDTH - LEFT - RIGHT) / bars.len().max(1) as f64;
     for (g, b) in bars.iter().enumerate() {
         let x0 = LEFT + group * g as f64;
