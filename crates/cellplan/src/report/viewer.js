@@ -285,6 +285,11 @@ precision highp float; in vec3 vC; out vec4 o; void main() { o = vec4(vC, 1.0); 
       cam.target[2] + cam.dist * Math.sin(cam.el),
     ];
   }
+  const home = { ...cam, target: cam.target.slice() };
+  document.getElementById('reset-view').addEventListener('click', () => {
+    Object.assign(cam, home, { target: home.target.slice() });
+    requestDraw();
+  });
   const show = { paths: true, before: false, conflicts: true, normals: true };
   let now = 0;
   let frames = 0;
@@ -465,6 +470,11 @@ precision highp float; in vec3 vC; out vec4 o; void main() { o = vec4(vC, 1.0); 
         set(t0 + ((pt.x - x0) / (x1 - x0)) * (t1 - t0));
       });
     }
+    document.addEventListener('keydown', (ev) => {
+      if (ev.code !== 'Space' || /^(INPUT|SELECT|BUTTON|TEXTAREA)$/.test(ev.target.tagName)) return;
+      ev.preventDefault();
+      play.click();
+    });
     set(t);
     if (hash.get('play') === '1') play.click();
   }
