@@ -582,7 +582,6 @@ fn config_violation(
     }
 }
 
-/// Position at `t` by linear interpolation of the samples (held before and after).
 /// Walks the trajectory forward along the legs' joint paths (home → MPs → home, straight
 /// joint segments between waypoints): each sample must lie on the path (within 1e-6 in every
 /// joint) at or after the previous sample's place, and the path covered between two samples
@@ -603,15 +602,19 @@ fn follow_legs(robot: &Robot, rp: &RobotPlan, vtol: f64) -> Option<(f64, String)
             })
         })
         .collect();
-    if segments.is_empty() {
+    let dof = robot.dof();
+    // Waypoints or samples of another length are reported by the other checks (joint limits,
+    // continuity); the walk needs every joint.
+    let sized = rp.legs.iter().flat_map(|l| &l.waypoints).all(|w| w.len() == dof)
+        && rp.trajectory.iter().all(|s| s.q.len() == dof);
+    if segments.is_empty() || !sized {
         return None;
     }
-    let dof = robot.dof();
     // Place on a segment: the nearest point's parameter and its max-abs distance.
     let place = |s: usize, q: &[f64]| -> (f64, f64) {
         let (a, b, _) = &segments[s];
         let (mut num, mut den) = (0.0, 0.0);
-        for j in 0..dof.min(q.len()) {
+        for j in 0..dof {
             num += (q[j] - a[j]) * (b[j] - a[j]);
             den += (b[j] - a[j]).powi(2);
         }
@@ -620,7 +623,7 @@ fn follow_legs(robot: &Robot, rp: &RobotPlan, vtol: f64) -> Option<(f64, String)
         } else {
             0.0
         };
-        let off = (0..dof.min(q.len()))
+        let off = (0..dof)
             .map(|j| (q[j] - (a[j] + f * (b[j] - a[j]))).abs())
             .fold(0.0, f64::max);
         (f, off)
@@ -677,6 +680,7 @@ fn follow_legs(robot: &Robot, rp: &RobotPlan, vtol: f64) -> Option<(f64, String)
     None
 }
 
+/// Position at `t` by linear interpolation of the samples (held before and after).
 fn position(tr: &[crate::plan::output::Sample], t: f64) -> Vec<f64> {
     let i = tr.partition_point(|s| s.t <= t);
     if i == 0 {

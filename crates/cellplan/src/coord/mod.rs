@@ -92,9 +92,10 @@ pub struct CoordSettings {
     pub perturb_evaluations: usize,
     /// Seed of the local path planner.
     pub seed: u64,
-    /// A cycle time to beat (s), from another plan of the same cell: `best` drops a priority
-    /// order as soon as its programs with waits end at or after it (waits only lengthen a
-    /// program, so it could not win), and fails when every order is dropped. `None`: no bar.
+    /// A cycle time to beat (s), from another plan of the same cell: `best` stops resolving a
+    /// priority order with waits as soon as its programs end after it (waits only lengthen a
+    /// program) and ranks it by that end; the two best orders are still tried with other
+    /// poses. `None`: every order is resolved to the end.
     pub bar: Option<f64>,
 }
 
@@ -241,7 +242,7 @@ pub fn coordinate(
                 _ => Mode::Perturb,
             };
             let mut progs = programs;
-            let res = resolve(&ctx, &mut progs, &rank_of(&cell_order), mode)?;
+            let res = resolve(&ctx, &mut progs, &rank_of(&cell_order), mode, None)?;
             let priority = if mode == Mode::Perturb {
                 Vec::new()
             } else {
@@ -304,6 +305,9 @@ pub(crate) struct Resolution {
     pub resolved: usize,
     pub waits: usize,
     pub poses_changed: usize,
+    /// Set when the run stopped early because its programs already ended after the bar: the
+    /// end so far (a lower bound of where waits alone would end).
+    pub outrun: Option<f64>,
 }
 
 /// Most conflicts one strategy resolves before giving up (each resolution moves a conflict
@@ -348,6 +352,7 @@ pub(crate) fn resolve(
     programs: &mut [Program],
     rank: &[usize],
     mode: Mode,
+    bar: Option<f64>,
 ) -> Result<Resolution, PlanError> {
     let mut timed: Vec<Timed> = programs.iter().map(|p| ctx.timed(p)).collect::<Result<_, _>>()?;
     let m = programs.len();
@@ -358,18 +363,14 @@ pub(crate) fn resolve(
         Mode::Perturb => (WaitSearch::Shortest, WaitReason::Fallback),
         _ => (WaitSearch::Shortest, WaitReason::GiveWay),
     };
-    // Waits only lengthen programs: with waits alone, a plan that already ends at or after
-    // the bar cannot beat it.
-    let outrun = |timed: &[Timed]| {
-        mode == Mode::GiveWay
-            && ctx
-                .settings
-                .bar
-                .is_some_and(|bar| timed.iter().map(Timed::end).fold(0.0, f64::max) >= bar)
-    };
+    // Waits only lengthen programs: with waits alone, programs that already end after the
+    // bar cannot beat it; the run stops there and says where it ended.
+    debug_assert!(bar.is_none() || mode == Mode::GiveWay);
     while let Some((t, a, b)) = ctx.timeline(&timed).first_conflict(from) {
-        if outrun(&timed) {
-            return Err(PlanError::Coordination("no shorter than the bar".into()));
+        let end = timed.iter().map(Timed::end).fold(0.0, f64::max);
+        if bar.is_some_and(|bar| end > bar) {
+            res.outrun = Some(end);
+            return Ok(res);
         }
         from = t;
         res.resolved += 1;
@@ -564,18 +565,29 @@ pub(crate) fn add_wait(
 /// A resolved schedule: cycle time, Δt, programs, counts.
 type Scheduled = (f64, f64, Vec<Program>, Resolution);
 
-/// Our strategy: every priority order resolved by the shortest waits; the best orders again
-/// with other poses allowed; the shortest cycle time (then Δt) kept.
+/// Our strategy: every priority order resolved by the shortest waits; the two best orders
+/// again with other poses allowed; the shortest cycle time (then Δt) kept.
+///
+/// With a bar (`CoordSettings::bar`, the cycle of another plan of the cell), a waits-only run
+/// stops as soon as its programs end after the bar, and ranks by that end (a lower bound of
+/// its own finish). The two best orders by that ranking are still run with other poses allowed,
+/// without the bar, since another pose can end sooner than a wait.
 fn best(ctx: &Ctx, programs: Vec<Program>) -> Result<(Vec<Program>, Resolution, Vec<usize>), PlanError> {
     let orders = priority_orders(&programs);
-    let run = |order: &Vec<usize>, mode: Mode| -> Option<Scheduled> {
+    let run = |order: &Vec<usize>, mode: Mode, bar: Option<f64>| -> Option<Scheduled> {
         let mut p = programs.clone();
-        let res = resolve(ctx, &mut p, &rank_of(order), mode).ok()?;
+        let res = resolve(ctx, &mut p, &rank_of(order), mode, bar).ok()?;
+        if let Some(end) = res.outrun {
+            return Some((end, f64::INFINITY, Vec::new(), res));
+        }
         let timed: Vec<Timed> = p.iter().map(|p| ctx.timed(p)).collect::<Result<_, _>>().ok()?;
         let (c, d) = cycle_and_delta(&timed);
         Some((c, d, p, res))
     };
-    let waits: Vec<Option<Scheduled>> = orders.par_iter().map(|o| run(o, Mode::GiveWay)).collect();
+    let waits: Vec<Option<Scheduled>> = orders
+        .par_iter()
+        .map(|o| run(o, Mode::GiveWay, ctx.settings.bar))
+        .collect();
     let mut ranked: Vec<(f64, f64, usize)> = waits
         .iter()
         .enumerate()
@@ -585,16 +597,16 @@ fn best(ctx: &Ctx, programs: Vec<Program>) -> Result<(Vec<Program>, Resolution, 
     let top: Vec<usize> = ranked.iter().take(2).map(|r| r.2).collect();
     let reposed: Vec<Option<Scheduled>> = top
         .par_iter()
-        .map(|&i| run(&orders[i], Mode::GiveWayOrRepose))
+        .map(|&i| run(&orders[i], Mode::GiveWayOrRepose, None))
         .collect();
-    // Each of the top orders with other poses, then with waits only.
+    // Each of the top orders with other poses, then with waits only (where that run finished).
     let mut waits = waits;
     let mut results: Vec<(Scheduled, usize)> = Vec::new();
     for (&i, r) in top.iter().zip(reposed) {
         results.extend(r.map(|r| (r, i)));
     }
     for &i in &top {
-        results.extend(waits[i].take().map(|r| (r, i)));
+        results.extend(waits[i].take().filter(|r| r.3.outrun.is_none()).map(|r| (r, i)));
     }
     let Some(((_, _, progs, res), i)) = results.into_iter().min_by(|a, b| {
         a.0.0
@@ -602,12 +614,9 @@ fn best(ctx: &Ctx, programs: Vec<Program>) -> Result<(Vec<Program>, Resolution, 
             .then(a.0.1.total_cmp(&b.0.1))
             .then(a.1.cmp(&b.1))
     }) else {
-        return Err(PlanError::Coordination(match ctx.settings.bar {
-            Some(bar) => format!("no priority order ends before the bar of {bar:.2} s"),
-            None => {
-                "no priority order resolves every conflict (a robot stands in another's path at home)".into()
-            }
-        }));
+        return Err(PlanError::Coordination(
+            "no priority order resolves every conflict (a robot stands in another's path at home)".into(),
+        ));
     };
     Ok((progs, res, orders[i].clone()))
 }

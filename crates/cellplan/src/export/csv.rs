@@ -36,16 +36,22 @@ fn safe(name: &str) -> String {
 
 /// A CSV field, quoted when needed.
 fn field(s: &str) -> String {
-    if s.contains([',', '"', '\n']) {
+    if s.contains([',', '"', '\n', '\r']) {
         format!("\"{}\"", s.replace('"', "\"\""))
     } else {
         s.to_string()
     }
 }
 
-fn pose_header(rp: &RobotPlan) -> String {
-    let joints: Vec<String> = rp.joints.iter().map(|j| field(j)).collect();
-    format!("{},x_m,y_m,z_m,qx,qy,qz,qw", joints.join(","))
+/// The header: `first`, the joint names, the probe pose, `last`, comma-joined.
+fn header(rp: &RobotPlan, first: &[&str], last: &[&str]) -> String {
+    let names = first
+        .iter()
+        .map(|s| s.to_string())
+        .chain(rp.joints.iter().map(|j| field(j)))
+        .chain(["x_m", "y_m", "z_m", "qx", "qy", "qz", "qw"].map(String::from))
+        .chain(last.iter().map(|s| s.to_string()));
+    names.collect::<Vec<_>>().join(",") + "\n"
 }
 
 fn pose_fields(s: &mut String, sr: &SceneRobot, q: &[f64]) {
@@ -63,7 +69,7 @@ fn pose_fields(s: &mut String, sr: &SceneRobot, q: &[f64]) {
 
 fn trajectory(rp: &RobotPlan, sr: &SceneRobot) -> String {
     let iv = intervals(rp);
-    let mut s = format!("t_s,{},activity,task\n", pose_header(rp));
+    let mut s = header(rp, &["t_s"], &["activity", "task"]);
     let mut k = 0;
     for sample in &rp.trajectory {
         while k + 1 < iv.len() && sample.t >= iv[k].end {
@@ -83,7 +89,7 @@ fn trajectory(rp: &RobotPlan, sr: &SceneRobot) -> String {
 }
 
 fn program(rp: &RobotPlan, sr: &SceneRobot) -> String {
-    let mut s = format!("step,kind,name,{},arrive_s,depart_s\n", pose_header(rp));
+    let mut s = header(rp, &["step", "kind", "name"], &["arrive_s", "depart_s"]);
     let mut step = 0;
     let mut row = |s: &mut String, kind: &str, name: &str, q: &[f64], times: Option<(f64, f64)>| {
         step += 1;
@@ -104,18 +110,25 @@ fn program(rp: &RobotPlan, sr: &SceneRobot) -> String {
         for (w, q) in leg.waypoints.iter().enumerate() {
             let wait = rp.waits.iter().find(|x| x.leg == k && x.waypoint == w);
             let wait_times = wait.map(|x| (x.start_s, x.start_s + x.duration_s));
-            if w == last && w > 0 {
+            // A wait stands at its waypoint: at the leg's start (the previous stop, before the
+            // motion), at a via point, or at its end.
+            if w == 0
+                && let Some(times) = wait_times
+            {
+                row(&mut s, "wait", &name, q, Some(times));
+            }
+            if w == last {
                 match rp.tasks.get(k) {
                     Some(v) => row(&mut s, "measure", &v.task, &v.q, Some((v.arrive_s, v.depart_s))),
                     None => row(&mut s, "home", "home", q, Some((rp.end_s, rp.end_s))),
                 }
             }
-            // A wait stands at its waypoint: at the leg's start (the previous stop), at a via
-            // point, or at its end.
-            if let Some(times) = wait_times {
-                row(&mut s, "wait", &name, q, Some(times));
-            } else if w > 0 && w < last {
-                row(&mut s, "via", &name, q, None);
+            if w > 0 {
+                match wait_times {
+                    Some(times) => row(&mut s, "wait", &name, q, Some(times)),
+                    None if w < last => row(&mut s, "via", &name, q, None),
+                    None => {}
+                }
             }
         }
     }

@@ -121,10 +121,11 @@ pub fn glb(plan: &Plan, cell: &Cell, scene: &Scene) -> Result<Vec<u8>, String> {
 
     let mut roots: Vec<usize> = Vec::new();
     for s in &scene.statics {
-        let mat = material(s.colour, &mut materials);
-        let m = mesh(s.placed.geometry, mat, &mut buf, &mut meshes);
         let mut n = node(&s.name, &s.placed.pose);
-        n["mesh"] = json!(m);
+        if !scene.geometries[s.placed.geometry].indices.is_empty() {
+            let mat = material(s.colour, &mut materials);
+            n["mesh"] = json!(mesh(s.placed.geometry, mat, &mut buf, &mut meshes));
+        }
         nodes.push(n);
         roots.push(nodes.len() - 1);
     }
@@ -138,7 +139,20 @@ pub fn glb(plan: &Plan, cell: &Cell, scene: &Scene) -> Result<Vec<u8>, String> {
         nodes.push(node(&rp.name, &sr.base));
         let base = nodes.len() - 1;
         roots.push(base);
-        let times: Vec<f32> = rp.trajectory.iter().map(|s| s.t as f32).collect();
+        // Keyframe times must increase strictly in f32: samples that would not are dropped
+        // (the last grid sample can sit within 1e-10 s of the end).
+        let mut last = f32::NEG_INFINITY;
+        let keys: Vec<&crate::plan::output::Sample> = rp
+            .trajectory
+            .iter()
+            .filter(|s| {
+                let t = s.t as f32;
+                let keep = t > last;
+                last = last.max(t);
+                keep
+            })
+            .collect();
+        let times: Vec<f32> = keys.iter().map(|s| s.t as f32).collect();
         let input = (!times.is_empty()).then(|| buf.floats(&times, "SCALAR", 1, None));
         let q0 = rp.trajectory.first().map_or(rp.home.clone(), |s| s.q.clone());
         let mut parent = base;
@@ -150,6 +164,9 @@ pub fn glb(plan: &Plan, cell: &Cell, scene: &Scene) -> Result<Vec<u8>, String> {
             let link = nodes.len() - 1;
             let mut children: Vec<usize> = Vec::new();
             for (p, part) in l.parts.iter().enumerate() {
+                if scene.geometries[part.geometry].indices.is_empty() {
+                    continue; // nothing to draw, and glTF has no empty accessors
+                }
                 let m = mesh(part.geometry, mat, &mut buf, &mut meshes);
                 let mut n = node(&format!("{}/{}/{}", rp.name, l.name, p), &part.pose);
                 n["mesh"] = json!(m);
@@ -163,8 +180,7 @@ pub fn glb(plan: &Plan, cell: &Cell, scene: &Scene) -> Result<Vec<u8>, String> {
             parent = link;
             if let (Some(_), Some(input)) = (l.joint, input) {
                 let (path, kind, width, values): (&str, &str, usize, Vec<f32>) = if l.prismatic {
-                    let v = rp
-                        .trajectory
+                    let v = keys
                         .iter()
                         .flat_map(|s| {
                             let t = at(value(&s.q)).translation;
@@ -174,8 +190,7 @@ pub fn glb(plan: &Plan, cell: &Cell, scene: &Scene) -> Result<Vec<u8>, String> {
                     ("translation", "VEC3", 3, v)
                 } else {
                     let mut prev: Option<DQuat> = None;
-                    let v = rp
-                        .trajectory
+                    let v = keys
                         .iter()
                         .flat_map(|s| {
                             // Keep neighbouring quaternions in one hemisphere so that slerp

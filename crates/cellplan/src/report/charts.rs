@@ -41,6 +41,17 @@ pub fn nice_step(span: f64, target: usize) -> f64 {
         .unwrap_or(10.0 * p)
 }
 
+/// Ticks from `first` to `last` by `step` (their count less one): at most 200, none when the
+/// range is not finite.
+fn ticks(first: f64, last: f64, step: f64) -> usize {
+    let n = ((last - first) / step + 1e-9).floor();
+    if n.is_finite() && n >= 0.0 {
+        (n as usize).min(200)
+    } else {
+        0
+    }
+}
+
 /// A linear map from data to pixels.
 #[derive(Clone, Copy)]
 struct Axis {
@@ -63,8 +74,8 @@ impl Axis {
 /// Ticks and labels of a time axis at the bottom (`y`) and vertical grid lines up to `top`.
 fn time_axis(s: &mut String, x: Axis, top: f64, y: f64) {
     let step = nice_step(x.d1 - x.d0, 12);
-    let mut t = 0.0;
-    while t <= x.d1 + 1e-9 {
+    for k in 0..=ticks(0.0, x.d1, step) {
+        let t = k as f64 * step;
         let px = x.at(t);
         let _ = write!(
             s,
@@ -72,7 +83,6 @@ fn time_axis(s: &mut String, x: Axis, top: f64, y: f64) {
             y + 14.0,
             trim(t)
         );
-        t += step;
     }
     let _ = write!(
         s,
@@ -92,8 +102,9 @@ fn trim(v: f64) -> String {
 /// label turned along it.
 fn value_axis(s: &mut String, y: Axis, label: &str) {
     let step = nice_step(y.d1 - y.d0, 6);
-    let mut v = (y.d0 / step).ceil() * step;
-    while v <= y.d1 + 1e-9 {
+    let first = (y.d0 / step).ceil() * step;
+    for k in 0..=ticks(first, y.d1, step) {
+        let v = first + k as f64 * step;
         let py = y.at(v);
         let _ = write!(
             s,
@@ -103,7 +114,6 @@ fn value_axis(s: &mut String, y: Axis, label: &str) {
             py + 4.0,
             trim(v)
         );
-        v += step;
     }
     let _ = write!(
         s,
@@ -536,6 +546,17 @@ mod tests {
         assert_eq!(nice_step(10.0, 12), 1.0);
         assert_eq!(nice_step(0.9, 6), 0.2);
         assert_eq!(nice_step(0.0, 6), 1.0);
+    }
+
+    #[test]
+    fn charts_of_absurd_values_finish() {
+        let tracks = [Track {
+            robot: 0,
+            name: "R1",
+            points: vec![(0.0, 1e17), (1.0, -1e17), (2.0, f64::NAN)],
+        }];
+        let svg = time_position("t", "title", &tracks, "y", 1, Marks::Conflicts(&[]), 1e300);
+        assert!(svg.ends_with("</svg>") && svg.matches("class=\"tick\"").count() < 500);
     }
 
     #[test]

@@ -232,8 +232,14 @@ pub fn plan_html(rep: &PlanReport) -> Result<String, String> {
         scene.drawn_triangles()
     );
     let data = viewer_data(plan, cell, scene, &order, &tracks_full, conflicts, t_end);
-    // `</` cannot appear in a script element; JSON escapes of '/' keep the data intact.
-    let data = data.to_string().replace("</", "<\\/");
+    // Names come from the cell file: `<`, `>` and `&` only occur inside JSON strings, where
+    // their \u escapes read the same, and keep the HTML parser out of the script element's
+    // text (`</script>`, `<!--`).
+    let data = data
+        .to_string()
+        .replace('<', "\\u003c")
+        .replace('>', "\\u003e")
+        .replace('&', "\\u0026");
     let _ = write!(
         page,
         r#"<script id="cellplan-data" type="application/json">{data}</script><script>{VIEWER}</script></body></html>"#

@@ -36,9 +36,11 @@ pub struct Interval {
     pub doing: Doing,
 }
 
-/// A robot's time from 0 to its end, cut into moving, measuring and waiting intervals: measuring
-/// from each MP's arrival to its departure, waiting as the plan's waits state, moving the rest.
-/// Intervals are in time order, do not overlap, and cover `[0, end_s]`.
+/// A robot's time from its start to its end, cut into moving, measuring and waiting intervals:
+/// measuring from each MP's arrival to its departure, waiting as the plan's waits state, moving
+/// the rest. Intervals are in time order, do not overlap, and cover `[start_s, end_s]`; where a
+/// wait and a measurement overlap (not in a verified plan), the later one starts when the
+/// earlier ends.
 pub fn intervals(rp: &RobotPlan) -> Vec<Interval> {
     let mut fixed: Vec<Interval> = rp
         .tasks

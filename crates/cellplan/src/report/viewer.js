@@ -11,7 +11,14 @@
   const hash = new Map(
     location.hash.replace(/^#/, '').split('&').filter(Boolean).map((kv) => {
       const [k, v] = kv.split('=');
-      return [decodeURIComponent(k), decodeURIComponent(v || '')];
+      const decode = (x) => {
+        try {
+          return decodeURIComponent(x);
+        } catch (e) {
+          return x;
+        }
+      };
+      return [decode(k), decode(v || '')];
     })
   );
   if (hash.get('view') === '3d') document.body.classList.add('only-3d');
@@ -328,7 +335,7 @@ precision highp float; in vec3 vC; out vec4 o; void main() { o = vec4(vC, 1.0); 
       links.forEach((m, i) => {
         for (const part of r.links[i].parts) drawPart(part.g, mat.mul(m, mat.pose(part.pose)), body);
       });
-      const t = mat.mul(links[links.length - 1], mat.pose(r.tcp));
+      const t = mat.mul(links.length ? links[links.length - 1] : mat.pose(r.base), mat.pose(r.tcp));
       tcp.push(t[12], t[13], t[14]);
     });
     gl.useProgram(lineProg.p);
