@@ -375,14 +375,3 @@ fn mixed_costs(graph: &RobotGraph, planned: &sequence::Planned) -> CostMatrix {
     }
     CostMatrix::new(n, data).expect("same size as the graph")
 }
-
-/// The tasks of a robot in visiting order.
-pub fn visited_tasks(outcome: &Outcome, robot: usize) -> Vec<TaskId> {
-    let g = &outcome.graphs[robot];
-    outcome.robots[robot]
-        .sequence
-        .nodes
-        .iter()
-        .filter_map(|&n| g.node_task[n].map(|(t, _)| t))
-        .collect()
-}
