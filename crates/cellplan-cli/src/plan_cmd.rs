@@ -209,60 +209,15 @@ pub fn run(args: &PlanArgs) -> Result<(), Failure> {
         seed: args.seed,
         ..CoordSettings::default()
     };
-    let (outcome, settings, coordinated) =
+    pb.set_message(
         if coord_settings.strategy == Coordination::Best && settings.allocation == Allocation::Balanced {
-            // Ours also coordinates the nearest-robot allocation (robots in their own zones meet
-            // less) and keeps whichever runs the shorter coordinated cycle. The proximity plan goes
-            // first: its cycle is the bar the balanced one's priority orders must stay under.
-            pb.set_message("planning and coordinating the proximity allocation");
-            let prox_settings = PlanSettings {
-                allocation: Allocation::Proximity,
-                ..settings.clone()
-            };
-            let prox = plan::plan(&cell, &table, &prox_settings, &|_| {})
-                .ok()
-                .and_then(|o| {
-                    let c = coord::coordinate_outcome(&cell, &table, &o, &coord_settings).ok()?;
-                    Some((o, c))
-                });
-            pb.set_message("coordinating the robots on one clock");
-            let bar = prox.as_ref().map(|(_, c)| coord::cycle_and_delta(&c.timed).0);
-            let lap = Instant::now();
-            let balanced = coord::coordinate_outcome(
-                &cell,
-                &table,
-                &outcome,
-                &CoordSettings {
-                    bar,
-                    ..coord_settings.clone()
-                },
-            );
-            let balanced_s = lap.elapsed().as_secs_f64();
-            match (balanced, prox) {
-                (Ok(b), Some((po, pc))) => {
-                    let key = |c: &coord::Coordinated| coord::cycle_and_delta(&c.timed);
-                    let spent = b.compute_s + pc.compute_s;
-                    let (o, s, mut c) = if key(&pc) < key(&b) {
-                        (po, prox_settings, pc)
-                    } else {
-                        (outcome, settings, b)
-                    };
-                    c.compute_s = spent;
-                    (o, s, c)
-                }
-                (Ok(b), None) => (outcome, settings, b),
-                (Err(_), Some((po, mut pc))) => {
-                    // Every balanced order ran past the proximity plan's cycle (or failed).
-                    pc.compute_s += balanced_s;
-                    (po, prox_settings, pc)
-                }
-                (Err(e), None) => return Err(failure(e)),
-            }
+            "coordinating the robots on one clock (and the proximity allocation against it)"
         } else {
-            pb.set_message("coordinating the robots on one clock");
-            let c = coord::coordinate_outcome(&cell, &table, &outcome, &coord_settings).map_err(failure)?;
-            (outcome, settings, c)
-        };
+            "coordinating the robots on one clock"
+        },
+    );
+    let (outcome, settings, coordinated) =
+        coord::coordinate_plan(&cell, &table, outcome, settings, &coord_settings).map_err(failure)?;
     let mut doc = output::build(
         &cell,
         &table,

@@ -871,9 +871,10 @@ fn bench_minmax_refuses_a_malformed_instance() {
     assert!(stderr.contains("out of range"), "{stderr}");
 }
 
-#[test]
-fn plan_writes_a_plan_and_a_stable_summary() {
-    let dir = scratch("plan");
+/// Plans the small cell in a fresh scratch folder `name` with `--json`: the folder, the cell
+/// file, the output folder and the printed summary.
+fn plan_small_cell(name: &str) -> (PathBuf, PathBuf, PathBuf, Value) {
+    let dir = scratch(name);
     small_cell(&dir);
     let cell = dir.join("cell.toml");
     let out_dir = dir.join("out");
@@ -889,6 +890,12 @@ fn plan_writes_a_plan_and_a_stable_summary() {
     );
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let summary: Value = serde_json::from_slice(&out.stdout).unwrap();
+    (dir, cell, out_dir, summary)
+}
+
+#[test]
+fn plan_writes_a_plan_and_a_stable_summary() {
+    let (dir, cell, out_dir, summary) = plan_small_cell("plan");
     for key in [
         "cycle_time_s",
         "delta_t_s",
@@ -1003,22 +1010,7 @@ fn plan_refuses_caps_that_cannot_hold_the_tasks() {
 
 #[test]
 fn plan_writes_a_report_and_export_writes_gltf_and_csv() {
-    let dir = scratch("report");
-    small_cell(&dir);
-    let cell = dir.join("cell.toml");
-    let out_dir = dir.join("out");
-    let out = cellplan(
-        &[
-            "plan",
-            cell.to_str().unwrap(),
-            "-o",
-            out_dir.to_str().unwrap(),
-            "--json",
-        ],
-        &dir,
-    );
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-    let summary: Value = serde_json::from_slice(&out.stdout).unwrap();
+    let (dir, cell, out_dir, summary) = plan_small_cell("report");
     let report = out_dir.join("report.html");
     assert_eq!(summary["report_file"], report.display().to_string());
     let page = std::fs::read_to_string(&report).unwrap();

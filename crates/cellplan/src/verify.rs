@@ -589,19 +589,21 @@ fn config_violation(
 /// failure: its time and a sentence.
 fn follow_legs(robot: &Robot, rp: &RobotPlan, vtol: f64) -> Option<(f64, String)> {
     const TOL: f64 = 1e-6;
-    let segments: Vec<(&[f64], &[f64], String)> = rp
+    // (start, end, leg) of every straight joint segment, in order.
+    let segments: Vec<(&[f64], &[f64], usize)> = rp
         .legs
         .iter()
-        .flat_map(|leg| {
-            leg.waypoints.windows(2).map(move |w| {
-                (
-                    w[0].as_slice(),
-                    w[1].as_slice(),
-                    format!("{} → {}", leg.from, leg.to),
-                )
-            })
+        .enumerate()
+        .flat_map(|(k, leg)| {
+            leg.waypoints
+                .windows(2)
+                .map(move |w| (w[0].as_slice(), w[1].as_slice(), k))
         })
         .collect();
+    let leg_name = |s: usize| {
+        let leg = &rp.legs[segments[s].2];
+        format!("{} → {}", leg.from, leg.to)
+    };
     let dof = robot.dof();
     // Waypoints or samples of another length are reported by the other checks (joint limits,
     // continuity); the walk needs every joint.
@@ -641,14 +643,11 @@ fn follow_legs(robot: &Robot, rp: &RobotPlan, vtol: f64) -> Option<(f64, String)
             return Some((
                 sample.t,
                 if behind {
-                    format!(
-                        "the trajectory goes back along its path on leg {}",
-                        segments[seg].2
-                    )
+                    format!("the trajectory goes back along its path on leg {}", leg_name(seg))
                 } else {
                     format!(
                         "the trajectory leaves the joint path of leg {} (the motion checked against the scene)",
-                        segments[seg].2
+                        leg_name(seg)
                     )
                 },
             ));

@@ -359,7 +359,7 @@ fn the_scene_instances_robot_meshes_and_decimates_to_budget() {
     let parts: usize = full
         .robots
         .iter()
-        .flat_map(|r| r.links.iter().map(|l| l.parts.len()))
+        .flat_map(|r| r.parts.iter().map(Vec::len))
         .sum();
     let per_robot = parts / full.robots.len();
     assert_eq!(full.robots.len(), 2);

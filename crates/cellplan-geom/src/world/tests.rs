@@ -349,8 +349,9 @@ fn self_pairs_are_filtered() {
     assert_eq!(w.group_self(g, &apart, 0.15), Some(BodyContact::SelfPair(0, 2)));
 }
 
-#[test]
-fn group_vs_group_pairs() {
+/// The three boxes and a second group (a cube and a sphere), with poses that keep them apart:
+/// the closest pair is box 2 and the sphere, 0.1–0.25 apart.
+fn two_groups() -> (CollisionWorld, GroupId, GroupId, [Pose; 3], [Pose; 2]) {
     let (mut w, a) = three_boxes();
     let b = w.add_group(
         "other",
@@ -361,6 +362,12 @@ fn group_vs_group_pairs() {
     );
     let pa = [at(0.0, 0.0, 0.0), at(0.0, 3.0, 0.0), at(0.0, 6.0, 0.0)];
     let pb = [at(10.0, 0.0, 0.0), at(1.2, 6.0, 0.0)];
+    (w, a, b, pa, pb)
+}
+
+#[test]
+fn group_vs_group_pairs() {
+    let (w, a, b, pa, pb) = two_groups();
     assert_eq!(w.group_vs_group(a, &pa, b, &pb, 0.0), None);
     assert_eq!(w.group_vs_group(a, &pa, b, &pb, 0.1), None);
     assert_eq!(
@@ -387,16 +394,7 @@ fn group_vs_group_pairs() {
 
 #[test]
 fn group_group_distance_is_the_closest_pair() {
-    let (mut w, a) = three_boxes();
-    let b = w.add_group(
-        "other",
-        vec![
-            body("x", vec![(cube(0.5), Pose::IDENTITY)]),
-            body("y", vec![(ShapeSpec::Sphere { radius: 0.5 }, Pose::IDENTITY)]),
-        ],
-    );
-    let pa = [at(0.0, 0.0, 0.0), at(0.0, 3.0, 0.0), at(0.0, 6.0, 0.0)];
-    let pb = [at(10.0, 0.0, 0.0), at(1.2, 6.0, 0.0)];
+    let (w, a, b, pa, pb) = two_groups();
     let d = w.group_group_distance(a, &pa, b, &pb, 10.0);
     assert!(d > 0.1 && d < 0.25, "{d}");
     assert!((w.group_group_distance(b, &pb, a, &pa, 10.0) - d).abs() < 1e-9);

@@ -299,6 +299,65 @@ pub fn coordinate_outcome(
     coordinate(cell, table, programs, settings)
 }
 
+/// What `cellplan plan` runs: `outcome` (planned with `settings`) coordinated with
+/// `coord`; with `best` and the balanced allocation (ours), the proximity allocation is planned
+/// and coordinated too, first, and its cycle is the bar of the balanced one
+/// ([`CoordSettings::bar`]); the shorter coordinated cycle (then Δt) wins, with the compute of
+/// both. Returns the winning run, its settings and its coordination.
+pub fn coordinate_plan(
+    cell: &Cell,
+    table: &CandidateTable,
+    outcome: crate::plan::Outcome,
+    settings: crate::plan::PlanSettings,
+    coord: &CoordSettings,
+) -> Result<(crate::plan::Outcome, crate::plan::PlanSettings, Coordinated), PlanError> {
+    use crate::plan::{Allocation, PlanSettings};
+    if coord.strategy != Coordination::Best || settings.allocation != Allocation::Balanced {
+        let c = coordinate_outcome(cell, table, &outcome, coord)?;
+        return Ok((outcome, settings, c));
+    }
+    // Robots in their own zones meet less: the nearest-robot allocation often wins.
+    let prox_settings = PlanSettings {
+        allocation: Allocation::Proximity,
+        ..settings.clone()
+    };
+    let prox = crate::plan::plan(cell, table, &prox_settings, &|_| {})
+        .ok()
+        .and_then(|o| {
+            let c = coordinate_outcome(cell, table, &o, coord).ok()?;
+            Some((o, c))
+        });
+    let bar = prox.as_ref().map(|(_, c)| cycle_and_delta(&c.timed).0);
+    let lap = Instant::now();
+    let balanced = coordinate_outcome(cell, table, &outcome, &CoordSettings { bar, ..coord.clone() });
+    let balanced_s = lap.elapsed().as_secs_f64();
+    Ok(match (balanced, prox) {
+        (Ok(b), Some((po, mut pc))) => {
+            pc.compute_s += balanced_s;
+            if cycle_and_delta(&pc.timed) < cycle_and_delta(&b.timed) {
+                (po, prox_settings, pc)
+            } else {
+                let spent = pc.compute_s;
+                (
+                    outcome,
+                    settings,
+                    Coordinated {
+                        compute_s: spent,
+                        ..b
+                    },
+                )
+            }
+        }
+        (Ok(b), None) => (outcome, settings, b),
+        // The balanced coordination failed.
+        (Err(_), Some((po, mut pc))) => {
+            pc.compute_s += balanced_s;
+            (po, prox_settings, pc)
+        }
+        (Err(e), None) => return Err(e),
+    })
+}
+
 /// Counts of a resolution.
 #[derive(Clone, Copy, Debug, Default)]
 pub(crate) struct Resolution {

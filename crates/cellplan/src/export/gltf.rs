@@ -156,19 +156,17 @@ pub fn glb(plan: &Plan, cell: &Cell, scene: &Scene) -> Result<Vec<u8>, String> {
         let input = (!times.is_empty()).then(|| buf.floats(&times, "SCALAR", 1, None));
         let q0 = rp.trajectory.first().map_or(rp.home.clone(), |s| s.q.clone());
         let mut parent = base;
-        for l in &sr.links {
-            let rest = l.origin;
-            let at = |v: f64| rest * sr.motion(l, v);
-            let value = |q: &[f64]| l.joint.and_then(|j| q.get(j).copied()).unwrap_or(0.0);
-            nodes.push(node(&format!("{}/{}", rp.name, l.name), &at(value(&q0))));
+        for (i, parts) in sr.parts.iter().enumerate() {
+            let name = &sr.model.chain.links[i].name;
+            nodes.push(node(&format!("{}/{name}", rp.name), &sr.local_pose(i, &q0)));
             let link = nodes.len() - 1;
             let mut children: Vec<usize> = Vec::new();
-            for (p, part) in l.parts.iter().enumerate() {
+            for (p, part) in parts.iter().enumerate() {
                 if scene.geometries[part.geometry].indices.is_empty() {
                     continue; // nothing to draw, and glTF has no empty accessors
                 }
                 let m = mesh(part.geometry, mat, &mut buf, &mut meshes);
-                let mut n = node(&format!("{}/{}/{}", rp.name, l.name, p), &part.pose);
+                let mut n = node(&format!("{}/{name}/{p}", rp.name), &part.pose);
                 n["mesh"] = json!(m);
                 nodes.push(n);
                 children.push(nodes.len() - 1);
@@ -178,12 +176,12 @@ pub fn glb(plan: &Plan, cell: &Cell, scene: &Scene) -> Result<Vec<u8>, String> {
             }
             push_child(&mut nodes, parent, link);
             parent = link;
-            if let (Some(_), Some(input)) = (l.joint, input) {
-                let (path, kind, width, values): (&str, &str, usize, Vec<f32>) = if l.prismatic {
+            if let (Some((_, joint)), Some(input)) = (sr.joint_of(i), input) {
+                let (path, kind, width, values): (&str, &str, usize, Vec<f32>) = if !joint.is_rotational() {
                     let v = keys
                         .iter()
                         .flat_map(|s| {
-                            let t = at(value(&s.q)).translation;
+                            let t = sr.local_pose(i, &s.q).translation;
                             [t.x as f32, t.y as f32, t.z as f32]
                         })
                         .collect();
@@ -195,7 +193,7 @@ pub fn glb(plan: &Plan, cell: &Cell, scene: &Scene) -> Result<Vec<u8>, String> {
                         .flat_map(|s| {
                             // Keep neighbouring quaternions in one hemisphere so that slerp
                             // takes the short way, as the joint does.
-                            let mut q = at(value(&s.q)).rotation;
+                            let mut q = sr.local_pose(i, &s.q).rotation;
                             if prev.is_some_and(|p| p.dot(q) < 0.0) {
                                 q = -q;
                             }
@@ -219,20 +217,20 @@ pub fn glb(plan: &Plan, cell: &Cell, scene: &Scene) -> Result<Vec<u8>, String> {
                 [p.x as f32, p.y as f32, p.z as f32]
             })
             .collect();
-        if path.len() >= 6 {
-            let acc = buf.floats(&path, "VEC3", 3, Some(ARRAY_BUFFER));
-            let mat = material(robot_colour(r), &mut materials);
-            meshes.push(json!({
-                "name": format!("{} probe path", rp.name),
-                "primitives": [{"attributes": {"POSITION": acc}, "mode": 3, "material": mat}],
-            }));
-            nodes.push(json!({"name": format!("{} probe path", rp.name), "mesh": meshes.len() - 1}));
-            roots.push(nodes.len() - 1);
-        }
+        lines(
+            &mut buf,
+            &mut meshes,
+            &mut nodes,
+            &mut roots,
+            &format!("{} probe path", rp.name),
+            &path,
+            LINE_STRIP,
+            material(robot_colour(r), &mut materials),
+        );
     }
     // MPs: a 10 cm normal line each, coloured by the robot that measures it.
     for (r, rp) in plan.robots.iter().enumerate() {
-        let lines: Vec<f32> = rp
+        let segments: Vec<f32> = rp
             .tasks
             .iter()
             .filter_map(|v| cell.tasks.iter().find(|t| t.name == v.task))
@@ -241,17 +239,17 @@ pub fn glb(plan: &Plan, cell: &Cell, scene: &Scene) -> Result<Vec<u8>, String> {
                 [a.x, a.y, a.z, b.x, b.y, b.z].map(|x| x as f32)
             })
             .collect();
-        if lines.is_empty() {
-            continue;
-        }
-        let acc = buf.floats(&lines, "VEC3", 3, Some(ARRAY_BUFFER));
         let mat = material(robot_colour(r), &mut materials);
-        meshes.push(json!({
-            "name": format!("{} MPs", rp.name),
-            "primitives": [{"attributes": {"POSITION": acc}, "mode": 1, "material": mat}],
-        }));
-        nodes.push(json!({"name": format!("{} MPs", rp.name), "mesh": meshes.len() - 1}));
-        roots.push(nodes.len() - 1);
+        lines(
+            &mut buf,
+            &mut meshes,
+            &mut nodes,
+            &mut roots,
+            &format!("{} MPs", rp.name),
+            &segments,
+            LINES,
+            mat,
+        );
     }
     let h = std::f32::consts::FRAC_1_SQRT_2;
     nodes.push(json!({"name": plan.cell, "rotation": [-h, 0.0, 0.0, h], "children": roots}));
@@ -271,6 +269,35 @@ pub fn glb(plan: &Plan, cell: &Cell, scene: &Scene) -> Result<Vec<u8>, String> {
         doc["animations"] = json!([{"name": "plan", "channels": channels, "samplers": samplers}]);
     }
     Ok(container(&doc, buf.bin))
+}
+
+const LINES: u32 = 1;
+const LINE_STRIP: u32 = 3;
+
+/// A node under the root drawing `points` (x, y, z, … in the world) as lines (`mode`
+/// [`LINES`] or [`LINE_STRIP`]) in material `mat`; nothing when there are fewer than two
+/// points.
+#[allow(clippy::too_many_arguments)]
+fn lines(
+    buf: &mut Buffers,
+    meshes: &mut Vec<Value>,
+    nodes: &mut Vec<Value>,
+    roots: &mut Vec<usize>,
+    name: &str,
+    points: &[f32],
+    mode: u32,
+    mat: usize,
+) {
+    if points.len() < 6 {
+        return;
+    }
+    let acc = buf.floats(points, "VEC3", 3, Some(ARRAY_BUFFER));
+    meshes.push(json!({
+        "name": name,
+        "primitives": [{"attributes": {"POSITION": acc}, "mode": mode, "material": mat}],
+    }));
+    nodes.push(json!({"name": name, "mesh": meshes.len() - 1}));
+    roots.push(nodes.len() - 1);
 }
 
 fn push_child(nodes: &mut [Value], parent: usize, child: usize) {

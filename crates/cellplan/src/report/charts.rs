@@ -4,6 +4,7 @@
 //! Charts that share the plan's clock carry `data-t0`, `data-t1`, `data-x0`, `data-x1` (the
 //! time range and the horizontal pixel range it maps to) and a `line.cursor`, so the page's
 //! script can move a time cursor over them and turn a click into a time.
+use super::escape;
 use super::playback::{Doing, intervals};
 use super::svg::ROBOT_COLOURS;
 use crate::plan::output::{ConflictOut, Plan};
@@ -14,14 +15,6 @@ pub const WIDTH: f64 = 960.0;
 const LEFT: f64 = 70.0;
 const RIGHT: f64 = 16.0;
 const WAIT_COLOUR: &str = "#d62728";
-
-/// Text made safe for XML.
-pub fn escape(s: &str) -> String {
-    s.replace('&', "&amp;")
-        .replace('<', "&lt;")
-        .replace('>', "&gt;")
-        .replace('"', "&quot;")
-}
 
 fn colour(r: usize) -> &'static str {
     ROBOT_COLOURS[r % ROBOT_COLOURS.len()]

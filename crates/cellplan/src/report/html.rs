@@ -2,7 +2,8 @@
 //! chart, time–position charts before and after coordination (paper 000 Fig. 7/8), and the 3D
 //! playback of the cell (the project's own WebGL2 viewer, `viewer.js`). One file with no
 //! outside references: it opens offline in any browser.
-use super::charts::{self, Marks, StrategyBar, Track, escape};
+use super::charts::{self, Marks, StrategyBar, Track};
+use super::escape;
 use super::playback::{Doing, intervals, probe_track};
 use super::scene::{Scene, robot_colour};
 use crate::Cell;
@@ -525,15 +526,18 @@ fn viewer_data(
                 .map(|b| b.xyz.iter().flat_map(|p| p.map(|v| v as f32)).collect())
                 .unwrap_or_default();
             let links: Vec<Value> = sr
-                .links
+                .parts
                 .iter()
-                .map(|l| {
+                .enumerate()
+                .map(|(i, parts)| {
+                    let joint = sr.joint_of(i);
+                    let axis = joint.map_or(cellplan_geom::DVec3::Z, |(_, jt)| jt.axis);
                     json!({
-                        "o": pose_json(&l.origin),
-                        "j": l.joint.map_or(-1, |j| j as i64),
-                        "axis": [l.axis.x, l.axis.y, l.axis.z],
-                        "prismatic": l.prismatic,
-                        "parts": l.parts.iter().map(|p| json!({"g": p.geometry, "pose": pose_json(&p.pose)})).collect::<Vec<_>>(),
+                        "o": pose_json(&sr.model.chain.links[i].origin),
+                        "j": joint.map_or(-1, |(j, _)| j as i64),
+                        "axis": [axis.x, axis.y, axis.z],
+                        "prismatic": joint.is_some_and(|(_, jt)| !jt.is_rotational()),
+                        "parts": parts.iter().map(|p| json!({"g": p.geometry, "pose": pose_json(&p.pose)})).collect::<Vec<_>>(),
                     })
                 })
                 .collect();

@@ -7,7 +7,8 @@
 //! ([`Mesh::decimated`]); collision checking never sees these copies.
 use crate::Cell;
 use crate::plan::output::Plan;
-use cellplan_geom::{DVec3, Mesh, Pose, ShapeSpec};
+use cellplan_geom::{Mesh, Pose, ShapeSpec};
+use cellplan_kin::{Joint, RobotModel};
 use std::collections::HashMap;
 use std::sync::Arc;
 
@@ -47,24 +48,8 @@ pub struct StaticItem {
     pub colour: [f32; 3],
 }
 
-/// A link of a robot's chain.
-#[derive(Clone, Debug)]
-pub struct SceneLink {
-    /// Name in the URDF.
-    pub name: String,
-    /// Pose in the parent link's frame at joint value zero.
-    pub origin: Pose,
-    /// The joint that moves it (index into the robot's joint values), if any.
-    pub joint: Option<usize>,
-    /// Joint axis in the link frame.
-    pub axis: DVec3,
-    /// Whether the joint translates (else it rotates).
-    pub prismatic: bool,
-    /// Geometry attached to the link (the tool hangs on the last link).
-    pub parts: Vec<Placed>,
-}
-
-/// A robot as a kinematic chain with geometry.
+/// A robot: its URDF model (the chain whose forward kinematics place the links) and the
+/// geometry drawn on each chain link.
 #[derive(Clone, Debug)]
 pub struct SceneRobot {
     /// Name in the cell.
@@ -73,42 +58,35 @@ pub struct SceneRobot {
     pub colour: [f32; 3],
     /// Pose of the chain root in the world.
     pub base: Pose,
-    /// Links from root to tip.
-    pub links: Vec<SceneLink>,
+    /// The URDF model (shared with the cell's robot).
+    pub model: Arc<RobotModel>,
+    /// Geometry per chain link, in the link's frame (the tool hangs on the last link).
+    pub parts: Vec<Vec<Placed>>,
     /// TCP in the tip link's frame.
     pub tcp: Pose,
 }
 
 impl SceneRobot {
-    /// World pose of every link at joint values `q` (as [`cellplan_kin::Chain::fk_all`], placed
-    /// at the base).
-    pub fn link_poses(&self, q: &[f64]) -> Vec<Pose> {
-        let mut parent = self.base;
-        self.links
-            .iter()
-            .map(|l| {
-                let mut pose = parent * l.origin;
-                if let Some(j) = l.joint {
-                    pose *= self.motion(l, q.get(j).copied().unwrap_or(0.0));
-                }
-                parent = pose;
-                pose
-            })
-            .collect()
+    /// The joint that moves chain link `i` (its index into the joint values, and the joint).
+    pub fn joint_of(&self, i: usize) -> Option<(usize, &Joint)> {
+        let chain = &self.model.chain;
+        let j = chain.links.get(i)?.joint?;
+        chain.joints.get(j).map(|jt| (j, jt))
     }
 
-    /// The joint motion of link `l` at value `v`.
-    pub fn motion(&self, l: &SceneLink, v: f64) -> Pose {
-        if l.prismatic {
-            Pose::from_translation(l.axis * v)
-        } else {
-            Pose::from_rotation(cellplan_geom::DQuat::from_axis_angle(l.axis, v))
+    /// Pose of chain link `i` in its parent link's frame at joint values `q` (a missing value
+    /// counts as zero, as in [`cellplan_kin::Chain::fk_all`]).
+    pub fn local_pose(&self, i: usize, q: &[f64]) -> Pose {
+        let origin = self.model.chain.links[i].origin;
+        match self.joint_of(i) {
+            Some((j, joint)) => joint.apply(origin, q.get(j).copied().unwrap_or(0.0)),
+            None => origin,
         }
     }
 
     /// World pose of the TCP at `q`.
     pub fn tcp_pose(&self, q: &[f64]) -> Pose {
-        *self.link_poses(q).last().unwrap_or(&self.base) * self.tcp
+        self.base * self.model.chain.fk_tip(q) * self.tcp
     }
 }
 
@@ -188,12 +166,11 @@ impl Scene {
             .map(|r| {
                 let chain = &r.model.chain;
                 let tip = chain.links.len().saturating_sub(1);
-                let links = chain
+                let parts = chain
                     .links
                     .iter()
                     .enumerate()
                     .map(|(i, l)| {
-                        let joint = l.joint.and_then(|j| chain.joints.get(j).map(|jt| (j, jt)));
                         let mut parts: Vec<Placed> = r.model.collision[i]
                             .iter()
                             .map(|(s, pose)| Placed {
@@ -207,21 +184,15 @@ impl Scene {
                                 pose: *pose,
                             }));
                         }
-                        SceneLink {
-                            name: l.name.clone(),
-                            origin: l.origin,
-                            joint: joint.map(|(j, _)| j),
-                            axis: joint.map_or(DVec3::Z, |(_, jt)| jt.axis),
-                            prismatic: joint.is_some_and(|(_, jt)| !jt.is_rotational()),
-                            parts,
-                        }
+                        parts
                     })
                     .collect();
                 SceneRobot {
                     name: r.name.clone(),
                     colour: robot_colour(r.id.0),
                     base: r.base,
-                    links,
+                    model: r.model.clone(),
+                    parts,
                     tcp: r.tool.tcp,
                 }
             })
@@ -244,7 +215,7 @@ impl Scene {
                     .iter()
                     .position(|r| r.name == rp.name)
                     .ok_or_else(|| format!("the plan's robot {} is not in the cell", rp.name))?;
-                let dof = self.robots[k].links.iter().filter(|l| l.joint.is_some()).count();
+                let dof = self.robots[k].model.chain.dof();
                 if rp.joints.len() != dof || rp.trajectory.iter().any(|s| s.q.len() != dof) {
                     return Err(format!(
                         "robot {} has {dof} joints in the cell, the plan gives {}",
@@ -264,7 +235,7 @@ impl Scene {
             + self
                 .robots
                 .iter()
-                .flat_map(|r| r.links.iter().flat_map(|l| l.parts.iter()))
+                .flat_map(|r| r.parts.iter().flatten())
                 .map(tri)
                 .sum::<usize>()
     }

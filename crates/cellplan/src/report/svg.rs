@@ -1,5 +1,6 @@
 //! A drawing of the cell from above (x–y) and from the side (y–z): static objects and robots at
 //! home as filled silhouettes, measurement points coloured by reachability class.
+use super::escape;
 use crate::candidates::CandidateTable;
 use crate::model::robot::{BodyFrame, Scratch};
 use crate::{Cell, TaskId};
@@ -12,14 +13,6 @@ pub const ROBOT_COLOURS: [&str; 8] = [
 ];
 const SHARED: &str = "#d6278c";
 const UNMEASURABLE: &str = "#d62728";
-
-/// Text made safe for XML.
-fn escape(s: &str) -> String {
-    s.replace('&', "&amp;")
-        .replace('<', "&lt;")
-        .replace('>', "&gt;")
-        .replace('"', "&quot;")
-}
 
 /// A 2D occupancy grid that triangles are rasterised into.
 struct Raster {
