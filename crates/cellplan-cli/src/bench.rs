@@ -366,7 +366,7 @@ pub fn generate(args: &BenchArgs) -> Result<String, BenchError> {
     p.validate().map_err(BenchError::Failed)?;
     let mut buf = Vec::new();
     write_minmax(&p, &stem(out), &mut buf).map_err(|e| BenchError::Failed(e.to_string()))?;
-    cellplan::io::write_atomic(out, &buf)
+    cellplan_model::io::write_atomic(out, &buf)
         .map_err(|e| BenchError::Failed(format!("cannot write {}: {e}", out.display())))?;
     let nodes: usize = p.vehicles.iter().map(|v| v.costs.n()).sum();
     Ok(format!(

@@ -1,14 +1,16 @@
 //! `cellplan compare`: allocation × coordination strategies on one cell (paper 000 Table 3),
 //! and over random MP sets drawn on the part (Table 4).
 use crate::{Failure, load_options, spinner};
-use cellplan::coord::{self, CoordSettings, Coordination};
-use cellplan::plan::{self, Allocation, PlanSettings, output};
-use cellplan::report::charts::StrategyBar;
-use cellplan::report::html::{CompareRow, compare_html};
-use cellplan::taskgen::{GenOptions, sample_tasks};
-use cellplan::verify::{VerifySettings, verify};
-use cellplan::{Cell, InputError, candidates, io::write_atomic};
+use cellplan_core::candidates;
+use cellplan_core::coord::{self, CoordSettings, Coordination};
+use cellplan_core::document as output;
+use cellplan_core::plan::{self, Allocation, PlanSettings};
+use cellplan_core::verify::{VerifySettings, verify};
 use cellplan_geom::ShapeSpec;
+use cellplan_model::taskgen::{GenOptions, sample_tasks};
+use cellplan_model::{Cell, InputError, io::write_atomic};
+use cellplan_report::charts::StrategyBar;
+use cellplan_report::html::{CompareRow, compare_html};
 use clap::Args;
 use serde::Serialize;
 use std::path::PathBuf;
@@ -99,15 +101,19 @@ pub fn run(args: &CompareArgs) -> Result<(), Failure> {
     let show = !args.quiet && !args.json;
     let opts = load_options(false, &None);
     let pb = spinner(show, "loading the cell");
-    let base = cellplan::model::load::load(&args.cell, &opts)?;
+    let base = crate::load_cell(&args.cell, &opts)?;
     let cases = match args.random_tasks {
         None => 1,
-        Some(0) => return Err(Failure::Other("--random-tasks must be at least 1".into())),
+        Some(k) if k == 0 || k > 1000 => {
+            return Err(Failure::Usage(format!(
+                "--random-tasks must be between 1 and 1000, not {k}"
+            )));
+        }
         Some(k) => k,
     };
     let mut rows = Vec::new();
     for case in 0..cases {
-        let mut cell = cellplan::model::load::load(&args.cell, &opts)?;
+        let mut cell = crate::load_cell(&args.cell, &opts)?;
         if args.random_tasks.is_some() {
             cell.tasks = random_tasks(&base, args.seed + case as u64)?;
         }
@@ -515,7 +521,7 @@ fn markdown(report: &Report) -> String {
 
 /// As many random MPs as `cell` has, on its largest mesh object, in the box of its MPs (grown
 /// by 10 cm) and facing within 80° of their mean normal.
-fn random_tasks(cell: &Cell, seed: u64) -> Result<Vec<cellplan::Task>, Failure> {
+fn random_tasks(cell: &Cell, seed: u64) -> Result<Vec<cellplan_model::Task>, Failure> {
     let part = cell
         .objects
         .iter()

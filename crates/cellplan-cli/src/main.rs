@@ -10,10 +10,12 @@ mod plan_cmd;
 mod report_cmd;
 mod verify_cmd;
 
-use cellplan::report::{check, svg};
-use cellplan::taskgen::{GenOptions, sample_tasks};
-use cellplan::{InputError, LoadOptions, candidates, io::write_atomic};
+use cellplan_core::{candidates, check};
 use cellplan_geom::{DVec3, load_mesh};
+use cellplan_model::io::write_atomic;
+use cellplan_model::taskgen::{GenOptions, sample_tasks};
+use cellplan_model::{Cell, InputError, LoadOptions, Registry};
+use cellplan_report::svg;
 use clap::{Args, Parser, Subcommand};
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -103,7 +105,7 @@ struct GenTasksArgs {
     #[arg(long, value_name = "AXIS=LO..HI", value_parser = parse_region)]
     region: Vec<(usize, f64, f64)>,
     /// Keep points whose outward normal points this way: +x, -x, +y, -y, +z, -z or `x,y,z`.
-    #[arg(long, value_parser = parse_direction)]
+    #[arg(long, value_parser = parse_direction, allow_hyphen_values = true)]
     facing: Option<DVec3>,
     /// Largest angle between normal and `--facing`, in degrees.
     #[arg(long, default_value_t = 60.0)]
@@ -111,7 +113,7 @@ struct GenTasksArgs {
     /// Move the points by this offset `x,y,z` (mesh units) after sampling — where the cell
     /// file places the part, when its pose is a pure translation. Regions and directions
     /// apply before the move, in the mesh frame.
-    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vector)]
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vector, allow_hyphen_values = true)]
     translate: Option<DVec3>,
     /// Output file (default: standard output).
     #[arg(long, short)]
@@ -167,6 +169,8 @@ fn parse_direction(s: &str) -> Result<DVec3, String> {
 
 enum Failure {
     Input(Box<InputError>),
+    /// A command-line value out of range (exit 2, the flag named).
+    Usage(String),
     Infeasible,
     /// `verify` found violations.
     Rejected,
@@ -189,6 +193,39 @@ fn spinner(show: bool, message: &str) -> indicatif::ProgressBar {
     pb
 }
 
+/// Most points `gen tasks` makes.
+const MAX_GENERATED_TASKS: usize = 100_000;
+
+/// `out/<cell name>`, refused when the name would lead outside `out/` (an absolute path, `..`,
+/// a separator): the name comes from the cell file.
+pub(crate) fn default_output_dir(cell: &Cell) -> Result<PathBuf, Failure> {
+    let name = &cell.name;
+    let plain = !name.is_empty()
+        && name != "."
+        && name != ".."
+        && !name.contains(['/', '\\', '\0'])
+        && std::path::Path::new(name).components().count() == 1;
+    if !plain {
+        return Err(Failure::Usage(format!(
+            "the cell name `{name}` is not a plain folder name, so it cannot name the output folder out/<name>; \
+             give the output folder with -o, or change `name` in {}",
+            cell.path.display()
+        )));
+    }
+    Ok(PathBuf::from("out").join(name))
+}
+
+/// The processes this binary knows.
+pub(crate) fn registry() -> Registry {
+    Registry::new().with(cellplan_optical::ENTRY)
+}
+
+/// Loads a cell with the processes of [`registry`].
+#[allow(clippy::result_large_err)] // built once, on the cold path of refusing input
+pub(crate) fn load_cell(path: &std::path::Path, opts: &LoadOptions) -> Result<Cell, InputError> {
+    cellplan_model::load(path, &registry(), opts)
+}
+
 /// Loader options from the cache flags shared by the commands that load a cell.
 fn load_options(no_cache: bool, cache_dir: &Option<PathBuf>) -> LoadOptions {
     LoadOptions {
@@ -206,7 +243,7 @@ fn run_check(args: &CheckArgs) -> Result<(), Failure> {
     let show = !args.quiet && !args.json;
     let opts = load_options(args.no_cache, &args.cache_dir);
     let pb = spinner(show, "loading the cell");
-    let cell = cellplan::model::load::load(&args.cell, &opts)?;
+    let cell = load_cell(&args.cell, &opts)?;
     pb.set_message(format!(
         "finding candidates for {} tasks × {} robots",
         cell.tasks.len(),
@@ -248,8 +285,17 @@ fn run_gen_tasks(args: &GenTasksArgs) -> Result<(), Failure> {
         }
         other => InputError::new(&args.mesh, other.to_string()).hint("give an STL or OBJ file"),
     })?;
-    if args.count == 0 {
-        return Err(InputError::new(&args.mesh, "`--count` must be at least 1").into());
+    if args.count == 0 || args.count > MAX_GENERATED_TASKS {
+        return Err(Failure::Usage(format!(
+            "--count must be between 1 and {MAX_GENERATED_TASKS}, not {}",
+            args.count
+        )));
+    }
+    if !(args.max_angle.is_finite() && (0.0..=180.0).contains(&args.max_angle)) {
+        return Err(Failure::Usage(format!(
+            "--max-angle must be between 0 and 180 degrees, not {}",
+            args.max_angle
+        )));
     }
     let mut opts = GenOptions::new(args.count, args.seed);
     for &(axis, lo, hi) in &args.region {
@@ -263,7 +309,7 @@ fn run_gen_tasks(args: &GenTasksArgs) -> Result<(), Failure> {
     if let Some(offset) = args.translate {
         tasks.iter_mut().for_each(|t| t.position += offset);
     }
-    let text = cellplan::model::tasks::tasks_to_csv(&tasks, 1.0);
+    let text = cellplan_model::tasks::tasks_to_csv(&tasks, 1.0, 1.0, &[]);
     match &args.out {
         Some(path) => write_atomic(path, text.as_bytes())
             .map_err(|e| Failure::Other(format!("cannot write {}: {e}", path.display())))?,
@@ -280,7 +326,8 @@ fn run_bench(args: &bench::BenchArgs) -> Result<(), Failure> {
                  (docs/minmax-format.md) files of the kind named",
             ),
         )),
-        bench::BenchError::Usage(m) | bench::BenchError::Failed(m) => Failure::Other(m),
+        bench::BenchError::Usage(m) => Failure::Usage(m),
+        bench::BenchError::Failed(m) => Failure::Other(m),
     };
     if args.generate {
         eprintln!("{}", bench::generate(args).map_err(failure)?);
@@ -323,6 +370,10 @@ fn main() -> ExitCode {
         Ok(()) => ExitCode::SUCCESS,
         Err(Failure::Input(e)) => {
             eprintln!("{:?}", miette::Report::new(*e));
+            ExitCode::from(2)
+        }
+        Err(Failure::Usage(m)) => {
+            eprintln!("error: {m}");
             ExitCode::from(2)
         }
         Err(Failure::Infeasible) => ExitCode::from(3),

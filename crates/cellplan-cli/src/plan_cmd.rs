@@ -1,10 +1,12 @@
 //! `cellplan plan`: the main job.
 use crate::{Failure, load_options, spinner};
-use cellplan::coord::{self, CoordSettings, Coordination};
-use cellplan::plan::{self, Allocation, CoverMethod, MoveModel, PlanError, PlanSettings, Stage, output};
-use cellplan::verify::{VerifySettings, verify};
-use cellplan::{InputError, candidates, io::write_atomic, report::check};
-use clap::{Args, ValueEnum};
+use cellplan_core::coord::{CoordSettings, Coordination};
+use cellplan_core::document as output;
+use cellplan_core::pipeline::{self, PipelineError, Step};
+use cellplan_core::plan::{Allocation, CoverMethod, MoveModel, PlanSettings, Stage};
+use cellplan_model::InputError;
+use cellplan_model::io::{check_writable, write_all_atomic};
+use clap::Args;
 use serde::Serialize;
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
@@ -17,14 +19,14 @@ pub struct PlanArgs {
     #[arg(short, long, value_name = "DIR")]
     output: Option<PathBuf>,
     /// Allocation strategy.
-    #[arg(long, value_enum, default_value_t = AllocationArg::Balanced)]
-    allocation: AllocationArg,
+    #[arg(long, value_enum, default_value_t = Allocation::Balanced)]
+    allocation: Allocation,
     /// Set-cover method of the local-robust allocation.
-    #[arg(long, value_enum, default_value_t = CoverArg::Penalty)]
-    cover: CoverArg,
+    #[arg(long, value_enum, default_value_t = CoverMethod::Penalty)]
+    cover: CoverMethod,
     /// Move-time model of the lower-bound costs (`instant` is paper 000's assumption 2).
-    #[arg(long, value_enum, default_value_t = MoveModelArg::Trapezoid)]
-    move_model: MoveModelArg,
+    #[arg(long, value_enum, default_value_t = MoveModel::Trapezoid)]
+    move_model: MoveModel,
     /// Seed of every random choice.
     #[arg(long, default_value_t = 0)]
     seed: u64,
@@ -45,8 +47,8 @@ pub struct PlanArgs {
     reallocation_rounds: usize,
     /// Coordination of the robots on the common clock (paper 000 §4.2 is `pose-perturbation`;
     /// `none` leaves conflicts in, and the verifier then refuses the plan).
-    #[arg(long, value_enum, default_value_t = CoordinationArg::Best)]
-    coordination: CoordinationArg,
+    #[arg(long, value_enum, default_value_t = Coordination::Best)]
+    coordination: Coordination,
     /// Write the plan even if `cellplan verify` rejects it.
     #[arg(long)]
     no_verify: bool,
@@ -66,46 +68,6 @@ pub struct PlanArgs {
     /// Do not read or write the cache.
     #[arg(long)]
     no_cache: bool,
-}
-
-#[derive(Clone, Copy, ValueEnum)]
-enum AllocationArg {
-    Proximity,
-    LocalRobust,
-    Balanced,
-}
-
-#[derive(Clone, Copy, ValueEnum)]
-pub(crate) enum CoordinationArg {
-    None,
-    DelayStartup,
-    FixedPriority,
-    PosePerturbation,
-    Best,
-}
-
-impl From<CoordinationArg> for Coordination {
-    fn from(a: CoordinationArg) -> Self {
-        match a {
-            CoordinationArg::None => Coordination::None,
-            CoordinationArg::DelayStartup => Coordination::DelayStartup,
-            CoordinationArg::FixedPriority => Coordination::FixedPriority,
-            CoordinationArg::PosePerturbation => Coordination::PosePerturbation,
-            CoordinationArg::Best => Coordination::Best,
-        }
-    }
-}
-
-#[derive(Clone, Copy, ValueEnum)]
-enum CoverArg {
-    Penalty,
-    Exact,
-}
-
-#[derive(Clone, Copy, ValueEnum)]
-enum MoveModelArg {
-    Trapezoid,
-    Instant,
 }
 
 #[derive(Serialize)]
@@ -138,47 +100,41 @@ struct RobotSummary<'a> {
 
 pub fn run(args: &PlanArgs) -> Result<(), Failure> {
     let start = Instant::now();
-    if !(args.time_limit.is_finite() && args.time_limit > 0.0) {
-        return Err(Failure::Other(
-            "--time-limit must be a positive number of seconds".into(),
+    if !(args.time_limit.is_finite() && args.time_limit > 0.0 && args.time_limit <= 1e6) {
+        return Err(Failure::Usage(
+            "--time-limit must be a number of seconds above 0 and at most 1e6".into(),
         ));
     }
-    if !(args.local_set_radius.is_finite() && args.local_set_radius >= 0.0) {
-        return Err(Failure::Other(
-            "--local-set-radius must be a non-negative length in metres".into(),
+    if !(args.local_set_radius.is_finite() && (0.0..=100.0).contains(&args.local_set_radius)) {
+        return Err(Failure::Usage(
+            "--local-set-radius must be a length in metres between 0 and 100".into(),
+        ));
+    }
+    if args.lazy_rounds > 1000 || args.reallocation_rounds > 1000 {
+        return Err(Failure::Usage(
+            "--lazy-rounds and --reallocation-rounds must be at most 1000".into(),
         ));
     }
     let show = !args.quiet && !args.json;
     let opts = load_options(args.no_cache, &args.cache_dir);
     let pb = spinner(show, "loading the cell");
-    let cell = cellplan::model::load::load(&args.cell, &opts)?;
+    let cell = crate::load_cell(&args.cell, &opts)?;
+    let dir = match &args.output {
+        Some(d) => d.clone(),
+        None => crate::default_output_dir(&cell)?,
+    };
+    // Before any planning: the output folder must take files.
+    check_writable(&dir).map_err(|e| {
+        Failure::Usage(format!(
+            "cannot write into the output folder {}: {e}; give a writable folder with -o",
+            dir.display()
+        ))
+    })?;
     let load_s = start.elapsed().as_secs_f64();
-    pb.set_message(format!(
-        "finding candidates for {} MPs × {} robots",
-        cell.tasks.len(),
-        cell.robots.len()
-    ));
-    let lap = Instant::now();
-    let table = candidates::generate(&cell);
-    let candidates_s = lap.elapsed().as_secs_f64();
-    if let Some(e) = check::idle_robot_error(&cell, &table) {
-        pb.finish_and_clear();
-        return Err(e.into());
-    }
     let settings = PlanSettings {
-        allocation: match args.allocation {
-            AllocationArg::Proximity => Allocation::Proximity,
-            AllocationArg::LocalRobust => Allocation::LocalRobust,
-            AllocationArg::Balanced => Allocation::Balanced,
-        },
-        cover: match args.cover {
-            CoverArg::Penalty => CoverMethod::Penalty,
-            CoverArg::Exact => CoverMethod::Exact,
-        },
-        move_model: match args.move_model {
-            MoveModelArg::Trapezoid => MoveModel::Trapezoid,
-            MoveModelArg::Instant => MoveModel::Instant,
-        },
+        allocation: args.allocation,
+        cover: args.cover,
+        move_model: args.move_model,
         seed: args.seed,
         time_limit: Duration::from_secs_f64(args.time_limit),
         local_set_radius: args.local_set_radius,
@@ -186,52 +142,41 @@ pub fn run(args: &PlanArgs) -> Result<(), Failure> {
         reallocation_rounds: args.reallocation_rounds,
         ..PlanSettings::default()
     };
-    let progress = {
-        let pb = pb.clone();
-        move |stage: Stage| {
-            pb.set_message(match stage {
-                Stage::Costs => "move-time bounds between candidates",
-                Stage::Allocation => "allocating MPs to robots",
-                Stage::Sequencing => "sequencing and planning collision-free legs",
-                Stage::Timing => "timing the trajectories",
-            })
-        }
-    };
-    let failure = |e: PlanError| match e {
-        PlanError::Infeasible(m) => Failure::Input(Box::new(
-            InputError::new(&cell.path, m).hint("see [process] task_cap and balance_limit in the cell file"),
-        )),
-        other => Failure::Other(other.to_string()),
-    };
-    let outcome = plan::plan(&cell, &table, &settings, &progress).map_err(failure)?;
     let coord_settings = CoordSettings {
-        strategy: args.coordination.into(),
+        strategy: args.coordination,
         seed: args.seed,
         ..CoordSettings::default()
     };
-    pb.set_message(
-        if coord_settings.strategy == Coordination::Best && settings.allocation == Allocation::Balanced {
-            "coordinating the robots on one clock (and the proximity allocation against it)"
-        } else {
-            "coordinating the robots on one clock"
-        },
-    );
-    let (outcome, settings, coordinated) =
-        coord::coordinate_plan(&cell, &table, outcome, settings, &coord_settings).map_err(failure)?;
-    let mut doc = output::build(
-        &cell,
-        &table,
-        &outcome,
-        &coordinated,
-        &settings,
-        load_s,
-        candidates_s,
-    );
-    pb.set_message("verifying the plan");
-    let lap = Instant::now();
-    let report = verify(&cell, &doc, &VerifySettings::default());
-    doc.compute_s.verification = lap.elapsed().as_secs_f64();
-    doc.verified = report.ok;
+    let words = cell.process.words();
+    let progress = {
+        let pb = pb.clone();
+        let (tasks, robots) = (cell.tasks.len(), cell.robots.len());
+        move |step: Step| {
+            pb.set_message(match step {
+                Step::Candidates => {
+                    format!("finding candidates for {tasks} {} × {robots} robots", words.tasks)
+                }
+                Step::Plan(Stage::Costs) => "move-time bounds between candidates".into(),
+                Step::Plan(Stage::Allocation) => format!("allocating {} to robots", words.tasks),
+                Step::Plan(Stage::Sequencing) => "sequencing and planning collision-free legs".into(),
+                Step::Plan(Stage::Timing) => "timing the trajectories".into(),
+                Step::Coordination { proximity_too: true } => {
+                    "coordinating the robots on one clock (and the proximity allocation against it)".into()
+                }
+                Step::Coordination { proximity_too: false } => "coordinating the robots on one clock".into(),
+                Step::Verification => "verifying the plan".into(),
+            })
+        }
+    };
+    let run = pipeline::run(&cell, &settings, &coord_settings, load_s, &progress).map_err(|e| match e {
+        PipelineError::Input(e) => Failure::Input(e),
+        PipelineError::Plan(e) if e.is_input() => Failure::Input(Box::new(
+            InputError::new(&cell.path, e.to_string())
+                .hint("see `task_cap` and `balance_limit` in the [planning] table of the cell file"),
+        )),
+        PipelineError::Plan(e) => Failure::Other(e.to_string()),
+    })?;
+    let (mut doc, report) = (run.plan, run.report);
     if !report.ok && !args.no_verify {
         pb.finish_and_clear();
         for v in &report.violations {
@@ -242,28 +187,29 @@ pub fn run(args: &PlanArgs) -> Result<(), Failure> {
             report.violations.len()
         )));
     }
-    let dir = args
-        .output
-        .clone()
-        .unwrap_or_else(|| PathBuf::from("out").join(&cell.name));
     let file = dir.join("plan.json");
+    let report_file = dir.join("report.html");
     doc.compute_s.total = start.elapsed().as_secs_f64();
     let text = serde_json::to_string_pretty(&doc).map_err(|e| Failure::Other(e.to_string()))?;
-    std::fs::create_dir_all(&dir)
-        .and_then(|()| write_atomic(&file, text.as_bytes()))
-        .map_err(|e| Failure::Other(format!("cannot write {}: {e}", file.display())))?;
-    let report_file = dir.join("report.html");
-    if !args.no_report {
+    // The plan and its report are written together or not at all.
+    let page = if args.no_report {
+        None
+    } else {
         pb.set_message("writing the report");
-        crate::report_cmd::write_report(
-            &report_file,
+        Some(crate::report_cmd::render_report(
             &file,
             &doc,
             &cell,
             Some(&report),
-            cellplan::report::scene::MESH_BUDGET,
-        )?;
+            cellplan_report::scene::MESH_BUDGET,
+        )?)
+    };
+    let mut files: Vec<(&std::path::Path, &[u8])> = vec![(&file, text.as_bytes())];
+    if let Some(page) = &page {
+        files.push((&report_file, page.as_bytes()));
     }
+    write_all_atomic(&files)
+        .map_err(|e| Failure::Other(format!("cannot write into {}: {e}", dir.display())))?;
     pb.finish_and_clear();
     cell.save_cache();
     if args.json {

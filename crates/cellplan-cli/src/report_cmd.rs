@@ -1,10 +1,10 @@
 //! `cellplan report` (the HTML page of a plan) and `cellplan export` (glTF, CSV).
 use crate::Failure;
-use cellplan::plan::output::Plan;
-use cellplan::report::html::{PlanReport, plan_html};
-use cellplan::report::scene::{MESH_BUDGET, Scene};
-use cellplan::verify::{self, VerifySettings};
-use cellplan::{Cell, InputError, LoadOptions, io::write_atomic};
+use cellplan_core::Plan;
+use cellplan_core::verify::{self, VerifySettings};
+use cellplan_model::{Cell, InputError, LoadOptions, io::write_atomic};
+use cellplan_report::html::{PlanReport, plan_html};
+use cellplan_report::scene::{MESH_BUDGET, Scene};
 use clap::Args;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -77,7 +77,7 @@ fn load_cell(plan_path: &Path, plan: &Plan, cell: &Option<PathBuf>) -> Result<Ce
             p
         }
     };
-    let cell = cellplan::model::load::load(&path, &LoadOptions::default())?;
+    let cell = crate::load_cell(&path, &LoadOptions::default())?;
     if cell.name != plan.cell {
         eprintln!(
             "note: the plan was made for cell `{}`, {} is cell `{}`",
@@ -97,6 +97,26 @@ fn mismatch(plan_path: &Path) -> impl Fn(String) -> Failure + '_ {
     }
 }
 
+/// The HTML report of `plan` (read from `plan_path`).
+pub fn render_report(
+    plan_path: &Path,
+    plan: &Plan,
+    cell: &Cell,
+    verification: Option<&verify::Report>,
+    mesh_budget: usize,
+) -> Result<String, Failure> {
+    let scene = Scene::new(cell, mesh_budget);
+    let name = plan_path.display().to_string();
+    plan_html(&PlanReport {
+        plan,
+        cell,
+        scene: &scene,
+        verification,
+        plan_file: Some(&name),
+    })
+    .map_err(mismatch(plan_path))
+}
+
 /// Writes the HTML report of `plan` to `path`; returns the bytes written.
 pub fn write_report(
     path: &Path,
@@ -106,16 +126,7 @@ pub fn write_report(
     verification: Option<&verify::Report>,
     mesh_budget: usize,
 ) -> Result<usize, Failure> {
-    let scene = Scene::new(cell, mesh_budget);
-    let name = plan_path.display().to_string();
-    let page = plan_html(&PlanReport {
-        plan,
-        cell,
-        scene: &scene,
-        verification,
-        plan_file: Some(&name),
-    })
-    .map_err(mismatch(plan_path))?;
+    let page = render_report(plan_path, plan, cell, verification, mesh_budget)?;
     write_atomic(path, page.as_bytes())
         .map_err(|e| Failure::Other(format!("cannot write {}: {e}", path.display())))?;
     Ok(page.len())
@@ -169,7 +180,7 @@ pub fn run_export(args: &ExportArgs) -> Result<(), Failure> {
     let scene = Scene::new(&cell, args.mesh_budget.max(12));
     if let Some(path) = &args.gltf {
         let start = Instant::now();
-        let bytes = cellplan::export::gltf::glb(&plan, &cell, &scene).map_err(mismatch(&args.plan))?;
+        let bytes = cellplan_report::gltf::glb(&plan, &cell, &scene).map_err(mismatch(&args.plan))?;
         write_atomic(path, &bytes)
             .map_err(|e| Failure::Other(format!("cannot write {}: {e}", path.display())))?;
         eprintln!(
@@ -180,7 +191,7 @@ pub fn run_export(args: &ExportArgs) -> Result<(), Failure> {
         );
     }
     if let Some(dir) = &args.csv {
-        let files = cellplan::export::csv::files(&plan, &scene).map_err(mismatch(&args.plan))?;
+        let files = cellplan_report::csv::files(&plan, &scene).map_err(mismatch(&args.plan))?;
         for (name, text) in &files {
             let path = dir.join(name);
             write_atomic(&path, text.as_bytes())

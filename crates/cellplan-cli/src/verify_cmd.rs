@@ -1,7 +1,7 @@
 //! `cellplan verify`: the independent check of a plan.
 use crate::Failure;
-use cellplan::LoadOptions;
-use cellplan::verify::{VerifySettings, Violation, verify};
+use cellplan_core::verify::{VerifySettings, Violation, verify};
+use cellplan_model::LoadOptions;
 use clap::Args;
 use std::path::PathBuf;
 
@@ -23,13 +23,14 @@ pub struct VerifyArgs {
 }
 
 pub fn run(args: &VerifyArgs) -> Result<(), Failure> {
-    if !(args.time_step.is_finite() && args.time_step > 0.0) {
-        return Err(Failure::Other(
-            "--time-step must be a positive number of seconds".into(),
-        ));
+    if !(args.time_step.is_finite() && (1e-4..=1.0).contains(&args.time_step)) {
+        return Err(Failure::Usage(format!(
+            "--time-step must be between 0.0001 and 1 s, not {}",
+            args.time_step
+        )));
     }
     let plan = crate::report_cmd::read_plan(&args.plan)?;
-    let cell = cellplan::model::load::load(&args.cell, &LoadOptions::default())?;
+    let cell = crate::load_cell(&args.cell, &LoadOptions::default())?;
     let settings = VerifySettings {
         robot_robot: !args.no_robot_robot,
         time_step: args.time_step,

@@ -357,7 +357,7 @@ fn gen_tasks_is_deterministic_and_valid() {
     }
     let a = std::fs::read_to_string(&out_a).unwrap();
     assert_eq!(a, std::fs::read_to_string(&out_b).unwrap());
-    let tasks = cellplan::model::tasks::parse_tasks(&out_a, &a, 1.0, 1.0).unwrap();
+    let tasks = cellplan_model::tasks::parse_tasks(&out_a, &a, 1.0, 1.0, &[]).unwrap();
     assert_eq!(tasks.len(), 12);
     for t in &tasks {
         assert!(t.position.x >= 0.0);
@@ -843,7 +843,7 @@ fn bench_minmax_generates_then_benchmarks() {
         &["bench", "minmax", file.to_str().unwrap(), "--method", "exact"],
         &dir,
     );
-    assert_eq!(out.status.code(), Some(1));
+    assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("not for minmax"));
 }
 
@@ -917,7 +917,7 @@ fn plan_writes_a_plan_and_a_stable_summary() {
     assert!(cycle > 4.5);
     let plan: Value = serde_json::from_slice(&std::fs::read(out_dir.join("plan.json")).unwrap()).unwrap();
     assert_eq!(plan["format"], "cellplan-plan");
-    assert_eq!(plan["version"], 1);
+    assert_eq!(plan["version"], 2);
     assert_eq!(plan["robots"][0]["tasks"].as_array().unwrap().len(), 3);
     assert_eq!(plan["robots"][0]["legs"].as_array().unwrap().len(), 4);
     // The same seed gives the same plan, whatever the thread count.

@@ -11,11 +11,23 @@
 //!   indices; polygons are fan-triangulated; everything else (`vt`, `vn`, `g`, `o`, `s`,
 //!   `usemtl`, `mtllib`, comments, ...) is ignored. Vertices no face refers to are dropped.
 //!
-//! Degenerate triangles (two equal vertex indices) are dropped; a mesh without triangles is an
-//! error. Units stay those of the file: the caller scales ([`Mesh::scaled`]).
+//! Degenerate triangles (two corners at the same point) are dropped; a mesh without triangles,
+//! or whose triangles all have zero area, is an error, whatever the format. Units stay those
+//! of the file: the caller scales ([`Mesh::scaled`]).
+//!
+//! Bad input is refused, never a panic or an unbounded read: files are read up to
+//! [`MAX_FILE_BYTES`], and a coordinate that is not finite or exceeds [`MAX_COORDINATE`] in
+//! magnitude is refused with its line (text) or triangle (binary STL).
 use crate::{DVec3, MeshError, Pose};
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
+
+/// Largest mesh file read, in bytes (1 GiB: some 21 million binary STL triangles).
+pub const MAX_FILE_BYTES: u64 = 1 << 30;
+
+/// Largest coordinate magnitude accepted, in the file's units: 1e6 is a kilometre in
+/// millimetres, so anything beyond it is a unit mistake or a damaged file.
+pub const MAX_COORDINATE: f64 = 1e6;
 
 /// An indexed triangle mesh (metres once loaded by the cell loader; loaders keep file units).
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -187,11 +199,50 @@ pub fn load_mesh(path: &Path) -> Result<Mesh, MeshError> {
             });
         }
     };
-    let bytes = std::fs::read(path).map_err(|source| MeshError::Io {
+    let bytes = read_bounded(path, MAX_FILE_BYTES)?;
+    parse(&bytes, path)
+}
+
+/// The bytes of `path`, at most `limit` of them. A regular file larger than `limit` is refused
+/// before reading; anything else (a pipe, `/dev/zero`) is read up to `limit + 1` bytes and
+/// refused if it has more.
+fn read_bounded(path: &Path, limit: u64) -> Result<Vec<u8>, MeshError> {
+    use std::io::Read as _;
+    let io = |source| MeshError::Io {
         path: path.to_path_buf(),
         source,
-    })?;
-    parse(&bytes, path)
+    };
+    let too_large = |size: String| {
+        let shown = if limit.is_multiple_of(1 << 20) {
+            format!("{} MiB", limit >> 20)
+        } else {
+            format!("{limit} bytes")
+        };
+        parse_err(
+            path,
+            None,
+            format!(
+                "the file is {size}, larger than the {shown} a mesh file may have: check that the \
+                 path names a mesh, or decimate the mesh (collision needs far fewer triangles)"
+            ),
+        )
+    };
+    let file = std::fs::File::open(path).map_err(io)?;
+    let stated = file.metadata().ok().filter(|m| m.is_file()).map(|m| m.len());
+    if let Some(len) = stated
+        && len > limit
+    {
+        return Err(too_large(format!("{len} bytes")));
+    }
+    // `stated <= limit` here, so the reservation is bounded.
+    let mut bytes = Vec::with_capacity(stated.map_or(0, |l| l as usize + 1));
+    file.take(limit.saturating_add(1))
+        .read_to_end(&mut bytes)
+        .map_err(io)?;
+    if bytes.len() as u64 > limit {
+        return Err(too_large(format!("more than {limit} bytes")));
+    }
+    Ok(bytes)
 }
 
 /// Parses the bytes of an STL file, binary or ASCII (`path` only names the file in errors).
@@ -282,7 +333,7 @@ pub fn parse_obj(bytes: &[u8], path: &Path) -> Result<Mesh, MeshError> {
                     ));
                 }
                 for i in 1..face.len() - 1 {
-                    push_triangle(&mut triangles, [face[0], face[i], face[i + 1]]);
+                    push_triangle(&mut triangles, &vertices, [face[0], face[i], face[i + 1]]);
                 }
             }
             // Texture coordinates, normals, groups, objects, smoothing, materials, lines,
@@ -290,9 +341,7 @@ pub fn parse_obj(bytes: &[u8], path: &Path) -> Result<Mesh, MeshError> {
             _ => {}
         }
     }
-    if triangles.is_empty() {
-        return Err(empty_error(path));
-    }
+    check_area(&vertices, &triangles, path)?;
     Ok(compact(vertices, triangles))
 }
 
@@ -378,13 +427,18 @@ fn parse_binary_stl(bytes: &[u8], n: usize, path: &Path) -> Result<Mesh, MeshErr
                     ),
                 ));
             }
+            if let Some(c) = v.to_array().into_iter().find(|c| c.abs() > MAX_COORDINATE) {
+                return Err(parse_err(
+                    path,
+                    None,
+                    format!("triangle {} of {n}: coordinate {}", k + 1, too_far(c)),
+                ));
+            }
             *idx = weld.index(v);
         }
-        push_triangle(&mut triangles, tri);
+        push_triangle(&mut triangles, &weld.vertices, tri);
     }
-    if triangles.is_empty() {
-        return Err(empty_error(path));
-    }
+    check_area(&weld.vertices, &triangles, path)?;
     Ok(Mesh {
         vertices: weld.vertices,
         triangles,
@@ -459,7 +513,11 @@ fn parse_ascii_stl(bytes: &[u8], path: &Path) -> Result<Mesh, MeshError> {
                     ));
                 }
                 for i in 1..corners.len() - 1 {
-                    push_triangle(&mut triangles, [corners[0], corners[i], corners[i + 1]]);
+                    push_triangle(
+                        &mut triangles,
+                        &weld.vertices,
+                        [corners[0], corners[i], corners[i + 1]],
+                    );
                 }
             }
             other => {
@@ -482,9 +540,7 @@ fn parse_ascii_stl(bytes: &[u8], path: &Path) -> Result<Mesh, MeshError> {
             "the file ends inside this facet: it is truncated; re-export it from CAD".into(),
         ));
     }
-    if triangles.is_empty() {
-        return Err(empty_error(path));
-    }
+    check_area(&weld.vertices, &triangles, path)?;
     Ok(Mesh {
         vertices: weld.vertices,
         triangles,
@@ -521,15 +577,49 @@ impl Welder {
     }
 }
 
-/// Adds a triangle unless two of its corners are the same vertex.
-fn push_triangle(triangles: &mut Vec<[u32; 3]>, [a, b, c]: [u32; 3]) {
-    if a != b && b != c && a != c {
+/// Adds a triangle unless two of its corners are at the same point (the same vertex, or in
+/// OBJ two vertices at the same position; STL welds those into one vertex).
+fn push_triangle(triangles: &mut Vec<[u32; 3]>, vertices: &[DVec3], [a, b, c]: [u32; 3]) {
+    let at = |k: u32| vertices[k as usize];
+    if a != b && b != c && a != c && at(a) != at(b) && at(b) != at(c) && at(a) != at(c) {
         triangles.push([a, b, c]);
     }
 }
 
+/// The check every loader ends with: at least one triangle, and not all of zero area (each
+/// corner on the line through the other two, to rounding relative to the mesh's size).
+fn check_area(vertices: &[DVec3], triangles: &[[u32; 3]], path: &Path) -> Result<(), MeshError> {
+    let corners = |t: &[u32; 3]| t.map(|k| vertices[k as usize]);
+    let (mut lo, mut hi) = (DVec3::INFINITY, DVec3::NEG_INFINITY);
+    for t in triangles {
+        for v in corners(t) {
+            (lo, hi) = (lo.min(v), hi.max(v));
+        }
+    }
+    let size = (hi - lo).max_element();
+    // Twice the area of a triangle whose corners are off a line by rounding only.
+    let flat = size * size * 1e-12;
+    let has_area = triangles.iter().any(|t| {
+        let [a, b, c] = corners(t);
+        (b - a).cross(c - a).length() > flat
+    });
+    if has_area { Ok(()) } else { Err(empty_error(path)) }
+}
+
+/// The message for a coordinate beyond [`MAX_COORDINATE`].
+fn too_far(c: f64) -> String {
+    format!(
+        "{c:e} exceeds {MAX_COORDINATE:e} in magnitude — is the unit right? (coordinates are \
+         in the file's units, and {MAX_COORDINATE:e} mm is already a kilometre); fix the export units \
+         or re-export the mesh"
+    )
+}
+
 fn number(word: &str, path: &Path, line: usize, what: &str) -> Result<f64, MeshError> {
     match word.parse::<f64>() {
+        Ok(x) if x.is_finite() && x.abs() > MAX_COORDINATE => {
+            Err(parse_err(path, Some(line), format!("{what} {}", too_far(x))))
+        }
         Ok(x) if x.is_finite() => Ok(x),
         Ok(_) => Err(parse_err(
             path,
@@ -570,8 +660,8 @@ fn empty_error(path: &Path) -> MeshError {
     parse_err(
         path,
         None,
-        "the mesh has no triangles (or only degenerate ones): check that the right file was \
-         exported, with its surfaces"
+        "the mesh has no triangles (or only degenerate ones, of zero area): check that the right \
+         file was exported, with its surfaces"
             .into(),
     )
 }
@@ -882,6 +972,107 @@ v 9 9 9
         assert!(matches!(err, MeshError::Parse { line: Some(4), .. }), "{err}");
         let err = load_temp("obj", b"v 0 0 0\nv 1 1.0.0 0\n").unwrap_err();
         assert!(message(&err).contains("`1.0.0` is not a number"), "{err}");
+    }
+
+    #[test]
+    fn zero_area_meshes_are_refused_alike_in_obj_and_stl() {
+        // Two corners at the same point: STL welds them and drops the triangle; OBJ now too.
+        let point = [DVec3::ZERO, DVec3::ZERO, DVec3::X];
+        // Corners on one line: every triangle has zero area.
+        let line = [DVec3::ZERO, DVec3::X, DVec3::X * 2.0];
+        for tri in [point, line] {
+            let obj: String = tri
+                .iter()
+                .map(|v| format!("v {} {} {}\n", v.x, v.y, v.z))
+                .chain(["f 1 2 3\nf 3 2 1\n".to_string()])
+                .collect();
+            for (ext, bytes) in [
+                ("obj", obj.into_bytes()),
+                ("stl", ascii_stl(&[tri, tri]).into_bytes()),
+                ("stl", binary_stl(b"x", &[tri, tri])),
+            ] {
+                let err = load_temp(ext, &bytes).unwrap_err();
+                assert!(matches!(err, MeshError::Parse { line: None, .. }), "{ext}: {err}");
+                assert!(
+                    message(&err).contains("only degenerate ones, of zero area"),
+                    "{ext}: {err}"
+                );
+            }
+        }
+        // One proper triangle among degenerate ones is a mesh; the OBJ one at a repeated
+        // point is dropped as STL drops it.
+        let m = load_temp("obj", b"v 0 0 0\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1 3 4\n").unwrap();
+        assert_eq!(m.triangles, vec![[0, 1, 2]]);
+    }
+
+    #[test]
+    fn far_coordinates_are_refused_with_line_or_triangle() {
+        let err = load_temp("obj", b"v 0 0 0\nv 1 0 0\nv 0 1e30 0\nf 1 2 3\n").unwrap_err();
+        assert!(matches!(err, MeshError::Parse { line: Some(3), .. }), "{err}");
+        let msg = message(&err);
+        assert!(
+            msg.contains("vertex coordinate 1e30 exceeds 1e6 in magnitude — is the unit right?"),
+            "{msg}"
+        );
+        let text = ascii_stl(&cube_triangles()).replacen("vertex 1 0 0", "vertex 1 -2e6 0", 1);
+        let line = text.lines().position(|l| l.contains("-2e6")).unwrap() + 1;
+        let err = load_temp("stl", text.as_bytes()).unwrap_err();
+        assert!(
+            matches!(err, MeshError::Parse { line: Some(l), .. } if l == line),
+            "{err}"
+        );
+        assert!(message(&err).contains("-2e6 exceeds 1e6"), "{err}");
+        let mut tris = cube_triangles();
+        tris[6][2].z = 1e30;
+        let err = load_temp("stl", &binary_stl(b"x", &tris)).unwrap_err();
+        let msg = message(&err);
+        assert!(
+            msg.contains("triangle 7 of 12: coordinate 1.0000000150474662e30 exceeds 1e6"),
+            "{msg}"
+        );
+        // Infinity in a binary STL (NaN is covered above) and in OBJ.
+        tris[6][2].z = f64::INFINITY;
+        let msg = message(&load_temp("stl", &binary_stl(b"x", &tris)).unwrap_err());
+        assert!(msg.contains("triangle 7 of 12 has a non-finite"), "{msg}");
+        let err = load_temp("obj", b"v 0 0 0\nv -inf 0 0\n").unwrap_err();
+        assert!(matches!(err, MeshError::Parse { line: Some(2), .. }), "{err}");
+        // Exactly at the limit is fine.
+        let m = load_temp("obj", b"v 0 0 0\nv 1e6 0 0\nv 0 -1e6 0\nf 1 2 3\n").unwrap();
+        assert_eq!(m.triangles.len(), 1);
+    }
+
+    #[test]
+    fn oversized_mesh_files_are_refused_before_reading() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("huge.stl");
+        // Sparse: no disk used, but its size is over the limit.
+        std::fs::File::create(&path)
+            .unwrap()
+            .set_len(MAX_FILE_BYTES + 1)
+            .unwrap();
+        let err = load_mesh(&path).unwrap_err();
+        assert!(matches!(err, MeshError::Parse { line: None, .. }), "{err}");
+        let msg = message(&err);
+        assert!(msg.contains("huge.stl"), "{msg}");
+        assert!(
+            msg.contains("the file is 1073741825 bytes, larger than the 1024 MiB a mesh file may have"),
+            "{msg}"
+        );
+    }
+
+    #[cfg(target_os = "linux")]
+    #[test]
+    fn endless_input_is_read_only_to_the_limit() {
+        let err = read_bounded(Path::new("/dev/zero"), 4096).unwrap_err();
+        assert!(matches!(err, MeshError::Parse { line: None, .. }), "{err}");
+        assert!(
+            message(&err)
+                .starts_with("/dev/zero: the file is more than 4096 bytes, larger than the 4096 bytes"),
+            "{err}"
+        );
+        // By extension it is no mesh at all.
+        let err = load_mesh(Path::new("/dev/zero")).unwrap_err();
+        assert!(matches!(err, MeshError::Unsupported { .. }), "{err}");
     }
 
     #[test]

@@ -34,11 +34,65 @@ pub fn load_urdf(
     packages: &BTreeMap<String, PathBuf>,
     tip: Option<&str>,
 ) -> Result<RobotModel, KinError> {
-    let text = std::fs::read_to_string(path).map_err(|source| KinError::Io {
+    let text = read_urdf(path, MAX_URDF_BYTES)?;
+    load_urdf_str(&text, path, packages, tip)
+}
+
+/// The text of `path`, at most `limit` bytes of UTF-8. A regular file larger than `limit` is
+/// refused before reading; anything else (a pipe, `/dev/zero`) is read up to `limit + 1` bytes
+/// and refused if it has more.
+fn read_urdf(path: &Path, limit: u64) -> Result<String, KinError> {
+    use std::io::Read as _;
+    let io = |source| KinError::Io {
         path: path.to_path_buf(),
         source,
-    })?;
-    load_urdf_str(&text, path, packages, tip)
+    };
+    let refuse = |line: Option<usize>, message: String, hint: &str| KinError::Urdf {
+        path: path.to_path_buf(),
+        line,
+        message,
+        hint: hint.to_string(),
+    };
+    let too_large = |size: String| {
+        let shown = if limit.is_multiple_of(1 << 20) {
+            format!("{} MiB", limit >> 20)
+        } else {
+            format!("{limit} bytes")
+        };
+        refuse(
+            None,
+            format!("the file is {size}, larger than the {shown} a URDF may have"),
+            "check that the path names a URDF (meshes belong in files of their own, named by <mesh filename>)",
+        )
+    };
+    let file = std::fs::File::open(path).map_err(io)?;
+    let stated = file.metadata().ok().filter(|m| m.is_file()).map(|m| m.len());
+    if let Some(len) = stated
+        && len > limit
+    {
+        return Err(too_large(format!("{len} bytes")));
+    }
+    // `stated <= limit` here, so the reservation is bounded.
+    let mut bytes = Vec::with_capacity(stated.map_or(0, |l| l as usize + 1));
+    file.take(limit.saturating_add(1))
+        .read_to_end(&mut bytes)
+        .map_err(io)?;
+    if bytes.len() as u64 > limit {
+        return Err(too_large(format!("more than {limit} bytes")));
+    }
+    String::from_utf8(bytes).map_err(|e| {
+        let at = e.utf8_error().valid_up_to();
+        let bytes = e.as_bytes();
+        let line = bytes[..at].iter().filter(|&&b| b == b'\n').count() + 1;
+        refuse(
+            Some(line),
+            format!(
+                "byte {at} (0x{:02x}) is not UTF-8 text: this is not a URDF file",
+                bytes[at]
+            ),
+            "check that the path names a URDF, and save it as UTF-8",
+        )
+    })
 }
 
 /// As [`load_urdf`] on URDF text already read; `path` names the file in errors and relative
@@ -75,7 +129,27 @@ impl Loader<'_> {
         }
     }
 
+    /// Reads the URDF in named steps: parse and check the text, build the link tree, pick the
+    /// chain from the root to the tip, turn its joints into [`Joint`]s, hang the off-chain
+    /// links on the chain, and gather the collision shapes.
     fn load(&self, tip: Option<&str>) -> Result<RobotModel, KinError> {
+        let (doc, robot) = self.parse()?;
+        let tree = self.tree(&doc, &robot)?;
+        let path_links = self.chain_path(&robot, &tree, tip)?;
+        let (chain, chain_pos) = self.chain(&doc, &robot, &tree, &path_links)?;
+        let attach = self.attachments(&robot, &tree, &chain_pos)?;
+        let collision = self.collision(&doc, &robot, &attach, chain.links.len())?;
+        Ok(RobotModel {
+            name: robot.name.clone(),
+            path: self.path.to_path_buf(),
+            chain,
+            collision,
+        })
+    }
+
+    /// The text as an XML document with lines (checked by [`Loader::validate`]) and as urdf-rs
+    /// reads it.
+    fn parse(&self) -> Result<(xml::Document, urdf_rs::Robot), KinError> {
         let doc = xml::parse(self.text).map_err(|(line, msg)| {
             self.err(
                 Some(line),
@@ -98,13 +172,13 @@ impl Loader<'_> {
                 },
             )
         })?;
-        let elem_line = |kind: &str, name: &str| -> Option<usize> {
-            doc.children(doc.root())
-                .find(|e| e.name == kind && e.attr("name") == Some(name))
-                .map(|e| e.line)
-        };
+        Ok((doc, robot))
+    }
 
-        // Tree structure.
+    /// The links as a tree: each link's parent joint and child joints, the one root, and a
+    /// depth-first order from it. Refuses unknown links, two parents, no or several roots and
+    /// cycles.
+    fn tree<'r>(&self, doc: &xml::Document, robot: &'r urdf_rs::Robot) -> Result<Tree<'r>, KinError> {
         let link_index: HashMap<&str, usize> = robot
             .links
             .iter()
@@ -114,7 +188,7 @@ impl Loader<'_> {
         let mut parent_joint: Vec<Option<usize>> = vec![None; robot.links.len()];
         let mut child_joints: Vec<Vec<usize>> = vec![Vec::new(); robot.links.len()];
         for (ji, joint) in robot.joints.iter().enumerate() {
-            let line = elem_line("joint", &joint.name);
+            let line = elem_line(doc, "joint", &joint.name);
             let find = |name: &str, role: &str| {
                 link_index.get(name).copied().ok_or_else(|| {
                     self.err(
@@ -142,59 +216,97 @@ impl Loader<'_> {
             parent_joint[child] = Some(ji);
             child_joints[parent].push(ji);
         }
-        let roots: Vec<usize> = (0..robot.links.len())
-            .filter(|&i| parent_joint[i].is_none())
-            .collect();
-        let root = match roots.as_slice() {
-            [r] => *r,
-            [] => {
-                return Err(self.err(
-                    None,
-                    if robot.links.is_empty() {
-                        "the URDF has no <link>".to_string()
-                    } else {
-                        "the joints form a cycle: no link is without a parent".to_string()
-                    },
-                    "a URDF is a tree with one root link",
-                ));
-            }
-            many => {
-                let names: Vec<&str> = many.iter().map(|&i| robot.links[i].name.as_str()).collect();
-                return Err(self.err(
-                    many.get(1).and_then(|&i| elem_line("link", &robot.links[i].name)),
-                    format!(
-                        "the URDF has {} root links (links without a parent joint): {}",
-                        many.len(),
-                        names.join(", ")
-                    ),
-                    "connect every link to the tree with a joint (a URDF has one root link)",
-                ));
-            }
+        let root = self.root(doc, robot, &parent_joint)?;
+        let mut tree = Tree {
+            link_index,
+            parent_joint,
+            child_joints,
+            root,
+            order: Vec::new(),
+            depth: Vec::new(),
         };
-        // Depth-first order from the root; links never reached sit on a cycle.
+        self.depth_first(doc, robot, &mut tree)?;
+        Ok(tree)
+    }
+
+    /// Fills `tree.order` and `tree.depth` by a depth-first walk from the root; links never
+    /// reached sit on a cycle.
+    fn depth_first(
+        &self,
+        doc: &xml::Document,
+        robot: &urdf_rs::Robot,
+        tree: &mut Tree<'_>,
+    ) -> Result<(), KinError> {
         let mut depth = vec![usize::MAX; robot.links.len()];
         let mut order = Vec::with_capacity(robot.links.len());
-        let mut stack = vec![(root, 0usize)];
+        let mut stack = vec![(tree.root, 0usize)];
         while let Some((l, d)) = stack.pop() {
             depth[l] = d;
             order.push(l);
-            for &ji in child_joints[l].iter().rev() {
-                if let Some(&c) = link_index.get(robot.joints[ji].child.link.as_str()) {
+            for &ji in tree.child_joints[l].iter().rev() {
+                if let Some(&c) = tree.link_index.get(robot.joints[ji].child.link.as_str()) {
                     stack.push((c, d + 1));
                 }
             }
         }
         if let Some(l) = (0..robot.links.len()).find(|&l| depth[l] == usize::MAX) {
             return Err(self.err(
-                elem_line("link", &robot.links[l].name),
+                elem_line(doc, "link", &robot.links[l].name),
                 format!("link '{}' is on a cycle of joints", robot.links[l].name),
                 "a URDF is a tree: remove the joint that closes the loop",
             ));
         }
+        (tree.order, tree.depth) = (order, depth);
+        Ok(())
+    }
 
-        // Tip and chain path.
+    /// The one link without a parent joint.
+    fn root(
+        &self,
+        doc: &xml::Document,
+        robot: &urdf_rs::Robot,
+        parent_joint: &[Option<usize>],
+    ) -> Result<usize, KinError> {
+        let roots: Vec<usize> = (0..robot.links.len())
+            .filter(|&i| parent_joint[i].is_none())
+            .collect();
+        match roots.as_slice() {
+            [r] => Ok(*r),
+            [] => Err(self.err(
+                None,
+                if robot.links.is_empty() {
+                    "the URDF has no <link>".to_string()
+                } else {
+                    "the joints form a cycle: no link is without a parent".to_string()
+                },
+                "a URDF is a tree with one root link",
+            )),
+            many => {
+                let names: Vec<&str> = many.iter().map(|&i| robot.links[i].name.as_str()).collect();
+                Err(self.err(
+                    many.get(1)
+                        .and_then(|&i| elem_line(doc, "link", &robot.links[i].name)),
+                    format!(
+                        "the URDF has {} root links (links without a parent joint): {}",
+                        many.len(),
+                        names.join(", ")
+                    ),
+                    "connect every link to the tree with a joint (a URDF has one root link)",
+                ))
+            }
+        }
+    }
+
+    /// The links from the root to the tip, root first. The tip is `tip`, else `tool0` when
+    /// present, else the deepest leaf (first in depth-first order on ties).
+    fn chain_path(
+        &self,
+        robot: &urdf_rs::Robot,
+        tree: &Tree<'_>,
+        tip: Option<&str>,
+    ) -> Result<Vec<usize>, KinError> {
         let tip_link = match tip {
-            Some(name) => link_index.get(name).copied().ok_or_else(|| {
+            Some(name) => tree.link_index.get(name).copied().ok_or_else(|| {
                 let names: Vec<&str> = robot.links.iter().map(|l| l.name.as_str()).collect();
                 self.err(
                     None,
@@ -205,13 +317,12 @@ impl Loader<'_> {
                     "set the tip to one of these links",
                 )
             })?,
-            None => match link_index.get("tool0") {
+            None => match tree.link_index.get("tool0") {
                 Some(&t) => t,
                 None => {
-                    // Deepest leaf, first in depth-first order on ties.
-                    let mut best = root;
-                    for &l in &order {
-                        if child_joints[l].is_empty() && depth[l] > depth[best] {
+                    let mut best = tree.root;
+                    for &l in &tree.order {
+                        if tree.child_joints[l].is_empty() && tree.depth[l] > tree.depth[best] {
                             best = l;
                         }
                     }
@@ -221,20 +332,29 @@ impl Loader<'_> {
         };
         let mut path_links = vec![tip_link];
         let mut cur = tip_link;
-        while let Some(ji) = parent_joint[cur] {
-            cur = link_index[robot.joints[ji].parent.link.as_str()];
+        while let Some(ji) = tree.parent_joint[cur] {
+            cur = tree.link_index[robot.joints[ji].parent.link.as_str()];
             path_links.push(cur);
         }
         path_links.reverse();
+        Ok(path_links)
+    }
 
-        // Chain.
+    /// The chain along `path_links`, and each link's position on it (`None` off the chain).
+    fn chain(
+        &self,
+        doc: &xml::Document,
+        robot: &urdf_rs::Robot,
+        tree: &Tree<'_>,
+        path_links: &[usize],
+    ) -> Result<(Chain, Vec<Option<usize>>), KinError> {
         let mut links = Vec::with_capacity(path_links.len());
         let mut joints = Vec::new();
         let mut chain_pos: Vec<Option<usize>> = vec![None; robot.links.len()];
         for (ci, &l) in path_links.iter().enumerate() {
             chain_pos[l] = Some(ci);
             let name = robot.links[l].name.clone();
-            let Some(ji) = parent_joint[l] else {
+            let Some(ji) = tree.parent_joint[l] else {
                 links.push(ChainLink {
                     name,
                     origin: Pose::IDENTITY,
@@ -243,77 +363,93 @@ impl Loader<'_> {
                 continue;
             };
             let uj = &robot.joints[ji];
-            let line = elem_line("joint", &uj.name);
-            let origin = origin_pose(&uj.origin);
-            let kind = match uj.joint_type {
-                urdf_rs::JointType::Fixed => None,
-                urdf_rs::JointType::Revolute => Some(JointKind::Revolute),
-                urdf_rs::JointType::Continuous => Some(JointKind::Continuous),
-                urdf_rs::JointType::Prismatic => Some(JointKind::Prismatic),
-                ref other => {
-                    return Err(self.err(
-                        line,
-                        format!(
-                            "joint '{}' on the chain is of type {other:?}, which is not supported",
-                            uj.name
-                        ),
-                        "the chain may hold revolute, continuous, prismatic and fixed joints only",
-                    ));
-                }
-            };
-            let joint = match kind {
+            let joint = match self.chain_joint(uj, elem_line(doc, "joint", &uj.name))? {
                 None => None,
-                Some(kind) => {
-                    let axis = DVec3::from_array(uj.axis.xyz.0);
-                    let len = axis.length();
-                    if !(len > 1e-12 && len.is_finite()) {
-                        return Err(self.err(
-                            line,
-                            format!(
-                                "joint '{}' has a zero or invalid axis {:?}",
-                                uj.name, uj.axis.xyz.0
-                            ),
-                            "give <axis xyz=\"...\"> a non-zero direction",
-                        ));
-                    }
-                    let (mut lower, mut upper) = (uj.limit.lower, uj.limit.upper);
-                    if kind == JointKind::Continuous {
-                        (lower, upper) = (-TAU, TAU);
-                    } else if kind == JointKind::Revolute && !(lower.is_finite() && upper.is_finite()) {
-                        // URDF 1.2: a revolute joint without limits turns freely.
-                        lower = if lower.is_finite() { lower } else { -TAU };
-                        upper = if upper.is_finite() { upper } else { TAU };
-                    }
-                    if lower.is_nan() || upper.is_nan() || lower > upper {
-                        return Err(self.err(
-                            line,
-                            format!("joint '{}' has limits lower {lower} > upper {upper}", uj.name),
-                            "make <limit lower> at most <limit upper>",
-                        ));
-                    }
-                    joints.push(Joint {
-                        name: uj.name.clone(),
-                        kind,
-                        axis: axis / len,
-                        lower,
-                        upper,
-                        // No <limit> (continuous) or a zero velocity: unknown, no limit.
-                        max_velocity: if uj.limit.velocity > 0.0 {
-                            uj.limit.velocity
-                        } else {
-                            f64::INFINITY
-                        },
-                        max_effort: uj.limit.effort,
-                    });
+                Some(j) => {
+                    joints.push(j);
                     Some(joints.len() - 1)
                 }
             };
-            links.push(ChainLink { name, origin, joint });
+            links.push(ChainLink {
+                name,
+                origin: origin_pose(&uj.origin),
+                joint,
+            });
         }
+        Ok((Chain { links, joints }, chain_pos))
+    }
 
-        // Where each link's shapes go: walk up to the nearest chain link.
+    /// The [`Joint`] of a URDF joint on the chain (`None` for a fixed one); `line` is its
+    /// element's.
+    fn chain_joint(&self, uj: &urdf_rs::Joint, line: Option<usize>) -> Result<Option<Joint>, KinError> {
+        let kind = match uj.joint_type {
+            urdf_rs::JointType::Fixed => return Ok(None),
+            urdf_rs::JointType::Revolute => JointKind::Revolute,
+            urdf_rs::JointType::Continuous => JointKind::Continuous,
+            urdf_rs::JointType::Prismatic => JointKind::Prismatic,
+            ref other => {
+                return Err(self.err(
+                    line,
+                    format!(
+                        "joint '{}' on the chain is of type {other:?}, which is not supported",
+                        uj.name
+                    ),
+                    "the chain may hold revolute, continuous, prismatic and fixed joints only",
+                ));
+            }
+        };
+        let axis = DVec3::from_array(uj.axis.xyz.0);
+        let len = axis.length();
+        if !(len > 1e-12 && len.is_finite()) {
+            return Err(self.err(
+                line,
+                format!(
+                    "joint '{}' has a zero or invalid axis {:?}",
+                    uj.name, uj.axis.xyz.0
+                ),
+                "give <axis xyz=\"...\"> a non-zero direction",
+            ));
+        }
+        let (mut lower, mut upper) = (uj.limit.lower, uj.limit.upper);
+        if kind == JointKind::Continuous {
+            (lower, upper) = (-TAU, TAU);
+        } else if kind == JointKind::Revolute && !(lower.is_finite() && upper.is_finite()) {
+            // URDF 1.2: a revolute joint without limits turns freely.
+            lower = if lower.is_finite() { lower } else { -TAU };
+            upper = if upper.is_finite() { upper } else { TAU };
+        }
+        if lower.is_nan() || upper.is_nan() || lower > upper {
+            return Err(self.err(
+                line,
+                format!("joint '{}' has limits lower {lower} > upper {upper}", uj.name),
+                "make <limit lower> at most <limit upper>",
+            ));
+        }
+        Ok(Some(Joint {
+            name: uj.name.clone(),
+            kind,
+            axis: axis / len,
+            lower,
+            upper,
+            // No <limit> (continuous) or a zero velocity: unknown, no limit.
+            max_velocity: if uj.limit.velocity > 0.0 {
+                uj.limit.velocity
+            } else {
+                f64::INFINITY
+            },
+            max_effort: uj.limit.effort,
+        }))
+    }
+
+    /// Where each link's shapes go: walk up to the nearest chain link.
+    fn attachments(
+        &self,
+        robot: &urdf_rs::Robot,
+        tree: &Tree<'_>,
+        chain_pos: &[Option<usize>],
+    ) -> Result<Vec<Option<Attachment>>, KinError> {
         let mut attach: Vec<Option<Attachment>> = vec![None; robot.links.len()];
-        for &l in &order {
+        for &l in &tree.order {
             attach[l] = Some(match chain_pos[l] {
                 Some(ci) => Attachment {
                     chain_link: ci,
@@ -321,9 +457,9 @@ impl Loader<'_> {
                 },
                 None => {
                     // The parent comes earlier in depth-first order, so it is set already.
-                    let ji =
-                        parent_joint[l].ok_or_else(|| self.err(None, "internal: root off the chain", ""))?;
-                    let p = link_index[robot.joints[ji].parent.link.as_str()];
+                    let ji = tree.parent_joint[l]
+                        .ok_or_else(|| self.err(None, "internal: root off the chain", ""))?;
+                    let p = tree.link_index[robot.joints[ji].parent.link.as_str()];
                     let up = attach[p].ok_or_else(|| self.err(None, "internal: unordered tree", ""))?;
                     Attachment {
                         chain_link: up.chain_link,
@@ -332,22 +468,21 @@ impl Loader<'_> {
                 }
             });
         }
-        let mut collision: Vec<Vec<(ShapeSpec, Pose)>> = vec![Vec::new(); links.len()];
+        Ok(attach)
+    }
+
+    /// The collision shapes of every link, placed in the frame of the chain link it hangs
+    /// from (`chain_links` of them). Meshes named twice are loaded once.
+    fn collision(
+        &self,
+        doc: &xml::Document,
+        robot: &urdf_rs::Robot,
+        attach: &[Option<Attachment>],
+        chain_links: usize,
+    ) -> Result<Vec<Vec<(ShapeSpec, Pose)>>, KinError> {
+        let mut collision: Vec<Vec<(ShapeSpec, Pose)>> = vec![Vec::new(); chain_links];
         let mut meshes: HashMap<PathBuf, Arc<Mesh>> = HashMap::new();
-        // Line of each collision <mesh>, by link and filename, for errors.
-        let mut mesh_lines: HashMap<(&str, &str), usize> = HashMap::new();
-        for link in doc.children(doc.root()).filter(|e| e.name == "link") {
-            let name = link.attr("name").unwrap_or_default();
-            for c in doc.children(link).filter(|c| c.name == "collision") {
-                for g in doc.children(c).filter(|g| g.name == "geometry") {
-                    for m in doc.children(g).filter(|m| m.name == "mesh") {
-                        if let Some(f) = m.attr("filename") {
-                            mesh_lines.entry((name, f)).or_insert(m.line);
-                        }
-                    }
-                }
-            }
-        }
+        let mesh_lines = mesh_lines(doc);
         for (l, link) in robot.links.iter().enumerate() {
             let Some(at) = attach[l] else { continue };
             for c in &link.collision {
@@ -357,12 +492,7 @@ impl Loader<'_> {
                 }
             }
         }
-        Ok(RobotModel {
-            name: robot.name.clone(),
-            path: self.path.to_path_buf(),
-            chain: Chain { links, joints },
-            collision,
-        })
+        Ok(collision)
     }
 
     /// Checks the structure urdf-rs would reject (or silently accept) with a line number.
@@ -414,13 +544,14 @@ impl Loader<'_> {
                 ));
             }
             if what == "link" {
+                let owner = format!("link '{name}'");
                 for c in doc.children(e) {
                     match c.name.as_str() {
                         "collision" | "visual" => {
-                            self.validate_origin(doc, c)?;
-                            self.validate_geometry(doc, c)?;
+                            self.validate_origin(doc, c, &owner)?;
+                            self.validate_geometry(doc, c, &owner)?;
                         }
-                        "inertial" => self.validate_inertial(doc, c)?,
+                        "inertial" => self.validate_inertial(doc, c, &owner)?,
                         _ => {}
                     }
                 }
@@ -474,16 +605,24 @@ impl Loader<'_> {
                 }
             }
         }
-        self.validate_origin(doc, e)?;
+        let owner = format!("joint '{name}'");
+        self.validate_origin(doc, e, &owner)?;
         if let Some(axis) = doc.child(e, "axis") {
-            self.numbers(axis, "xyz", 3, true)?;
+            self.numbers(&owner, axis, "xyz", 3, true, Bound::Finite)?;
         }
         match doc.child(e, "limit") {
             Some(limit) => {
-                for attr in ["lower", "upper", "effort"] {
-                    self.numbers(limit, attr, 1, false)?;
+                // A prismatic joint's limits are lengths; a revolute joint's are angles.
+                let position = if ty == "prismatic" {
+                    Bound::Length
+                } else {
+                    Bound::Finite
+                };
+                for attr in ["lower", "upper"] {
+                    self.numbers(&owner, limit, attr, 1, false, position)?;
                 }
-                self.numbers(limit, "velocity", 1, true)?;
+                self.numbers(&owner, limit, "effort", 1, false, Bound::Finite)?;
+                self.numbers(&owner, limit, "velocity", 1, true, Bound::Finite)?;
             }
             None if ty == "revolute" || ty == "prismatic" => {
                 return Err(self.err(
@@ -497,10 +636,10 @@ impl Loader<'_> {
         Ok(())
     }
 
-    fn validate_inertial(&self, doc: &xml::Document, e: &xml::Element) -> Result<(), KinError> {
-        self.validate_origin(doc, e)?;
+    fn validate_inertial(&self, doc: &xml::Document, e: &xml::Element, owner: &str) -> Result<(), KinError> {
+        self.validate_origin(doc, e, owner)?;
         match doc.child(e, "mass") {
-            Some(m) => self.numbers(m, "value", 1, true)?,
+            Some(m) => self.numbers(owner, m, "value", 1, true, Bound::Finite)?,
             None => {
                 return Err(self.err(
                     Some(e.line),
@@ -512,7 +651,7 @@ impl Loader<'_> {
         match doc.child(e, "inertia") {
             Some(i) => {
                 for attr in ["ixx", "ixy", "ixz", "iyy", "iyz", "izz"] {
-                    self.numbers(i, attr, 1, true)?;
+                    self.numbers(owner, i, attr, 1, true, Bound::Finite)?;
                 }
                 Ok(())
             }
@@ -524,15 +663,20 @@ impl Loader<'_> {
         }
     }
 
-    fn validate_origin(&self, doc: &xml::Document, e: &xml::Element) -> Result<(), KinError> {
+    fn validate_origin(&self, doc: &xml::Document, e: &xml::Element, owner: &str) -> Result<(), KinError> {
         if let Some(o) = doc.child(e, "origin") {
-            self.numbers(o, "xyz", 3, false)?;
-            self.numbers(o, "rpy", 3, false)?;
+            self.numbers(owner, o, "xyz", 3, false, Bound::Length)?;
+            self.numbers(owner, o, "rpy", 3, false, Bound::Finite)?;
         }
         Ok(())
     }
 
-    fn validate_geometry(&self, doc: &xml::Document, collision: &xml::Element) -> Result<(), KinError> {
+    fn validate_geometry(
+        &self,
+        doc: &xml::Document,
+        collision: &xml::Element,
+        owner: &str,
+    ) -> Result<(), KinError> {
         let Some(g) = doc.child(collision, "geometry") else {
             return Err(self.err(
                 Some(collision.line),
@@ -548,12 +692,12 @@ impl Loader<'_> {
             ));
         };
         match shape.name.as_str() {
-            "box" => self.numbers(shape, "size", 3, true),
+            "box" => self.numbers(owner, shape, "size", 3, true, Bound::Length),
             "cylinder" | "capsule" => {
-                self.numbers(shape, "radius", 1, true)?;
-                self.numbers(shape, "length", 1, true)
+                self.numbers(owner, shape, "radius", 1, true, Bound::Length)?;
+                self.numbers(owner, shape, "length", 1, true, Bound::Length)
             }
-            "sphere" => self.numbers(shape, "radius", 1, true),
+            "sphere" => self.numbers(owner, shape, "radius", 1, true, Bound::Length),
             "mesh" => {
                 if shape.attr("filename").is_none() {
                     return Err(self.err(
@@ -562,7 +706,8 @@ impl Loader<'_> {
                         "add filename=\"package://...\"",
                     ));
                 }
-                self.numbers(shape, "scale", 3, false)
+                // A factor: the scaled mesh is checked when it is loaded.
+                self.numbers(owner, shape, "scale", 3, false, Bound::Finite)
             }
             other => Err(self.err(
                 Some(shape.line),
@@ -572,8 +717,17 @@ impl Loader<'_> {
         }
     }
 
-    /// Attribute `attr` of `e` holds `n` numbers (not NaN).
-    fn numbers(&self, e: &xml::Element, attr: &str, n: usize, required: bool) -> Result<(), KinError> {
+    /// Attribute `attr` of `e` (an element of `owner`, e.g. `joint 'j1'`) holds `n` numbers,
+    /// finite and within `bound`.
+    fn numbers(
+        &self,
+        owner: &str,
+        e: &xml::Element,
+        attr: &str,
+        n: usize,
+        required: bool,
+        bound: Bound,
+    ) -> Result<(), KinError> {
         let Some(v) = e.attr(attr) else {
             if required {
                 return Err(self.err(
@@ -593,6 +747,30 @@ impl Loader<'_> {
                 Some(e.line),
                 format!("attribute {attr}=\"{v}\" of <{}> must be {n} number(s)", e.name),
                 format!("write {n} number(s) separated by spaces"),
+            ));
+        }
+        let values = parsed.into_iter().flatten();
+        if let Some(x) = values.clone().find(|x| !x.is_finite()) {
+            return Err(self.err(
+                Some(e.line),
+                format!(
+                    "attribute {attr}=\"{v}\" of <{}> in {owner} is {x}, not a finite number",
+                    e.name
+                ),
+                "write finite numbers (to leave a joint limit open, leave the attribute out)",
+            ));
+        }
+        if bound == Bound::Length
+            && let Some(x) = values.clone().find(|x| x.abs() > MAX_LENGTH_M)
+        {
+            return Err(self.err(
+                Some(e.line),
+                format!(
+                    "attribute {attr}=\"{v}\" of <{}> in {owner}: {x:e} m exceeds {MAX_LENGTH_M:e} m \
+                     in magnitude — is the unit right?",
+                    e.name
+                ),
+                "URDF lengths are in metres: convert millimetres (divide by 1000)",
             ));
         }
         Ok(())
@@ -703,6 +881,23 @@ impl Loader<'_> {
                     Some(s) if s.0 != [1.0, 1.0, 1.0] => Arc::new(scale_mesh(&mesh, DVec3::from_array(s.0))),
                     _ => mesh,
                 };
+                // Metres from here on: a mesh reaching beyond MAX_LENGTH_M has the wrong unit.
+                let reach = mesh
+                    .vertices
+                    .iter()
+                    .map(|v| v.abs().max_element())
+                    .fold(0.0, f64::max);
+                if reach > MAX_LENGTH_M {
+                    return Err(self.err(
+                        line,
+                        format!(
+                            "collision mesh \"{filename}\" of link '{link}' reaches {reach:e} m from \
+                             its origin once scaled, beyond {MAX_LENGTH_M:e} m — is the unit right?"
+                        ),
+                        "URDF meshes are in metres: give a mesh in millimetres \
+                         scale=\"0.001 0.001 0.001\"",
+                    ));
+                }
                 vec![(ShapeSpec::Mesh(mesh), Pose::IDENTITY)]
             }
         })
@@ -743,6 +938,63 @@ impl Loader<'_> {
         };
         Ok(if p.is_absolute() { p } else { base.join(p) })
     }
+}
+
+/// Largest URDF file read, in bytes (64 MiB; real robot descriptions are well under 1 MiB, and
+/// meshes live in files of their own).
+pub const MAX_URDF_BYTES: u64 = 64 << 20;
+
+/// Largest length accepted in a URDF, in metres (10 km): an origin offset, a primitive's size,
+/// a prismatic joint's limit, or a collision mesh's reach once scaled. Anything beyond is a
+/// unit mistake or a damaged file.
+pub const MAX_LENGTH_M: f64 = 1e4;
+
+/// Which bound the numbers of an attribute must meet.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Bound {
+    /// Finite.
+    Finite,
+    /// Finite and at most [`MAX_LENGTH_M`] in magnitude.
+    Length,
+}
+
+/// The link tree of a URDF (indices into `links` and `joints` of the urdf-rs robot).
+struct Tree<'r> {
+    link_index: HashMap<&'r str, usize>,
+    /// Per link, the joint whose child it is (`None` for the root).
+    parent_joint: Vec<Option<usize>>,
+    /// Per link, the joints whose parent it is, in file order.
+    child_joints: Vec<Vec<usize>>,
+    root: usize,
+    /// Depth-first order from the root.
+    order: Vec<usize>,
+    /// Per link, its number of joints from the root.
+    depth: Vec<usize>,
+}
+
+/// Line of the top-level `<kind name="name">` element.
+fn elem_line(doc: &xml::Document, kind: &str, name: &str) -> Option<usize> {
+    doc.children(doc.root())
+        .find(|e| e.name == kind && e.attr("name") == Some(name))
+        .map(|e| e.line)
+}
+
+/// Line of each collision `<mesh>`, by link and filename, for errors.
+fn mesh_lines(doc: &xml::Document) -> HashMap<(&str, &str), usize> {
+    let mut lines = HashMap::new();
+    for link in doc.children(doc.root()).filter(|e| e.name == "link") {
+        let name = link.attr("name").unwrap_or_default();
+        for c in doc.children(link).filter(|c| c.name == "collision") {
+            for g in doc.children(c).filter(|g| g.name == "geometry") {
+                for m in doc.children(g).filter(|m| m.name == "mesh") {
+                    if let Some(f) = m.attr("filename") {
+                        lines.entry((name, f)).or_insert(m.line);
+                    }
+                }
+            }
+        }
+    }
+    lines
 }
 
 /// 1-based line of the first occurrence of `needle` in `text`.

@@ -401,3 +401,140 @@ fn visual_and_inertial_are_checked_with_lines() {
     // A visual mesh that is missing on disk is fine: visuals are not loaded.
     assert!(load(&PRIMITIVES.replacen("<link name=\"slider\"/>", "<link name=\"slider\"><visual><geometry><mesh filename=\"package://gone/x.dae\"/></geometry></visual></link>", 1), None).is_ok());
 }
+
+/// 1-based line of the first line of `text` holding `needle`.
+fn line_with(text: &str, needle: &str) -> usize {
+    text.lines().position(|l| l.contains(needle)).unwrap() + 1
+}
+
+#[test]
+fn absurd_numbers_are_refused_naming_the_element() {
+    let cases: [(&str, &str, &str); 8] = [
+        // (from, to, the message says)
+        (
+            "<origin xyz=\"0 0 0.1\"/>",
+            "<origin xyz=\"0 0 inf\"/>",
+            "attribute xyz=\"0 0 inf\" of <origin> in joint 'j_arm' is inf, not a finite number",
+        ),
+        (
+            "<origin xyz=\"0 0 0.1\"/>",
+            "<origin xyz=\"0 1e30 0.1\"/>",
+            "attribute xyz=\"0 1e30 0.1\" of <origin> in joint 'j_arm': 1e30 m exceeds 1e4 m in magnitude — is the unit right?",
+        ),
+        (
+            "<box size=\"0.4 0.2 0.1\"/>",
+            "<box size=\"400 200 20000\"/>",
+            "of <box> in link 'base': 2e4 m exceeds 1e4 m",
+        ),
+        (
+            "<sphere radius=\"0.03\"/>",
+            "<sphere radius=\"-inf\"/>",
+            "of <sphere> in link 'hand' is -inf, not a finite number",
+        ),
+        (
+            "lower=\"-1\" upper=\"2\"",
+            "lower=\"-inf\" upper=\"2\"",
+            "attribute lower=\"-inf\" of <limit> in joint 'j_hand' is -inf",
+        ),
+        (
+            "lower=\"-0.1\" upper=\"0.3\"",
+            "lower=\"-0.1\" upper=\"30000\"",
+            "attribute upper=\"30000\" of <limit> in joint 'j_slide': 3e4 m exceeds 1e4 m",
+        ),
+        (
+            "effort=\"5\" velocity=\"1.5\"",
+            "effort=\"5\" velocity=\"inf\"",
+            "attribute velocity=\"inf\" of <limit> in joint 'j_hand' is inf",
+        ),
+        (
+            "<axis xyz=\"0 1 0\"/>",
+            "<axis xyz=\"0 1 -inf\"/>",
+            "of <axis> in joint 'j_hand' is -inf",
+        ),
+    ];
+    for (from, to, says) in cases {
+        assert!(PRIMITIVES.contains(from), "{from}");
+        let text = PRIMITIVES.replacen(from, to, 1);
+        let (line, msg, hint) = urdf_err(load(&text, None));
+        assert_eq!(line, Some(line_with(&text, to)), "{to}: {msg}");
+        assert!(msg.contains(says), "{to}: {msg}");
+        assert!(!hint.is_empty());
+    }
+    // A revolute joint's limits are angles: large but finite is not a length error.
+    let text = PRIMITIVES.replacen("lower=\"-1\" upper=\"2\"", "lower=\"-20000\" upper=\"2\"", 1);
+    assert!(load(&text, None).is_ok());
+}
+
+#[test]
+fn a_mesh_scaled_beyond_reason_is_refused() {
+    let urdf = data().join("robots/ur5/urdf/virtual.urdf");
+    let packages = BTreeMap::from([(
+        "ur_description".to_string(),
+        data().join("robots/ur5/ur_description"),
+    )]);
+    let file = "package://ur_description/meshes/ur5/collision/base.stl";
+    let text = mesh_robot(file, "scale=\"1e6 1e6 1e6\"");
+    let err = load_urdf_str(&text, &urdf, &packages, None).unwrap_err();
+    let KinError::Urdf {
+        line, message, hint, ..
+    } = err
+    else {
+        panic!("{err}")
+    };
+    assert_eq!(line, Some(5));
+    assert!(
+        message.contains(&format!("collision mesh \"{file}\" of link 'shell' reaches"))
+            && message.contains("beyond 1e4 m — is the unit right?"),
+        "{message}"
+    );
+    assert!(hint.contains("scale=\"0.001 0.001 0.001\""), "{hint}");
+    // The same mesh in metres loads.
+    assert!(load_urdf_str(&mesh_robot(file, ""), &urdf, &packages, None).is_ok());
+}
+
+#[test]
+fn oversized_and_non_utf8_urdf_files_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let huge = dir.path().join("huge.urdf");
+    std::fs::File::create(&huge)
+        .unwrap()
+        .set_len(MAX_URDF_BYTES + 1)
+        .unwrap();
+    let err = load_urdf(&huge, &no_packages(), None).unwrap_err();
+    let KinError::Urdf { line, message, .. } = &err else {
+        panic!("{err}")
+    };
+    assert_eq!(*line, None);
+    assert_eq!(
+        message,
+        "the file is 67108865 bytes, larger than the 64 MiB a URDF may have"
+    );
+    assert!(err.to_string().contains("huge.urdf"), "{err}");
+
+    let latin1 = dir.path().join("latin1.urdf");
+    std::fs::write(
+        &latin1,
+        b"<robot name=\"r\">\n<!-- caf\xe9 -->\n<link name=\"a\"/>\n</robot>\n",
+    )
+    .unwrap();
+    let (line, msg, _) = urdf_err(load_urdf(&latin1, &no_packages(), None));
+    assert_eq!(line, Some(2));
+    assert!(msg.contains("(0xe9) is not UTF-8 text"), "{msg}");
+}
+
+#[cfg(target_os = "linux")]
+#[test]
+fn dev_zero_is_refused_not_read_forever() {
+    // Reads MAX_URDF_BYTES + 1 bytes, then stops.
+    let err = load_urdf(Path::new("/dev/zero"), &no_packages(), None).unwrap_err();
+    let KinError::Urdf { line, message, .. } = &err else {
+        panic!("{err}")
+    };
+    assert_eq!(*line, None);
+    assert!(
+        message.contains("more than 67108864 bytes, larger than the 64 MiB"),
+        "{message}"
+    );
+    let err = read_urdf(Path::new("/dev/zero"), 100).unwrap_err();
+    assert!(err.to_string().contains("more than 100 bytes"), "{err}");
+}

@@ -3,8 +3,8 @@
 //! line per set `set-id node ...`, then the full `N × N` matrix).
 use std::path::Path;
 
-use super::tsplib::{Kind, MAX_DIMENSION, parse_document};
-use super::{Ctx, read_text, text_path, tokens};
+use super::tsplib::{Kind, parse_document, too_many_sets};
+use super::{Ctx, DENSE_NODES, MAX_DENSE_NODES, SETS, read_text, text_path};
 use crate::error::ReadError;
 use crate::problem::{CostMatrix, Gtsp};
 
@@ -57,6 +57,9 @@ fn parse_gtsplib_at(text: &str, path: &Path) -> Result<GtspInstance, ReadError> 
         ));
     };
     let n = doc.dimension;
+    if m > n {
+        return Err(too_many_sets(ctx, gl, m, n));
+    }
     let mut clusters: Vec<Option<Vec<usize>>> = vec![None; m];
     for set in raw {
         if set.id == 0 || set.id > m {
@@ -85,7 +88,22 @@ fn parse_gtsplib_at(text: &str, path: &Path) -> Result<GtspInstance, ReadError> 
     }
     let clusters: Vec<Vec<usize>> = clusters.into_iter().map(Option::unwrap_or_default).collect();
     let gtsp = Gtsp::new(doc.costs, clusters).map_err(|e| ctx.invalid(Some(sl), e))?;
+    if let Some(v) = node_in_no_set(&gtsp) {
+        return Err(ctx.invalid(
+            Some(sl),
+            format!(
+                "node {} is in no set; every node 1..={n} (DIMENSION) must be in exactly one of \
+                 the {m} sets of GTSP_SET_SECTION: add it to a set, or renumber and lower DIMENSION",
+                v + 1
+            ),
+        ));
+    }
     Ok(GtspInstance { name: doc.name, gtsp })
+}
+
+/// The first node (0-based) that no cluster holds.
+fn node_in_no_set(g: &Gtsp) -> Option<usize> {
+    g.node_clusters().iter().position(Option::is_none)
 }
 
 /// The GLNS format: `N: n`, `M: m`, optional `Symmetric:`/`Triangle:` lines, then `m` set lines
@@ -105,8 +123,14 @@ fn parse_glns(text: &str, ctx: Ctx<'_>) -> Result<GtspInstance, ReadError> {
         lines.next();
         last = ln;
         match k.trim().to_ascii_uppercase().as_str() {
-            "N" => n = Some((ln, ctx.integer(ln, v.trim(), "the number of nodes after N:")?)),
-            "M" => m = Some(ctx.integer(ln, v.trim(), "the number of sets after M:")?),
+            "N" => {
+                let count = ctx.count(ln, v.trim(), "N", "the number of nodes after N:", DENSE_NODES)?;
+                n = Some((ln, count));
+            }
+            "M" => {
+                let count = ctx.count(ln, v.trim(), "M", "the number of sets after M:", SETS)?;
+                m = Some((ln, count));
+            }
             "SYMMETRIC" | "TRIANGLE" => {}
             other => {
                 return Err(ctx.syntax(
@@ -116,21 +140,21 @@ fn parse_glns(text: &str, ctx: Ctx<'_>) -> Result<GtspInstance, ReadError> {
             }
         }
     }
-    let (Some((nl, n)), Some(m)) = (n, m) else {
+    let (Some((nl, n)), Some((ml, m))) = (n, m) else {
         return Err(ctx.syntax(
             Some(last),
             "the GLNS header needs both `N: <nodes>` and `M: <sets>`",
         ));
     };
-    if n == 0 || n > MAX_DIMENSION {
+    if n == 0 {
         return Err(ctx.invalid(
             Some(nl),
-            format!("N is {n}; this reader takes 1..={MAX_DIMENSION} nodes"),
+            format!("N is 0; this reader takes 1..={MAX_DENSE_NODES} nodes"),
         ));
     }
     if m > n {
         return Err(ctx.invalid(
-            None,
+            Some(ml),
             format!("M is {m} but there are only {n} nodes; sets are disjoint and non-empty"),
         ));
     }
@@ -148,8 +172,14 @@ fn parse_glns(text: &str, ctx: Ctx<'_>) -> Result<GtspInstance, ReadError> {
             return Err(ctx.invalid(Some(sl), format!("set id {id} is out of range; ids run 1..={m}")));
         }
         let mut nodes = Vec::new();
-        for t in toks {
+        while let Some(t) = toks.next() {
             if t == "-1" {
+                if let Some(extra) = toks.next() {
+                    return Err(ctx.syntax(
+                        Some(sl),
+                        format!("`{extra}` after the -1 that ends set {id}; one set per line, -1 last"),
+                    ));
+                }
                 break;
             }
             let v = ctx.integer(sl, t, "a node id")?;
@@ -161,53 +191,80 @@ fn parse_glns(text: &str, ctx: Ctx<'_>) -> Result<GtspInstance, ReadError> {
             }
             nodes.push(v - 1);
         }
+        if nodes.is_empty() {
+            return Err(ctx.invalid(
+                Some(sl),
+                format!("set {id} has no nodes; every set needs at least one (M: {m} set lines)"),
+            ));
+        }
         if clusters[id - 1].replace(nodes).is_some() {
             return Err(ctx.invalid(Some(sl), format!("set {id} is given twice")));
         }
     }
-    let rest: String = lines.map(|(_, l)| format!("{l}\n")).collect();
-    // Line numbers in `rest` are lost; count weights instead.
-    let mut data = Vec::with_capacity(n * n);
-    for (k, (_, t)) in tokens(&rest).enumerate() {
-        if data.len() == n * n {
-            return Err(ctx.syntax(
-                None,
-                format!(
-                    "more than the {} weights of an {n} × {n} matrix (extra `{t}`)",
-                    n * n
-                ),
-            ));
-        }
-        let v = t
-            .parse::<f64>()
-            .ok()
-            .filter(|v| v.is_finite() && *v >= 0.0)
-            .ok_or_else(|| {
-                ctx.syntax(
-                    None,
-                    format!(
-                        "weight {} (row {}, column {}) is `{t}`; expected a non-negative number",
-                        k + 1,
-                        k / n + 1,
-                        k % n + 1
-                    ),
-                )
-            })?;
-        data.push(v);
-    }
-    if data.len() != n * n {
-        return Err(ctx.syntax(
-            None,
-            format!("the matrix has {} weights; N = {n} needs {}", data.len(), n * n),
-        ));
-    }
-    let costs = CostMatrix::new(n, data).map_err(|e| ctx.invalid(None, e))?;
+    let costs = read_glns_matrix(lines, ctx, n)?;
     let clusters = clusters.into_iter().map(Option::unwrap_or_default).collect();
     let gtsp = Gtsp::new(costs, clusters).map_err(|e| ctx.invalid(None, e))?;
+    if let Some(v) = node_in_no_set(&gtsp) {
+        return Err(ctx.invalid(
+            Some(ml),
+            format!(
+                "node {} is in no set; every node 1..={n} (N) must be in exactly one of the \
+                 M = {m} sets: add it to a set, or renumber and lower N",
+                v + 1
+            ),
+        ));
+    }
     Ok(GtspInstance {
         name: String::new(),
         gtsp,
     })
+}
+
+/// The `n × n` weights after the GLNS set lines, wrapping freely across lines. Grows with the
+/// weights read, not with the count stated.
+fn read_glns_matrix<'t>(
+    lines: impl Iterator<Item = (usize, &'t str)>,
+    ctx: Ctx<'_>,
+    n: usize,
+) -> Result<CostMatrix, ReadError> {
+    let want = n * n;
+    let mut data = Vec::new();
+    let mut last = None;
+    for (ln, l) in lines {
+        last = Some(ln);
+        for t in l.split_whitespace() {
+            let k = data.len();
+            if k == want {
+                return Err(ctx.syntax(
+                    Some(ln),
+                    format!("more than the {want} weights of an {n} × {n} matrix (extra `{t}`)"),
+                ));
+            }
+            let v = t
+                .parse::<f64>()
+                .ok()
+                .filter(|v| v.is_finite() && *v >= 0.0)
+                .ok_or_else(|| {
+                    ctx.syntax(
+                        Some(ln),
+                        format!(
+                            "weight {} (row {}, column {}) is `{t}`; expected a non-negative number",
+                            k + 1,
+                            k / n + 1,
+                            k % n + 1
+                        ),
+                    )
+                })?;
+            data.push(v);
+        }
+    }
+    if data.len() != want {
+        return Err(ctx.syntax(
+            last,
+            format!("the matrix has {} weights; N = {n} needs {want}", data.len()),
+        ));
+    }
+    CostMatrix::new(n, data).map_err(|e| ctx.invalid(None, e))
 }
 
 #[cfg(test)]

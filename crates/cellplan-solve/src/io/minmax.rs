@@ -27,16 +27,34 @@
 //! EOF                            optional
 //! ```
 //!
+//! Counts are bounded before anything is allocated for them: `VEHICLES` at most
+//! [`MAX_VEHICLES`], `TASKS` at most [`MAX_TASKS`], `NODES` at most
+//! [`MAX_DENSE_NODES`](super::MAX_DENSE_NODES) (the matrix is dense).
+//!
 //! Nodes are 0-based and local to their vehicle. Numbers are decimal (`f64` as Rust or Python
 //! print them); costs and service times finite and non-negative. [`write_minmax`] prints every
 //! number in its shortest exact form, so reading a written problem gives it back bit for bit.
 use std::io::Write;
 use std::path::Path;
 
-use super::{Ctx, read_text, text_path};
+use super::{Ctx, DENSE_NODES, Limit, read_text, text_path};
 use crate::error::ReadError;
 use crate::minmax::{MinMaxProblem, Vehicle};
 use crate::problem::CostMatrix;
+
+/// Largest `VEHICLES` read.
+pub const MAX_VEHICLES: usize = 10_000;
+/// Largest `TASKS` read.
+pub const MAX_TASKS: usize = 1_000_000;
+
+const VEHICLES_LIMIT: Limit = Limit {
+    max: MAX_VEHICLES,
+    why: "",
+};
+const TASKS_LIMIT: Limit = Limit {
+    max: MAX_TASKS,
+    why: "",
+};
 
 /// A min-max instance as read: the problem with its name and best known makespan.
 #[derive(Clone, Debug, PartialEq)]
@@ -198,8 +216,8 @@ fn parse(text: &str, ctx: Ctx<'_>) -> Result<MinMaxInstance, ReadError> {
                     ));
                 }
             }
-            "VEHICLES" => m = Some(ctx.integer(ln, value, "VEHICLES")?),
-            "TASKS" => n = Some(ctx.integer(ln, value, "TASKS")?),
+            "VEHICLES" => m = Some(ctx.count(ln, value, "VEHICLES", "VEHICLES", VEHICLES_LIMIT)?),
+            "TASKS" => n = Some(ctx.count(ln, value, "TASKS", "TASKS", TASKS_LIMIT)?),
             "BALANCE_LIMIT" => balance = Some(non_negative(ctx, ln, value, "BALANCE_LIMIT")?),
             "BEST_KNOWN" => best = Some(non_negative(ctx, ln, value, "BEST_KNOWN")?),
             other => {
@@ -245,7 +263,10 @@ fn parse(text: &str, ctx: Ctx<'_>) -> Result<MinMaxInstance, ReadError> {
             _ => {
                 return Err(ctx.syntax(
                     Some(ln),
-                    format!("expected `VEHICLE: {i}` (VEHICLES: {m}, vehicles in order), found `{l}`"),
+                    format!(
+                        "expected `VEHICLE: {i}` (VEHICLES: {m}, vehicles in order), found `{l}`{}",
+                        too_many_lines_hint(l, i, n)
+                    ),
                 ));
             }
         }
@@ -278,6 +299,21 @@ fn parse(text: &str, ctx: Ctx<'_>) -> Result<MinMaxInstance, ReadError> {
         best_known: best,
         problem,
     })
+}
+
+/// Why a line stands where `VEHICLE: i` should: the block before it has more lines than
+/// TASKS says.
+fn too_many_lines_hint(l: &str, i: usize, tasks: usize) -> String {
+    if i == 0 && l.parse::<f64>().is_ok() {
+        format!("; there are more service times than TASKS: {tasks}")
+    } else if i > 0 && key_value(l).is_some_and(|(k, _)| k.parse::<usize>().is_ok()) {
+        format!(
+            "; vehicle {} has more alternative lines than TASKS: {tasks}",
+            i - 1
+        )
+    } else {
+        String::new()
+    }
 }
 
 fn non_negative(ctx: Ctx<'_>, ln: usize, tok: &str, what: &str) -> Result<f64, ReadError> {
@@ -316,7 +352,12 @@ fn parse_vehicle(
         if field.is_some() {
             return Err(ctx.syntax(Some(ln), format!("{key} of vehicle {i} is given twice")));
         }
-        *field = Some((ctx.integer(ln, v, key)?, ln));
+        let value = if key == "NODES" {
+            ctx.count(ln, v, "NODES", "NODES", DENSE_NODES)?
+        } else {
+            ctx.integer(ln, v, key)?
+        };
+        *field = Some((value, ln));
     };
     let missing = |key: &str| {
         ctx.syntax(
@@ -334,7 +375,8 @@ fn parse_vehicle(
         ));
     }
 
-    let mut data = Vec::with_capacity(k.saturating_mul(k));
+    // Grows with the rows read, not with the count stated.
+    let mut data = Vec::new();
     for r in 0..k {
         let (ln, l) = lines.next(&format!("row {r} of vehicle {i}'s matrix"))?;
         let count = l.split_whitespace().count();

@@ -3,7 +3,7 @@
 //! freely.
 use std::path::Path;
 
-use super::{Ctx, read_text, text_path, tokens};
+use super::{Ctx, Limit, read_text, text_path, tokens};
 use crate::error::ReadError;
 use crate::problem::SetCover;
 
@@ -32,17 +32,15 @@ fn parse_at(text: &str, path: &Path) -> Result<SetCover, ReadError> {
             None => Err(ctx.syntax(Some(last_line), format!("the file ends early; expected {what}"))),
         }
     };
+    // The largest OR-Library instances have about a million columns.
+    const LIMIT: Limit = Limit {
+        max: 100_000_000,
+        why: "",
+    };
     let (l, t) = next("the number of rows m")?;
-    let rows = ctx.integer(l, t, "the number of rows m")?;
+    let rows = ctx.count(l, t, "the number of rows m", "the number of rows m", LIMIT)?;
     let (l, t) = next("the number of columns n")?;
-    let columns = ctx.integer(l, t, "the number of columns n")?;
-    const LIMIT: usize = 100_000_000;
-    if rows > LIMIT || columns > LIMIT {
-        return Err(ctx.invalid(
-            Some(l),
-            format!("{rows} rows × {columns} columns is beyond this reader's limit of {LIMIT}"),
-        ));
-    }
+    let columns = ctx.count(l, t, "the number of columns n", "the number of columns n", LIMIT)?;
     let mut costs = Vec::with_capacity(columns.min(1 << 20));
     for j in 0..columns {
         let what = format!("the cost of column {} of {columns}", j + 1);
@@ -76,7 +74,8 @@ fn parse_at(text: &str, path: &Path) -> Result<SetCover, ReadError> {
                 ),
             ));
         }
-        let mut cols = Vec::with_capacity(k);
+        // `k <= columns` but may still be far more than the file holds: reserve little.
+        let mut cols = Vec::with_capacity(k.min(1 << 10));
         for _ in 0..k {
             let what = format!("a column (1..={columns}) covering row {}", i + 1);
             let (l, t) = next(&what)?;

@@ -1,0 +1,290 @@
+//! The `cellplan check` report: candidates per task and robot, reachability classes, and every
+//! task no robot can do with the reason. Its JSON keys are stable: scripts read `tasks`,
+//! `robots`, `candidates`, `unmeasurable` and `shared`.
+use crate::candidates::{CandidateTable, Classes, classes};
+use cellplan_model::{Cell, InputError, Rejection, RobotId, TaskId};
+use serde::Serialize;
+use serde_json::{Map, Value};
+use std::fmt::Write;
+
+/// Candidates of one task.
+#[derive(Clone, Debug, Serialize)]
+pub struct TaskCandidates {
+    /// Task id.
+    pub task: String,
+    /// Robot name → number of candidates.
+    pub robots: Map<String, Value>,
+}
+
+/// Why one robot cannot do a task.
+#[derive(Clone, Debug, Serialize)]
+pub struct RobotReason {
+    /// Robot name.
+    pub robot: String,
+    /// Stable reason code (`no-ik`, `joint-limits`, `collision`, or the process's own, such as
+    /// `beam-occluded`), `none` when it can.
+    pub reason: &'static str,
+    /// Sampled poses by the furthest stage they reached.
+    pub poses: Map<String, Value>,
+}
+
+/// A task no robot can do.
+#[derive(Clone, Debug, Serialize)]
+pub struct Unmeasurable {
+    /// Task id.
+    pub task: String,
+    /// One entry per robot.
+    pub reasons: Vec<RobotReason>,
+}
+
+/// A task more than one robot can do.
+#[derive(Clone, Debug, Serialize)]
+pub struct Shared {
+    /// Task id.
+    pub task: String,
+    /// The robots that can.
+    pub robots: Vec<String>,
+}
+
+/// Q_il of paper 000.
+#[derive(Clone, Debug, Serialize)]
+pub struct PairClass {
+    /// The two robots.
+    pub robots: [String; 2],
+    /// Tasks both can do.
+    pub tasks: Vec<String>,
+}
+
+/// δ and Q classes by name.
+#[derive(Clone, Debug, Serialize)]
+pub struct ClassReport {
+    /// δ_i: robot name → tasks only it can do.
+    pub exclusive: Map<String, Value>,
+    /// Q_il for every pair sharing tasks.
+    pub pairs: Vec<PairClass>,
+}
+
+/// The whole report.
+#[derive(Clone, Debug, Serialize)]
+pub struct CheckReport {
+    /// Cell name.
+    pub cell: String,
+    /// Number of tasks.
+    pub tasks: usize,
+    /// Robot names, in file order.
+    pub robots: Vec<String>,
+    /// Candidates per task and robot.
+    pub candidates: Vec<TaskCandidates>,
+    /// Total number of candidates.
+    pub total_candidates: usize,
+    /// Reachability classes.
+    pub classes: ClassReport,
+    /// Tasks more than one robot can do.
+    pub shared: Vec<Shared>,
+    /// Tasks no robot can do, with reasons.
+    pub unmeasurable: Vec<Unmeasurable>,
+}
+
+fn names(cell: &Cell, tasks: &[TaskId]) -> Vec<String> {
+    tasks.iter().map(|t| cell.tasks[t.0].name.clone()).collect()
+}
+
+/// Builds the report.
+pub fn report(cell: &Cell, table: &CandidateTable) -> CheckReport {
+    let cls: Classes = classes(table, cell.robots.len());
+    let robots: Vec<String> = cell.robots.iter().map(|r| r.name.clone()).collect();
+    let candidates = cell
+        .tasks
+        .iter()
+        .map(|t| TaskCandidates {
+            task: t.name.clone(),
+            robots: cell
+                .robots
+                .iter()
+                .map(|r| {
+                    (
+                        r.name.clone(),
+                        Value::from(table.get(t.id, r.id).candidates.len()),
+                    )
+                })
+                .collect(),
+        })
+        .collect();
+    let shared = cell
+        .tasks
+        .iter()
+        .filter_map(|t| {
+            let who = table.robots_for(t.id);
+            (who.len() > 1).then(|| Shared {
+                task: t.name.clone(),
+                robots: who.iter().map(|r| cell.robots[r.0].name.clone()).collect(),
+            })
+        })
+        .collect();
+    let unmeasurable = cls
+        .unmeasurable
+        .iter()
+        .map(|&t| Unmeasurable {
+            task: cell.tasks[t.0].name.clone(),
+            reasons: cell
+                .robots
+                .iter()
+                .map(|r| {
+                    let reach = table.get(t, r.id);
+                    RobotReason {
+                        robot: r.name.clone(),
+                        reason: reach.reason().map_or("none", Rejection::code),
+                        poses: reach
+                            .rejected
+                            .iter()
+                            .map(|(k, v)| (k.code().to_string(), Value::from(*v)))
+                            .collect(),
+                    }
+                })
+                .collect(),
+        })
+        .collect();
+    CheckReport {
+        cell: cell.name.clone(),
+        tasks: cell.tasks.len(),
+        robots,
+        candidates,
+        total_candidates: table.total(),
+        classes: ClassReport {
+            exclusive: cell
+                .robots
+                .iter()
+                .map(|r| (r.name.clone(), Value::from(names(cell, &cls.exclusive[r.id.0]))))
+                .collect(),
+            pairs: cls
+                .shared_pairs
+                .iter()
+                .map(|((a, b), t)| PairClass {
+                    robots: [cell.robots[a.0].name.clone(), cell.robots[b.0].name.clone()],
+                    tasks: names(cell, t),
+                })
+                .collect(),
+        },
+        shared,
+        unmeasurable,
+    }
+}
+
+/// A robot that can do no task at all is a mistake in the cell, not a result: the error points
+/// at its base.
+pub fn idle_robot_error(cell: &Cell, table: &CandidateTable) -> Option<InputError> {
+    let robot = cell.robots.iter().find(|r| {
+        cell.tasks
+            .iter()
+            .all(|t| table.get(t.id, r.id).candidates.is_empty())
+    })?;
+    let nearest = cell
+        .tasks
+        .iter()
+        .map(|t| (t.position - robot.base.translation).length())
+        .fold(f64::INFINITY, f64::min);
+    let mut why = std::collections::BTreeMap::<Rejection, usize>::new();
+    for t in &cell.tasks {
+        if let Some(r) = table.get(t.id, robot.id).reason() {
+            *why.entry(r).or_default() += 1;
+        }
+    }
+    let why: Vec<String> = why
+        .iter()
+        .rev()
+        .map(|(r, n)| format!("{n} × {}", r.text()))
+        .collect();
+    let unit = cell.units.length.to_m();
+    let unit_name = if unit == 1.0 { "m" } else { "mm" };
+    Some(
+        cell.error_at_robot_base(
+            robot.id,
+            format!(
+                "robot `{}` can do none of the {} tasks from this base ({}); the nearest task is {:.0} {unit_name} away and its reach is at most {:.0} {unit_name}",
+                robot.name,
+                cell.tasks.len(),
+                why.join(", "),
+                nearest / unit,
+                robot.reach / unit,
+            ),
+        )
+        .hint("move the robot's `base` towards the part (or remove the robot)"),
+    )
+}
+
+/// The report as a table for people.
+pub fn render_text(cell: &Cell, table: &CandidateTable, r: &CheckReport) -> String {
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "cell `{}`: {} robots, {} tasks, {} candidates",
+        r.cell,
+        r.robots.len(),
+        r.tasks,
+        r.total_candidates
+    );
+    let width = cell.tasks.iter().map(|t| t.name.len()).max().unwrap_or(4).max(4);
+    let cols: Vec<usize> = r.robots.iter().map(|n| n.len().max(5)).collect();
+    let _ = write!(s, "\n{:<width$}", "task");
+    for (n, w) in r.robots.iter().zip(&cols) {
+        let _ = write!(s, "  {n:>w$}");
+    }
+    let _ = writeln!(s, "  class");
+    for t in &cell.tasks {
+        let _ = write!(s, "{:<width$}", t.name);
+        for (rb, w) in cell.robots.iter().zip(&cols) {
+            let reach = table.get(t.id, rb.id);
+            let cellv = if reach.candidates.is_empty() {
+                "-".to_string()
+            } else {
+                reach.candidates.len().to_string()
+            };
+            let _ = write!(s, "  {cellv:>w$}");
+        }
+        let who: Vec<RobotId> = table.robots_for(t.id);
+        let class = match who.len() {
+            0 => "UNMEASURABLE".to_string(),
+            1 => format!("δ {}", cell.robots[who[0].0].name),
+            _ => format!(
+                "Q {}",
+                who.iter()
+                    .map(|r| cell.robots[r.0].name.as_str())
+                    .collect::<Vec<_>>()
+                    .join("+")
+            ),
+        };
+        let _ = writeln!(s, "  {class}");
+    }
+    let _ = writeln!(s);
+    for (name, tasks) in &r.classes.exclusive {
+        let n = tasks.as_array().map_or(0, Vec::len);
+        let _ = writeln!(
+            s,
+            "δ {name}: {n} task{} only it can do",
+            if n == 1 { "" } else { "s" }
+        );
+    }
+    for p in &r.classes.pairs {
+        let n = p.tasks.len();
+        let plural = if n == 1 { "" } else { "s" };
+        let _ = writeln!(
+            s,
+            "Q {}+{}: {n} task{plural} both can do",
+            p.robots[0], p.robots[1]
+        );
+    }
+    if r.unmeasurable.is_empty() {
+        let _ = writeln!(s, "every task can be done by at least one robot");
+    } else {
+        let _ = writeln!(s, "\n{} task(s) no robot can do:", r.unmeasurable.len());
+        for u in &r.unmeasurable {
+            let parts: Vec<String> = u
+                .reasons
+                .iter()
+                .map(|x| format!("{}: {}", x.robot, x.reason))
+                .collect();
+            let _ = writeln!(s, "  {}  {}", u.task, parts.join(", "));
+        }
+    }
+    s
+}

@@ -1,0 +1,365 @@
+//! A robot's program — its legs (collision-free joint polylines), its measurements and its
+//! waits — and the program timed on the cell's common clock.
+//!
+//! Every leg is timed segment by segment, each segment a synchronised trapezoid from rest to
+//! rest (as [`time_path_exact`] does for a whole polyline: it stops at every waypoint), so a
+//! wait at any waypoint changes nothing but the clock: the robot is at rest there anyway.
+use crate::candidates::{Candidate, CandidateTable};
+use crate::plan::PlanError;
+use crate::plan::graph::RobotGraph;
+use crate::plan::sequence::Sequence;
+use cellplan_geom::Pose;
+use cellplan_model::Cell;
+use cellplan_model::robot::Robot;
+use cellplan_model::tasks::TaskId;
+use cellplan_motion::timing::{Limits, Trajectory, time_path_exact};
+
+/// One measurement of a program.
+#[derive(Clone, Debug, PartialEq)]
+pub struct VisitPose {
+    /// The MP.
+    pub task: TaskId,
+    /// The table candidate this pose is (or was perturbed from).
+    pub candidate: usize,
+    /// Joint configuration.
+    pub q: Vec<f64>,
+    /// Tool (TCP) pose in the world.
+    pub tcp: Pose,
+    /// Time spent at the task (s): the process's work.
+    pub dwell: f64,
+    /// The (Δw, Δp, Δr) increments (rad) of paper 000 §4.2 when the orientation was perturbed.
+    pub perturbation: Option<[f64; 3]>,
+}
+
+impl VisitPose {
+    /// Candidate `index` of the table, as it is, with the task's `dwell`.
+    pub fn from_candidate(task: TaskId, index: usize, c: &Candidate, dwell: f64) -> Self {
+        VisitPose {
+            task,
+            candidate: index,
+            q: c.q.clone(),
+            tcp: c.tcp,
+            dwell,
+            perturbation: None,
+        }
+    }
+}
+
+/// One leg: a collision-free joint polyline.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ProgramLeg {
+    /// From the previous stop to the next, inclusive.
+    pub waypoints: Vec<Vec<f64>>,
+    /// Whether it is the direct segment.
+    pub straight: bool,
+    /// Duration of each segment (rest to rest).
+    pub segments: Vec<f64>,
+}
+
+impl ProgramLeg {
+    /// A leg from its waypoints, each segment timed under `limits`.
+    pub fn new(waypoints: Vec<Vec<f64>>, straight: bool, limits: &Limits) -> Result<Self, PlanError> {
+        let segments = waypoints
+            .windows(2)
+            .map(|w| segment_trajectory(&w[0], &w[1], limits).map(|t| t.duration()))
+            .collect::<Result<_, _>>()?;
+        Ok(ProgramLeg {
+            waypoints,
+            straight,
+            segments,
+        })
+    }
+
+    /// Moving time (s).
+    pub fn duration(&self) -> f64 {
+        self.segments.iter().sum()
+    }
+}
+
+/// Why a robot waits.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+pub enum WaitReason {
+    /// Delayed start (delay-startup).
+    Startup,
+    /// Gives way to a robot of higher priority.
+    GiveWay,
+    /// No perturbed pose cleared the conflict (pose-perturbation's fallback).
+    Fallback,
+}
+
+/// A stop: the robot stands at `legs[leg].waypoints[waypoint]` for `duration` before going on.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Wait {
+    /// The leg.
+    pub leg: usize,
+    /// The waypoint of the leg (0: its start, after the previous measurement or at home).
+    pub waypoint: usize,
+    /// Seconds.
+    pub duration: f64,
+    /// Why.
+    pub reason: WaitReason,
+    /// The robot it waits for, if any.
+    pub for_robot: Option<usize>,
+}
+
+/// A robot's program: home → visits → home.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Program {
+    /// Index of the robot in the cell.
+    pub robot: usize,
+    /// Home configuration.
+    pub home: Vec<f64>,
+    /// `visits.len() + 1` legs.
+    pub legs: Vec<ProgramLeg>,
+    /// The measurements in order.
+    pub visits: Vec<VisitPose>,
+    /// Stops, at most one per waypoint, sorted by (leg, waypoint).
+    pub waits: Vec<Wait>,
+}
+
+/// What a robot does during a span of its timeline.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Activity {
+    /// Moving along segment `segment` of leg `leg`.
+    Move {
+        /// Leg.
+        leg: usize,
+        /// Segment of the leg.
+        segment: usize,
+    },
+    /// Measuring visit `visit`.
+    Measure {
+        /// Index into the visits.
+        visit: usize,
+    },
+    /// Standing at a waypoint.
+    Wait {
+        /// Leg.
+        leg: usize,
+        /// Waypoint.
+        waypoint: usize,
+    },
+}
+
+impl Activity {
+    /// Whether the robot stands still.
+    pub fn holds(self) -> bool {
+        !matches!(self, Activity::Move { .. })
+    }
+}
+
+/// A span of a robot's timeline.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Span {
+    /// Start (s).
+    pub start: f64,
+    /// End (s).
+    pub end: f64,
+    /// What.
+    pub what: Activity,
+}
+
+/// A program on the clock.
+#[derive(Clone, Debug)]
+pub struct Timed {
+    /// Home to home, waits and measurements included; afterwards the robot stands at home.
+    pub trajectory: Trajectory,
+    /// The spans, in order, covering `[0, trajectory.duration()]`.
+    pub spans: Vec<Span>,
+    /// (arrive, depart) per visit.
+    pub visits: Vec<(f64, f64)>,
+    /// Start (s) of each wait, in the order of [`Program::waits`].
+    pub wait_starts: Vec<f64>,
+    /// Arrival time (s) at each waypoint of each leg (before any wait there).
+    pub arrivals: Vec<Vec<f64>>,
+}
+
+impl Timed {
+    /// End of the program (s).
+    pub fn end(&self) -> f64 {
+        self.trajectory.duration()
+    }
+
+    /// Index of the span at `t` (the last one for `t` past the end).
+    pub fn span_at(&self, t: f64) -> usize {
+        let i = self.spans.partition_point(|s| s.end <= t);
+        i.min(self.spans.len() - 1)
+    }
+
+    /// Until when the robot is certain to stand still from `t` on (`t` itself when moving;
+    /// infinity after its end: it stays home).
+    pub fn hold_until(&self, t: f64) -> f64 {
+        if t >= self.end() {
+            return f64::INFINITY;
+        }
+        let mut i = self.span_at(t);
+        if !self.spans[i].what.holds() {
+            return t;
+        }
+        // Consecutive holds (a wait then a measurement) add up.
+        while i + 1 < self.spans.len() && self.spans[i + 1].what.holds() {
+            i += 1;
+        }
+        if i + 1 == self.spans.len() {
+            f64::INFINITY
+        } else {
+            self.spans[i].end
+        }
+    }
+}
+
+/// One straight segment timed from rest to rest.
+pub fn segment_trajectory(a: &[f64], b: &[f64], limits: &Limits) -> Result<Trajectory, PlanError> {
+    time_path_exact(&[a.to_vec(), b.to_vec()], limits)
+        .map(|t| t.trajectory)
+        .map_err(PlanError::Timing)
+}
+
+impl Program {
+    /// A robot's program from its final sequence, without waits: the sequence's candidates
+    /// as visits, every leg timed segment by segment.
+    pub fn from_sequence(
+        cell: &Cell,
+        table: &CandidateTable,
+        robot: &Robot,
+        graph: &RobotGraph,
+        seq: &Sequence,
+    ) -> Result<Program, PlanError> {
+        let visits = seq
+            .nodes
+            .iter()
+            .map(|&node| {
+                let (t, c) = graph.node_task[node].expect("visited nodes are candidates");
+                VisitPose::from_candidate(
+                    t,
+                    c,
+                    &table.get(t, robot.id).candidates[c],
+                    crate::plan::dwell(cell, t),
+                )
+            })
+            .collect();
+        let legs = seq
+            .legs
+            .iter()
+            .map(|l| ProgramLeg::new(l.waypoints.clone(), l.straight, &graph.limits))
+            .collect::<Result<_, _>>()?;
+        Ok(Program {
+            robot: robot.id.0,
+            home: robot.home.clone(),
+            legs,
+            visits,
+            waits: Vec::new(),
+        })
+    }
+
+    /// Name of stop `k` of the program: 0 and `visits.len() + 1` are "home", else the MP of
+    /// visit `k − 1` (leg `k` runs from stop `k` to stop `k + 1`).
+    pub fn stop_name(&self, cell: &Cell, k: usize) -> String {
+        if k == 0 || k > self.visits.len() {
+            "home".to_string()
+        } else {
+            cell.tasks[self.visits[k - 1].task.0].name.clone()
+        }
+    }
+
+    /// The wait at a waypoint, if any.
+    pub fn wait_at(&self, leg: usize, waypoint: usize) -> Option<&Wait> {
+        self.waits.iter().find(|w| w.leg == leg && w.waypoint == waypoint)
+    }
+
+    /// Sets (replaces) the wait at a waypoint; a duration of 0 removes it.
+    pub fn set_wait(&mut self, wait: Wait) {
+        self.waits
+            .retain(|w| !(w.leg == wait.leg && w.waypoint == wait.waypoint));
+        if wait.duration > 0.0 {
+            self.waits.push(wait);
+            self.waits.sort_by_key(|w| (w.leg, w.waypoint));
+        }
+    }
+
+    /// Total waiting (s).
+    pub fn waiting(&self) -> f64 {
+        self.waits.iter().map(|w| w.duration).fold(0.0, |a, b| a + b)
+    }
+
+    /// Time at the tasks, doing the work (s).
+    pub fn working(&self) -> f64 {
+        self.visits.iter().map(|v| v.dwell).sum()
+    }
+
+    /// Moving time (s).
+    pub fn motion(&self) -> f64 {
+        self.legs.iter().map(ProgramLeg::duration).sum()
+    }
+
+    /// The program's length without building its trajectory (s).
+    pub fn duration(&self) -> f64 {
+        self.motion() + self.working() + self.waiting()
+    }
+
+    /// The program on the clock.
+    pub fn timed(&self, limits: &Limits) -> Result<Timed, PlanError> {
+        let mut parts: Vec<Trajectory> = Vec::new();
+        let mut spans = Vec::new();
+        let mut visits = Vec::with_capacity(self.visits.len());
+        let mut wait_starts = vec![0.0; self.waits.len()];
+        let mut arrivals = Vec::with_capacity(self.legs.len());
+        let mut t = 0.0;
+        for (k, leg) in self.legs.iter().enumerate() {
+            let mut at = Vec::with_capacity(leg.waypoints.len());
+            for w in 0..leg.waypoints.len() {
+                at.push(t);
+                if let Some(i) = self.waits.iter().position(|x| x.leg == k && x.waypoint == w) {
+                    let d = self.waits[i].duration;
+                    wait_starts[i] = t;
+                    parts.push(Trajectory::dwell(&leg.waypoints[w], d));
+                    spans.push(Span {
+                        start: t,
+                        end: t + d,
+                        what: Activity::Wait { leg: k, waypoint: w },
+                    });
+                    t += d;
+                }
+                if w + 1 < leg.waypoints.len() {
+                    let seg = segment_trajectory(&leg.waypoints[w], &leg.waypoints[w + 1], limits)?;
+                    let d = seg.duration();
+                    parts.push(seg);
+                    spans.push(Span {
+                        start: t,
+                        end: t + d,
+                        what: Activity::Move { leg: k, segment: w },
+                    });
+                    t += d;
+                }
+            }
+            arrivals.push(at);
+            if k < self.visits.len() {
+                let dwell = self.visits[k].dwell;
+                parts.push(Trajectory::dwell(&self.visits[k].q, dwell));
+                spans.push(Span {
+                    start: t,
+                    end: t + dwell,
+                    what: Activity::Measure { visit: k },
+                });
+                visits.push((t, t + dwell));
+                t += dwell;
+            }
+        }
+        if parts.is_empty() {
+            parts.push(Trajectory::dwell(&self.home, 0.0));
+            spans.push(Span {
+                start: 0.0,
+                end: 0.0,
+                what: Activity::Wait { leg: 0, waypoint: 0 },
+            });
+        }
+        let trajectory = Trajectory::concat(&parts)?;
+        Ok(Timed {
+            trajectory,
+            spans,
+            visits,
+            wait_starts,
+            arrivals,
+        })
+    }
+}

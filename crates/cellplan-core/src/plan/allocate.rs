@@ -1,0 +1,383 @@
+//! Allocation strategies: which robot measures which MP (paper 000 §3.2).
+//!
+//! - [`Allocation::Proximity`]: the paper's benchmark — every MP goes to the nearest robot
+//!   (base to MP) that can measure it and has room under its cap φ.
+//! - [`Allocation::LocalRobust`]: the paper's method — MPs only one robot can measure go to it
+//!   (δ_i); the shared ones, per group of robots able to measure them (Q_il), are grouped into
+//!   local robust MP sets (eq. 4: closer than ε, admissible probe-orientation cones that
+//!   overlap), a set cover picks the sets (eq. 5, solved by the penalty/auxiliary-function
+//!   method of eq. 6–7 or exactly), and Algorithm 1 gives each set to the robot whose tour
+//!   (eq. 8–9: Euclidean, from its base through its MPs) is shortest, within φ.
+//! - [`Allocation::Balanced`]: ours — allocation, order and candidate chosen together as a
+//!   min-max multi-robot routing with alternatives over the candidates' lower-bound move times
+//!   and the measuring time, within φ and γ.
+use super::graph::RobotGraph;
+use super::{PlanError, PlanSettings};
+use crate::candidates::CandidateTable;
+use cellplan_model::Cell;
+use cellplan_model::tasks::TaskId;
+use cellplan_solve::minmax::{self, MinMaxMethod, MinMaxParams, MinMaxProblem, Vehicle};
+use cellplan_solve::setcover::{self, ExactLimits, PenaltyParams};
+use cellplan_solve::{CostMatrix, Gtsp, GtspParams, SetCover};
+use glam::DVec3;
+use std::collections::BTreeMap;
+use std::time::Duration;
+
+/// Allocation strategy.
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Allocation {
+    /// Nearest robot (paper 000's benchmark).
+    Proximity,
+    /// Local robust MP sets, set cover, Algorithm 1 (paper 000's method).
+    LocalRobust,
+    /// Min-max routing with alternatives (ours).
+    Balanced,
+}
+
+impl Allocation {
+    /// Name as on the command line and in the plan document.
+    pub fn name(self) -> &'static str {
+        match self {
+            Allocation::Proximity => "proximity",
+            Allocation::LocalRobust => "local-robust",
+            Allocation::Balanced => "balanced",
+        }
+    }
+}
+
+/// How the local-robust strategy solves its set cover.
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum CoverMethod {
+    /// Paper 000's penalty and auxiliary function (eq. 6–7).
+    Penalty,
+    /// Branch and bound with Lagrangian bounds.
+    Exact,
+}
+
+/// The allocation, and for `balanced` the routes it found.
+#[derive(Clone, Debug, Default)]
+pub struct Allocated {
+    /// Tasks per robot.
+    pub tasks: Vec<Vec<TaskId>>,
+    /// Local robust sets built and chosen by the set cover (local-robust only).
+    pub local_sets: (usize, usize),
+    /// Lower bound of the min-max problem on the lower-bound costs (valid for any allocation).
+    pub lower_bound: f64,
+}
+
+/// Allocate the measurable tasks of `cell` to its robots. `costs`, when given, replaces each
+/// robot's lower-bound matrix in the balanced strategy's routing (the lower bound reported
+/// stays the one of the lower-bound costs).
+pub fn allocate(
+    cell: &Cell,
+    table: &CandidateTable,
+    graphs: &[RobotGraph],
+    settings: &PlanSettings,
+    costs: Option<&[CostMatrix]>,
+) -> Result<Allocated, PlanError> {
+    let m = cell.robots.len();
+    let capable: Vec<Vec<usize>> = (0..cell.tasks.len())
+        .map(|t| table.robots_for(TaskId(t)).into_iter().map(|r| r.0).collect())
+        .collect();
+    let problem = min_max_problem(cell, graphs, &capable)?;
+    let lower_bound = minmax::lower_bound(&problem.0);
+    let cap = cell.planning.task_cap;
+    let mut tasks: Vec<Vec<TaskId>> = vec![Vec::new(); m];
+    let mut local_sets = (0, 0);
+    match settings.allocation {
+        Allocation::Proximity => {
+            // Exclusive tasks first (they have no choice), then the shared ones.
+            let mut order: Vec<usize> = (0..cell.tasks.len())
+                .filter(|&t| !capable[t].is_empty())
+                .collect();
+            order.sort_by_key(|&t| (capable[t].len() > 1, t));
+            for t in order {
+                let p = cell.tasks[t].position;
+                let mut who = capable[t].clone();
+                who.sort_by(|&a, &b| {
+                    let da = (cell.robots[a].base.translation - p).length();
+                    let db = (cell.robots[b].base.translation - p).length();
+                    da.total_cmp(&db).then(a.cmp(&b))
+                });
+                let r = who
+                    .into_iter()
+                    .find(|&r| tasks[r].len() < cap)
+                    .ok_or_else(|| cap_error(cell, t, cap))?;
+                tasks[r].push(TaskId(t));
+            }
+        }
+        Allocation::LocalRobust => {
+            local_sets = local_robust(cell, &capable, settings, &mut tasks)?;
+        }
+        Allocation::Balanced => {
+            let problem = match costs {
+                Some(c) => {
+                    let mut p = problem.0.clone();
+                    for (v, m) in p.vehicles.iter_mut().zip(c) {
+                        v.costs = m.clone();
+                    }
+                    (p, problem.1)
+                }
+                None => problem,
+            };
+            let sol = minmax::solve(
+                &problem.0,
+                &MinMaxParams {
+                    time_limit: settings.time_limit,
+                    seed: settings.seed,
+                    max_iterations: Some(settings.balanced_iterations),
+                    method: MinMaxMethod::Ils,
+                },
+            );
+            for (r, tour) in sol.routes.tours.iter().enumerate() {
+                tasks[r] = tour.iter().map(|&(t, _)| TaskId(problem.1[t])).collect();
+            }
+        }
+    }
+    for list in &mut tasks {
+        list.sort();
+    }
+    Ok(Allocated {
+        tasks,
+        local_sets,
+        lower_bound,
+    })
+}
+
+fn cap_error(cell: &Cell, t: usize, cap: usize) -> PlanError {
+    PlanError::TaskCap {
+        task: cell.tasks[t].name.clone(),
+        cap,
+    }
+}
+
+/// The min-max problem over the measurable tasks, and the cell task of each of its tasks.
+fn min_max_problem(
+    cell: &Cell,
+    graphs: &[RobotGraph],
+    capable: &[Vec<usize>],
+) -> Result<(MinMaxProblem, Vec<usize>), PlanError> {
+    let measurable: Vec<usize> = (0..cell.tasks.len())
+        .filter(|&t| !capable[t].is_empty())
+        .collect();
+    let vehicles = graphs
+        .iter()
+        .map(|g| Vehicle {
+            costs: g.costs.clone(),
+            depot: 0,
+            cap: cell.planning.task_cap,
+            alternatives: measurable.iter().map(|&t| g.alternatives[t].clone()).collect(),
+        })
+        .collect();
+    let p = MinMaxProblem::new(
+        vehicles,
+        measurable.len(),
+        measurable
+            .iter()
+            .map(|&t| super::dwell(cell, TaskId(t)))
+            .collect(),
+        cell.planning.balance_limit,
+    )
+    .map_err(|reason| PlanError::CapsTooSmall { reason })?;
+    Ok((p, measurable))
+}
+
+/// Paper 000 §3.2 steps 1–6 and Algorithm 1, generalised from pairs to any group of robots
+/// sharing MPs. Returns (local sets built, sets chosen).
+fn local_robust(
+    cell: &Cell,
+    capable: &[Vec<usize>],
+    settings: &PlanSettings,
+    tasks: &mut [Vec<TaskId>],
+) -> Result<(usize, usize), PlanError> {
+    let cap = cell.planning.task_cap;
+    // U_i ← δ_i.
+    let mut groups: BTreeMap<Vec<usize>, Vec<usize>> = BTreeMap::new();
+    for (t, who) in capable.iter().enumerate() {
+        match who.len() {
+            0 => {}
+            1 => {
+                if tasks[who[0]].len() >= cap {
+                    return Err(cap_error(cell, t, cap));
+                }
+                tasks[who[0]].push(TaskId(t));
+            }
+            _ => groups.entry(who.clone()).or_default().push(t),
+        }
+    }
+    let eps = settings.local_set_radius;
+    let (mut built, mut chosen_total) = (0, 0);
+    for (who, members) in groups {
+        // Step 2: the local robust set of every MP of the group (eq. 4), as the process
+        // defines it.
+        let ids: Vec<TaskId> = members.iter().map(|&t| TaskId(t)).collect();
+        let sets: Vec<Vec<usize>> = cell
+            .process
+            .local_sets(&cell.tasks, &ids, eps)
+            .ok_or(PlanError::Unsupported {
+                what: "the local-robust allocation",
+                process: cell.process.kind(),
+            })?
+            .into_iter()
+            .map(|set| set.into_iter().map(|t| t.0).collect())
+            .collect();
+        built += sets.len();
+        // Step 3: the cover model (eq. 5). The paper asks for the fewest sets and weighs a set
+        // by its running time once sorted (its measuring time and shortest open path at the
+        // nominal TCP speed); c_j = 1 + time_j / (1 + Σ time) keeps the count first and the
+        // time as the tie-break (with c_j = time alone, singletons would always win).
+        let row_of: BTreeMap<usize, usize> = members.iter().enumerate().map(|(r, &t)| (t, r)).collect();
+        let mut covers = vec![Vec::new(); members.len()];
+        for (c, set) in sets.iter().enumerate() {
+            for t in set {
+                covers[row_of[t]].push(c);
+            }
+        }
+        for row in &mut covers {
+            row.sort_unstable();
+        }
+        let times: Vec<f64> = sets
+            .iter()
+            .map(|s| {
+                let pts: Vec<DVec3> = s.iter().map(|&t| cell.tasks[t].position).collect();
+                s.iter().map(|&t| super::dwell(cell, TaskId(t))).sum::<f64>()
+                    + open_path(&pts, settings.seed) / NOMINAL_TCP_SPEED
+            })
+            .collect();
+        let sum: f64 = times.iter().sum();
+        let costs: Vec<f64> = times.iter().map(|t| 1.0 + t / (1.0 + sum)).collect();
+        let sc = SetCover {
+            rows: members.len(),
+            columns: sets.len(),
+            costs,
+            covers,
+        };
+        // Step 4.
+        let cover = match settings.cover {
+            CoverMethod::Penalty => setcover::penalty_method(
+                &sc,
+                &PenaltyParams {
+                    seed: settings.seed,
+                    ..PenaltyParams::default()
+                },
+            ),
+            CoverMethod::Exact => setcover::exact(
+                &sc,
+                &ExactLimits {
+                    time_limit: None,
+                    max_nodes: Some(200_000),
+                },
+            ),
+        };
+        chosen_total += cover.columns.len();
+        // Each MP belongs to the first chosen set holding it (a_uk = 0 for the others).
+        let mut taken = vec![false; members.len()];
+        let mut parts: Vec<Vec<usize>> = Vec::new();
+        for &c in &cover.columns {
+            let part: Vec<usize> = sets[c]
+                .iter()
+                .copied()
+                .filter(|t| !std::mem::replace(&mut taken[row_of[t]], true))
+                .collect();
+            if !part.is_empty() {
+                parts.push(part);
+            }
+        }
+        // Steps 5–6, Algorithm 1: each set to the robot with the cheaper tour (eq. 8–9).
+        for part in parts {
+            let mut best: Option<(f64, usize)> = None;
+            for &r in &who {
+                if tasks[r].len() + part.len() > cap {
+                    continue;
+                }
+                let mut pts: Vec<DVec3> = tasks[r].iter().map(|t| cell.tasks[t.0].position).collect();
+                pts.extend(part.iter().map(|&t| cell.tasks[t].position));
+                let cost = closed_tour(cell.robots[r].base.translation, &pts, settings.seed);
+                if best.is_none_or(|(c, _)| cost < c) {
+                    best = Some((cost, r));
+                }
+            }
+            match best {
+                Some((_, r)) => tasks[r].extend(part.iter().map(|&t| TaskId(t))),
+                // No robot has room for the whole set: place its MPs one by one.
+                None => {
+                    for &t in &part {
+                        let r = who
+                            .iter()
+                            .copied()
+                            .filter(|&r| tasks[r].len() < cap)
+                            .min_by(|&a, &b| {
+                                let p = cell.tasks[t].position;
+                                let da = (cell.robots[a].base.translation - p).length();
+                                let db = (cell.robots[b].base.translation - p).length();
+                                da.total_cmp(&db)
+                            })
+                            .ok_or_else(|| cap_error(cell, t, cap))?;
+                        tasks[r].push(TaskId(t));
+                    }
+                }
+            }
+        }
+    }
+    Ok((built, chosen_total))
+}
+
+/// TCP speed (m/s) that turns path lengths into the running time of a set cover column.
+const NOMINAL_TCP_SPEED: f64 = 1.0;
+/// Kicks of the tour heuristic inside the allocation (deterministic).
+const TOUR_ITERATIONS: usize = 200;
+
+fn euclid(points: &[DVec3]) -> CostMatrix {
+    CostMatrix::from_fn(points.len(), |i, j| (points[i] - points[j]).length())
+}
+
+/// Eq. 8: the shortest closed tour from `base` through `points` (Euclidean).
+fn closed_tour(base: DVec3, points: &[DVec3], seed: u64) -> f64 {
+    if points.is_empty() {
+        return 0.0;
+    }
+    let mut all = vec![base];
+    all.extend_from_slice(points);
+    let n = all.len();
+    let g = Gtsp::new(euclid(&all), (1..n).map(|i| vec![i]).collect())
+        .and_then(|g| g.with_depots(Some(0), None))
+        .expect("a Euclidean tour instance is valid");
+    tour_cost(&g, seed)
+}
+
+/// The shortest open path through `points` (any end points).
+fn open_path(points: &[DVec3], seed: u64) -> f64 {
+    if points.len() < 2 {
+        return 0.0;
+    }
+    // A dummy node at zero distance from every point turns the path into a tour.
+    let n = points.len();
+    let costs = CostMatrix::from_fn(n + 1, |i, j| {
+        if i == n || j == n {
+            0.0
+        } else {
+            (points[i] - points[j]).length()
+        }
+    });
+    let g = Gtsp::new(costs, (0..n).map(|i| vec![i]).collect())
+        .and_then(|g| g.with_depots(Some(n), None))
+        .expect("a Euclidean path instance is valid");
+    tour_cost(&g, seed)
+}
+
+fn tour_cost(g: &Gtsp, seed: u64) -> f64 {
+    cellplan_solve::solve_gtsp(
+        g,
+        &GtspParams {
+            time_limit: Duration::from_secs(60),
+            seed,
+            max_iterations: Some(TOUR_ITERATIONS),
+            ..GtspParams::default()
+        },
+    )
+    .cost
+}

@@ -1,0 +1,464 @@
+//! `cellplan plan`: allocation, sequencing, collision-free motion and timing (paper 000 §3–§4.1,
+//! with paper 002's lazy path costs). Stages, each a function of plain data:
+//!
+//! 1. [`graph`]: per robot, home and candidates with lower-bound move times between them;
+//! 2. [`allocate`]: which robot measures which MP (proximity, local-robust, balanced);
+//! 3. [`sequence`]: per robot, the order and candidates as a GTSP, legs planned lazily;
+//! 4. timing: every leg timed under the joint limits, a dwell for each measurement;
+//! 5. [`crate::document`]: the Plan document.
+pub mod allocate;
+pub mod graph;
+pub mod sequence;
+
+pub use allocate::{Allocation, CoverMethod};
+pub use graph::MoveModel;
+
+use crate::candidates::CandidateTable;
+use crate::coord::Program;
+use cellplan_model::Cell;
+use cellplan_model::tasks::TaskId;
+use cellplan_motion::plan::PlanSettings as MotionSettings;
+use cellplan_solve::CostMatrix;
+use graph::RobotGraph;
+use rayon::prelude::*;
+use std::time::{Duration, Instant};
+
+/// Knobs of a planning run.
+#[derive(Clone, Debug)]
+pub struct PlanSettings {
+    /// Allocation strategy.
+    pub allocation: Allocation,
+    /// Set-cover method of the local-robust strategy.
+    pub cover: CoverMethod,
+    /// Move-time model of the lower-bound costs.
+    pub move_model: MoveModel,
+    /// Seed of every random choice.
+    pub seed: u64,
+    /// Budget of the search stages (allocation search and lazy sequencing); they also stop
+    /// after fixed iteration counts, so the plan only depends on the budget when it cuts.
+    pub time_limit: Duration,
+    /// ε of eq. 4 (m): MPs closer than this may form a local robust set.
+    pub local_set_radius: f64,
+    /// Kicks of the balanced strategy's min-max search.
+    pub balanced_iterations: usize,
+    /// Re-allocations of the balanced strategy on the costs learnt while sequencing.
+    pub reallocation_rounds: usize,
+    /// Most sequencing rounds of the lazy loop per robot (twice that while its best order
+    /// still needs a leg the quick planner gave up on).
+    pub lazy_rounds: usize,
+    /// The lazy loop stops when no order can beat the best fully planned one by more than
+    /// this fraction (its optimistic cost, with unplanned legs at their bound, is not lower).
+    pub lazy_tolerance: f64,
+    /// Candidates kept per task and robot for sequencing (see [`graph::select`]).
+    pub alternatives: usize,
+    /// Candidates with at least this much more clearance (m) than the process asks are kept
+    /// first (see [`graph::select`]); 0 keeps them regardless.
+    pub roomy: f64,
+    /// Settings of every leg's path planner (its seed is derived per leg); its shortcut
+    /// iterations apply while the lazy loop ranks orders.
+    pub motion: MotionSettings,
+    /// Shortcut iterations for the sampled legs of the final orders.
+    pub final_shortcut_iterations: usize,
+    /// Sample budget for legs of the final orders that the lazy rounds' budget
+    /// (`motion.max_samples`) did not solve.
+    pub final_max_samples: usize,
+    /// Time step of the trajectory samples written to the plan (s).
+    pub sample_dt: f64,
+}
+
+impl Default for PlanSettings {
+    fn default() -> Self {
+        PlanSettings {
+            allocation: Allocation::Balanced,
+            cover: CoverMethod::Penalty,
+            move_model: MoveModel::Trapezoid,
+            seed: 0,
+            time_limit: Duration::from_secs(30),
+            local_set_radius: 0.3,
+            balanced_iterations: 200,
+            alternatives: 24,
+            roomy: 0.02,
+            lazy_rounds: 4,
+            reallocation_rounds: 0,
+            lazy_tolerance: 0.01,
+            motion: MotionSettings {
+                time_limit: Duration::from_secs(30),
+                shortcut_iterations: 10,
+                max_samples: 60,
+                ..MotionSettings::default()
+            },
+            final_shortcut_iterations: 40,
+            final_max_samples: 20_000,
+            sample_dt: 0.02,
+        }
+    }
+}
+
+/// Why a leg could not be had.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum LegError {
+    /// The path planner found no collision-free path.
+    #[error(transparent)]
+    Motion(#[from] cellplan_motion::plan::PlanError),
+    /// The path could not be timed.
+    #[error(transparent)]
+    Timing(#[from] cellplan_motion::timing::TimingError),
+}
+
+/// Where a robot stands between legs: at home or at a task.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum Stop {
+    /// The robot's home configuration.
+    Home,
+    /// A task, by its name.
+    Task(String),
+}
+
+impl std::fmt::Display for Stop {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Stop::Home => f.write_str("home"),
+            Stop::Task(t) => write!(f, "task `{t}`"),
+        }
+    }
+}
+
+/// Why no plan.
+#[derive(Debug, Clone, thiserror::Error)]
+pub enum PlanError {
+    /// A task only robots already at their task cap can do.
+    #[error(
+        "task `{task}` cannot be allocated: every robot able to do it already has task_cap = {cap} tasks"
+    )]
+    TaskCap {
+        /// The task.
+        task: String,
+        /// φ.
+        cap: usize,
+    },
+    /// The robots' caps cannot hold every task some robot can do.
+    #[error("the robots' task caps cannot hold every task they can do: {reason}")]
+    CapsTooSmall {
+        /// The solver's finding.
+        reason: String,
+    },
+    /// A strategy the process does not support.
+    #[error("{what} needs something the `{process}` process does not define")]
+    Unsupported {
+        /// The strategy.
+        what: &'static str,
+        /// The process kind.
+        process: &'static str,
+    },
+    /// A leg of the final order has no path.
+    #[error("robot `{robot}`: no collision-free path from {from} to {to}: {source}")]
+    NoPath {
+        /// The robot.
+        robot: String,
+        /// Where the leg starts.
+        from: Stop,
+        /// Where it ends.
+        to: Stop,
+        /// Why.
+        source: LegError,
+    },
+    /// Two robots still meet after coordination.
+    #[error("coordination: robots `{}` and `{}` still meet at {at:.2} s", robots[0], robots[1])]
+    StillMeet {
+        /// The robots.
+        robots: [String; 2],
+        /// When (s).
+        at: f64,
+    },
+    /// Neither robot of a conflict can give way.
+    #[error("coordination: robots `{}` and `{}` meet at {at:.2} s and neither can wait (or, where allowed, take another pose) to let the other pass", robots[0], robots[1])]
+    Deadlock {
+        /// The robots.
+        robots: [String; 2],
+        /// When (s).
+        at: f64,
+    },
+    /// Resolutions keep producing conflicts.
+    #[error("coordination: {0} conflicts resolved and more keep coming; giving up")]
+    TooManyConflicts(usize),
+    /// No priority order resolves every conflict.
+    #[error(
+        "coordination: no priority order resolves every conflict (a robot stands in another's path at home)"
+    )]
+    NoPriorityOrder,
+    /// Timing failed (should not happen on a planner's path).
+    #[error("timing: {0}")]
+    Timing(#[from] cellplan_motion::timing::TimingError),
+}
+
+impl PlanError {
+    /// Whether the cell's own limits (caps, the process) rule the plan out, rather than the
+    /// search failing.
+    pub fn is_input(&self) -> bool {
+        matches!(
+            self,
+            PlanError::TaskCap { .. } | PlanError::CapsTooSmall { .. } | PlanError::Unsupported { .. }
+        )
+    }
+}
+
+/// The stages, for progress reports.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Stage {
+    /// Lower-bound move times between candidates.
+    Costs,
+    /// Allocation.
+    Allocation,
+    /// Sequencing with lazy motion planning.
+    Sequencing,
+    /// Time parameterisation and assembly.
+    Timing,
+}
+
+impl Stage {
+    /// Name in reports and in `compute_s`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Stage::Costs => "costs",
+            Stage::Allocation => "allocation",
+            Stage::Sequencing => "sequencing_motion",
+            Stage::Timing => "timing",
+        }
+    }
+}
+
+/// One robot's result, before coordination.
+#[derive(Clone, Debug)]
+pub struct RobotResult {
+    /// The sequence with its legs.
+    pub sequence: sequence::Sequence,
+    /// The sequence as a program: its measuring poses and its legs, timed (no waits yet).
+    pub program: Program,
+}
+
+/// Everything a run produced.
+#[derive(Clone, Debug)]
+pub struct Outcome {
+    /// Per robot graphs.
+    pub graphs: Vec<RobotGraph>,
+    /// The allocation.
+    pub allocated: allocate::Allocated,
+    /// Per robot results.
+    pub robots: Vec<RobotResult>,
+    /// Seconds per stage, in stage order.
+    pub compute: Vec<(Stage, f64)>,
+}
+
+/// Plan `cell` from its candidate table. `progress` is told when each stage starts.
+pub fn plan(
+    cell: &Cell,
+    table: &CandidateTable,
+    settings: &PlanSettings,
+    progress: &(dyn Fn(Stage) + Sync),
+) -> Result<Outcome, PlanError> {
+    let started = Instant::now();
+    let deadline = started + settings.time_limit;
+    let mut compute = Vec::new();
+    let mut lap = Instant::now();
+    let mut tick = |stage: Stage, compute: &mut Vec<(Stage, f64)>| {
+        compute.push((stage, lap.elapsed().as_secs_f64()));
+        lap = Instant::now();
+    };
+
+    progress(Stage::Costs);
+    let graphs: Vec<RobotGraph> = cell
+        .robots
+        .par_iter()
+        .map(|r| {
+            RobotGraph::new(
+                cell,
+                r,
+                table,
+                settings.move_model,
+                settings.alternatives,
+                settings.roomy,
+            )
+        })
+        .collect();
+    tick(Stage::Costs, &mut compute);
+
+    progress(Stage::Allocation);
+    let mut allocated = allocate::allocate(cell, table, &graphs, settings, None)?;
+    tick(Stage::Allocation, &mut compute);
+
+    progress(Stage::Sequencing);
+    let mut planned: Vec<sequence::Planned> = vec![Default::default(); cell.robots.len()];
+    let mut counts = vec![(0usize, 0usize, 0usize); cell.robots.len()];
+    let mut sequences = sequence_all(
+        cell,
+        &graphs,
+        &allocated.tasks,
+        settings,
+        deadline,
+        f64::INFINITY,
+        &mut planned,
+        &mut counts,
+    )?
+    .expect("no bar, so never beaten");
+    if settings.allocation == Allocation::Balanced {
+        // Re-allocate on what is known now: planned legs at their real time (paper 002's lazy
+        // costs, one level up); keep the better plan. An alternative is sequenced only as long
+        // as its robots' optimistic times stay below the best real makespan (the lazy bar), so
+        // one that cannot win costs a sequencing round, not its legs.
+        let makespan = |seqs: &[sequence::Sequence], planned: &[sequence::Planned]| {
+            seqs.iter()
+                .enumerate()
+                .map(|(r, s)| sequence::order_cost(&graphs[r], &planned[r], &s.nodes))
+                .fold(0.0, f64::max)
+        };
+        // The nearest-robot allocation is tried too, so that ours is never worse than the
+        // baseline on the real times.
+        let proximity = allocate::allocate(
+            cell,
+            table,
+            &graphs,
+            &PlanSettings {
+                allocation: Allocation::Proximity,
+                ..settings.clone()
+            },
+            None,
+        )?;
+        let mut tried = vec![allocated.tasks.clone()];
+        for round in 0..=settings.reallocation_rounds {
+            if Instant::now() >= deadline {
+                break;
+            }
+            let next = if round == 0 {
+                proximity.tasks.clone()
+            } else {
+                let mixed: Vec<CostMatrix> = graphs
+                    .iter()
+                    .zip(&planned)
+                    .map(|(g, p)| mixed_costs(g, p))
+                    .collect();
+                allocate::allocate(cell, table, &graphs, settings, Some(&mixed))?.tasks
+            };
+            if tried.contains(&next) {
+                continue;
+            }
+            tried.push(next.clone());
+            let bar = makespan(&sequences, &planned) - 1e-9;
+            let Some(seqs) = sequence_all(
+                cell,
+                &graphs,
+                &next,
+                settings,
+                deadline,
+                bar,
+                &mut planned,
+                &mut counts,
+            )?
+            else {
+                continue;
+            };
+            if makespan(&seqs, &planned) < makespan(&sequences, &planned) - 1e-9 {
+                sequences = seqs;
+                allocated.tasks = next;
+            }
+        }
+    }
+    for (s, c) in sequences.iter_mut().zip(&counts) {
+        (s.legs_planned, s.legs_sampled, s.legs_failed) = *c;
+    }
+    sequences
+        .par_iter_mut()
+        .zip(&cell.robots)
+        .zip(&graphs)
+        .for_each(|((seq, robot), graph)| sequence::polish(cell, robot, graph, seq, settings));
+    tick(Stage::Sequencing, &mut compute);
+
+    progress(Stage::Timing);
+    let mut robots = Vec::with_capacity(sequences.len());
+    for ((sequence, graph), robot) in sequences.into_iter().zip(&graphs).zip(&cell.robots) {
+        let program = Program::from_sequence(cell, table, robot, graph, &sequence)?;
+        robots.push(RobotResult { sequence, program });
+    }
+    tick(Stage::Timing, &mut compute);
+    Ok(Outcome {
+        graphs,
+        allocated,
+        robots,
+        compute,
+    })
+}
+
+/// The time `cell`'s process spends at `task` (s).
+pub fn dwell(cell: &Cell, task: TaskId) -> f64 {
+    cell.process.work(&cell.tasks[task.0]).duration()
+}
+
+/// Sequence every robot's tasks (in parallel), reusing and extending each robot's planned legs;
+/// `counts` accumulates (planned, sampled, failed) legs per robot. `None` when some robot's
+/// time cannot get below `bar` (see [`sequence::sequence`]): every robot first finds its best
+/// order on the current costs, and only when all of them are below the bar are legs planned.
+#[allow(clippy::too_many_arguments)]
+fn sequence_all(
+    cell: &Cell,
+    graphs: &[RobotGraph],
+    tasks: &[Vec<TaskId>],
+    settings: &PlanSettings,
+    deadline: Instant,
+    bar: f64,
+    planned: &mut [sequence::Planned],
+    counts: &mut [(usize, usize, usize)],
+) -> Result<Option<Vec<sequence::Sequence>>, PlanError> {
+    // Every robot's first order, looked at before any robot plans a leg when there is a bar.
+    let firsts: Vec<Option<Vec<usize>>> = if bar.is_finite() {
+        let orders: Vec<(Vec<usize>, f64)> = cell
+            .robots
+            .par_iter()
+            .zip(graphs)
+            .zip(tasks)
+            .zip(planned.par_iter())
+            .map(|(((robot, graph), tasks), planned)| {
+                let order =
+                    sequence::best_order(graph, tasks, planned, sequence::order_seed(settings, robot));
+                let time = sequence::order_cost(graph, planned, &order);
+                (order, time)
+            })
+            .collect();
+        if orders.iter().any(|(_, time)| *time >= bar) {
+            return Ok(None);
+        }
+        orders.into_iter().map(|(order, _)| Some(order)).collect()
+    } else {
+        vec![None; graphs.len()]
+    };
+    let seqs: Vec<sequence::Sequence> = cell
+        .robots
+        .par_iter()
+        .zip(graphs)
+        .zip(tasks)
+        .zip(firsts)
+        .zip(planned.par_iter_mut())
+        .map(|((((robot, graph), tasks), first), planned)| {
+            sequence::sequence(cell, robot, graph, tasks, settings, deadline, bar, first, planned)
+        })
+        .collect::<Result<_, _>>()?;
+    for (s, c) in seqs.iter().zip(counts.iter_mut()) {
+        c.0 += s.legs_planned;
+        c.1 += s.legs_sampled;
+        c.2 += s.legs_failed;
+    }
+    Ok((!seqs.iter().any(|s| s.beaten)).then_some(seqs))
+}
+
+/// A robot's costs with its planned legs at their real time (failed ones prohibitive).
+fn mixed_costs(graph: &RobotGraph, planned: &sequence::Planned) -> CostMatrix {
+    let n = graph.len();
+    let mut data = graph.costs.data().to_vec();
+    for (&(a, b), leg) in planned {
+        let c = match leg {
+            Ok(l) => l.duration,
+            Err(_) => sequence::NO_PATH,
+        };
+        data[a * n + b] = c;
+        data[b * n + a] = c;
+    }
+    CostMatrix::new(n, data).expect("same size as the graph")
+}

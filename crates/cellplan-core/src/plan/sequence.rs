@@ -1,0 +1,382 @@
+//! Sequencing with lazy path costs (paper 002 §2.1): each robot's tasks as a GTSP over its
+//! candidates, home → tasks → home, first on the lower-bound move times; the legs the sequence
+//! uses are planned (collision-free path, timed under the limits) and their real times replace
+//! the bounds; re-sequence until the sequence uses only planned legs, or the budget ends.
+use super::graph::RobotGraph;
+use super::{LegError, PlanError, PlanSettings};
+use cellplan_model::Cell;
+use cellplan_model::robot::Robot;
+use cellplan_model::tasks::TaskId;
+use cellplan_motion::plan::PlanSettings as MotionSettings;
+use cellplan_motion::timing::time_path_exact;
+use cellplan_solve::{CostMatrix, Gtsp, GtspParams};
+use rayon::prelude::*;
+use std::collections::BTreeMap;
+use std::time::{Duration, Instant};
+
+/// A planned leg between two nodes of a robot graph.
+#[derive(Clone, Debug)]
+pub struct Leg {
+    /// The collision-free joint path (waypoints, straight segments between them).
+    pub waypoints: Vec<Vec<f64>>,
+    /// Time to drive it from rest to rest under the limits (s).
+    pub duration: f64,
+    /// Whether it is the direct segment.
+    pub straight: bool,
+    /// Random samples a sampling planner drew for it.
+    pub samples: usize,
+    /// Validity (clearance) calls spent on it.
+    pub validity_calls: usize,
+    /// Seconds spent planning it (one thread).
+    pub compute_s: f64,
+}
+
+/// One robot's sequence.
+#[derive(Clone, Debug, Default)]
+pub struct Sequence {
+    /// Nodes visited in order (home excluded).
+    pub nodes: Vec<usize>,
+    /// Legs: home → first, …, last → home (one leg home → home when there are no tasks).
+    pub legs: Vec<Leg>,
+    /// Sequencing rounds.
+    pub rounds: usize,
+    /// Legs planned (each pair once).
+    pub legs_planned: usize,
+    /// Of those, legs that needed the sampling planner.
+    pub legs_sampled: usize,
+    /// Legs for which no path was found (their nodes were avoided).
+    pub legs_failed: usize,
+    /// The search stopped because no order could finish below the bar it was given: `nodes`
+    /// and `legs` are empty (the counts still say what was planned).
+    pub beaten: bool,
+}
+
+/// Kicks of the GTSP heuristic per sequencing round (fixed, for determinism).
+const GTSP_ITERATIONS: usize = 400;
+/// The lazy loop may run this many times its rounds while its best order needs a failed leg.
+const STUCK_ROUNDS_FACTOR: usize = 2;
+/// Cost of a leg no path was found for: large enough never to be chosen when another exists.
+pub const NO_PATH: f64 = 1e6;
+
+/// Legs planned so far for one robot, by unordered node pair (a < b), or why none was found.
+pub type Planned = BTreeMap<(usize, usize), Result<Leg, LegError>>;
+
+/// Sequence `tasks` for `robot` with lazily planned legs.
+///
+/// `bar` (s) is the time to beat: as soon as the best order the sequencer finds under the
+/// current costs (planned legs real, the others at their lower bound) takes at least `bar`,
+/// the search stops and returns a sequence marked [`Sequence::beaten`]. The legs planned until
+/// then stay in `planned`. Pass `f64::INFINITY` to always finish. `first`, when given, is the
+/// first round's order, as [`best_order`] gives it for the same `planned` (already computed by
+/// a caller that looked before it leapt).
+#[allow(clippy::too_many_arguments)]
+pub fn sequence(
+    cell: &Cell,
+    robot: &Robot,
+    graph: &RobotGraph,
+    tasks: &[TaskId],
+    settings: &PlanSettings,
+    deadline: Instant,
+    bar: f64,
+    mut first: Option<Vec<usize>>,
+    planned: &mut Planned,
+) -> Result<Sequence, PlanError> {
+    let mut out = Sequence::default();
+    // The best order whose every leg is planned, with its real time.
+    let mut best: Option<(f64, Vec<usize>)> = None;
+    let mut nodes: Vec<usize>;
+    loop {
+        out.rounds += 1;
+        nodes = match first.take() {
+            Some(order) => order,
+            None => best_order(graph, tasks, planned, order_seed(settings, robot)),
+        };
+        let optimistic = order_cost(graph, planned, &nodes);
+        if optimistic >= bar {
+            out.beaten = true;
+            return Ok(out);
+        }
+        // No order can beat the best real one by more than the tolerance: stop.
+        if let Some((b, order)) = &best
+            && optimistic >= b * (1.0 - settings.lazy_tolerance)
+        {
+            nodes = order.clone();
+            break;
+        }
+        let new: Vec<(usize, usize)> = legs_of(&nodes)
+            .into_iter()
+            .map(|(a, b)| key(a, b))
+            .filter(|k| !planned.contains_key(k))
+            .collect::<std::collections::BTreeSet<_>>()
+            .into_iter()
+            .collect();
+        if new.is_empty() {
+            // Its cost is real already, and the sequencer found nothing cheaper.
+            if best.as_ref().is_none_or(|(b, _)| optimistic < *b) {
+                best = Some((optimistic, nodes.clone()));
+            }
+            nodes = best.as_ref().map(|b| b.1.clone()).unwrap_or_default();
+            break;
+        }
+        let results: Vec<((usize, usize), Result<Leg, LegError>)> = new
+            .par_iter()
+            .map(|&(a, b)| ((a, b), plan_leg(cell, robot, graph, a, b, settings)))
+            .collect();
+        for (k, r) in results {
+            match &r {
+                Ok(leg) => {
+                    out.legs_planned += 1;
+                    out.legs_sampled += usize::from(!leg.straight);
+                }
+                Err(_) => out.legs_failed += 1,
+            }
+            planned.insert(k, r);
+        }
+        let real = order_cost(graph, planned, &nodes);
+        if best.as_ref().is_none_or(|(b, _)| real < *b) {
+            best = Some((real, nodes.clone()));
+        }
+        // While the best planned order still needs a leg the quick planner gave up on, more
+        // rounds (each a GTSP and a few legs) are cheaper than the full-budget retry below.
+        let stuck = best.as_ref().is_some_and(|(b, _)| *b >= NO_PATH);
+        let rounds = if stuck {
+            STUCK_ROUNDS_FACTOR * settings.lazy_rounds
+        } else {
+            settings.lazy_rounds
+        };
+        if out.rounds >= rounds || Instant::now() >= deadline {
+            nodes = best.as_ref().map(|b| b.1.clone()).unwrap_or_default();
+            break;
+        }
+    }
+    // Legs of the final order the quick planner gave up on get the full search budget.
+    let retry: Vec<(usize, usize)> = legs_of(&nodes)
+        .into_iter()
+        .map(|(a, b)| key(a, b))
+        .filter(|k| matches!(planned.get(k), Some(Err(_))))
+        .collect::<std::collections::BTreeSet<_>>()
+        .into_iter()
+        .collect();
+    let retried: Vec<((usize, usize), Result<Leg, LegError>)> = retry
+        .par_iter()
+        .map(|&(a, b)| {
+            let full = PlanSettings {
+                motion: MotionSettings {
+                    max_samples: settings.final_max_samples,
+                    ..settings.motion.clone()
+                },
+                ..settings.clone()
+            };
+            ((a, b), plan_leg(cell, robot, graph, a, b, &full))
+        })
+        .collect();
+    for (k, r) in retried {
+        if r.is_ok() {
+            out.legs_failed -= 1;
+            out.legs_planned += 1;
+            out.legs_sampled += 1;
+        }
+        planned.insert(k, r);
+    }
+    let mut legs = Vec::new();
+    for (a, b) in legs_of(&nodes) {
+        let leg = match planned.get(&key(a, b)) {
+            Some(Ok(leg)) => leg.clone(),
+            Some(Err(e)) => {
+                return Err(PlanError::NoPath {
+                    robot: robot.name.clone(),
+                    from: stop_of(cell, graph, a),
+                    to: stop_of(cell, graph, b),
+                    source: e.clone(),
+                });
+            }
+            None => unreachable!("every leg of the final order is planned"),
+        };
+        legs.push(if (a, b) == key(a, b) { leg } else { reversed(leg) });
+    }
+    out.nodes = nodes;
+    out.legs = legs;
+    Ok(out)
+}
+
+/// Give the sampled legs of a final sequence the full shortcutting (the lazy rounds used a few
+/// iterations per leg, enough to rank orders); a leg is replaced only when it gets faster.
+pub fn polish(cell: &Cell, robot: &Robot, graph: &RobotGraph, seq: &mut Sequence, settings: &PlanSettings) {
+    let mut prev = 0usize;
+    let ends: Vec<(usize, usize)> = seq
+        .nodes
+        .iter()
+        .chain(std::iter::once(&0))
+        .map(|&n| {
+            let e = (prev, n);
+            prev = n;
+            e
+        })
+        .collect();
+    let polished: Vec<Option<Leg>> = seq
+        .legs
+        .par_iter()
+        .zip(&ends)
+        .map(|(leg, &(a, b))| {
+            (!leg.straight).then(|| polish_leg(cell, robot, graph, &key(a, b), leg.clone(), settings))
+        })
+        .collect();
+    for (leg, p) in seq.legs.iter_mut().zip(polished) {
+        if let Some(p) = p {
+            *leg = p;
+        }
+    }
+}
+
+/// The unordered key of a leg between nodes `a` and `b`.
+pub fn key(a: usize, b: usize) -> (usize, usize) {
+    (a.min(b), a.max(b))
+}
+
+fn reversed(mut leg: Leg) -> Leg {
+    leg.waypoints.reverse();
+    leg
+}
+
+fn legs_of(nodes: &[usize]) -> Vec<(usize, usize)> {
+    let mut out = Vec::with_capacity(nodes.len() + 1);
+    let mut prev = 0;
+    for &n in nodes {
+        out.push((prev, n));
+        prev = n;
+    }
+    out.push((prev, 0));
+    out
+}
+
+/// Where `node` stands: home, or its task.
+pub fn stop_of(cell: &Cell, graph: &RobotGraph, node: usize) -> super::Stop {
+    match graph.node_task[node] {
+        None => super::Stop::Home,
+        Some((t, _)) => super::Stop::Task(cell.tasks[t.0].name.clone()),
+    }
+}
+
+/// Time of an order under the current costs (planned legs real, the others their bound).
+pub fn order_cost(graph: &RobotGraph, planned: &Planned, nodes: &[usize]) -> f64 {
+    legs_of(nodes)
+        .into_iter()
+        .map(|(a, b)| match planned.get(&key(a, b)) {
+            Some(Ok(leg)) => leg.duration,
+            Some(Err(_)) => NO_PATH,
+            None => graph.costs.get(a, b),
+        })
+        .sum::<f64>()
+        + nodes.iter().map(|&n| graph.dwell[n]).sum::<f64>()
+}
+
+/// The seed of `robot`'s sequencing GTSPs.
+pub fn order_seed(settings: &PlanSettings, robot: &Robot) -> u64 {
+    settings.seed ^ robot.id.0 as u64
+}
+
+/// The best order (GTSP over the tasks' candidates) under the current costs: planned legs at
+/// their real time, the others at their lower bound.
+pub fn best_order(graph: &RobotGraph, tasks: &[TaskId], planned: &Planned, seed: u64) -> Vec<usize> {
+    if tasks.is_empty() {
+        return Vec::new();
+    }
+    let mut local = vec![0usize];
+    let mut clusters = Vec::with_capacity(tasks.len());
+    for t in tasks {
+        let mut cl = Vec::new();
+        for &n in &graph.alternatives[t.0] {
+            cl.push(local.len());
+            local.push(n);
+        }
+        clusters.push(cl);
+    }
+    let cost = |a: usize, b: usize| match planned.get(&key(a, b)) {
+        Some(Ok(leg)) => leg.duration,
+        Some(Err(_)) => NO_PATH,
+        None => graph.costs.get(a, b),
+    };
+    let costs = CostMatrix::from_fn(
+        local.len(),
+        |i, j| if i == j { 0.0 } else { cost(local[i], local[j]) },
+    );
+    let service = (0..local.len()).map(|i| graph.dwell[local[i]]).collect();
+    let g = Gtsp::new(costs, clusters)
+        .and_then(|g| g.with_depots(Some(0), None))
+        .and_then(|g| g.with_service(service))
+        .expect("every allocated task has candidates");
+    let sol = cellplan_solve::solve_gtsp(
+        &g,
+        &GtspParams {
+            time_limit: Duration::from_secs(600),
+            seed,
+            max_iterations: Some(GTSP_ITERATIONS),
+            ..GtspParams::default()
+        },
+    );
+    sol.tour.nodes.iter().map(|&i| local[i]).collect()
+}
+
+/// Shortcut a sampled leg with the full iteration count; keep it if it is faster.
+fn polish_leg(
+    cell: &Cell,
+    robot: &Robot,
+    graph: &RobotGraph,
+    k: &(usize, usize),
+    mut leg: Leg,
+    settings: &PlanSettings,
+) -> Leg {
+    let space = crate::motion::joint_space(cell, robot);
+    let validity = crate::motion::RobotValidity::new(cell, robot, cell.planning.clearance);
+    let motion = MotionSettings {
+        seed: leg_seed(settings.seed, robot.id.0, k.0, k.1) ^ 1,
+        shortcut_iterations: settings.final_shortcut_iterations,
+        ..settings.motion.clone()
+    };
+    let mut waypoints = leg.waypoints.clone();
+    cellplan_motion::plan::shortcut(&space, &validity, &mut waypoints, &motion);
+    if let Ok(timed) = time_path_exact(&waypoints, &graph.limits)
+        && timed.trajectory.duration() < leg.duration
+    {
+        leg.duration = timed.trajectory.duration();
+        leg.waypoints = waypoints;
+    }
+    leg
+}
+
+fn plan_leg(
+    cell: &Cell,
+    robot: &Robot,
+    graph: &RobotGraph,
+    a: usize,
+    b: usize,
+    settings: &PlanSettings,
+) -> Result<Leg, LegError> {
+    let started = Instant::now();
+    let motion = MotionSettings {
+        seed: leg_seed(settings.seed, robot.id.0, a, b),
+        ..settings.motion.clone()
+    };
+    let path = crate::motion::plan_leg(cell, robot, &graph.q[a], &graph.q[b], &motion)?;
+    let timed = time_path_exact(&path.waypoints, &graph.limits)?;
+    Ok(Leg {
+        waypoints: path.waypoints,
+        duration: timed.trajectory.duration(),
+        straight: path.straight,
+        samples: path.samples,
+        validity_calls: path.validity_calls,
+        compute_s: started.elapsed().as_secs_f64(),
+    })
+}
+
+/// A seed per leg, so that a leg's path does not depend on which thread plans it or when.
+fn leg_seed(seed: u64, robot: usize, a: usize, b: usize) -> u64 {
+    let mut h = 0xcbf2_9ce4_8422_2325u64;
+    for x in [seed, robot as u64, a as u64, b as u64] {
+        for byte in x.to_le_bytes() {
+            h ^= u64::from(byte);
+            h = h.wrapping_mul(0x0100_0000_01b3);
+        }
+    }
+    h
+}

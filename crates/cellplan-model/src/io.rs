@@ -1,0 +1,106 @@
+//! Reading inputs with a size limit, and writing outputs so that nothing is ever half-written.
+use std::io::{Read, Write};
+use std::path::Path;
+
+/// Reads a UTF-8 text file of at most `limit` bytes. A larger file (or an endless one, such as
+/// `/dev/zero`) is refused after reading `limit + 1` bytes, so no input can exhaust memory.
+pub fn read_bounded(path: &Path, limit: u64) -> std::io::Result<String> {
+    let file = std::fs::File::open(path)?;
+    let mut bytes = Vec::new();
+    file.take(limit + 1).read_to_end(&mut bytes)?;
+    if bytes.len() as u64 > limit {
+        return Err(std::io::Error::new(
+            std::io::ErrorKind::InvalidData,
+            format!(
+                "the file is larger than {} MiB, the most cellplan reads",
+                limit >> 20
+            ),
+        ));
+    }
+    String::from_utf8(bytes).map_err(|e| {
+        std::io::Error::new(
+            std::io::ErrorKind::InvalidData,
+            format!("not UTF-8 text (byte {})", e.utf8_error().valid_up_to()),
+        )
+    })
+}
+
+/// Writes `bytes` to a temporary file beside `path`, then renames it over `path`. Parent
+/// folders are created. On error the target is untouched.
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
+    write_all_atomic(&[(path, bytes)])
+}
+
+/// Writes several files all or nothing: each goes to a temporary file beside its target, and
+/// only when every one is complete are they renamed over their targets. If a write fails, no
+/// target is touched.
+pub fn write_all_atomic(files: &[(&Path, &[u8])]) -> std::io::Result<()> {
+    let mut staged = Vec::with_capacity(files.len());
+    for (path, bytes) in files {
+        let dir = path
+            .parent()
+            .filter(|d| !d.as_os_str().is_empty())
+            .unwrap_or(Path::new("."));
+        std::fs::create_dir_all(dir)?;
+        let mut tmp = tempfile::Builder::new().prefix(".cellplan-").tempfile_in(dir)?;
+        tmp.write_all(bytes)?;
+        tmp.as_file().sync_all()?;
+        staged.push((tmp, *path));
+    }
+    for (tmp, path) in staged {
+        tmp.persist(path).map_err(|e| e.error)?;
+    }
+    Ok(())
+}
+
+/// Checks, before any work, that `dir` can take the files of a run: creates it and writes and
+/// removes a temporary file in it.
+pub fn check_writable(dir: &Path) -> std::io::Result<()> {
+    std::fs::create_dir_all(dir)?;
+    tempfile::Builder::new()
+        .prefix(".cellplan-probe-")
+        .tempfile_in(dir)?;
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn writes_whole_file_and_leaves_no_temporary() {
+        let dir = tempfile::tempdir().unwrap();
+        let target = dir.path().join("sub/out.txt");
+        write_atomic(&target, b"hello").unwrap();
+        assert_eq!(std::fs::read_to_string(&target).unwrap(), "hello");
+        let leftovers = std::fs::read_dir(target.parent().unwrap()).unwrap().count();
+        assert_eq!(leftovers, 1);
+    }
+
+    #[test]
+    fn all_or_nothing_when_one_target_cannot_be_written() {
+        let dir = tempfile::tempdir().unwrap();
+        let good = dir.path().join("plan.json");
+        // A folder where the second file should go: its rename cannot succeed, but the first
+        // target is only renamed if every temporary was written.
+        let blocked = dir.path().join("missing-parent-is-a-file");
+        std::fs::write(&blocked, b"x").unwrap();
+        let bad = blocked.join("report.html");
+        assert!(write_all_atomic(&[(&good, b"plan"), (&bad, b"report")]).is_err());
+        assert!(
+            !good.exists(),
+            "the plan was written although the report could not be"
+        );
+    }
+
+    #[test]
+    fn endless_and_oversized_files_are_refused() {
+        let e = read_bounded(Path::new("/dev/zero"), 1 << 20).unwrap_err();
+        assert!(e.to_string().contains("larger than 1 MiB"), "{e}");
+        let dir = tempfile::tempdir().unwrap();
+        let f = dir.path().join("bin");
+        std::fs::write(&f, [0xff, 0xfe]).unwrap();
+        assert!(read_bounded(&f, 100).unwrap_err().to_string().contains("UTF-8"));
+        assert!(check_writable(&f.join("sub")).is_err());
+    }
+}

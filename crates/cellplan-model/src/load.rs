@@ -1,0 +1,753 @@
+//! Loading a cell file: parse, apply units, resolve paths, load robots and meshes, build the
+//! collision world, and refuse anything inconsistent with an error that names file and line.
+use crate::cell::{Cell, Object, Planning, Source};
+use crate::io::read_bounded;
+use crate::pose::pose_from_spec;
+use crate::process::{Process, ProcessInput, Registry, key_span};
+use crate::robot::{BodyFrame, IkKind, Robot, RobotId, Scratch, Tool};
+use crate::self_pairs::{SelfPairs, cached_self_pairs, geometry_key, non_adjacent_pairs};
+use crate::spec::{CellSpec, OpwSpec, PlanningSpec, PoseSpec, ShapeEntry};
+use crate::tasks::read_tasks;
+use crate::{InputError, error::line_of};
+use cellplan_geom::{BodyContact, CollisionWorld, DVec3, GroupBody, MeshError, Pose, ShapeSpec, load_mesh};
+use cellplan_kin::{
+    DlsIk, DlsParams, IkSolver, JointKind, KinError, OpwIk, OpwParameters, RobotModel, load_urdf,
+};
+use std::collections::{BTreeMap, HashMap};
+use std::ops::Range;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use toml::Spanned;
+
+/// Largest cell file read (bytes).
+pub const MAX_CELL_FILE: u64 = 16 << 20;
+
+/// How to load a cell.
+#[derive(Clone, Debug)]
+pub struct LoadOptions {
+    /// Folder for cached self-collision pair lists (`None`: no cache).
+    pub cache_dir: Option<PathBuf>,
+    /// Random configurations sampled to find the self-collision pairs.
+    pub self_pair_samples: usize,
+    /// Seed of that sampling.
+    pub seed: u64,
+}
+
+impl Default for LoadOptions {
+    fn default() -> Self {
+        LoadOptions {
+            cache_dir: None,
+            self_pair_samples: 10_000,
+            seed: 0,
+        }
+    }
+}
+
+impl LoadOptions {
+    /// The usual cache folder: `$CELLPLAN_CACHE_DIR`, else `$XDG_CACHE_HOME/cellplan`, else
+    /// `$HOME/.cache/cellplan`.
+    pub fn default_cache_dir() -> Option<PathBuf> {
+        let env = |k: &str| std::env::var_os(k).filter(|v| !v.is_empty()).map(PathBuf::from);
+        env("CELLPLAN_CACHE_DIR")
+            .or_else(|| env("XDG_CACHE_HOME").map(|d| d.join("cellplan")))
+            .or_else(|| env("HOME").map(|d| d.join(".cache/cellplan")))
+    }
+}
+
+/// Time in which a joint reaches full speed when no acceleration limit is given (s).
+pub const DEFAULT_ACCELERATION_TIME: f64 = 0.25;
+
+struct Ctx<'a> {
+    path: &'a Path,
+    dir: PathBuf,
+    text: &'a str,
+    to_m: f64,
+    to_rad: f64,
+}
+
+impl Ctx<'_> {
+    /// An error at `span` of the cell file, with a general hint that callers may replace.
+    fn err(&self, span: Range<usize>, msg: impl Into<String>) -> InputError {
+        InputError::at_span(self.path, self.text, span, msg)
+            .hint("docs/cell-format.md describes every key of the cell file, its unit and default")
+    }
+
+    /// The span of `key = ...` inside `within` (see [`key_span`]).
+    fn key_span(&self, within: &Range<usize>, key: &str) -> Range<usize> {
+        key_span(self.text, within, key)
+    }
+
+    fn resolve(&self, rel: &str) -> PathBuf {
+        self.dir.join(rel)
+    }
+
+    fn pose(&self, spec: &Spanned<PoseSpec>) -> Result<Pose, InputError> {
+        pose_from_spec(spec.get_ref(), self.to_m, self.to_rad).map_err(|m| {
+            self.err(spec.span(), m).hint(
+                "a pose is { xyz = [x, y, z] } plus at most one of rpy = [r, p, y], quat = [x, y, z, w], matrix = [[..], [..], [..]] (rows)",
+            )
+        })
+    }
+}
+
+/// Loads and checks a cell file; its process is found in `registry` by `[process] kind`.
+pub fn load(path: &Path, registry: &Registry, opts: &LoadOptions) -> Result<Cell, InputError> {
+    let text = read_bounded(path, MAX_CELL_FILE).map_err(|e| {
+        InputError::new(path, format!("cannot read the cell file: {e}"))
+            .hint("give the path of a cell TOML file, e.g. examples/autobody-4r/cell.toml")
+    })?;
+    let spec: CellSpec = toml::from_str(&text).map_err(|e| {
+        let span = e.span().unwrap_or(0..0);
+        InputError::at_span(
+            path,
+            &text,
+            span,
+            format!("invalid cell file: {}", e.message().trim()),
+        )
+        .hint("docs/cell-format.md lists every key and its type")
+    })?;
+    let ctx = Ctx {
+        path,
+        dir: path.parent().map(Path::to_path_buf).unwrap_or_default(),
+        text: &text,
+        to_m: spec.units.length.to_m(),
+        to_rad: spec.units.angle.to_rad(),
+    };
+
+    let process_span = spec.process.span();
+    let entry = registry.find(
+        &spec.process.get_ref().kind,
+        path,
+        &text,
+        ctx.key_span(&process_span, "kind"),
+    )?;
+    let planning = planning(&ctx, spec.planning.as_ref())?;
+
+    // Tools.
+    let mut tools = BTreeMap::new();
+    for (name, tool) in &spec.tools {
+        let tcp = ctx.pose(&tool.get_ref().tcp)?;
+        let mut shapes = Vec::new();
+        for entry in &tool.get_ref().shapes {
+            shapes.push(shape(&ctx, entry, tool.span(), &format!("tool `{name}`"))?);
+        }
+        tools.insert(
+            name.clone(),
+            Tool {
+                name: name.clone(),
+                tcp,
+                shapes,
+            },
+        );
+    }
+
+    // Static objects.
+    let mut world = CollisionWorld::new();
+    let mut objects: Vec<Object> = Vec::new();
+    for entry in &spec.objects {
+        let span = entry.span();
+        let e = entry.get_ref();
+        let name = e
+            .name
+            .clone()
+            .ok_or_else(|| ctx.err(span.clone(), "an object needs a `name`"))?;
+        if objects.iter().any(|o| o.name == name) {
+            return Err(ctx.err(
+                ctx.key_span(&span, "name"),
+                format!("object name `{name}` is used twice"),
+            ));
+        }
+        let (shape, local) = shape(&ctx, e, span, &format!("object `{name}`"))?;
+        let id = world.add_static(&name, &shape, local);
+        objects.push(Object {
+            name,
+            shape,
+            pose: local,
+            id,
+        });
+    }
+
+    // Robots.
+    let mut models: HashMap<String, Arc<RobotModel>> = HashMap::new();
+    let mut robots: Vec<Robot> = Vec::new();
+    let mut source = Source {
+        text: text.clone(),
+        ..Source::default()
+    };
+    for entry in &spec.robots {
+        let robot = robot(&ctx, entry, RobotId(robots.len()), &tools, &mut models, &robots)?;
+        source.robot_base.push(entry.get_ref().base.span());
+        robots.push(robot);
+    }
+    if robots.is_empty() {
+        return Err(InputError::new(path, "the cell has no robots").hint("add a [[robots]] table"));
+    }
+
+    // Bodies into the world.
+    for robot in &mut robots {
+        let mut bodies = Vec::new();
+        let mut frames = Vec::new();
+        for (i, shapes) in robot.model.collision.iter().enumerate() {
+            if !shapes.is_empty() {
+                bodies.push(GroupBody {
+                    name: robot.model.chain.links[i].name.clone(),
+                    shapes: shapes.clone(),
+                });
+                frames.push(BodyFrame::Link(i));
+            }
+        }
+        if !robot.tool.shapes.is_empty() {
+            bodies.push(GroupBody {
+                name: format!("tool:{}", robot.tool.name),
+                shapes: robot.tool.shapes.clone(),
+            });
+            frames.push(BodyFrame::Tool);
+        }
+        robot.group = world.add_group(&robot.name, bodies);
+        robot.bodies = frames;
+    }
+    // A robot's base (the bodies before its first joint) never moves: it stands on its floor or
+    // pedestal, so it is left out of the static checks.
+    for robot in &robots {
+        let chain = &robot.model.chain;
+        let first_moving = chain
+            .links
+            .iter()
+            .position(|l| l.joint.is_some())
+            .unwrap_or(chain.links.len());
+        let fixed: Vec<usize> = robot
+            .bodies
+            .iter()
+            .enumerate()
+            .filter(|(_, b)| matches!(b, BodyFrame::Link(l) if *l < first_moving))
+            .map(|(i, _)| i)
+            .collect();
+        world.set_static_exempt(robot.group, &fixed);
+    }
+
+    let clearance = planning.clearance;
+    let tasks_path = ctx.resolve(&spec.tasks.get_ref().file);
+    let tasks = read_tasks(&tasks_path, ctx.to_m, ctx.to_rad, entry.task_columns)?;
+    let process: std::sync::Arc<dyn Process> = (entry.build)(&ProcessInput {
+        path,
+        text: &text,
+        span: process_span,
+        to_m: ctx.to_m,
+        to_rad: ctx.to_rad,
+        tasks: &tasks,
+        tasks_path: &tasks_path,
+    })?;
+
+    // Every robot must stand clear at home: of the scene (by the clearance), of itself (every
+    // non-adjacent pair) and of the other robots.
+    let mut home_poses: Vec<Vec<Pose>> = Vec::new();
+    for (i, robot) in robots.iter().enumerate() {
+        let mut scratch = Scratch::default();
+        robot.body_poses(&robot.home, &mut scratch);
+        let entry = &spec.robots[i];
+        let home_span = entry.get_ref().home.as_ref().map_or(entry.span(), |h| h.span());
+        let self_contact = non_adjacent_pairs(robot)
+            .into_iter()
+            .find(|&(a, b)| world.bodies_within(robot.group, a, b, &scratch.bodies, 0.0))
+            .map(|(a, b)| BodyContact::SelfPair(a, b));
+        if let Some(contact) = world
+            .group_vs_static(robot.group, &scratch.bodies, clearance)
+            .or(self_contact)
+        {
+            let what = describe_contact(&world, robot, None, contact);
+            return Err(ctx
+                .err(home_span, format!("robot `{}` collides at its home configuration: {what}", robot.name))
+                .hint("move the robot's `base` or change its `home` so that it stands clear (by the `[planning] clearance` from static objects)"));
+        }
+        for (j, other) in robots[..i].iter().enumerate() {
+            if let Some(contact) =
+                world.group_vs_group(robot.group, &scratch.bodies, other.group, &home_poses[j], 0.0)
+            {
+                let what = describe_contact(&world, robot, Some(other), contact);
+                return Err(ctx
+                    .err(
+                        entry.get_ref().base.span(),
+                        format!(
+                            "robots `{}` and `{}` collide at home: {what}",
+                            robot.name, other.name
+                        ),
+                    )
+                    .hint("place the robots further apart or change their `home`"));
+            }
+        }
+        home_poses.push(scratch.bodies.clone());
+    }
+
+    // Self-collision pairs, sampled once per distinct robot geometry (or read from the cache).
+    let mut sampled: HashMap<u64, SelfPairs> = HashMap::new();
+    let mut pending_cache = Vec::new();
+    for robot in &mut robots {
+        let key = geometry_key(robot, opts.self_pair_samples, opts.seed);
+        let pairs = match sampled.get(&key) {
+            Some(p) => p.clone(),
+            None => {
+                let (p, pending) = cached_self_pairs(
+                    robot,
+                    &world,
+                    opts.self_pair_samples,
+                    opts.seed,
+                    opts.cache_dir.as_deref(),
+                );
+                pending_cache.extend(pending);
+                sampled.insert(key, p.clone());
+                p
+            }
+        };
+        world.set_self_pairs(robot.group, pairs.pairs.clone());
+        robot.self_pairs = pairs.pairs;
+    }
+
+    let name = spec.name.clone().unwrap_or_else(|| {
+        path.canonicalize()
+            .ok()
+            .and_then(|p| {
+                p.parent()
+                    .and_then(|d| d.file_name())
+                    .map(|n| n.to_string_lossy().into_owned())
+            })
+            .unwrap_or_else(|| "cell".into())
+    });
+    Ok(Cell {
+        name,
+        path: path.to_path_buf(),
+        units: spec.units,
+        process,
+        planning,
+        robots,
+        objects,
+        tasks,
+        world,
+        tasks_path,
+        source,
+        pending_cache,
+    })
+}
+
+fn describe_contact(world: &CollisionWorld, robot: &Robot, other: Option<&Robot>, c: BodyContact) -> String {
+    let body = |r: &Robot, i: usize| world.body_name(r.group, i).to_string();
+    match c {
+        BodyContact::Static { body: b, object } => {
+            format!(
+                "`{}` touches object `{}`",
+                body(robot, b),
+                world.static_name(object)
+            )
+        }
+        BodyContact::SelfPair(a, b) => format!("`{}` touches `{}`", body(robot, a), body(robot, b)),
+        BodyContact::Pair(a, b) => match other {
+            Some(o) => format!("`{}` touches `{}` of `{}`", body(robot, a), body(o, b), o.name),
+            None => format!("bodies {a} and {b}"),
+        },
+    }
+}
+
+fn positive(ctx: &Ctx, span: &Range<usize>, key: &str, v: f64) -> Result<f64, InputError> {
+    if v.is_finite() && v > 0.0 {
+        Ok(v)
+    } else {
+        Err(ctx.err(
+            ctx.key_span(span, key),
+            format!("`{key}` must be positive, not {v}"),
+        ))
+    }
+}
+
+/// Reads `[planning]` (defaults where absent).
+fn planning(ctx: &Ctx, spec: Option<&Spanned<PlanningSpec>>) -> Result<Planning, InputError> {
+    let mut out = Planning::default();
+    let Some(spec) = spec else { return Ok(out) };
+    let span = spec.span();
+    let p = spec.get_ref();
+    if let Some(v) = p.clearance {
+        if !(v.is_finite() && v >= 0.0) {
+            return Err(ctx.err(
+                ctx.key_span(&span, "clearance"),
+                format!("`clearance` must be ≥ 0, not {v}"),
+            ));
+        }
+        out.clearance = v * ctx.to_m;
+        if out.clearance > MAX_CLEARANCE {
+            return Err(ctx
+                .err(ctx.key_span(&span, "clearance"), format!("`clearance` of {:.3} m is beyond {MAX_CLEARANCE} m", out.clearance))
+                .hint("the clearance is the gap kept between robots and objects, a few millimetres to centimetres; check `units.length`"));
+        }
+    }
+    if let Some(v) = p.task_cap {
+        if v == 0 || v > MAX_TASK_CAP {
+            return Err(ctx
+                .err(
+                    ctx.key_span(&span, "task_cap"),
+                    format!("`task_cap` must be between 1 and {MAX_TASK_CAP}, not {v}"),
+                )
+                .hint("φ is the most tasks one robot may be given"));
+        }
+        out.task_cap = v;
+    }
+    if let Some(v) = p.balance_limit {
+        out.balance_limit = Some(positive(ctx, &span, "balance_limit", v)?);
+    }
+    Ok(out)
+}
+
+/// Largest `[planning] clearance` (m).
+pub const MAX_CLEARANCE: f64 = 1.0;
+/// Largest `[planning] task_cap`.
+pub const MAX_TASK_CAP: usize = 100_000;
+
+fn shape(
+    ctx: &Ctx,
+    e: &ShapeEntry,
+    span: Range<usize>,
+    owner: &str,
+) -> Result<(ShapeSpec, Pose), InputError> {
+    let given = [
+        e.box_size.is_some(),
+        e.cylinder.is_some(),
+        e.sphere.is_some(),
+        e.mesh.is_some(),
+    ]
+    .iter()
+    .filter(|&&b| b)
+    .count();
+    if given != 1 {
+        return Err(ctx.err(
+            span,
+            format!("{owner} needs exactly one of `box`, `cylinder`, `sphere`, `mesh` (found {given})"),
+        ));
+    }
+    let pose = ctx.pose(&e.pose)?;
+    let m = ctx.to_m;
+    let shape = if let Some(b) = e.box_size {
+        for v in b {
+            positive(ctx, &span, "box", v)?;
+        }
+        ShapeSpec::Box {
+            half_extents: DVec3::from_array(b) * (m / 2.0),
+        }
+    } else if let Some(c) = e.cylinder {
+        ShapeSpec::Cylinder {
+            radius: positive(ctx, &span, "cylinder", c.radius)? * m,
+            half_height: positive(ctx, &span, "cylinder", c.length)? * m / 2.0,
+        }
+    } else if let Some(r) = e.sphere {
+        ShapeSpec::Sphere {
+            radius: positive(ctx, &span, "sphere", r)? * m,
+        }
+    } else {
+        let rel = e.mesh.as_deref().unwrap_or_default();
+        let file = ctx.resolve(rel);
+        let mesh = load_mesh(&file).map_err(|err| match err {
+            MeshError::Parse { path, line, message } => {
+                InputError::at_line(&path, line, message).hint(format!(
+                    "the mesh of {owner} ({}:{}); fix or re-export the file",
+                    ctx.path.display(),
+                    line_of(ctx.text, span.start)
+                ))
+            }
+            other => ctx
+                .err(ctx.key_span(&span, "mesh"), format!("{owner}: {other}"))
+                .hint("mesh paths are relative to the cell file; STL (binary or ASCII) and OBJ are read"),
+        })?;
+        let factor = e.mesh_units.map_or(m, |u| u.to_m());
+        ShapeSpec::Mesh(Arc::new(mesh.scaled(factor)))
+    };
+    Ok((shape, pose))
+}
+
+fn kin_error(ctx: &Ctx, span: Range<usize>, robot: &str, e: KinError) -> InputError {
+    let at = format!(
+        "robot `{robot}` ({}:{})",
+        ctx.path.display(),
+        line_of(ctx.text, span.start)
+    );
+    match e {
+        KinError::Urdf {
+            path,
+            line,
+            message,
+            hint,
+        } => InputError::at_line(&path, line, message).hint(format!("{hint} (used by {at})")),
+        KinError::Mesh {
+            urdf,
+            line,
+            link,
+            source,
+        } => InputError::at_line(&urdf, line, format!("link `{link}`: {source}"))
+            .hint(format!("check the mesh file and the `packages` of {at}")),
+        KinError::Io { path, source } => InputError::new(&path, format!("cannot read: {source}"))
+            .hint(format!("check the path given for {at}")),
+        KinError::Opw { path, line, message } => {
+            InputError::at_line(&path, line, message).hint(format!("check the `opw` parameters of {at}"))
+        }
+    }
+}
+
+fn robot(
+    ctx: &Ctx,
+    entry: &Spanned<crate::spec::RobotSpec>,
+    id: RobotId,
+    tools: &BTreeMap<String, Tool>,
+    models: &mut HashMap<String, Arc<RobotModel>>,
+    earlier: &[Robot],
+) -> Result<Robot, InputError> {
+    let span = entry.span();
+    let r = entry.get_ref();
+    if earlier.iter().any(|o| o.name == r.name) {
+        return Err(ctx.err(
+            ctx.key_span(&span, "name"),
+            format!("robot name `{}` is used twice", r.name),
+        ));
+    }
+    // The URDF model, shared by robots that name the same file, packages and tip.
+    let urdf = ctx.resolve(r.urdf.get_ref());
+    let packages: BTreeMap<String, PathBuf> = r
+        .packages
+        .iter()
+        .map(|(k, v)| (k.clone(), ctx.resolve(v)))
+        .collect();
+    let key = format!("{}|{:?}|{:?}", urdf.display(), packages, r.tip);
+    let model = match models.get(&key) {
+        Some(m) => m.clone(),
+        None => {
+            if !urdf.exists() {
+                return Err(ctx
+                    .err(
+                        r.urdf.span(),
+                        format!("URDF file {} does not exist", urdf.display()),
+                    )
+                    .hint("`urdf` is relative to the cell file"));
+            }
+            let m = Arc::new(
+                load_urdf(&urdf, &packages, r.tip.as_deref())
+                    .map_err(|e| kin_error(ctx, span.clone(), &r.name, e))?,
+            );
+            models.insert(key, m.clone());
+            m
+        }
+    };
+    let chain = &model.chain;
+    let dof = chain.dof();
+    if dof == 0 {
+        return Err(ctx
+            .err(
+                r.urdf.span(),
+                format!("the chain of robot `{}` has no movable joint", r.name),
+            )
+            .hint(
+                "check the URDF and the robot's `tip`: the chain runs from the URDF root to the tip link",
+            ));
+    }
+    let joint_scale = |j: usize| match chain.joints[j].kind {
+        JointKind::Prismatic => ctx.to_m,
+        _ => ctx.to_rad,
+    };
+
+    // Inverse kinematics.
+    let (ik, ik_kind): (Arc<dyn IkSolver>, IkKind) = match &r.opw {
+        Some(opw) => {
+            let params = match opw.get_ref() {
+                OpwSpec::File(rel) => {
+                    let file = ctx.resolve(rel);
+                    let text = read_bounded(&file, 1 << 20).map_err(|e| {
+                        ctx.err(
+                            opw.span(),
+                            format!("cannot read OPW parameters {}: {e}", file.display()),
+                        )
+                        .hint("`opw` is a path relative to the cell file, or an inline table")
+                    })?;
+                    OpwParameters::from_ros_yaml(&text).map_err(|(line, m)| {
+                        InputError::at_line(&file, line, m)
+                            .hint("expected a ROS-Industrial opw_parameters yaml")
+                    })?
+                }
+                OpwSpec::Inline(p) => OpwParameters {
+                    a1: p.a1 * ctx.to_m,
+                    a2: p.a2 * ctx.to_m,
+                    b: p.b * ctx.to_m,
+                    c1: p.c1 * ctx.to_m,
+                    c2: p.c2 * ctx.to_m,
+                    c3: p.c3 * ctx.to_m,
+                    c4: p.c4 * ctx.to_m,
+                    offsets: p.offsets.map(|o| o * ctx.to_rad),
+                    sign_corrections: p.sign_corrections,
+                },
+            };
+            if dof != 6 {
+                return Err(ctx
+                    .err(
+                        opw.span(),
+                        format!(
+                            "OPW needs a 6-joint arm; the chain of `{}` has {dof} joints",
+                            r.name
+                        ),
+                    )
+                    .hint("remove `opw` to use the numeric IK"));
+            }
+            let solver = OpwIk::for_robot(&model, params).map_err(|e| match e {
+                KinError::Opw { message, .. } => ctx
+                    .err(opw.span(), format!("robot `{}`: {message}", r.name))
+                    .hint("the OPW parameters must describe this URDF (same robot model and tip link)"),
+                other => kin_error(ctx, span.clone(), &r.name, other),
+            })?;
+            (Arc::new(solver), IkKind::Opw)
+        }
+        None => (Arc::new(DlsIk::new(chain, DlsParams::default())), IkKind::Numeric),
+    };
+
+    let base = ctx.pose(&r.base)?;
+
+    // Home: given, else zero where that is within limits, else mid-range.
+    let home = match &r.home {
+        Some(h) => {
+            if h.get_ref().len() != dof {
+                return Err(ctx.err(
+                    h.span(),
+                    format!(
+                        "`home` has {} values but `{}` has {dof} joints",
+                        h.get_ref().len(),
+                        r.name
+                    ),
+                ));
+            }
+            let q: Vec<f64> = h
+                .get_ref()
+                .iter()
+                .enumerate()
+                .map(|(j, v)| v * joint_scale(j))
+                .collect();
+            for (j, joint) in chain.joints.iter().enumerate() {
+                if !(joint.lower - 1e-9..=joint.upper + 1e-9).contains(&q[j]) {
+                    return Err(ctx
+                        .err(
+                            h.span(),
+                            format!("`home` puts joint `{}` outside its limits", joint.name),
+                        )
+                        .hint(format!(
+                            "its range is [{:.4}, {:.4}] in file units",
+                            joint.lower / joint_scale(j),
+                            joint.upper / joint_scale(j)
+                        )));
+                }
+            }
+            q
+        }
+        None => chain
+            .joints
+            .iter()
+            .map(|j| {
+                if j.lower <= 0.0 && 0.0 <= j.upper {
+                    0.0
+                } else {
+                    (j.lower + j.upper) / 2.0
+                }
+            })
+            .collect(),
+    };
+
+    let tool = match &r.tool {
+        Some(name) => tools.get(name.get_ref()).cloned().ok_or_else(|| {
+            let known: Vec<&str> = tools.keys().map(String::as_str).collect();
+            ctx.err(name.span(), format!("no tool named `{}`", name.get_ref()))
+                .hint(format!(
+                    "tools defined under [tools]: {}",
+                    if known.is_empty() {
+                        "none".into()
+                    } else {
+                        known.join(", ")
+                    }
+                ))
+        })?,
+        None => Tool {
+            name: "flange".into(),
+            tcp: Pose::IDENTITY,
+            shapes: Vec::new(),
+        },
+    };
+
+    let limits = |given: &Option<Spanned<Vec<f64>>>, key: &str| -> Result<Option<Vec<f64>>, InputError> {
+        let Some(v) = given else { return Ok(None) };
+        if v.get_ref().len() != dof {
+            return Err(ctx.err(
+                v.span(),
+                format!(
+                    "`{key}` has {} values but `{}` has {dof} joints",
+                    v.get_ref().len(),
+                    r.name
+                ),
+            ));
+        }
+        v.get_ref()
+            .iter()
+            .enumerate()
+            .map(|(j, &x)| {
+                if x.is_finite() && x > 0.0 {
+                    Ok(x * joint_scale(j))
+                } else {
+                    Err(ctx.err(v.span(), format!("`{key}` values must be positive")))
+                }
+            })
+            .collect::<Result<Vec<_>, _>>()
+            .map(Some)
+    };
+    let max_velocity = match limits(&r.max_velocity, "max_velocity")? {
+        Some(v) => v,
+        None => {
+            if let Some(j) = chain
+                .joints
+                .iter()
+                .find(|j| !(j.max_velocity.is_finite() && j.max_velocity > 0.0))
+            {
+                return Err(ctx
+                    .err(
+                        ctx.key_span(&span, "urdf"),
+                        format!("joint `{}` has no velocity limit in the URDF", j.name),
+                    )
+                    .hint("give `max_velocity` for the robot in the cell file"));
+            }
+            chain.joints.iter().map(|j| j.max_velocity).collect()
+        }
+    };
+    let max_acceleration = match limits(&r.max_acceleration, "max_acceleration")? {
+        Some(a) => a,
+        None => max_velocity
+            .iter()
+            .map(|v| v / DEFAULT_ACCELERATION_TIME)
+            .collect(),
+    };
+
+    // Upper bound of the TCP's distance from the base: link offsets, prismatic strokes, TCP.
+    let reach = chain
+        .links
+        .iter()
+        .map(|l| l.origin.translation.length())
+        .sum::<f64>()
+        + chain
+            .joints
+            .iter()
+            .filter(|j| j.kind == JointKind::Prismatic)
+            .map(|j| j.lower.abs().max(j.upper.abs()))
+            .sum::<f64>()
+        + tool.tcp.translation.length();
+
+    Ok(Robot {
+        id,
+        name: r.name.clone(),
+        model,
+        base,
+        home,
+        tool,
+        ik,
+        ik_kind,
+        max_velocity,
+        max_acceleration,
+        group: cellplan_geom::GroupId(u32::MAX),
+        bodies: Vec::new(),
+        self_pairs: Vec::new(),
+        reach,
+    })
+}

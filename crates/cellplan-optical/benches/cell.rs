@@ -1,0 +1,53 @@
+//! Benchmarks on the bundled autobody-4r cell: one robot configuration's full collision check
+//! against the car body, fixtures and itself; and candidate generation for the whole cell.
+use cellplan_core::candidates::generate;
+use cellplan_model::load as load_with;
+#[allow(clippy::result_large_err)]
+fn load(
+    p: &std::path::Path,
+    o: &cellplan_model::LoadOptions,
+) -> Result<cellplan_model::Cell, cellplan_model::InputError> {
+    load_with(p, &cellplan_optical::registry(), o)
+}
+use cellplan_model::robot::Scratch;
+use cellplan_model::{LoadOptions, TaskId};
+use criterion::{Criterion, criterion_group, criterion_main};
+use std::hint::black_box;
+use std::path::Path;
+
+fn cell_benches(c: &mut Criterion) {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/autobody-4r/cell.toml");
+    let cell = load(&path, &LoadOptions::default()).expect("example cell loads");
+    let table = generate(&cell);
+    let robot = &cell.robots[0];
+    // A measuring configuration: the probe close to the car body.
+    let near = (0..cell.tasks.len())
+        .find_map(|t| table.get(TaskId(t), robot.id).candidates.first().cloned())
+        .expect("R1 measures something");
+    let clearance = cell.planning.clearance;
+    let mut scratch = Scratch::default();
+    c.bench_function(
+        "collision check, R-2000iC + probe vs car body (measuring pose)",
+        |b| {
+            b.iter(|| {
+                robot.body_poses(black_box(&near.q), &mut scratch);
+                black_box(robot.contact_at(&cell.world, &scratch, clearance))
+            })
+        },
+    );
+    c.bench_function("collision check, R-2000iC + probe vs car body (home)", |b| {
+        b.iter(|| {
+            robot.body_poses(black_box(&robot.home), &mut scratch);
+            black_box(robot.contact_at(&cell.world, &scratch, clearance))
+        })
+    });
+    let mut group = c.benchmark_group("candidates");
+    group.sample_size(10);
+    group.bench_function("autobody-4r, 45 MPs x 4 robots", |b| {
+        b.iter(|| black_box(generate(&cell)))
+    });
+    group.finish();
+}
+
+criterion_group!(benches, cell_benches);
+criterion_main!(benches);

@@ -1,0 +1,533 @@
+//! `cellplan plan` through the library on a reduced copy of the two-robot example (its first 8
+//! MPs): every plan is re-checked here, independently of the planner — every MP measured
+//! exactly once at a pose that meets the probe constraints, every leg re-sampled finely (joint
+//! steps of 1 mrad) against the static scene at the margin, joint position, velocity and
+//! acceleration limits from the written samples, the document's totals recomputed.
+use cellplan_core::candidates::{CandidateTable, generate};
+use cellplan_core::coord::{self, CoordSettings};
+use cellplan_model::load as load_with;
+#[allow(clippy::result_large_err)]
+fn load(
+    p: &std::path::Path,
+    o: &cellplan_model::LoadOptions,
+) -> Result<cellplan_model::Cell, cellplan_model::InputError> {
+    load_with(p, &cellplan_optical::registry(), o)
+}
+use cellplan_core::document as output;
+use cellplan_core::plan::{self, Allocation, PlanSettings};
+use cellplan_core::verify::{VerifySettings, ViolationKind, verify};
+use cellplan_model::robot::Scratch;
+use cellplan_model::{Cell, LoadOptions, TaskId};
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::sync::OnceLock;
+
+/// The two-robot example with only its first `n` MPs, written to a temporary folder.
+fn small_cell(n: usize) -> PathBuf {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../..")
+        .canonicalize()
+        .unwrap();
+    let example = root.join("examples/autobody-2r");
+    let dir = std::env::temp_dir().join(format!("cellplan-plan-test-{}-{n}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let text = std::fs::read_to_string(example.join("cell.toml")).unwrap();
+    let text = text
+        .replace("../../data", &root.join("data").display().to_string())
+        .replace("name = \"autobody-2r\"", "name = \"autobody-2r-small\"");
+    std::fs::write(dir.join("cell.toml"), text).unwrap();
+    let tasks = std::fs::read_to_string(example.join("tasks.csv")).unwrap();
+    let mut lines = tasks.lines().filter(|l| !l.starts_with('#'));
+    let mut out = String::new();
+    for l in lines.by_ref().take(n + 1) {
+        out += l;
+        out += "\n";
+    }
+    std::fs::write(dir.join("tasks.csv"), out).unwrap();
+    dir.join("cell.toml")
+}
+
+struct Fixture {
+    cell: Cell,
+    table: CandidateTable,
+}
+
+fn fixture() -> &'static Fixture {
+    static F: OnceLock<Fixture> = OnceLock::new();
+    F.get_or_init(|| {
+        let cell = load(&small_cell(8), &LoadOptions::default()).expect("the reduced cell loads");
+        let table = generate(&cell);
+        Fixture { cell, table }
+    })
+}
+
+fn settings(allocation: Allocation) -> PlanSettings {
+    PlanSettings {
+        allocation,
+        alternatives: 8,
+        balanced_iterations: 60,
+        // Never cut by the clock: the plan must depend only on the input and the seed.
+        time_limit: std::time::Duration::from_secs(3600),
+        ..PlanSettings::default()
+    }
+}
+
+fn make(allocation: Allocation) -> output::Plan {
+    let f = fixture();
+    let s = settings(allocation);
+    let outcome = plan::plan(&f.cell, &f.table, &s, &|_| {}).expect("the reduced cell plans");
+    let doc = build(&f.cell, &f.table, &outcome, &s);
+    // The document survives its own JSON.
+    let text = serde_json::to_string(&doc).unwrap();
+    let back: output::Plan = serde_json::from_str(&text).unwrap();
+    assert_eq!(serde_json::to_string(&back).unwrap(), text);
+    check_plan(&f.cell, &doc);
+    verified(&f.cell, &doc);
+    doc
+}
+
+/// The plan document of a run, coordinated by `best`.
+fn build(cell: &Cell, table: &CandidateTable, outcome: &plan::Outcome, s: &PlanSettings) -> output::Plan {
+    let c = coord::coordinate_outcome(cell, table, outcome, &CoordSettings::default())
+        .expect("coordination succeeds");
+    output::build(cell, table, outcome, &c, s, 0.0, 0.0)
+}
+
+/// The verifier accepts the plan, robot–robot clearance included.
+fn verified(cell: &Cell, doc: &output::Plan) {
+    let report = verify(cell, doc, &VerifySettings::default());
+    assert!(report.ok, "{:#?}", report.violations);
+    assert!(report.configurations_checked > 0);
+}
+
+/// The independent re-check of a plan.
+fn check_plan(cell: &Cell, doc: &output::Plan) {
+    let process = cellplan_optical::of(cell).expect("an optical cell");
+    assert_eq!(doc.format, output::FORMAT);
+    assert_eq!(doc.robots.len(), cell.robots.len());
+    let by_name: BTreeMap<&str, usize> = cell.tasks.iter().map(|t| (t.name.as_str(), t.id.0)).collect();
+    let mut measured = vec![0usize; cell.tasks.len()];
+    let mut scratch = Scratch::default();
+    let mut times = Vec::new();
+    for (robot, rp) in cell.robots.iter().zip(&doc.robots) {
+        assert_eq!(rp.name, robot.name);
+        assert!(
+            rp.tasks.len() <= cell.planning.task_cap,
+            "{} over its cap",
+            rp.name
+        );
+        for v in &rp.tasks {
+            let t = &cell.tasks[by_name[v.task.as_str()]];
+            measured[t.id.0] += 1;
+            assert!(robot.within_limits(&v.q));
+            let tcp = robot.tcp_pose(&v.q);
+            assert!((tcp.translation - glam::DVec3::from(v.tcp.xyz)).length() < 1e-6);
+            let angle = process
+                .measurement(t, &tcp)
+                .unwrap_or_else(|r| panic!("{} does not measure {} from its pose: {r:?}", rp.name, v.task));
+            assert!((angle - v.figures["view_angle_rad"]).abs() < 1e-6);
+            robot.body_poses(&v.q, &mut scratch);
+            assert!(
+                robot
+                    .contact_at(&cell.world, &scratch, cell.planning.clearance - 1e-6)
+                    .is_none()
+            );
+            assert!(v.depart_s - v.arrive_s >= process.measure_time - 1e-9);
+        }
+        // Legs: chained home → … → home, re-sampled at 1 mrad per joint step.
+        assert_eq!(rp.legs.len(), rp.tasks.len() + 1);
+        let mut at = rp.home.clone();
+        for (i, leg) in rp.legs.iter().enumerate() {
+            let to = rp.tasks.get(i).map_or(&rp.home, |v| &v.q);
+            assert!(
+                dist(&leg.waypoints[0], &at) < 1e-9,
+                "{} leg {i} starts elsewhere",
+                rp.name
+            );
+            assert!(
+                dist(leg.waypoints.last().unwrap(), to) < 1e-9,
+                "{} leg {i} ends elsewhere",
+                rp.name
+            );
+            for w in leg.waypoints.windows(2) {
+                let steps = (dist(&w[0], &w[1]) / 1e-3).ceil().max(1.0) as usize;
+                for s in 0..=steps {
+                    let f = s as f64 / steps as f64;
+                    let q: Vec<f64> = w[0].iter().zip(&w[1]).map(|(a, b)| a + f * (b - a)).collect();
+                    assert!(
+                        robot.within_limits(&q),
+                        "{} leg {i} leaves the joint limits",
+                        rp.name
+                    );
+                    robot.body_poses(&q, &mut scratch);
+                    assert!(
+                        robot
+                            .contact_at(&cell.world, &scratch, cell.planning.clearance - 1e-6)
+                            .is_none(),
+                        "{} leg {i} ({} → {}) comes closer than the clearance at {q:?}",
+                        rp.name,
+                        leg.from,
+                        leg.to
+                    );
+                }
+            }
+            at = to.clone();
+        }
+        // Samples: within limits; finite differences bound the mean velocity and acceleration.
+        let tr = &rp.trajectory;
+        assert!(tr.first().unwrap().t.abs() < 1e-12);
+        assert!((tr.last().unwrap().t - rp.total_s).abs() < 1e-9);
+        assert!(dist(&tr.first().unwrap().q, &rp.home) < 1e-9);
+        assert!(dist(&tr.last().unwrap().q, &rp.home) < 1e-9);
+        for s in tr {
+            assert!(robot.within_limits(&s.q));
+        }
+        for w in tr.windows(3) {
+            let (h1, h2) = (w[1].t - w[0].t, w[2].t - w[1].t);
+            for j in 0..robot.dof() {
+                let v = (w[1].q[j] - w[0].q[j]) / h1;
+                assert!(
+                    v.abs() <= robot.max_velocity[j] * (1.0 + 1e-6),
+                    "{} joint {j} too fast",
+                    rp.name
+                );
+                if (h1 - h2).abs() < 1e-9 {
+                    let a = (w[2].q[j] - 2.0 * w[1].q[j] + w[0].q[j]) / (h1 * h1);
+                    assert!(
+                        a.abs() <= robot.max_acceleration[j] * (1.0 + 1e-6),
+                        "{} joint {j} accelerates too hard",
+                        rp.name
+                    );
+                }
+            }
+        }
+        times.push(rp.total_s);
+    }
+    // Every measurable MP exactly once; the others listed as unmeasured.
+    let unmeasured: Vec<&str> = doc.unmeasured.iter().map(|u| u.task.as_str()).collect();
+    for t in &cell.tasks {
+        let want = usize::from(!unmeasured.contains(&t.name.as_str()));
+        assert_eq!(
+            measured[t.id.0], want,
+            "MP {} measured {} times",
+            t.name, measured[t.id.0]
+        );
+    }
+    let cycle = times.iter().copied().fold(0.0, f64::max);
+    assert!((doc.cycle_time_s - cycle).abs() < 1e-9);
+    let spread = cycle - times.iter().copied().fold(f64::INFINITY, f64::min);
+    assert!((doc.delta_t_s - spread).abs() < 1e-9);
+    assert!(doc.lower_bound_s > 0.0 && doc.lower_bound_s <= doc.cycle_time_s + 1e-9);
+}
+
+fn dist(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| (x - y).powi(2)).sum::<f64>().sqrt()
+}
+
+#[test]
+fn every_strategy_gives_a_plan_that_rechecks_clean() {
+    let f = fixture();
+    let prox = make(Allocation::Proximity);
+    // Proximity: every MP with the nearest robot able to measure it (the caps do not bind here).
+    for (r, rp) in prox.robots.iter().enumerate() {
+        for v in &rp.tasks {
+            let t = f.cell.tasks.iter().find(|t| t.name == v.task).unwrap();
+            let d = |i: usize| (f.cell.robots[i].base.translation - t.position).length();
+            for other in f.table.robots_for(t.id) {
+                assert!(
+                    d(r) <= d(other.0) + 1e-12,
+                    "MP {} is not with its nearest robot",
+                    v.task
+                );
+            }
+        }
+    }
+    let robust = make(Allocation::LocalRobust);
+    assert!(robust.stats.local_sets_built >= robust.stats.local_sets_chosen);
+    let balanced = make(Allocation::Balanced);
+    for doc in [&prox, &robust, &balanced] {
+        assert!(doc.stats.legs_planned >= doc.robots.iter().map(|r| r.legs.len()).sum::<usize>() / 2);
+    }
+}
+
+#[test]
+fn the_plan_does_not_depend_on_the_thread_count() {
+    let f = fixture();
+    let s = settings(Allocation::Balanced);
+    let run = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| {
+            let outcome = plan::plan(&f.cell, &f.table, &s, &|_| {}).unwrap();
+            let mut doc = build(&f.cell, &f.table, &outcome, &s);
+            doc.compute_s = output::ComputeTimes::default();
+            doc.coordination.compute_s = 0.0;
+            doc
+        })
+    };
+    let one = run(1);
+    check_plan(&f.cell, &one);
+    assert_eq!(one, run(2));
+    let _ = TaskId(0);
+}
+
+/// Every key the schema requires is in a written plan, at every level.
+#[test]
+fn written_plans_have_every_key_the_schema_requires() {
+    let schema: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("../../docs/plan.schema.json"))
+            .unwrap(),
+    )
+    .unwrap();
+    let f = fixture();
+    let s = PlanSettings {
+        allocation: Allocation::Proximity,
+        ..settings(Allocation::Proximity)
+    };
+    let outcome = plan::plan(&f.cell, &f.table, &s, &|_| {}).unwrap();
+    let doc = serde_json::to_value(build(&f.cell, &f.table, &outcome, &s)).unwrap();
+    fn required(schema: &serde_json::Value, value: &serde_json::Value, root: &serde_json::Value, at: &str) {
+        let schema = match schema.get("$ref").and_then(|r| r.as_str()) {
+            Some(r) => root.pointer(r.trim_start_matches('#')).unwrap(),
+            None => schema,
+        };
+        if let Some(keys) = schema.get("required").and_then(|r| r.as_array()) {
+            for k in keys {
+                let k = k.as_str().unwrap();
+                assert!(value.get(k).is_some(), "{at} lacks `{k}`");
+            }
+        }
+        if let (Some(props), Some(obj)) = (
+            schema.get("properties").and_then(|p| p.as_object()),
+            value.as_object(),
+        ) {
+            for (k, sub) in props {
+                if let Some(v) = obj.get(k) {
+                    required(sub, v, root, &format!("{at}.{k}"));
+                }
+            }
+        }
+        if let (Some(items), Some(arr)) = (schema.get("items"), value.as_array()) {
+            for (i, v) in arr.iter().enumerate() {
+                required(items, v, root, &format!("{at}[{i}]"));
+            }
+        }
+    }
+    required(&schema, &doc, &schema, "plan");
+    assert_eq!(doc["version"], schema["properties"]["version"]["const"]);
+}
+
+/// Two robots 2 m apart facing a box, four MPs close together on its top, all nearer to R1
+/// and measurable by both: proximity gives all four to R1; local robust sets group them
+/// (closer than ε, same normal) and Algorithm 1 gives the set to R1 (the shorter tour from its
+/// base); the balanced min-max splits them two and two (four measurements on one robot take
+/// 6 s, two take 3 s).
+#[test]
+fn allocation_strategies_give_the_known_answers_on_a_hand_made_cell() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../..")
+        .canonicalize()
+        .unwrap();
+    let fanuc = root.join("data/robots/fanuc_r2000ic");
+    let dir = std::env::temp_dir().join(format!("cellplan-plan-known-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let robot = |name: &str, y: i32| {
+        format!(
+            r#"
+[[robots]]
+name = "{name}"
+urdf = "{f}/urdf/r2000ic125l.urdf"
+packages = {{ fanuc_r2000ic_support = "{f}/fanuc_r2000ic_support" }}
+opw = "{f}/fanuc_r2000ic_support/config/opw_parameters_r2000ic125l.yaml"
+base = {{ xyz = [0, {y}, 0] }}
+home = [0, -30, 0, 0, -60, 0]
+tool = "probe"
+"#,
+            f = fanuc.display()
+        )
+    };
+    let cell = format!(
+        r#"name = "known"
+units = {{ length = "mm", angle = "deg" }}
+
+[process]
+kind = "optical-inspection"
+standoff = 250
+stripe_length = 60
+baseline = 100
+
+[tools.probe]
+tcp = {{ xyz = [0, 0, 300] }}
+
+[[tools.probe.shape]]
+box = [180, 120, 220]
+pose = {{ xyz = [45, 0, 190] }}
+{}{}
+[[objects]]
+name = "part"
+box = [600, 600, 600]
+pose = {{ xyz = [1900, 0, 300] }}
+
+[tasks]
+file = "tasks.csv"
+"#,
+        robot("R1", 1000),
+        robot("R2", -1000)
+    );
+    std::fs::write(dir.join("cell.toml"), cell).unwrap();
+    std::fs::write(
+        dir.join("tasks.csv"),
+        "id,x,y,z,nx,ny,nz\nA,1800,150,600,0,0,1\nB,1900,150,600,0,0,1\nC,1800,250,600,0,0,1\nD,1900,250,600,0,0,1\n",
+    )
+    .unwrap();
+    let cell = load(&dir.join("cell.toml"), &LoadOptions::default()).expect("the hand-made cell loads");
+    let table = generate(&cell);
+    for t in 0..4 {
+        assert_eq!(table.robots_for(TaskId(t)).len(), 2, "both robots measure MP {t}");
+    }
+    let graphs: Vec<_> = cell
+        .robots
+        .iter()
+        .map(|r| plan::graph::RobotGraph::new(&cell, r, &table, plan::MoveModel::Trapezoid, 8, 0.02))
+        .collect();
+    let counts = |a: Allocation| {
+        let s = settings(a);
+        let got = plan::allocate::allocate(&cell, &table, &graphs, &s, None).unwrap();
+        got.tasks.iter().map(Vec::len).collect::<Vec<_>>()
+    };
+    assert_eq!(counts(Allocation::Proximity), vec![4, 0]);
+    assert_eq!(counts(Allocation::LocalRobust), vec![4, 0]);
+    assert_eq!(counts(Allocation::Balanced), vec![2, 2]);
+    // And the plans of all three recheck clean.
+    for a in [
+        Allocation::Proximity,
+        Allocation::LocalRobust,
+        Allocation::Balanced,
+    ] {
+        let s = settings(a);
+        let outcome = plan::plan(&cell, &table, &s, &|_| {}).unwrap();
+        let doc = build(&cell, &table, &outcome, &s);
+        check_plan(&cell, &doc);
+        verified(&cell, &doc);
+    }
+}
+
+/// Faults injected into a good plan are each caught by the verifier.
+#[test]
+fn the_verifier_catches_injected_faults() {
+    let f = fixture();
+    let s = settings(Allocation::Balanced);
+    let outcome = plan::plan(&f.cell, &f.table, &s, &|_| {}).unwrap();
+    let good = build(&f.cell, &f.table, &outcome, &s);
+    let quiet = VerifySettings::default();
+    assert!(verify(&f.cell, &good, &quiet).ok);
+    let kinds = |doc: &output::Plan| -> Vec<ViolationKind> {
+        verify(&f.cell, doc, &quiet)
+            .violations
+            .iter()
+            .map(|v| v.kind)
+            .collect()
+    };
+    let busy = good.robots.iter().position(|r| !r.tasks.is_empty()).unwrap();
+    // A skipped MP.
+    let mut skipped = good.clone();
+    skipped.robots[busy].tasks.remove(0);
+    assert!(kinds(&skipped).contains(&ViolationKind::MissingTask));
+    // A joint-limit breach in the trajectory.
+    let mut breach = good.clone();
+    let n = breach.robots[busy].trajectory.len();
+    breach.robots[busy].trajectory[n / 2].q[0] = 10.0;
+    let k = kinds(&breach);
+    assert!(
+        k.contains(&ViolationKind::JointLimit) && k.contains(&ViolationKind::Velocity),
+        "{k:?}"
+    );
+    // A measuring pose turned away from its MP.
+    let mut turned = good.clone();
+    turned.robots[busy].tasks[0].q[4] += 0.5; // tilt the wrist: the beam leaves the view cone
+    assert!(kinds(&turned).contains(&ViolationKind::ProbeConstraint));
+    // A cycle time that does not match.
+    let mut fudged = good.clone();
+    fudged.cycle_time_s -= 1.0;
+    assert!(kinds(&fudged).contains(&ViolationKind::Totals));
+    // A leg waypoint pushed into the part: the home-to-first-MP leg detoured through the car.
+    let mut through = good.clone();
+    let leg = &mut through.robots[busy].legs[0];
+    let mid: Vec<f64> = leg.waypoints[0]
+        .iter()
+        .zip(leg.waypoints.last().unwrap())
+        .map(|(a, b)| 0.5 * (a + b))
+        .collect();
+    let mut into = mid.clone();
+    into[1] += 0.9; // lean far forward, into the car
+    leg.waypoints.insert(1, into);
+    let k = kinds(&through);
+    assert!(
+        k.iter().any(|k| matches!(
+            k,
+            ViolationKind::StaticClearance | ViolationKind::SelfCollision | ViolationKind::JointLimit
+        )),
+        "{k:?}"
+    );
+}
+
+/// The two bundled example cells, whole, with the default settings: the plans re-check clean.
+#[test]
+fn both_example_cells_plan_and_recheck_clean() {
+    for name in ["autobody-2r", "autobody-4r"] {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("../../examples/{name}/cell.toml"));
+        let cell = load(&path, &LoadOptions::default()).expect("the example loads");
+        let table = generate(&cell);
+        let s = PlanSettings {
+            time_limit: std::time::Duration::from_secs(3600),
+            ..PlanSettings::default()
+        };
+        let outcome = plan::plan(&cell, &table, &s, &|_| {}).expect("the example plans");
+        let doc = build(&cell, &table, &outcome, &s);
+        assert!(
+            doc.unmeasured.is_empty(),
+            "{name}: every MP of the examples is measurable"
+        );
+        check_plan(&cell, &doc);
+        verified(&cell, &doc);
+    }
+}
+
+/// The lazy bar: a robot whose best order cannot finish below the bar stops before planning a
+/// leg; with no bar it finishes, and its real time is what the bar is measured against.
+#[test]
+fn sequencing_against_a_bar_stops_before_planning() {
+    let f = fixture();
+    let s = settings(Allocation::Balanced);
+    let robot = &f.cell.robots[0];
+    let graph =
+        plan::graph::RobotGraph::new(&f.cell, robot, &f.table, plan::MoveModel::Trapezoid, 8, s.roomy);
+    let tasks: Vec<TaskId> = (0..f.cell.tasks.len())
+        .map(TaskId)
+        .filter(|&t| !graph.alternatives[t.0].is_empty())
+        .take(3)
+        .collect();
+    assert_eq!(tasks.len(), 3, "the robot measures at least three MPs");
+    let deadline = std::time::Instant::now() + std::time::Duration::from_secs(3600);
+    let measure = cellplan_optical::of(&f.cell).unwrap().measure_time;
+    // Three measurements alone take longer than this bar.
+    let bar = 3.0 * measure - 1e-3;
+    let run = |bar: f64, planned: &mut plan::sequence::Planned| {
+        plan::sequence::sequence(&f.cell, robot, &graph, &tasks, &s, deadline, bar, None, planned).unwrap()
+    };
+    let mut planned = plan::sequence::Planned::new();
+    let beaten = run(bar, &mut planned);
+    assert!(beaten.beaten && beaten.nodes.is_empty() && beaten.legs.is_empty());
+    assert!(planned.is_empty(), "no leg planned for a hopeless allocation");
+    let done = run(f64::INFINITY, &mut planned);
+    assert!(!done.beaten);
+    assert_eq!(done.nodes.len(), 3);
+    assert_eq!(done.legs.len(), 4);
+    let real = plan::sequence::order_cost(&graph, &planned, &done.nodes);
+    assert!(real < plan::sequence::NO_PATH && real > 3.0 * measure);
+    // A bar just above the real time does not stop it.
+    let kept = run(real + 1.0, &mut planned.clone());
+    assert!(!kept.beaten);
+}

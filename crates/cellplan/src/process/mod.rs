@@ -1,2 +1,0 @@
-//! Processes: what a cell does at a task, and the physical constraints of doing it.
-pub mod optical;
