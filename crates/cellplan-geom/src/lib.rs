@@ -5,6 +5,7 @@
 //!
 //! - [`mesh`]: [`Mesh`] and its loaders, [`load_mesh`] (binary/ASCII STL, OBJ), with errors
 //!   that name the file and line.
+//! - [`read`]: reading input files with a size limit (meshes, URDFs, cell files).
 //! - [`shape`]: [`ShapeSpec`], the shapes a cell file can state (box, cylinder, sphere, mesh).
 //! - [`world`]: [`CollisionWorld`], the static scene plus articulated body groups (robots),
 //!   with contact, distance and ray queries.
@@ -13,6 +14,7 @@
 pub mod error;
 mod hull;
 pub mod mesh;
+pub mod read;
 pub mod shape;
 pub mod world;
 

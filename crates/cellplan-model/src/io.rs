@@ -1,28 +1,21 @@
 //! Reading inputs with a size limit, and writing outputs so that nothing is ever half-written.
-use std::io::{Read, Write};
+use cellplan_geom::read::{LimitedReadError, read_limited, show_bytes, utf8_text};
+use std::io::Write;
 use std::path::Path;
 
 /// Reads a UTF-8 text file of at most `limit` bytes. A larger file (or an endless one, such as
-/// `/dev/zero`) is refused after reading `limit + 1` bytes, so no input can exhaust memory.
+/// `/dev/zero`) is refused without reading more than `limit + 1` bytes, so no input can
+/// exhaust memory (see [`cellplan_geom::read`]).
 pub fn read_bounded(path: &Path, limit: u64) -> std::io::Result<String> {
-    let file = std::fs::File::open(path)?;
-    let mut bytes = Vec::new();
-    file.take(limit + 1).read_to_end(&mut bytes)?;
-    if bytes.len() as u64 > limit {
-        return Err(std::io::Error::new(
-            std::io::ErrorKind::InvalidData,
-            format!(
-                "the file is larger than {} MiB, the most cellplan reads",
-                limit >> 20
-            ),
-        ));
-    }
-    String::from_utf8(bytes).map_err(|e| {
-        std::io::Error::new(
-            std::io::ErrorKind::InvalidData,
-            format!("not UTF-8 text (byte {})", e.utf8_error().valid_up_to()),
-        )
-    })
+    let invalid = |m: String| std::io::Error::new(std::io::ErrorKind::InvalidData, m);
+    let bytes = read_limited(path, limit).map_err(|e| match e {
+        LimitedReadError::Io(e) => e,
+        LimitedReadError::TooLarge { size } => invalid(format!(
+            "the file is {size}, larger than {}, the most cellplan reads",
+            show_bytes(limit)
+        )),
+    })?;
+    utf8_text(bytes).map_err(|e| invalid(format!("not UTF-8 text (line {}, byte {})", e.line, e.offset)))
 }
 
 /// Writes `bytes` to a temporary file beside `path`, then renames it over `path`. Parent
