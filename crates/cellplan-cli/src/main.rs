@@ -251,7 +251,7 @@ fn run_check(args: &CheckArgs) -> Result<(), Failure> {
     ));
     let table = candidates::generate(&cell);
     pb.finish_and_clear();
-    if let Some(e) = check::idle_robot_error(&cell, &table) {
+    if let Some(e) = check::idle_robot_error(&cell, &table).or_else(|| check::cap_error(&cell, &table)) {
         return Err(e.into());
     }
     let report = check::report(&cell, &table);

@@ -127,7 +127,6 @@ pub fn reach(
     parked: &[(GroupId, Vec<Pose>)],
 ) -> Reach {
     let world = &cell.world;
-    let clearance = cell.planning.clearance;
     let mut reach = Reach::default();
     let mut scratch = Scratch::default();
     let mut solutions = Vec::new();
@@ -168,17 +167,7 @@ pub fn reach(
             let verdict = match verdicts.iter().find(|(p, _)| same_geometry(p, q)) {
                 Some((_, v)) => *v,
                 None => {
-                    let v = check_configuration(
-                        cell,
-                        process,
-                        robot,
-                        task,
-                        tcp,
-                        q,
-                        parked,
-                        clearance,
-                        &mut scratch,
-                    );
+                    let v = check_configuration(cell, process, robot, task, tcp, q, parked, &mut scratch);
                     verdicts.push((q.clone(), v));
                     v
                 }
@@ -212,10 +201,9 @@ fn check_configuration(
     tcp: &Pose,
     q: &[f64],
     parked: &[(GroupId, Vec<Pose>)],
-    clearance: f64,
     scratch: &mut Scratch,
 ) -> Result<(), Rejection> {
-    let world = &cell.world;
+    let (world, clearance) = (&cell.world, cell.planning.clearance);
     robot.body_poses(q, scratch);
     process
         .arm_check(world, robot, &scratch.bodies, task, tcp)

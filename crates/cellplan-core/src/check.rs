@@ -212,6 +212,34 @@ pub fn idle_robot_error(cell: &Cell, table: &CandidateTable) -> Option<InputErro
     )
 }
 
+/// Task caps that cannot hold every task some robot can do are a mistake in the cell: the same
+/// test `plan` makes (an assignment of every doable task within the caps), so `check` and `plan`
+/// agree on what they refuse.
+pub fn cap_error(cell: &Cell, table: &CandidateTable) -> Option<InputError> {
+    let doable: Vec<TaskId> = cell
+        .tasks
+        .iter()
+        .map(|t| t.id)
+        .filter(|&t| !table.robots_for(t).is_empty())
+        .collect();
+    let cap = cell.planning.task_cap;
+    let caps = vec![cap; cell.robots.len()];
+    let stuck = cellplan_solve::minmax::assign_within_caps(doable.len(), &caps, |r, k| {
+        !table.get(doable[k], RobotId(r)).candidates.is_empty()
+    })
+    .err()?;
+    Some(
+        InputError::new(
+            &cell.path,
+            format!(
+                "with task_cap = {cap}, the robots cannot take every task they can do: task `{}` finds no robot with room",
+                cell.tasks[doable[stuck].0].name
+            ),
+        )
+        .hint("raise `task_cap` in the [planning] table, or add a robot that can reach those tasks"),
+    )
+}
+
 /// The report as a table for people.
 pub fn render_text(cell: &Cell, table: &CandidateTable, r: &CheckReport) -> String {
     let mut s = String::new();

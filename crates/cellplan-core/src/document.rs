@@ -2,7 +2,7 @@
 //! units (m, rad, s), written atomically. Its key names are stable.
 use crate::candidates::CandidateTable;
 use crate::coord::{Activity, Conflict, Coordinated, Coordination, WaitReason};
-use crate::plan::{self as super_plan, Outcome, PlanSettings, Stage};
+use crate::plan::{self, Outcome, PlanSettings, Stage};
 use cellplan_model::Cell;
 use cellplan_model::Process;
 use cellplan_model::tasks::TaskId;
@@ -56,11 +56,11 @@ pub struct Plan {
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
 pub struct SettingsOut {
     /// `proximity`, `local-robust` or `balanced`.
-    pub allocation: super_plan::Allocation,
+    pub allocation: plan::Allocation,
     /// `penalty` or `exact` (local-robust only).
-    pub cover: super_plan::CoverMethod,
+    pub cover: plan::CoverMethod,
     /// `trapezoid` or `instant`.
-    pub move_model: super_plan::MoveModel,
+    pub move_model: plan::MoveModel,
     /// Seed.
     pub seed: u64,
     /// Search budget (s).
@@ -338,7 +338,7 @@ fn uncoordinated_probe(cell: &Cell, outcome: &Outcome) -> Vec<ProbeTrack> {
         .iter()
         .zip(&outcome.robots)
         .map(|(robot, res)| {
-            let xyz = match res.program.timed(&super_plan::graph::limits_of(robot)) {
+            let xyz = match res.program.timed(&plan::graph::limits_of(robot)) {
                 Ok(timed) => {
                     let end = timed.trajectory.duration();
                     let steps = (end / PROBE_TRACK_DT).ceil() as usize;

@@ -4,7 +4,7 @@
 //! proximity allocation is planned and coordinated too, and the shorter coordinated cycle wins.
 //! `cellplan compare` takes its "ours" row from here as well.
 use crate::candidates::{self, CandidateTable};
-use crate::check::idle_robot_error;
+use crate::check::{cap_error, idle_robot_error};
 use crate::coord::{CoordSettings, Coordinated, Coordination, coordinate_outcome, cycle_and_delta};
 use crate::document::{self, Plan};
 use crate::plan::{self, Allocation, Outcome, PlanError, PlanSettings, Stage};
@@ -31,7 +31,8 @@ pub enum Step {
 /// Why a run made no plan.
 #[derive(Debug, thiserror::Error)]
 pub enum PipelineError {
-    /// The cell is unusable as given (a robot that can do nothing).
+    /// The cell is unusable as given (a robot that can do nothing, caps that cannot hold the
+    /// tasks).
     #[error(transparent)]
     Input(Box<InputError>),
     /// Planning failed.
@@ -59,11 +60,20 @@ pub fn run(
     load_s: f64,
     progress: &(dyn Fn(Step) + Sync),
 ) -> Result<Run, PipelineError> {
+    if !cell.process.relations().is_empty() {
+        // Precedence and pairing are part of the interface for the processes to come; no
+        // allocation or sequencing honours them yet, so a plan that ignored them would be wrong.
+        return Err(PlanError::Unsupported {
+            what: "planning with relations between tasks (precedence, pairing)",
+            process: cell.process.kind(),
+        }
+        .into());
+    }
     progress(Step::Candidates);
     let lap = Instant::now();
     let table = candidates::generate(cell);
     let candidates_s = lap.elapsed().as_secs_f64();
-    if let Some(e) = idle_robot_error(cell, &table) {
+    if let Some(e) = idle_robot_error(cell, &table).or_else(|| cap_error(cell, &table)) {
         return Err(PipelineError::Input(Box::new(e)));
     }
     let outcome = plan::plan(cell, &table, settings, &|s| progress(Step::Plan(s)))?;
@@ -105,7 +115,7 @@ pub fn coordinate(
     settings: PlanSettings,
     coord: &CoordSettings,
 ) -> Result<(Outcome, PlanSettings, Coordinated), PlanError> {
-    if coord.strategy != Coordination::Best || settings.allocation != Allocation::Balanced {
+    if !ours_tries_proximity(&settings, coord) {
         let c = coordinate_outcome(cell, table, &outcome, coord)?;
         return Ok((outcome, settings, c));
     }

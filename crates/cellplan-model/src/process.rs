@@ -67,18 +67,6 @@ impl Rejection {
     }
 }
 
-impl fmt::Display for Rejection {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.code())
-    }
-}
-
-impl serde::Serialize for Rejection {
-    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
-        s.serialize_str(self.code())
-    }
-}
-
 /// The work a machine does at a task, once it stands in the task's pose.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Work {
@@ -113,10 +101,6 @@ pub struct Words {
     pub tasks: &'static str,
     /// Doing the work, as an activity ("measuring").
     pub working: &'static str,
-    /// Done ("measured").
-    pub done: &'static str,
-    /// Not done ("unmeasured").
-    pub not_done: &'static str,
     /// What the TCP is ("probe").
     pub tool: &'static str,
 }
@@ -366,7 +350,14 @@ impl Registry {
     ) -> Result<&ProcessEntry, InputError> {
         self.get(kind).ok_or_else(|| {
             InputError::at_span(path, text, span, format!("unknown process kind `{kind}`"))
-                .hint(format!("this cellplan knows: {}", self.kinds().join(", ")))
+                .hint(format!(
+                    "this cellplan knows: {}",
+                    self.entries
+                        .iter()
+                        .map(|e| format!("`{}` ({})", e.kind, e.summary))
+                        .collect::<Vec<_>>()
+                        .join("; ")
+                ))
         })
     }
 }

@@ -13,8 +13,6 @@ static WORDS: Words = Words {
     task: "task",
     tasks: "tasks",
     working: "working",
-    done: "done",
-    not_done: "not done",
     tool: "tool",
 };
 

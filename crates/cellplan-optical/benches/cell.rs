@@ -1,16 +1,9 @@
 //! Benchmarks on the bundled autobody-4r cell: one robot configuration's full collision check
 //! against the car body, fixtures and itself; and candidate generation for the whole cell.
 use cellplan_core::candidates::generate;
-use cellplan_model::load as load_with;
-#[allow(clippy::result_large_err)]
-fn load(
-    p: &std::path::Path,
-    o: &cellplan_model::LoadOptions,
-) -> Result<cellplan_model::Cell, cellplan_model::InputError> {
-    load_with(p, &cellplan_optical::registry(), o)
-}
 use cellplan_model::robot::Scratch;
 use cellplan_model::{LoadOptions, TaskId};
+use cellplan_optical::load;
 use criterion::{Criterion, criterion_group, criterion_main};
 use std::hint::black_box;
 use std::path::Path;

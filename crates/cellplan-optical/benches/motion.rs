@@ -3,17 +3,10 @@
 //! straight leg from home to a measuring candidate, and an RRT-Connect leg (with shortcutting)
 //! between two candidates whose straight segment is blocked.
 use cellplan_core::candidates::generate;
-use cellplan_model::load as load_with;
-#[allow(clippy::result_large_err)]
-fn load(
-    p: &std::path::Path,
-    o: &cellplan_model::LoadOptions,
-) -> Result<cellplan_model::Cell, cellplan_model::InputError> {
-    load_with(p, &cellplan_optical::registry(), o)
-}
 use cellplan_core::motion::{RobotValidity, joint_space, plan_leg};
 use cellplan_model::{LoadOptions, TaskId};
 use cellplan_motion::plan::{PlanSettings, Planner, StateValidity, Straight, check_segment};
+use cellplan_optical::load;
 use criterion::{Criterion, criterion_group, criterion_main};
 use std::hint::black_box;
 use std::path::Path;

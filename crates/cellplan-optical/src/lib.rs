@@ -40,8 +40,6 @@ static WORDS: Words = Words {
     task: "MP",
     tasks: "MPs",
     working: "measuring",
-    done: "measured",
-    not_done: "unmeasured",
     tool: "probe",
 };
 
@@ -356,6 +354,15 @@ impl Process for OpticalProcess {
 /// The optical process of `cell`, if it runs this process.
 pub fn of(cell: &cellplan_model::Cell) -> Option<&OpticalProcess> {
     cell.process.as_any().downcast_ref()
+}
+
+/// Loads a cell with [`registry`] (for tests, benchmarks and embedding).
+#[allow(clippy::result_large_err)]
+pub fn load(
+    path: &std::path::Path,
+    opts: &cellplan_model::LoadOptions,
+) -> Result<cellplan_model::Cell, InputError> {
+    cellplan_model::load(path, &registry(), opts)
 }
 
 /// A registry with this process alone (for tests, benchmarks and embedding).

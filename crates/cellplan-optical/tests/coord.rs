@@ -4,18 +4,11 @@
 //! rejected, naming the conflict; injected faults must be caught.
 use cellplan_core::candidates::{CandidateTable, generate};
 use cellplan_core::coord::{self, CoordSettings, Coordination};
-use cellplan_model::load as load_with;
-#[allow(clippy::result_large_err)]
-fn load(
-    p: &std::path::Path,
-    o: &cellplan_model::LoadOptions,
-) -> Result<cellplan_model::Cell, cellplan_model::InputError> {
-    load_with(p, &cellplan_optical::registry(), o)
-}
 use cellplan_core::document as output;
 use cellplan_core::plan::{self, Outcome, PlanSettings};
 use cellplan_core::verify::{VerifySettings, ViolationKind, verify};
 use cellplan_model::{Cell, LoadOptions};
+use cellplan_optical::load;
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 

@@ -2,18 +2,11 @@
 //! legs from home to measuring candidates and back, and a blocked leg solved by RRT-Connect —
 //! every path re-checked densely (1 mm Cartesian steps) with `Robot::contact_at`.
 use cellplan_core::candidates::generate;
-use cellplan_model::load as load_with;
-#[allow(clippy::result_large_err)]
-fn load(
-    p: &std::path::Path,
-    o: &cellplan_model::LoadOptions,
-) -> Result<cellplan_model::Cell, cellplan_model::InputError> {
-    load_with(p, &cellplan_optical::registry(), o)
-}
 use cellplan_core::motion::{RobotValidity, joint_space, plan_leg};
 use cellplan_model::robot::Scratch;
 use cellplan_model::{Cell, LoadOptions, Robot, TaskId};
 use cellplan_motion::plan::{PlanError, PlanSettings, Planner, StateValidity, Straight};
+use cellplan_optical::load;
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::path::Path;

@@ -5,19 +5,12 @@
 //! acceleration limits from the written samples, the document's totals recomputed.
 use cellplan_core::candidates::{CandidateTable, generate};
 use cellplan_core::coord::{self, CoordSettings};
-use cellplan_model::load as load_with;
-#[allow(clippy::result_large_err)]
-fn load(
-    p: &std::path::Path,
-    o: &cellplan_model::LoadOptions,
-) -> Result<cellplan_model::Cell, cellplan_model::InputError> {
-    load_with(p, &cellplan_optical::registry(), o)
-}
 use cellplan_core::document as output;
 use cellplan_core::plan::{self, Allocation, PlanSettings};
 use cellplan_core::verify::{VerifySettings, ViolationKind, verify};
 use cellplan_model::robot::Scratch;
 use cellplan_model::{Cell, LoadOptions, TaskId};
+use cellplan_optical::load;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;

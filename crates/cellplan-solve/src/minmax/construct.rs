@@ -16,17 +16,29 @@ pub(crate) type TaskMove = (usize, usize, usize);
 /// task currently held by `from` to `to` (the last `to` ... first `from` chain ends at a
 /// vehicle with room). `None` when no assignment of the tasks in `sets` plus `t` fits the caps.
 pub(crate) fn augment(p: &MinMaxProblem, sets: &[Vec<usize>], t: usize) -> Option<(usize, Vec<TaskMove>)> {
-    let m = p.vehicles.len();
+    let caps: Vec<usize> = p.vehicles.iter().map(|v| v.cap).collect();
+    augment_by(&caps, &|v, u| p.can_do(v, u), sets, t)
+}
+
+/// [`augment`] on plain data: vehicle `v` takes at most `caps[v]` tasks and can do task `u`
+/// when `can_do(v, u)`.
+pub(crate) fn augment_by(
+    caps: &[usize],
+    can_do: &dyn Fn(usize, usize) -> bool,
+    sets: &[Vec<usize>],
+    t: usize,
+) -> Option<(usize, Vec<TaskMove>)> {
+    let m = caps.len();
     // parent[w] = Some((v, task)) when w was reached by moving `task` from v to w.
     let mut parent: Vec<Option<(usize, usize)>> = vec![None; m];
     let mut seen = vec![false; m];
     let mut queue = VecDeque::new();
-    for v in p.capable(t) {
+    for v in (0..m).filter(|&v| can_do(v, t)) {
         seen[v] = true;
         queue.push_back(v);
     }
     while let Some(v) = queue.pop_front() {
-        if sets[v].len() < p.vehicles[v].cap {
+        if sets[v].len() < caps[v] {
             let mut moves = Vec::new();
             let mut w = v;
             while let Some((from, task)) = parent[w] {
@@ -37,7 +49,7 @@ pub(crate) fn augment(p: &MinMaxProblem, sets: &[Vec<usize>], t: usize) -> Optio
         }
         for &u in &sets[v] {
             for w in 0..m {
-                if !seen[w] && p.can_do(w, u) {
+                if !seen[w] && can_do(w, u) {
                     seen[w] = true;
                     parent[w] = Some((v, u));
                     queue.push_back(w);

@@ -146,17 +146,10 @@ impl MinMaxProblem {
         if cap < self.tasks {
             return Err(format!("total cap {cap} is below the {} tasks", self.tasks));
         }
-        let mut sets = vec![Vec::new(); self.vehicles.len()];
-        for t in 0..self.tasks {
-            let (v0, moves) = construct::augment(self, &sets, t)
-                .ok_or_else(|| format!("the caps admit no assignment of every task (stuck at task {t})"))?;
-            for &(u, from, to) in &moves {
-                sets[from].retain(|&x| x != u);
-                sets[to].push(u);
-            }
-            sets[v0].push(t);
-        }
-        Ok(())
+        let caps: Vec<usize> = self.vehicles.iter().map(|v| v.cap).collect();
+        assign_within_caps(self.tasks, &caps, |v, t| self.can_do(v, t))
+            .map(|_| ())
+            .map_err(|t| format!("the caps admit no assignment of every task (stuck at task {t})"))
     }
 
     /// Whether vehicle `v` can do task `t`.
@@ -180,6 +173,26 @@ impl MinMaxProblem {
         }
         time + veh.costs.get(prev, veh.depot)
     }
+}
+
+/// An assignment of `tasks` tasks to vehicles, vehicle `v` taking at most `caps[v]` and only
+/// tasks it `can_do(v, t)` (a b-matching by augmenting paths). `Err(t)`: task `t` is the first
+/// that no assignment can place.
+pub fn assign_within_caps(
+    tasks: usize,
+    caps: &[usize],
+    can_do: impl Fn(usize, usize) -> bool,
+) -> Result<Vec<Vec<usize>>, usize> {
+    let mut sets = vec![Vec::new(); caps.len()];
+    for t in 0..tasks {
+        let (v0, moves) = construct::augment_by(caps, &can_do, &sets, t).ok_or(t)?;
+        for &(u, from, to) in &moves {
+            sets[from].retain(|&x| x != u);
+            sets[to].push(u);
+        }
+        sets[v0].push(t);
+    }
+    Ok(sets)
 }
 
 /// One route per vehicle: the (task, node) visits in order, depots excluded.

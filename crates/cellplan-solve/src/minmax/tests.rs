@@ -272,3 +272,14 @@ fn lower_bound_is_below_every_solution_and_tight_on_one_task() {
     let p = MinMaxProblem::new(vec![v], 1, vec![0.5], None).unwrap();
     assert!((lower_bound(&p) - (1.0 + 0.5 + 2.0)).abs() < 1e-12);
 }
+
+#[test]
+fn assignment_within_caps_moves_tasks_along_augmenting_paths() {
+    // Task 0 either vehicle, task 1 only vehicle 0: task 0 must move to vehicle 1.
+    let can = |v: usize, t: usize| t == 0 || v == 0;
+    let sets = super::assign_within_caps(2, &[1, 1], can).unwrap();
+    assert_eq!(sets, vec![vec![1], vec![0]]);
+    // A third task only vehicle 0 can do does not fit.
+    let can3 = |v: usize, t: usize| t == 0 || v == 0;
+    assert_eq!(super::assign_within_caps(3, &[1, 1], can3), Err(2));
+}

@@ -1,0 +1,243 @@
+//! `cellplan plan`, `report`, `export` and `compare`.
+use super::*;
+use serde_json::Value;
+
+#[test]
+fn plan_writes_a_plan_and_a_stable_summary() {
+    let (dir, cell, out_dir, summary) = plan_small_cell("plan");
+    for key in [
+        "cycle_time_s",
+        "delta_t_s",
+        "lower_bound_s",
+        "robots",
+        "unmeasured",
+        "compute_s",
+    ] {
+        assert!(summary.get(key).is_some(), "summary lacks {key}");
+    }
+    let robots = summary["robots"].as_array().unwrap();
+    assert_eq!(robots.len(), 1);
+    assert_eq!(robots[0]["name"], "R1");
+    assert_eq!(robots[0]["tasks"], 3);
+    let cycle = summary["cycle_time_s"].as_f64().unwrap();
+    assert!(cycle >= summary["lower_bound_s"].as_f64().unwrap() - 1e-9);
+    assert!((robots[0]["total_s"].as_f64().unwrap() - cycle).abs() < 1e-9);
+    // Three measurements at the default 1.5 s, plus motion.
+    assert!(cycle > 4.5);
+    let plan: Value = serde_json::from_slice(&std::fs::read(out_dir.join("plan.json")).unwrap()).unwrap();
+    assert_eq!(plan["format"], "cellplan-plan");
+    assert_eq!(plan["version"], 2);
+    assert_eq!(plan["robots"][0]["tasks"].as_array().unwrap().len(), 3);
+    assert_eq!(plan["robots"][0]["legs"].as_array().unwrap().len(), 4);
+    // The same seed gives the same plan, whatever the thread count.
+    let again = dir.join("again");
+    let out = cellplan(
+        &[
+            "--threads",
+            "1",
+            "plan",
+            cell.to_str().unwrap(),
+            "-o",
+            again.to_str().unwrap(),
+            "-q",
+        ],
+        &dir,
+    );
+    assert!(out.status.success());
+    let second: Value = serde_json::from_slice(&std::fs::read(again.join("plan.json")).unwrap()).unwrap();
+    assert_eq!(plan["robots"], second["robots"]);
+    // The verifier accepts it (one robot: nothing to coordinate) ...
+    let plan_file = out_dir.join("plan.json");
+    let out = cellplan(
+        &[
+            "verify",
+            plan_file.to_str().unwrap(),
+            cell.to_str().unwrap(),
+            "--json",
+        ],
+        &dir,
+    );
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stdout));
+    let verdict: Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(verdict["ok"], true);
+    assert!(verdict["violations"].as_array().unwrap().is_empty());
+    // ... and rejects it with an MP removed and the cycle time fudged (exit 4, both named).
+    let mut broken = plan.clone();
+    broken["robots"][0]["tasks"].as_array_mut().unwrap().remove(0);
+    broken["cycle_time_s"] = Value::from(1.0);
+    let bad = dir.join("broken.json");
+    std::fs::write(&bad, serde_json::to_string(&broken).unwrap()).unwrap();
+    let out = cellplan(
+        &["verify", bad.to_str().unwrap(), cell.to_str().unwrap(), "--json"],
+        &dir,
+    );
+    assert_eq!(out.status.code(), Some(4));
+    let verdict: Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(verdict["ok"], false);
+    let kinds: Vec<&str> = verdict["violations"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v["kind"].as_str().unwrap())
+        .collect();
+    assert!(
+        kinds.contains(&"missing-task") && kinds.contains(&"totals"),
+        "{kinds:?}"
+    );
+    // Not a plan: exit 2 naming the file and line.
+    std::fs::write(&bad, "{\n  \"format\": 3\n").unwrap();
+    let out = cellplan(&["verify", bad.to_str().unwrap(), cell.to_str().unwrap()], &dir);
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("broken.json") && err.contains("help:"), "{err}");
+}
+
+#[test]
+fn plan_refuses_caps_that_cannot_hold_the_tasks() {
+    let dir = scratch("plan-cap");
+    let (cell, _) = small_cell(&dir);
+    std::fs::write(
+        dir.join("cell.toml"),
+        cell.replace("[tools.probe]", "[planning]\ntask_cap = 1\n\n[tools.probe]"),
+    )
+    .unwrap();
+    let out_dir = dir.join("out");
+    let out = cellplan(
+        &[
+            "plan",
+            dir.join("cell.toml").to_str().unwrap(),
+            "-o",
+            out_dir.to_str().unwrap(),
+        ],
+        &dir,
+    );
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("cell.toml") && err.contains("task_cap"), "{err}");
+    assert!(!out_dir.join("plan.json").exists());
+}
+
+#[test]
+fn plan_writes_a_report_and_export_writes_gltf_and_csv() {
+    let (dir, cell, out_dir, summary) = plan_small_cell("report");
+    let report = out_dir.join("report.html");
+    assert_eq!(summary["report_file"], report.display().to_string());
+    let page = std::fs::read_to_string(&report).unwrap();
+    assert!(page.starts_with("<!DOCTYPE html>") && page.ends_with("</html>"));
+    for id in ["gantt", "timepos-after", "view", "cellplan-data"] {
+        assert!(page.contains(&format!("id=\"{id}\"")), "no #{id}");
+    }
+    // Self-contained: nothing fetched from elsewhere.
+    assert!(!page.contains("src=\"http") && !page.contains("href=\"http"));
+    let plan = out_dir.join("plan.json");
+
+    // `report` again, elsewhere, with the cell named.
+    let other = dir.join("again/page.html");
+    let out = cellplan(
+        &[
+            "report",
+            plan.to_str().unwrap(),
+            cell.to_str().unwrap(),
+            "-o",
+            other.to_str().unwrap(),
+        ],
+        &dir,
+    );
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("report written to"));
+    assert!(std::fs::read_to_string(&other).unwrap().contains("id=\"gantt\""));
+
+    // Exports.
+    let glb = dir.join("cell.glb");
+    let csv_dir = dir.join("csv");
+    let out = cellplan(
+        &[
+            "export",
+            plan.to_str().unwrap(),
+            cell.to_str().unwrap(),
+            "--gltf",
+            glb.to_str().unwrap(),
+            "--csv",
+            csv_dir.to_str().unwrap(),
+        ],
+        &dir,
+    );
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let bytes = std::fs::read(&glb).unwrap();
+    assert_eq!(&bytes[..4], b"glTF");
+    let traj = std::fs::read_to_string(csv_dir.join("R1-trajectory.csv")).unwrap();
+    assert!(traj.starts_with("t_s,joint_1,"), "{}", &traj[..60]);
+    let prog = std::fs::read_to_string(csv_dir.join("R1-program.csv")).unwrap();
+    assert_eq!(prog.lines().filter(|l| l.contains(",measure,")).count(), 3);
+
+    // Nothing asked: refused.
+    let out = cellplan(&["export", plan.to_str().unwrap(), cell.to_str().unwrap()], &dir);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--gltf"));
+    // Not a plan: exit 2 naming the file and line; nothing written.
+    let bad = dir.join("bad.json");
+    std::fs::write(&bad, "{\n  \"format\": [\n").unwrap();
+    let target = dir.join("bad.html");
+    let out = cellplan(
+        &[
+            "report",
+            bad.to_str().unwrap(),
+            cell.to_str().unwrap(),
+            "-o",
+            target.to_str().unwrap(),
+        ],
+        &dir,
+    );
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("bad.json") && err.contains("help:"), "{err}");
+    assert!(!target.exists());
+    // A plan for other robots: exit 2 naming the robot.
+    let mut doc: Value = serde_json::from_str(&std::fs::read_to_string(&plan).unwrap()).unwrap();
+    doc["robots"][0]["name"] = Value::from("R7");
+    std::fs::write(&bad, serde_json::to_string(&doc).unwrap()).unwrap();
+    let out = cellplan(
+        &[
+            "report",
+            bad.to_str().unwrap(),
+            cell.to_str().unwrap(),
+            "-o",
+            target.to_str().unwrap(),
+            "--no-verify",
+        ],
+        &dir,
+    );
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("R7"));
+    assert!(!target.exists());
+}
+
+#[test]
+fn compare_writes_its_table_and_bar_chart_as_html() {
+    let dir = scratch("compare");
+    small_cell(&dir);
+    let cell = dir.join("cell.toml");
+    let out_dir = dir.join("cmp");
+    let out = cellplan(
+        &[
+            "compare",
+            cell.to_str().unwrap(),
+            "-o",
+            out_dir.to_str().unwrap(),
+            "--json",
+            "-q",
+        ],
+        &dir,
+    );
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let report: Value = serde_json::from_slice(&out.stdout).unwrap();
+    let rows = report["strategies"].as_array().unwrap();
+    let solved = rows.iter().filter(|r| r["error"].is_null()).count();
+    assert!(solved > 0);
+    let page = std::fs::read_to_string(out_dir.join("compare.html")).unwrap();
+    assert!(page.contains("id=\"strategy-bars\"") && page.contains("id=\"strategies\""));
+    // A bar per robot of every solved strategy (one robot here), a table row per strategy.
+    assert_eq!(page.matches("class=\"bar\"").count(), solved);
+    assert_eq!(page.matches("<tr><td").count(), rows.len());
+    assert!(page.contains("<b>balanced+proximity + best</b>"));
+}

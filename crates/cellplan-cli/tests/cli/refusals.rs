@@ -1,0 +1,204 @@
+//! Bad input of every kind, table-driven: each case builds its input in a scratch folder, runs
+//! one command, and expects exit 2, words naming what is wrong, and nothing written.
+use super::*;
+use std::path::Path;
+
+struct Case {
+    name: &'static str,
+    /// Writes the inputs into the folder; returns the command's arguments.
+    setup: fn(&Path) -> Vec<String>,
+    /// Words the error must contain.
+    says: &'static [&'static str],
+}
+
+/// The small cell with `edit` applied to its text, written as `cell.toml` with its tasks.
+fn cell_with(dir: &Path, edit: impl Fn(String) -> String) -> String {
+    let (cell, tasks) = small_cell(dir);
+    std::fs::write(dir.join("cell.toml"), edit(cell)).unwrap();
+    std::fs::write(dir.join("tasks.csv"), tasks).unwrap();
+    dir.join("cell.toml").display().to_string()
+}
+
+fn check_args(cell: String) -> Vec<String> {
+    vec!["check".into(), cell]
+}
+
+fn plan_args(cell: String, dir: &Path) -> Vec<String> {
+    vec![
+        "plan".into(),
+        cell,
+        "-o".into(),
+        dir.join("out").display().to_string(),
+        "--quiet".into(),
+    ]
+}
+
+const CASES: &[Case] = &[
+    Case {
+        name: "absurd pose sampling",
+        setup: |d| {
+            check_args(cell_with(d, |c| {
+                c + "\n[process.sampling]\nspin_steps = 100000000\n"
+            }))
+        },
+        says: &["cell.toml:", "spin_steps", "probe poses per MP"],
+    },
+    Case {
+        name: "a shared limit left in [process]",
+        setup: |d| {
+            check_args(cell_with(d, |c| {
+                c.replace("baseline = 100", "baseline = 100\ntask_cap = 2")
+            }))
+        },
+        says: &["cell.toml:", "task_cap", "[planning]"],
+    },
+    Case {
+        name: "task cap of zero",
+        setup: |d| check_args(cell_with(d, |c| c + "\n[planning]\ntask_cap = 0\n")),
+        says: &["cell.toml:", "`task_cap` must be between 1"],
+    },
+    Case {
+        name: "caps that cannot hold the tasks, in check as in plan",
+        setup: |d| check_args(cell_with(d, |c| c + "\n[planning]\ntask_cap = 1\n")),
+        says: &["cell.toml", "task_cap = 1", "no robot with room"],
+    },
+    Case {
+        name: "endless task file",
+        setup: |d| {
+            check_args(cell_with(d, |c| {
+                c.replace("file = \"tasks.csv\"", "file = \"/dev/zero\"")
+            }))
+        },
+        says: &["/dev/zero", "larger than 256 MiB"],
+    },
+    Case {
+        name: "a task column named twice",
+        setup: |d| {
+            let cell = cell_with(d, |c| c);
+            std::fs::write(d.join("tasks.csv"), "id,x,y,z,nx,ny,nz,y\nA,1900,0,600,0,0,1,0\n").unwrap();
+            check_args(cell)
+        },
+        says: &["tasks.csv:1", "column `y` is named twice"],
+    },
+    Case {
+        name: "a cell name that leads outside the output folder",
+        setup: |d| {
+            let cell = cell_with(d, |c| c.replace("name = \"small\"", "name = \"../../../x\""));
+            vec!["plan".into(), cell, "--quiet".into()]
+        },
+        says: &["`../../../x` is not a plain folder name", "-o"],
+    },
+    Case {
+        name: "an output folder that cannot be written",
+        setup: |d| {
+            let cell = cell_with(d, |c| c);
+            std::fs::write(d.join("out"), "a file where the folder should be").unwrap();
+            plan_args(cell, d)
+        },
+        says: &["cannot write into the output folder", "-o"],
+    },
+    Case {
+        name: "a time limit out of range",
+        setup: |d| {
+            let mut a = plan_args(cell_with(d, |c| c), d);
+            a.extend(["--time-limit".into(), "0".into()]);
+            a
+        },
+        says: &["--time-limit"],
+    },
+    Case {
+        name: "a verify time step that would run for hours",
+        setup: |d| {
+            let cell = cell_with(d, |c| c);
+            vec![
+                "verify".into(),
+                d.join("plan.json").display().to_string(),
+                cell,
+                "--time-step".into(),
+                "1e-9".into(),
+            ]
+        },
+        says: &["--time-step must be between"],
+    },
+    Case {
+        name: "gen tasks count out of range",
+        setup: |d| {
+            vec![
+                "gen".into(),
+                "tasks".into(),
+                "--mesh".into(),
+                root()
+                    .join("data/parts/body-in-white/car5.obj")
+                    .display()
+                    .to_string(),
+                "--count".into(),
+                "0".into(),
+                "-o".into(),
+                d.join("out").display().to_string(),
+            ]
+        },
+        says: &["--count must be between 1 and"],
+    },
+];
+
+#[test]
+fn bad_input_is_refused_with_exit_2_and_nothing_written() {
+    for case in CASES {
+        let dir = scratch("refusal");
+        let args = (case.setup)(&dir);
+        let before: Vec<_> = std::fs::read_dir(&dir)
+            .unwrap()
+            .map(|e| e.unwrap().path())
+            .collect();
+        let argv: Vec<&str> = args.iter().map(String::as_str).collect();
+        let out = cellplan(&argv, &dir.join("cache"));
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{}: {stderr}", case.name);
+        for words in case.says {
+            assert!(
+                stderr.contains(words),
+                "{}: expected `{words}` in: {stderr}",
+                case.name
+            );
+        }
+        let after: Vec<_> = std::fs::read_dir(&dir)
+            .unwrap()
+            .map(|e| e.unwrap().path())
+            .collect();
+        assert_eq!(before, after, "{}: something was written", case.name);
+    }
+}
+
+#[test]
+fn negative_directions_are_values_not_flags() {
+    let dir = scratch("facing");
+    let out_file = dir.join("tasks.csv");
+    let mesh = root().join("data/parts/body-in-white/car5.obj");
+    let args = [
+        "gen",
+        "tasks",
+        "--mesh",
+        mesh.to_str().unwrap(),
+        "--count",
+        "3",
+        "--facing",
+        "-y",
+        "--translate",
+        "-1,0,0",
+        "-o",
+        out_file.to_str().unwrap(),
+    ];
+    let out = cellplan(&args, &dir);
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = std::fs::read_to_string(&out_file).unwrap();
+    // Every normal faces -y within the default 60°.
+    for row in text.lines().skip(1) {
+        let ny: f64 = row.split(',').nth(5).unwrap().parse().unwrap();
+        assert!(ny < -0.49, "{row}");
+    }
+}
