@@ -1,0 +1,45 @@
+#!/usr/bin/env bash
+# bad_inputs.sh [BIN]: runs the bad inputs of issue 13 against the cellplan binary and prints
+# one line per case: exit code and the first line of the error. Scratch files go to a temp dir.
+set -u
+BIN=${1:-target/release/cellplan}
+cd "$(dirname "$0")/.."
+BIN=$(realpath "$BIN")
+T=$(mktemp -d)
+R=$PWD
+cell() { # cell NAME EDIT-SED: the 2r example, edited, with absolute paths
+  mkdir -p "$T/$1"
+  sed -e "s#\.\./\.\./#$R/#g" -e "s#file = \"tasks.csv\"#file = \"$R/examples/autobody-2r/tasks.csv\"#" \
+      examples/autobody-2r/cell.toml | sed -e "$2" > "$T/$1/cell.toml"
+  echo "$T/$1/cell.toml"
+}
+run() { # run LABEL ARGS...
+  local label=$1; shift
+  local out; out=$(cd "$T" && NO_COLOR=1 timeout 120 "$BIN" "$@" 2>&1 >/dev/null)
+  local rc=$?
+  printf '%-44s exit %-3s %s\n' "$label" "$rc" "$(echo "$out" | grep -v '^\s*$' | grep -m1 -E '×|^error' | sed 's/^ *//' | cut -c1-150)"
+}
+run "spin_steps = 100000000" check "$(cell spin 's/^spin_steps = 8/spin_steps = 100000000/')"
+run "task file is /dev/zero" check "$(cell zero "s#file = \"$R/examples/autobody-2r/tasks.csv\"#file = \"/dev/zero\"#")"
+run "cell file is /dev/zero" check /dev/zero
+printf 'id,x,y,z,nx,ny,nz,x\nA,1,2,3,0,0,1,4\n' > "$T/twice.csv"
+run "CSV column named twice" check "$(cell twice "s#$R/examples/autobody-2r/tasks.csv#$T/twice.csv#")"
+run "task_cap left in [process]" check "$(cell cap1 's/^measure_time = 1.5 .*/&\ntask_cap = 3/')"
+run "check: caps plan refuses ([planning] 1)" check "$(cell cap2 's/^task_cap = 14 .*/task_cap = 1/')"
+run "cell name ../../../x, plan without -o" plan "$(cell name '0,/^name = .*/s##name = "../../../x"#')" --quiet
+run "cell name /abs, plan without -o" plan "$(cell abs '0,/^name = .*/s##name = "/tmp/abs"#')" --quiet
+touch "$T/file"
+run "unwritable -o" plan "$(cell out 's/x/x/')" -o "$T/file/out" --quiet
+run "plan --time-limit 0" plan "$(cell tl 's/x/x/')" --time-limit 0
+run "verify --time-step 1e-9" verify "$T/none.json" "$(cell vs 's/x/x/')" --time-step 1e-9
+run "gen tasks --facing -y (must pass)" gen tasks --mesh "$R/data/parts/body-in-white/car5.obj" --count 3 --facing -y -o "$T/g.csv"
+(cd "$T" && "$BIN" bench minmax --generate --vehicles 2 --tasks 4 --seed 1 -o "$T/g.minmax" 2>/dev/null)
+for k in NODES VEHICLES TASKS; do
+  sed "0,/^$k: [0-9]*/s//$k: 4000000000/" "$T/g.minmax" > "$T/$k.minmax"
+  run "min-max $k: 4000000000" bench minmax "$T/$k.minmax"
+done
+printf 'v 0 0 0\nv 1 1 1\nv 2 2 2\nf 1 2 3\n' > "$T/flat.obj"
+run "OBJ of zero-area triangles" gen tasks --mesh "$T/flat.obj" --count 3
+printf 'v 0 0 0\nv 1e30 0 0\nv 0 1 0\nf 1 2 3\n' > "$T/far.obj"
+run "OBJ vertex at 1e30" gen tasks --mesh "$T/far.obj" --count 3
+rm -rf "$T"
