@@ -349,15 +349,14 @@ impl Registry {
         span: Range<usize>,
     ) -> Result<&ProcessEntry, InputError> {
         self.get(kind).ok_or_else(|| {
-            InputError::at_span(path, text, span, format!("unknown process kind `{kind}`"))
-                .hint(format!(
-                    "this cellplan knows: {}",
-                    self.entries
-                        .iter()
-                        .map(|e| format!("`{}` ({})", e.kind, e.summary))
-                        .collect::<Vec<_>>()
-                        .join("; ")
-                ))
+            InputError::at_span(path, text, span, format!("unknown process kind `{kind}`")).hint(format!(
+                "this cellplan knows: {}",
+                self.entries
+                    .iter()
+                    .map(|e| format!("`{}` ({})", e.kind, e.summary))
+                    .collect::<Vec<_>>()
+                    .join("; ")
+            ))
         })
     }
 }
