@@ -42,4 +42,37 @@ printf 'v 0 0 0\nv 1 1 1\nv 2 2 2\nf 1 2 3\n' > "$T/flat.obj"
 run "OBJ of zero-area triangles" gen tasks --mesh "$T/flat.obj" --count 3
 printf 'v 0 0 0\nv 1e30 0 0\nv 0 1 0\nf 1 2 3\n' > "$T/far.obj"
 run "OBJ vertex at 1e30" gen tasks --mesh "$T/far.obj" --count 3
+# Edited plans: a real plan of the 4r example in which robots wait (fixed-priority), each
+# edit verified (exit 2: refused when read, naming the place; exit 4: rejected, with the
+# verifier's first violation).
+mkdir -p "$T/plan4"
+sed -e "s#\.\./\.\./#$R/#g" -e "s#file = \"tasks.csv\"#file = \"$R/examples/autobody-4r/tasks.csv\"#" \
+    examples/autobody-4r/cell.toml > "$T/plan4/cell.toml"
+P=$T/plan4/cell.toml
+(cd "$T" && "$BIN" plan "$P" -o "$T/good" --coordination fixed-priority --quiet >/dev/null 2>&1)
+runv() { # runv LABEL PYTHON-EDIT (d: the plan as JSON)
+  python3 - "$T/good/plan.json" "$T/edited.json" "$2" <<'PY'
+import json, sys
+d = json.load(open(sys.argv[1])); r = next(x for x in d["robots"] if x["waits"]) if any(x["waits"] for x in d["robots"]) else d["robots"][0]
+exec(sys.argv[3])
+json.dump(d, open(sys.argv[2], "w"))
+PY
+  local out; out=$(cd "$T" && NO_COLOR=1 timeout 120 "$BIN" verify "$T/edited.json" "$P" 2>&1)
+  local rc=$?
+  printf '%-44s exit %-3s %s\n' "$1" "$rc" "$(echo "$out" | grep -v '^\s*$' | grep -m1 -E '×|^error|^[A-Z][a-zA-Z]+ ' | sed 's/^ *//' | cut -c1-150)"
+}
+runv "plan: a waypoint of 1e9" 'r["legs"][0]["waypoints"][0][0] = 1e9'
+runv "plan: a sample shorter than the one before" 'r["trajectory"][5]["q"].pop()'
+runv "plan: time going back" 'r["trajectory"][5]["t"] = 0.0'
+runv "plan: a trajectory sample deleted" 'del r["trajectory"][len(r["trajectory"]) // 2]'
+runv "plan: motion_s changed" 'r["motion_s"] += 0.5'
+runv "plan: measuring_s changed" 'r["measuring_s"] += 0.5'
+runv "plan: waiting_s changed" 'r["waiting_s"] += 0.5'
+runv "plan: end_s changed" 'r["end_s"] += 0.5'
+runv "plan: lower_bound_s changed" 'd["lower_bound_s"] *= 0.9'
+runv "plan: joints reversed" 'r["joints"].reverse()'
+runv "plan: a robot's waits deleted" 'r["waits"] = []'
+runv "plan: a task measured and unmeasured" 'd["unmeasured"].append({"task": r["tasks"][0]["task"], "reason": "no-ik"})'
+runv "plan: coordination record erased" 'del d["coordination"]'
+runv "plan: version 2" 'd["version"] = 2'
 rm -rf "$T"

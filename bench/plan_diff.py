@@ -1,17 +1,40 @@
 #!/usr/bin/env python3
 """Compare two trees of plan.json files (as bench/plan_matrix.sh writes them) for equality of
-everything planned: compute times are dropped, and the settings keys that moved between document
-versions (settings.measure_time_s in version 1; settings.process in version 2) are set aside.
+everything planned: compute times are dropped, and what changed spelling between document
+versions (settings.measure_time_s in version 1; settings.process in version 2; typed stops and
+activities, derived wait places and conflict legs, the wait count, in version 3) is set aside.
 Usage: plan_diff.py OLD_DIR NEW_DIR; exit 1 when any plan differs."""
 import json, sys, pathlib
 
+def stop(v):
+    """A leg end as version 3 writes it ("home" or {"task": id}) from either version."""
+    if isinstance(v, dict):
+        return v["task"]
+    return v
+
 def norm(doc):
+    """Version 2 and 3 to one form: what is planned, not how the document spells it."""
     doc.pop("compute_s", None)
-    doc.get("coordination", {}).pop("compute_s", None)
-    s = doc.get("settings", {})
-    s.pop("measure_time_s", None)
-    s.pop("process", None)
     doc.pop("version", None)
+    c = doc.get("coordination", {})
+    c.pop("compute_s", None)
+    # Version 3 moved the count of resolutions to stats and counts the waits the programs
+    # hold (version 2 counted waits added; one added where one stood lengthens it).
+    doc.get("stats", {}).pop("conflicts_resolved", None)
+    c.pop("conflicts_resolved", None)
+    c.pop("waits", None)
+    for conflict in c.get("conflicts_before", []) + c.get("conflicts_after", []):
+        # Version 2 stated activities as text with legs and tasks; version 3 types them.
+        for k in ("activity", "legs", "tasks"):
+            conflict.pop(k, None)
+    s = doc.get("settings", {})
+    for k in ("measure_time_s", "process", "alternatives", "roomy_m"):
+        s.pop(k, None)
+    for r in doc.get("robots", []):
+        for w in r.get("waits", []):
+            w.pop("at", None)
+        for leg in r.get("legs", []):
+            leg["from"], leg["to"] = stop(leg["from"]), stop(leg["to"])
     return doc
 
 def diff(a, b, path=""):

@@ -243,7 +243,7 @@ pub fn run(args: &PlanArgs) -> Result<(), Failure> {
         let text = serde_json::to_string_pretty(&summary).map_err(|e| Failure::Other(e.to_string()))?;
         println!("{text}");
     } else if !args.quiet {
-        print!("{}", render(&doc));
+        print!("{}", render(&doc, cell.process.words().working));
         println!("plan written to {}", file.display());
         if !args.no_report {
             println!("report written to {}", report_file.display());
@@ -256,7 +256,7 @@ pub fn run(args: &PlanArgs) -> Result<(), Failure> {
     }
 }
 
-fn render(doc: &output::Plan) -> String {
+fn render(doc: &output::Plan, working: &str) -> String {
     let mut s = format!(
         "{} — allocation {}, coordination {}, seed {}\n\n",
         doc.cell,
@@ -283,7 +283,7 @@ fn render(doc: &output::Plan) -> String {
     s += &format!(
         "\nconflicts before coordination {}, resolved {} ({} waits, {} poses changed); cycle time without coordination {:.2} s\n",
         c.conflicts_before.len(),
-        c.conflicts_resolved,
+        doc.stats.conflicts_resolved,
         c.waits,
         c.poses_changed,
         c.uncoordinated_cycle_time_s
@@ -291,13 +291,24 @@ fn render(doc: &output::Plan) -> String {
     for k in &c.conflicts_before {
         s += &format!(
             "  {:.2}–{:.2} s {} & {} (scenario {}): {}; {}\n",
-            k.start_s, k.end_s, k.robots[0], k.robots[1], k.scenario, k.activity[0], k.activity[1]
+            k.start_s,
+            k.end_s,
+            k.robots[0],
+            k.robots[1],
+            k.scenario,
+            k.activity[0].text(working),
+            k.activity[1].text(working)
         );
     }
     for k in &c.conflicts_after {
         s += &format!(
             "  NOT RESOLVED {:.2}–{:.2} s {} & {}: {}; {}\n",
-            k.start_s, k.end_s, k.robots[0], k.robots[1], k.activity[0], k.activity[1]
+            k.start_s,
+            k.end_s,
+            k.robots[0],
+            k.robots[1],
+            k.activity[0].text(working),
+            k.activity[1].text(working)
         );
     }
     s += &format!(

@@ -1,8 +1,12 @@
 //! `cellplan report` (the HTML page of a plan) and `cellplan export` (glTF, CSV).
 use crate::Failure;
 use cellplan_core::Plan;
+use cellplan_core::document::{self, DocumentError};
 use cellplan_core::verify::{self, VerifySettings};
-use cellplan_model::{Cell, InputError, LoadOptions, io::write_atomic};
+use cellplan_model::{
+    Cell, InputError, LoadOptions,
+    io::{write_all_atomic, write_atomic},
+};
 use cellplan_report::html::{PlanReport, plan_html};
 use cellplan_report::scene::{MESH_BUDGET, Scene};
 use clap::Args;
@@ -43,18 +47,19 @@ pub struct ExportArgs {
     mesh_budget: usize,
 }
 
-/// Reads a plan document, with errors that name the file and line.
+/// Reads and validates a plan document, with errors that name the file, the line or the
+/// place in the document, and what to do.
 pub fn read_plan(path: &Path) -> Result<Plan, Failure> {
-    let text = std::fs::read_to_string(path).map_err(|e| {
+    document::read(path).map_err(|e| {
+        let hint = match &e {
+            DocumentError::Version { .. } => "plan the cell again with this cellplan (`cellplan plan CELL`)",
+            DocumentError::Read(_) | DocumentError::TooLarge { .. } => {
+                "give the plan.json that `cellplan plan` wrote"
+            }
+            _ => "give the plan.json that `cellplan plan` wrote, unedited (docs/plan-format.md)",
+        };
         Failure::Input(Box::new(
-            InputError::new(path, format!("cannot read the plan: {e}"))
-                .hint("give the plan.json that `cellplan plan` wrote"),
-        ))
-    })?;
-    serde_json::from_str(&text).map_err(|e| {
-        Failure::Input(Box::new(
-            InputError::at_line(path, Some(e.line()), format!("not a cellplan plan: {e}"))
-                .hint("give the plan.json that `cellplan plan` wrote (docs/plan-format.md)"),
+            InputError::at_line(path, e.line(), e.to_string()).hint(hint),
         ))
     })
 }
@@ -78,6 +83,7 @@ fn load_cell(plan_path: &Path, plan: &Plan, cell: &Option<PathBuf>) -> Result<Ce
         }
     };
     let cell = crate::load_cell(&path, &LoadOptions::default())?;
+    document::matches_cell(plan, &cell).map_err(|e| mismatch(plan_path)(e.to_string()))?;
     if cell.name != plan.cell {
         eprintln!(
             "note: the plan was made for cell `{}`, {} is cell `{}`",
@@ -171,7 +177,7 @@ pub fn run_report(args: &ReportArgs) -> Result<(), Failure> {
 
 pub fn run_export(args: &ExportArgs) -> Result<(), Failure> {
     if args.gltf.is_none() && args.csv.is_none() {
-        return Err(Failure::Other(
+        return Err(Failure::Usage(
             "nothing to export: give --gltf FILE and/or --csv DIR".into(),
         ));
     }
@@ -192,11 +198,13 @@ pub fn run_export(args: &ExportArgs) -> Result<(), Failure> {
     }
     if let Some(dir) = &args.csv {
         let files = cellplan_report::csv::files(&plan, &scene).map_err(mismatch(&args.plan))?;
-        for (name, text) in &files {
-            let path = dir.join(name);
-            write_atomic(&path, text.as_bytes())
-                .map_err(|e| Failure::Other(format!("cannot write {}: {e}", path.display())))?;
-        }
+        let outputs: Vec<(PathBuf, &[u8])> = files
+            .iter()
+            .map(|(name, text)| (dir.join(name), text.as_bytes()))
+            .collect();
+        let outputs: Vec<(&Path, &[u8])> = outputs.iter().map(|(p, b)| (p.as_path(), *b)).collect();
+        write_all_atomic(&outputs)
+            .map_err(|e| Failure::Other(format!("cannot write the CSV files in {}: {e}", dir.display())))?;
         eprintln!("{} CSV files written to {}", files.len(), dir.display());
     }
     Ok(())

@@ -36,6 +36,12 @@ pub fn run(args: &VerifyArgs) -> Result<(), Failure> {
         time_step: args.time_step,
         ..VerifySettings::default()
     };
+    if let Some(why) = cellplan_core::verify::too_large(&plan, &settings) {
+        return Err(Failure::Input(Box::new(
+            cellplan_model::InputError::new(&args.plan, format!("the plan is too large to check: {why}"))
+                .hint("give a larger --time-step, or check a plan `cellplan plan` wrote"),
+        )));
+    }
     let report = verify(&cell, &plan, &settings);
     if args.json {
         println!(

@@ -92,7 +92,7 @@ pub fn run(
     );
     progress(Step::Verification);
     let lap = Instant::now();
-    let report = verify::verify(cell, &plan, &VerifySettings::default());
+    let report = verify::verify_with(cell, Some(&table), &plan, &VerifySettings::default());
     plan.compute_s.verification = lap.elapsed().as_secs_f64();
     plan.verified = report.ok;
     Ok(Run { table, plan, report })

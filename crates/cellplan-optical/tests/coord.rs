@@ -88,7 +88,10 @@ fn the_uncoordinated_plan_has_a_conflict_and_the_verifier_names_it() {
     assert_eq!(first.robots, ["R1".to_string(), "R2".to_string()]);
     assert!(first.end_s > first.start_s);
     // Scenario 1 exactly when both probes are measuring.
-    let measuring = first.activity.iter().all(|a| a.starts_with("measuring"));
+    let measuring = first
+        .activity
+        .iter()
+        .all(|a| matches!(a, output::ActivityOut::Working { .. }));
     assert_eq!(first.scenario == 1, measuring, "{first:?}");
     let report = verify(&f.cell, &doc, &VerifySettings::default());
     assert!(!report.ok);
@@ -157,7 +160,6 @@ fn coordination_does_not_depend_on_the_thread_count() {
             .install(|| {
                 let (mut doc, _) = document(Coordination::Best);
                 doc.compute_s = output::ComputeTimes::default();
-                doc.coordination.compute_s = 0.0;
                 doc
             })
     };
@@ -232,6 +234,29 @@ fn the_verifier_catches_injected_faults() {
     hurried.cycle_time_s = doc_none.cycle_time_s;
     hurried.delta_t_s = doc_none.delta_t_s;
     assert!(kinds(&hurried).contains(&ViolationKind::RobotRobot));
+    // A robot's waits list deleted (the exported program would lose its wait): the clock
+    // no longer adds up, nor does the waiting time.
+    let waiter = good
+        .robots
+        .iter()
+        .position(|r| !r.waits.is_empty())
+        .expect("a robot that waits");
+    let mut unwaited = good.clone();
+    unwaited.robots[waiter].waits.clear();
+    let k = kinds(&unwaited);
+    assert!(
+        k.contains(&ViolationKind::Continuity) && k.contains(&ViolationKind::Totals),
+        "{k:?}"
+    );
+    // A wait moved to another time: not a standstill there.
+    let mut moved_wait = good.clone();
+    let w = &mut moved_wait.robots[waiter].waits[0];
+    w.start_s += 0.5 * w.duration_s.max(0.2) + 0.3;
+    assert!(kinds(&moved_wait).contains(&ViolationKind::Continuity));
+    // The priority order named with a robot the plan does not have.
+    let mut stranger = good.clone();
+    stranger.coordination.priority = vec!["R9".into()];
+    assert!(kinds(&stranger).contains(&ViolationKind::Totals));
 }
 
 /// Reads `count` × `width` little-endian floats of accessor `a` from the GLB's binary chunk.

@@ -256,7 +256,6 @@ fn the_plan_does_not_depend_on_the_thread_count() {
             let outcome = plan::plan(&f.cell, &f.table, &s, &|_| {}).unwrap();
             let mut doc = build(&f.cell, &f.table, &outcome, &s);
             doc.compute_s = output::ComputeTimes::default();
-            doc.coordination.compute_s = 0.0;
             doc
         })
     };
@@ -266,14 +265,11 @@ fn the_plan_does_not_depend_on_the_thread_count() {
     let _ = TaskId(0);
 }
 
-/// Every key the schema requires is in a written plan, at every level.
+/// Every key the schema (generated from the document's types) requires is in a written
+/// plan, at every level.
 #[test]
 fn written_plans_have_every_key_the_schema_requires() {
-    let schema: serde_json::Value = serde_json::from_str(
-        &std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("../../docs/plan.schema.json"))
-            .unwrap(),
-    )
-    .unwrap();
+    let schema: serde_json::Value = serde_json::from_str(&output::schema()).unwrap();
     let f = fixture();
     let s = PlanSettings {
         allocation: Allocation::Proximity,
@@ -281,15 +277,22 @@ fn written_plans_have_every_key_the_schema_requires() {
     };
     let outcome = plan::plan(&f.cell, &f.table, &s, &|_| {}).unwrap();
     let doc = serde_json::to_value(build(&f.cell, &f.table, &outcome, &s)).unwrap();
-    fn required(schema: &serde_json::Value, value: &serde_json::Value, root: &serde_json::Value, at: &str) {
+    fn required(
+        schema: &serde_json::Value,
+        value: &serde_json::Value,
+        root: &serde_json::Value,
+        at: &str,
+    ) -> usize {
         let schema = match schema.get("$ref").and_then(|r| r.as_str()) {
             Some(r) => root.pointer(r.trim_start_matches('#')).unwrap(),
             None => schema,
         };
+        let mut checked = 0;
         if let Some(keys) = schema.get("required").and_then(|r| r.as_array()) {
             for k in keys {
                 let k = k.as_str().unwrap();
                 assert!(value.get(k).is_some(), "{at} lacks `{k}`");
+                checked += 1;
             }
         }
         if let (Some(props), Some(obj)) = (
@@ -298,18 +301,210 @@ fn written_plans_have_every_key_the_schema_requires() {
         ) {
             for (k, sub) in props {
                 if let Some(v) = obj.get(k) {
-                    required(sub, v, root, &format!("{at}.{k}"));
+                    checked += required(sub, v, root, &format!("{at}.{k}"));
                 }
             }
         }
         if let (Some(items), Some(arr)) = (schema.get("items"), value.as_array()) {
             for (i, v) in arr.iter().enumerate() {
-                required(items, v, root, &format!("{at}[{i}]"));
+                checked += required(items, v, root, &format!("{at}[{i}]"));
             }
         }
+        checked
     }
-    required(&schema, &doc, &schema, "plan");
-    assert_eq!(doc["version"], schema["properties"]["version"]["const"]);
+    assert!(required(&schema, &doc, &schema, "plan") > 100);
+    assert_eq!(doc["version"], output::VERSION);
+}
+
+/// Edits of a valid plan: each is refused when the document is read (a clean error naming
+/// the place) or caught by the verifier, never accepted.
+#[test]
+fn edited_plans_are_refused_or_caught() {
+    let f = fixture();
+    let s = settings(Allocation::Balanced);
+    let outcome = plan::plan(&f.cell, &f.table, &s, &|_| {}).unwrap();
+    let good = build(&f.cell, &f.table, &outcome, &s);
+    let quiet = VerifySettings::default();
+    assert!(verify(&f.cell, &good, &quiet).ok);
+    let r = good.robots.iter().position(|r| r.tasks.len() >= 2).unwrap();
+    let n = good.robots[r].trajectory.len();
+    type Edit = fn(&mut output::Plan, usize, usize);
+    // (what, edit, the violation it must cause; None: refused when read)
+    let cases: Vec<(&str, Edit, Option<ViolationKind>)> = vec![
+        (
+            "a sample deleted",
+            |p, r, n| drop(p.robots[r].trajectory.remove(n / 2)),
+            Some(ViolationKind::Continuity),
+        ),
+        (
+            "motion_s changed",
+            |p, r, _| p.robots[r].motion_s += 0.25,
+            Some(ViolationKind::Totals),
+        ),
+        (
+            "measuring_s changed",
+            |p, r, _| p.robots[r].measuring_s += 0.25,
+            Some(ViolationKind::Totals),
+        ),
+        (
+            "waiting_s changed",
+            |p, r, _| p.robots[r].waiting_s += 0.25,
+            Some(ViolationKind::Totals),
+        ),
+        (
+            "end_s changed",
+            |p, r, _| p.robots[r].end_s += 0.25,
+            Some(ViolationKind::Totals),
+        ),
+        (
+            "total_s changed",
+            |p, r, _| p.robots[r].total_s -= 0.25,
+            Some(ViolationKind::Totals),
+        ),
+        (
+            "lower_bound_s changed",
+            |p, _, _| p.lower_bound_s *= 0.9,
+            Some(ViolationKind::Totals),
+        ),
+        (
+            "ratio changed",
+            |p, _, _| p.ratio_to_lower_bound *= 0.9,
+            Some(ViolationKind::Totals),
+        ),
+        (
+            "joints reversed",
+            |p, r, _| p.robots[r].joints.reverse(),
+            Some(ViolationKind::Format),
+        ),
+        (
+            "a leg's duration changed",
+            |p, r, _| p.robots[r].legs[1].duration_s += 0.25,
+            Some(ViolationKind::Totals),
+        ),
+        (
+            "a visit moved in time",
+            |p, r, _| p.robots[r].tasks[1].arrive_s += 0.25,
+            Some(ViolationKind::Continuity),
+        ),
+        (
+            "a leg's stop renamed",
+            |p, r, _| p.robots[r].legs[0].from = plan::Stop::Task("M1".into()),
+            Some(ViolationKind::Continuity),
+        ),
+        (
+            "a task done and listed as undoable",
+            |p, r, _| {
+                let task = p.robots[r].tasks[0].task.clone();
+                p.unmeasured.push(output::UnmeasuredTask {
+                    task,
+                    reason: "no-ik".into(),
+                });
+            },
+            Some(ViolationKind::Unmeasured),
+        ),
+        (
+            "the candidate count changed",
+            |p, _, _| p.stats.candidates += 1,
+            Some(ViolationKind::Totals),
+        ),
+        (
+            "the candidate index changed",
+            |p, r, _| p.robots[r].tasks[0].candidate += 1,
+            Some(ViolationKind::ProbeConstraint),
+        ),
+        (
+            "the clearance changed",
+            |p, _, _| p.settings.clearance_m = 0.0,
+            Some(ViolationKind::Totals),
+        ),
+        (
+            "the wait count changed",
+            |p, _, _| p.coordination.waits += 1,
+            Some(ViolationKind::Totals),
+        ),
+        (
+            "the strategy changed",
+            |p, _, _| p.coordination.strategy = coord::Coordination::None,
+            Some(ViolationKind::Totals),
+        ),
+        (
+            "the uncoordinated cycle changed",
+            |p, _, _| p.coordination.uncoordinated_cycle_time_s += 1.0,
+            Some(ViolationKind::Totals),
+        ),
+        (
+            "a recorded tool rotation changed",
+            |p, r, _| p.robots[r].tasks[0].tcp.quat = [0.0, 0.0, 0.0, 1.0],
+            Some(ViolationKind::ProbeConstraint),
+        ),
+        (
+            "a sample of fewer joints",
+            |p, r, n| {
+                p.robots[r].trajectory[n / 2].q.pop();
+            },
+            None,
+        ),
+        (
+            "a sample before the one before it",
+            |p, r, n| p.robots[r].trajectory[n / 2].t -= 1.0,
+            None,
+        ),
+        (
+            "a waypoint at 1e9",
+            |p, r, _| p.robots[r].legs[0].waypoints[0][0] = 1e9,
+            None,
+        ),
+        ("a time of 1e12 s", |p, r, _| p.robots[r].end_s = 1e12, None),
+        (
+            "a wait at a leg that does not exist",
+            |p, r, _| {
+                p.robots[r].waits.push(output::WaitOut {
+                    leg: 99,
+                    waypoint: 0,
+                    start_s: 0.0,
+                    duration_s: 1.0,
+                    reason: coord::WaitReason::GiveWay,
+                    for_robot: None,
+                })
+            },
+            None,
+        ),
+        ("another version", |p, _, _| p.version = 2, None),
+    ];
+    let dir = tempfile::tempdir().unwrap();
+    for (what, edit, expected) in cases {
+        let mut doc = good.clone();
+        edit(&mut doc, r, n);
+        let path = dir.path().join("plan.json");
+        std::fs::write(&path, serde_json::to_string(&doc).unwrap()).unwrap();
+        match (output::read(&path), expected) {
+            (Ok(read), Some(kind)) => {
+                let report = verify(&f.cell, &read, &quiet);
+                let kinds: Vec<ViolationKind> = report.violations.iter().map(|v| v.kind).collect();
+                assert!(kinds.contains(&kind), "{what}: want {kind:?}, got {kinds:?}");
+            }
+            (Err(e), None) => {
+                // The library verifier refuses it too, without walking it.
+                let report = verify(&f.cell, &doc, &quiet);
+                assert_eq!(report.violations.len(), 1, "{what}: {e}");
+                assert_eq!(report.violations[0].kind, ViolationKind::Format, "{what}");
+            }
+            (Ok(_), None) => panic!("{what}: read as valid"),
+            (Err(e), Some(_)) => panic!("{what}: refused when read ({e}); the verifier should name it"),
+        }
+    }
+    // The coordination record erased: not a plan of this layout.
+    let mut json = serde_json::to_value(&good).unwrap();
+    json.as_object_mut().unwrap().remove("coordination");
+    let path = dir.path().join("erased.json");
+    std::fs::write(&path, serde_json::to_string_pretty(&json).unwrap()).unwrap();
+    let e = output::read(&path).unwrap_err();
+    assert!(e.to_string().contains("coordination"), "{e}");
+    // A file too large is refused before it is read.
+    let big = std::fs::File::create(dir.path().join("big.json")).unwrap();
+    big.set_len(output::MAX_PLAN_BYTES + 1).unwrap();
+    let e = output::read(&dir.path().join("big.json")).unwrap_err();
+    assert!(matches!(e, output::DocumentError::TooLarge { .. }), "{e}");
 }
 
 /// Two robots 2 m apart facing a box, four MPs close together on its top, all nearer to R1

@@ -182,7 +182,7 @@ pub fn gantt(plan: &Plan) -> String {
                     (
                         WAIT_COLOUR,
                         0.9,
-                        format!("waiting ({}){whom} at {}", w.reason, w.at),
+                        format!("waiting ({}){whom} at {}", w.reason, rp.wait_place(w)),
                     )
                 }
             };
@@ -343,8 +343,8 @@ pub fn time_position(
                     c.start_s,
                     c.end_s,
                     c.scenario,
-                    escape(&c.activity[0]),
-                    escape(&c.activity[1])
+                    escape(&c.activity[0].text("measuring")),
+                    escape(&c.activity[1].text("measuring"))
                 );
             }
         }
@@ -367,8 +367,8 @@ pub fn time_position(
                         (x.at(w.start_s + w.duration_s) - x.at(w.start_s)).max(2.0),
                         escape(&rp.name),
                         w.duration_s,
-                        escape(&w.at),
-                        escape(&w.reason)
+                        escape(&rp.wait_place(w)),
+                        w.reason
                     );
                 }
                 for v in rp.tasks.iter().filter(|v| v.perturbation_rad.is_some()) {

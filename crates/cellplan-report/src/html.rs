@@ -291,7 +291,7 @@ fn summary(page: &mut String, rep: &PlanReport) {
         &format!(
             "{} / {}",
             plan.coordination.conflicts_before.len(),
-            plan.coordination.conflicts_resolved
+            plan.stats.conflicts_resolved
         ),
         "conflicts found / resolved",
         "",
@@ -384,8 +384,8 @@ fn details(page: &mut String, plan: &Plan) {
             format!(", priority {}", escape(&c.priority.join(" > ")))
         },
         c.conflicts_before.len(),
-        c.conflicts_resolved,
-        c.compute_s
+        plan.stats.conflicts_resolved,
+        plan.compute_s.coordination
     );
     let list = if c.conflicts_after.is_empty() {
         &c.conflicts_before
@@ -409,9 +409,9 @@ fn details(page: &mut String, plan: &Plan) {
                     "2: moving"
                 },
                 escape(&x.robots[0]),
-                escape(&x.activity[0]),
+                escape(&x.activity[0].text("measuring")),
                 escape(&x.robots[1]),
-                escape(&x.activity[1])
+                escape(&x.activity[1].text("measuring"))
             );
         }
         page.push_str("</table>");
@@ -428,10 +428,10 @@ fn details(page: &mut String, plan: &Plan) {
                 page,
                 r#"<tr><td>{}</td><td class="text">{}</td><td>{:.2}</td><td>{:.2}</td><td>{}</td><td>{}</td></tr>"#,
                 escape(&r.name),
-                escape(&w.at),
+                escape(&r.wait_place(w)),
                 w.start_s,
                 w.duration_s,
-                escape(&w.reason),
+                w.reason,
                 escape(w.for_robot.as_deref().unwrap_or(""))
             );
         }

@@ -148,10 +148,9 @@ mod tests {
             waits: vec![WaitOut {
                 leg: 1,
                 waypoint: 0,
-                at: "A".into(),
                 start_s: 3.5,
                 duration_s: 1.0,
-                reason: "give-way".into(),
+                reason: cellplan_core::coord::WaitReason::GiveWay,
                 for_robot: Some("S".into()),
             }],
             legs: Vec::new(),

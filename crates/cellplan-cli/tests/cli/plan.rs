@@ -26,7 +26,7 @@ fn plan_writes_a_plan_and_a_stable_summary() {
     assert!(cycle > 4.5);
     let plan: Value = serde_json::from_slice(&std::fs::read(out_dir.join("plan.json")).unwrap()).unwrap();
     assert_eq!(plan["format"], "cellplan-plan");
-    assert_eq!(plan["version"], 2);
+    assert_eq!(plan["version"], 3);
     assert_eq!(plan["robots"][0]["tasks"].as_array().unwrap().len(), 3);
     assert_eq!(plan["robots"][0]["legs"].as_array().unwrap().len(), 4);
     // The same seed gives the same plan, whatever the thread count.
@@ -172,12 +172,13 @@ fn plan_writes_a_report_and_export_writes_gltf_and_csv() {
 
     // Nothing asked: refused.
     let out = cellplan(&["export", plan.to_str().unwrap(), cell.to_str().unwrap()], &dir);
-    assert_eq!(out.status.code(), Some(1));
+    assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("--gltf"));
     // Not a plan: exit 2 naming the file and line; nothing written.
     let bad = dir.join("bad.json");
     std::fs::write(&bad, "{\n  \"format\": [\n").unwrap();
     let target = dir.join("bad.html");
+    let glb_bad = dir.join("bad.glb");
     let out = cellplan(
         &[
             "report",
@@ -210,6 +211,62 @@ fn plan_writes_a_report_and_export_writes_gltf_and_csv() {
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("R7"));
     assert!(!target.exists());
+    // Edited plans that would make `verify`, `report` or `export` panic or run for hours:
+    // refused when read (exit 2, naming the place), nothing written.
+    let good: Value = serde_json::from_str(&std::fs::read_to_string(&plan).unwrap()).unwrap();
+    type Edit = fn(&mut Value);
+    let edits: [(&str, Edit, &str); 4] = [
+        (
+            "a waypoint of 1e9",
+            |d| d["robots"][0]["legs"][0]["waypoints"][0][0] = Value::from(1e9),
+            "legs[0]",
+        ),
+        (
+            "a shorter sample",
+            |d| {
+                d["robots"][0]["trajectory"][3]["q"].as_array_mut().unwrap().pop();
+            },
+            "trajectory[3]",
+        ),
+        (
+            "time going back",
+            |d| d["robots"][0]["trajectory"][3]["t"] = Value::from(0.0),
+            "trajectory[3]",
+        ),
+        ("version 2", |d| d["version"] = Value::from(2), "version 2"),
+    ];
+    for (what, edit, place) in edits {
+        let mut doc = good.clone();
+        edit(&mut doc);
+        std::fs::write(&bad, serde_json::to_string(&doc).unwrap()).unwrap();
+        for args in [
+            vec!["verify", bad.to_str().unwrap(), cell.to_str().unwrap()],
+            vec![
+                "report",
+                bad.to_str().unwrap(),
+                cell.to_str().unwrap(),
+                "-o",
+                target.to_str().unwrap(),
+            ],
+            vec![
+                "export",
+                bad.to_str().unwrap(),
+                cell.to_str().unwrap(),
+                "--gltf",
+                glb_bad.to_str().unwrap(),
+            ],
+        ] {
+            let out = cellplan(&args, &dir);
+            let err = String::from_utf8_lossy(&out.stderr);
+            assert_eq!(out.status.code(), Some(2), "{what}, {}: {err}", args[0]);
+            assert!(
+                err.contains(place) && err.contains("bad.json"),
+                "{what}, {}: {err}",
+                args[0]
+            );
+        }
+        assert!(!target.exists() && !glb_bad.exists(), "{what}");
+    }
 }
 
 #[test]

@@ -43,7 +43,9 @@ pub const REPLAY_SLACK: f64 = 0.003;
 
 /// Coordination strategy.
 #[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, PartialOrd, Ord)]
+#[derive(
+    Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, PartialOrd, Ord, schemars::JsonSchema,
+)]
 #[serde(rename_all = "kebab-case")]
 pub enum Coordination {
     /// No coordination: robots may meet (for studies; `verify` rejects such plans when they do).

@@ -5,9 +5,9 @@
 //! rest (as [`time_path_exact`] does for a whole polyline: it stops at every waypoint), so a
 //! wait at any waypoint changes nothing but the clock: the robot is at rest there anyway.
 use crate::candidates::{Candidate, CandidateTable};
-use crate::plan::PlanError;
 use crate::plan::graph::RobotGraph;
 use crate::plan::sequence::Sequence;
+use crate::plan::{PlanError, Stop};
 use cellplan_geom::Pose;
 use cellplan_model::Cell;
 use cellplan_model::robot::Robot;
@@ -77,7 +77,19 @@ impl ProgramLeg {
 }
 
 /// Why a robot waits.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+#[derive(
+    Clone,
+    Copy,
+    Debug,
+    PartialEq,
+    Eq,
+    PartialOrd,
+    Ord,
+    serde::Serialize,
+    serde::Deserialize,
+    schemars::JsonSchema,
+)]
+#[serde(rename_all = "kebab-case")]
 pub enum WaitReason {
     /// Delayed start (delay-startup).
     Startup,
@@ -85,6 +97,12 @@ pub enum WaitReason {
     GiveWay,
     /// No perturbed pose cleared the conflict (pose-perturbation's fallback).
     Fallback,
+}
+
+impl std::fmt::Display for WaitReason {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        crate::write_serde_name(self, f)
+    }
 }
 
 /// A stop: the robot stands at `legs[leg].waypoints[waypoint]` for `duration` before going on.
@@ -252,13 +270,13 @@ impl Program {
         })
     }
 
-    /// Name of stop `k` of the program: 0 and `visits.len() + 1` are "home", else the MP of
-    /// visit `k − 1` (leg `k` runs from stop `k` to stop `k + 1`).
-    pub fn stop_name(&self, cell: &Cell, k: usize) -> String {
+    /// Stop `k` of the program: 0 and `visits.len() + 1` are home, else the task of visit
+    /// `k − 1` (leg `k` runs from stop `k` to stop `k + 1`).
+    pub fn stop(&self, cell: &Cell, k: usize) -> Stop {
         if k == 0 || k > self.visits.len() {
-            "home".to_string()
+            Stop::Home
         } else {
-            cell.tasks[self.visits[k - 1].task.0].name.clone()
+            Stop::Task(cell.tasks[self.visits[k - 1].task.0].name.clone())
         }
     }
 

@@ -8,7 +8,7 @@
 //! while the robot stands: measuring, waiting, or home after its program). The next sample is
 //! the largest `Δ` at which the two robots together cannot have closed `d − margin`, so the
 //! distance stays above the margin in between.
-use super::program::{Activity, Program, Timed};
+use super::program::{Activity, Timed};
 use cellplan_geom::DVec3;
 use cellplan_model::Cell;
 use cellplan_model::robot::{Robot, Scratch};
@@ -298,16 +298,5 @@ impl<'a> Timeline<'a> {
             tcp: [tcp(a), tcp(b)],
             scenario,
         }
-    }
-}
-
-/// Describes an activity for people: "moving M3 → M7", "measuring M7", "waiting at M3".
-pub fn activity_text(cell: &Cell, program: &Program, a: Activity) -> String {
-    let name = |k: usize| program.stop_name(cell, k);
-    match a {
-        Activity::Move { leg, .. } => format!("moving {} → {}", name(leg), name(leg + 1)),
-        Activity::Measure { visit } => format!("measuring {}", name(visit + 1)),
-        Activity::Wait { leg, waypoint: 0 } => format!("waiting at {}", name(leg)),
-        Activity::Wait { leg, .. } => format!("waiting on the way {} → {}", name(leg), name(leg + 1)),
     }
 }

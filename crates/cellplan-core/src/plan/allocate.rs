@@ -25,7 +25,7 @@ use std::time::Duration;
 
 /// Allocation strategy.
 #[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize, schemars::JsonSchema)]
 #[serde(rename_all = "kebab-case")]
 pub enum Allocation {
     /// Nearest robot (paper 000's benchmark).
@@ -49,7 +49,7 @@ impl Allocation {
 
 /// How the local-robust strategy solves its set cover.
 #[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize, schemars::JsonSchema)]
 #[serde(rename_all = "kebab-case")]
 pub enum CoverMethod {
     /// Paper 000's penalty and auxiliary function (eq. 6–7).
@@ -153,6 +153,15 @@ fn cap_error(cell: &Cell, t: usize, cap: usize) -> PlanError {
         task: cell.tasks[t].name.clone(),
         cap,
     }
+}
+
+/// The lower bound of the min-max problem on the graphs' lower-bound costs: what
+/// [`Allocated::lower_bound`] reports, recomputed by the verifier.
+pub fn lower_bound(cell: &Cell, table: &CandidateTable, graphs: &[RobotGraph]) -> Result<f64, PlanError> {
+    let capable: Vec<Vec<usize>> = (0..cell.tasks.len())
+        .map(|t| table.robots_for(TaskId(t)).into_iter().map(|r| r.0).collect())
+        .collect();
+    Ok(minmax::lower_bound(&min_max_problem(cell, graphs, &capable)?.0))
 }
 
 /// The min-max problem over the measurable tasks, and the cell task of each of its tasks.

@@ -10,7 +10,7 @@ use cellplan_solve::CostMatrix;
 
 /// How the time of a move between two configurations is estimated before it is planned.
 #[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize, schemars::JsonSchema)]
 #[serde(rename_all = "kebab-case")]
 pub enum MoveModel {
     /// Synchronised trapezoidal/triangular profiles under the velocity and acceleration

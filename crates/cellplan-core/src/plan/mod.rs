@@ -105,13 +105,33 @@ pub enum LegError {
     Timing(#[from] cellplan_motion::timing::TimingError),
 }
 
-/// Where a robot stands between legs: at home or at a task.
-#[derive(Clone, Debug, PartialEq, Eq)]
+/// Where a robot stands between legs: at home or at a task. In the Plan document: `"home"` or
+/// `{"task": "M3"}` (so a task may be named `home`).
+#[derive(Clone, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize, schemars::JsonSchema)]
+#[serde(rename_all = "kebab-case")]
 pub enum Stop {
     /// The robot's home configuration.
     Home,
     /// A task, by its name.
     Task(String),
+}
+
+impl Stop {
+    /// The task's name, or `home`: a label for people, not an identifier.
+    pub fn label(&self) -> &str {
+        match self {
+            Stop::Home => "home",
+            Stop::Task(t) => t,
+        }
+    }
+
+    /// The task's name, if it is a task.
+    pub fn task(&self) -> Option<&str> {
+        match self {
+            Stop::Home => None,
+            Stop::Task(t) => Some(t),
+        }
+    }
 }
 
 impl std::fmt::Display for Stop {

@@ -1,0 +1,426 @@
+//! The Plan document (`docs/plan-format.md`, schema `docs/plan.schema.json`, generated from
+//! these types): versioned JSON, SI units (m, rad, s), written atomically. Its key names are
+//! stable. Every number it states about the plan is recomputed by [`crate::verify`]; `stats`
+//! and `compute_s` describe the search that found it and are not claims about the plan.
+//!
+//! A document read from a file is checked by [`validate`] (sizes, magnitudes, orders) before
+//! anything walks it; [`read`] does both.
+mod build;
+mod validate;
+
+pub use build::{build, process_settings};
+pub(crate) use build::{ratio, unmeasured_reason};
+pub use validate::{DocumentError, MAX_PLAN_BYTES, matches_cell, read, validate};
+
+use crate::coord::{Coordination, WaitReason};
+use crate::plan::{self, Stop};
+use schemars::JsonSchema;
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+
+/// Value of the `format` key.
+pub const FORMAT: &str = "cellplan-plan";
+/// Value of the `version` key; raised when a key changes meaning or disappears.
+pub const VERSION: u32 = 3;
+
+/// A plan for a cell.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct Plan {
+    /// Always `cellplan-plan`.
+    pub format: String,
+    /// The layout's version (3).
+    pub version: u32,
+    /// Cell name.
+    pub cell: String,
+    /// Cell file, as given.
+    pub cell_file: String,
+    /// How the plan was made.
+    pub settings: SettingsOut,
+    /// The longest robot time (s).
+    pub cycle_time_s: f64,
+    /// Largest difference between robot times (s).
+    pub delta_t_s: f64,
+    /// A lower bound of the cycle time over the candidates the planner considered (s): the
+    /// min-max bound of paper 000's allocation problem on lower-bound move times.
+    pub lower_bound_s: f64,
+    /// `cycle_time_s / lower_bound_s` (1 when the bound is 0).
+    pub ratio_to_lower_bound: f64,
+    /// Whether `cellplan verify` accepted the plan before it was written (false only when
+    /// written with `--no-verify`).
+    pub verified: bool,
+    /// What coordination did.
+    pub coordination: CoordinationOut,
+    /// One entry per robot, in cell order.
+    pub robots: Vec<RobotPlan>,
+    /// Tasks no robot can do, with the reason.
+    pub unmeasured: Vec<UnmeasuredTask>,
+    /// Counts of the search (not claims about the plan; `candidates` is checked).
+    pub stats: Stats,
+    /// Wall-clock seconds per stage.
+    pub compute_s: ComputeTimes,
+}
+
+/// The settings of the run.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct SettingsOut {
+    /// Allocation strategy.
+    pub allocation: plan::Allocation,
+    /// Set-cover method (local-robust only).
+    pub cover: plan::CoverMethod,
+    /// Move-time model of the lower-bound costs.
+    pub move_model: plan::MoveModel,
+    /// Seed.
+    pub seed: u64,
+    /// Search budget (s).
+    pub time_limit_s: f64,
+    /// ε of the local robust sets (m).
+    pub local_set_radius_m: f64,
+    /// Candidates kept per task and robot for allocation and sequencing.
+    pub alternatives: usize,
+    /// Candidates this much roomier (m) than the clearance are kept first.
+    pub roomy_m: f64,
+    /// Trajectory sample step (s).
+    pub sample_dt_s: f64,
+    /// Clearance kept from the static scene (m).
+    pub clearance_m: f64,
+    /// The process: its `kind` and parameters (SI, keys with units).
+    pub process: serde_json::Value,
+    /// φ.
+    pub task_cap: usize,
+    /// γ (s), if any.
+    pub balance_limit_s: Option<f64>,
+    /// Coordination strategy.
+    pub coordination: Coordination,
+}
+
+/// What coordination did.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct CoordinationOut {
+    /// The strategy.
+    pub strategy: Coordination,
+    /// Cycle time of the programs before coordination (s): what the plan would take if the
+    /// robots could pass through each other.
+    pub uncoordinated_cycle_time_s: f64,
+    /// Conflicts of the programs before coordination.
+    pub conflicts_before: Vec<ConflictOut>,
+    /// Conflicts left (only with strategy `none`).
+    pub conflicts_after: Vec<ConflictOut>,
+    /// Waits in the programs.
+    pub waits: usize,
+    /// Working poses changed (perturbed).
+    pub poses_changed: usize,
+    /// Priority order (highest first), where the strategy uses one.
+    pub priority: Vec<String>,
+    /// Each robot's tool (TCP) position over time as planned before coordination, for the
+    /// time–position chart of paper 000 Fig. 7 (the plan's own trajectories give Fig. 8).
+    pub uncoordinated_probe: Vec<ProbeTrack>,
+}
+
+/// A robot's tool position sampled at a fixed step from time 0 to the end of its program.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct ProbeTrack {
+    /// Robot name.
+    pub robot: String,
+    /// Sampling step (s); the last sample is the end of the program.
+    pub dt_s: f64,
+    /// Positions (m), rounded to 0.1 mm.
+    pub xyz: Vec<[f64; 3]>,
+}
+
+/// Step of [`ProbeTrack`]s in plans.
+pub const PROBE_TRACK_DT: f64 = 0.1;
+
+/// A robot–robot conflict.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct ConflictOut {
+    /// The two robots.
+    pub robots: [String; 2],
+    /// First time found closer than the clearance (s).
+    pub start_s: f64,
+    /// First time found clear again (s).
+    pub end_s: f64,
+    /// Paper 000's scenario: 1 both working, 2 at least one moving or waiting.
+    pub scenario: u8,
+    /// What each robot was doing.
+    pub activity: [ActivityOut; 2],
+    /// Tool positions at `start_s` (m).
+    pub probe_xyz: [[f64; 3]; 2],
+}
+
+/// What a robot is doing at a moment.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq, JsonSchema)]
+#[serde(tag = "kind", rename_all = "kebab-case", deny_unknown_fields)]
+pub enum ActivityOut {
+    /// Moving along leg `leg`, from one stop to the next.
+    Moving {
+        /// Index of the leg in the robot's `legs`.
+        leg: usize,
+        /// Where the leg starts.
+        from: Stop,
+        /// Where it ends.
+        to: Stop,
+    },
+    /// Doing the work at a task.
+    Working {
+        /// The task id.
+        task: String,
+    },
+    /// Standing at waypoint `waypoint` of leg `leg`.
+    Waiting {
+        /// Index of the leg.
+        leg: usize,
+        /// Index of the waypoint (0: the leg's start).
+        waypoint: usize,
+        /// Where the leg starts.
+        from: Stop,
+        /// Where it ends.
+        to: Stop,
+    },
+}
+
+impl ActivityOut {
+    /// A phrase for people ("moving M3 → M7", "measuring M7", "waiting at M3"); `working` is
+    /// the process's word for its work ([`Words::working`](cellplan_model::process::Words)).
+    pub fn text(&self, working: &str) -> String {
+        match self {
+            ActivityOut::Moving { from, to, .. } => format!("moving {} → {}", from.label(), to.label()),
+            ActivityOut::Working { task } => format!("{working} {task}"),
+            ActivityOut::Waiting {
+                waypoint: 0, from, ..
+            } => format!("waiting at {}", from.label()),
+            ActivityOut::Waiting { from, to, .. } => {
+                format!("waiting on the way {} → {}", from.label(), to.label())
+            }
+        }
+    }
+
+    /// The tasks involved: the task ends of a leg, or the task worked at.
+    pub fn tasks(&self) -> Vec<&str> {
+        match self {
+            ActivityOut::Moving { from, to, .. } => [from, to].into_iter().filter_map(Stop::task).collect(),
+            ActivityOut::Working { task } => vec![task.as_str()],
+            ActivityOut::Waiting {
+                waypoint: 0, from, ..
+            } => from.task().into_iter().collect(),
+            ActivityOut::Waiting { .. } => Vec::new(),
+        }
+    }
+}
+
+/// One robot's part of the plan.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct RobotPlan {
+    /// Robot name.
+    pub name: String,
+    /// Joint names, the order of every `q`.
+    pub joints: Vec<String>,
+    /// Home configuration (rad or m per joint).
+    pub home: Vec<f64>,
+    /// The tasks in visiting order.
+    pub tasks: Vec<Visit>,
+    /// Start of the robot's program (s).
+    pub start_s: f64,
+    /// End, back at home (s).
+    pub end_s: f64,
+    /// Time moving: the legs' durations (s).
+    pub motion_s: f64,
+    /// Time working at the tasks (s).
+    pub measuring_s: f64,
+    /// Time standing still to let other robots pass: the waits' durations (s).
+    pub waiting_s: f64,
+    /// `end_s − start_s` (s).
+    pub total_s: f64,
+    /// Where and how long the robot waits, in program order.
+    pub waits: Vec<WaitOut>,
+    /// The legs: home → first task, …, last task → home.
+    pub legs: Vec<LegOut>,
+    /// The timed trajectory, sampled every `sample_dt_s` (and at its end), home to home.
+    pub trajectory: Vec<Sample>,
+}
+
+impl RobotPlan {
+    /// Where a wait stands, for people ("home", "M3", "on the way M3 → M7").
+    pub fn wait_place(&self, w: &WaitOut) -> String {
+        match self.legs.get(w.leg) {
+            Some(leg) if w.waypoint == 0 => leg.from.label().to_string(),
+            Some(leg) => format!("on the way {} → {}", leg.from.label(), leg.to.label()),
+            None => format!("leg {}", w.leg),
+        }
+    }
+}
+
+/// One visit of a task.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq, JsonSchema)]
+pub struct Visit {
+    /// Task id (the task file's `id`).
+    pub task: String,
+    /// Index of the candidate among the robot's candidates for this task.
+    pub candidate: usize,
+    /// Joint configuration.
+    pub q: Vec<f64>,
+    /// Tool (TCP) pose in the world.
+    pub tcp: PoseOut,
+    /// The figures the process states about the visit (the optical probe's `view_angle_rad`),
+    /// recomputed by the verifier.
+    #[serde(flatten)]
+    pub figures: BTreeMap<String, f64>,
+    /// (Δw, Δp, Δr) (rad) when coordination perturbed the tool orientation of the candidate
+    /// (paper 000 §4.2); null otherwise.
+    pub perturbation_rad: Option<[f64; 3]>,
+    /// Arrival (start of the work) (s).
+    pub arrive_s: f64,
+    /// Departure (end of the work) (s).
+    pub depart_s: f64,
+}
+
+/// A wait.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct WaitOut {
+    /// Index of the leg.
+    pub leg: usize,
+    /// Index of the waypoint of the leg where the robot stands (0: the leg's start).
+    pub waypoint: usize,
+    /// Start (s).
+    pub start_s: f64,
+    /// Duration (s).
+    pub duration_s: f64,
+    /// Why.
+    pub reason: WaitReason,
+    /// The robot it lets pass, if any.
+    pub for_robot: Option<String>,
+}
+
+/// A pose: position (m) and unit quaternion (x, y, z, w).
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct PoseOut {
+    /// Position (m).
+    pub xyz: [f64; 3],
+    /// Orientation (x, y, z, w).
+    pub quat: [f64; 4],
+}
+
+/// One leg's path.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct LegOut {
+    /// Where it starts.
+    pub from: Stop,
+    /// Where it ends.
+    pub to: Stop,
+    /// Start of the motion (after any wait at its first waypoint) (s).
+    pub start_s: f64,
+    /// Moving time, waits excluded (s).
+    pub duration_s: f64,
+    /// Whether it is the direct joint segment (else found by the sampling planner).
+    pub straight: bool,
+    /// The collision-free joint path: straight segments between these waypoints.
+    pub waypoints: Vec<Vec<f64>>,
+}
+
+/// A trajectory sample.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct Sample {
+    /// Time (s).
+    pub t: f64,
+    /// Joint positions.
+    pub q: Vec<f64>,
+}
+
+/// A task no robot can do.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct UnmeasuredTask {
+    /// Task id.
+    pub task: String,
+    /// The furthest check any robot's pose passed: the process's rejection code (`view-angle`,
+    /// `stripe`, … for the optical probe) or `no-ik`, `joint-limits`, `collision`.
+    pub reason: String,
+}
+
+/// Counts of the search.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct Stats {
+    /// Candidates in the table (checked by the verifier).
+    pub candidates: usize,
+    /// Legs planned by the motion planner (straight or sampled).
+    pub legs_planned: usize,
+    /// Of those, legs the sampling planner had to solve.
+    pub legs_sampled: usize,
+    /// Legs for which no path was found (and that the sequence then avoided).
+    pub legs_failed: usize,
+    /// Sequencing rounds of the lazy loop, the most over the robots.
+    pub sequencing_rounds: usize,
+    /// Local robust sets built and chosen by the set cover (local-robust only).
+    pub local_sets_built: usize,
+    /// See `local_sets_built`.
+    pub local_sets_chosen: usize,
+    /// Conflicts coordination met and resolved (a resolution may meet new ones later on).
+    pub conflicts_resolved: usize,
+}
+
+/// Wall-clock seconds per stage.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq, Default, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct ComputeTimes {
+    /// Loading the cell.
+    pub load: f64,
+    /// Candidate generation.
+    pub candidates: f64,
+    /// Lower-bound move times.
+    pub costs: f64,
+    /// Allocation.
+    pub allocation: f64,
+    /// Sequencing with lazy motion planning.
+    pub sequencing_motion: f64,
+    /// Timing and assembly.
+    pub timing: f64,
+    /// Coordination.
+    pub coordination: f64,
+    /// The verifier.
+    pub verification: f64,
+    /// Everything, including writing.
+    pub total: f64,
+}
+
+/// The JSON Schema of the document, as `docs/plan.schema.json` holds it.
+pub fn schema() -> String {
+    let schema = schemars::schema_for!(Plan);
+    let mut text = serde_json::to_string_pretty(&schema).unwrap_or_default();
+    text.push('\n');
+    text
+}
+
+#[cfg(test)]
+mod tests {
+    use std::path::Path;
+
+    /// `docs/plan.schema.json` is the schema of these types (regenerate it with
+    /// `CELLPLAN_UPDATE_SCHEMA=1 cargo test -p cellplan-core schema`).
+    #[test]
+    fn the_schema_in_docs_is_generated_from_the_types() {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../docs/plan.schema.json");
+        let generated = super::schema();
+        if std::env::var_os("CELLPLAN_UPDATE_SCHEMA").is_some() {
+            std::fs::write(&path, &generated).unwrap();
+        }
+        let on_disk = std::fs::read_to_string(&path).unwrap();
+        assert!(
+            on_disk == generated,
+            "docs/plan.schema.json is not the schema of the document's types; regenerate it with \
+             CELLPLAN_UPDATE_SCHEMA=1 cargo test -p cellplan-core schema"
+        );
+        let schema: serde_json::Value = serde_json::from_str(&on_disk).unwrap();
+        let required = schema["required"].as_array().unwrap();
+        assert!(required.iter().any(|k| k == "coordination"), "{required:?}");
+    }
+}

@@ -1,0 +1,269 @@
+//! The plan's record: the settings the cell fixes, the cycle time, Δt, the lower bound and its
+//! ratio (recomputed from the candidates the settings name), the candidate count, and the
+//! coordination record (strategy, wait and pose counts, priority, the tracks before
+//! coordination and the conflicts met on them).
+use super::{Violation, ViolationKind};
+use crate::candidates::CandidateTable;
+use crate::document::{self, ActivityOut, ConflictOut, Plan, ProbeTrack, RobotPlan};
+use crate::plan::allocate;
+use crate::plan::graph::RobotGraph;
+use cellplan_geom::DVec3;
+use cellplan_model::Cell;
+use cellplan_model::robot::Robot;
+
+/// How far a conflict's stated tool position may lie from the track before coordination
+/// (m): the tracks are sampled every 0.1 s and interpolated.
+const TRACK_TOL: f64 = 0.05;
+
+/// The record checks; returns the recomputed cycle time and Δt.
+pub(super) fn check(
+    cell: &Cell,
+    table: &CandidateTable,
+    plan: &Plan,
+    robots: &[(&Robot, &RobotPlan)],
+    times: &[f64],
+    out: &mut Vec<Violation>,
+) -> (f64, f64) {
+    let mut totals = |detail: String| out.push(Violation::plan(ViolationKind::Totals, detail));
+    settings(cell, plan, &mut totals);
+    let cycle = times.iter().copied().fold(0.0, f64::max);
+    let delta = cycle - times.iter().copied().fold(f64::INFINITY, f64::min).min(cycle);
+    if (plan.cycle_time_s - cycle).abs() > 1e-6 || (plan.delta_t_s - delta).abs() > 1e-6 {
+        totals(format!(
+            "states cycle time {:.6} s and Δt {:.6} s; recomputed {cycle:.6} s and {delta:.6} s",
+            plan.cycle_time_s, plan.delta_t_s
+        ));
+    }
+    lower_bound(cell, table, plan, &mut totals);
+    if plan.stats.candidates != table.total() {
+        totals(format!(
+            "states {} candidates; the cell has {}",
+            plan.stats.candidates,
+            table.total()
+        ));
+    }
+    coordination(plan, robots, out);
+    (cycle, delta)
+}
+
+/// The settings the cell fixes: clearance, task cap, balance limit, the process.
+fn settings(cell: &Cell, plan: &Plan, totals: &mut dyn FnMut(String)) {
+    let s = &plan.settings;
+    let p = &cell.planning;
+    if s.clearance_m != p.clearance || s.task_cap != p.task_cap || s.balance_limit_s != p.balance_limit {
+        totals(format!(
+            "states clearance {} m, task cap {}, balance limit {:?} s; the cell has {} m, {}, {:?} s",
+            s.clearance_m, s.task_cap, s.balance_limit_s, p.clearance, p.task_cap, p.balance_limit
+        ));
+    }
+    let process = document::process_settings(cell.process.as_ref());
+    if s.process != process {
+        totals(format!(
+            "states the process {}; the cell's is {}",
+            s.process, process
+        ));
+    }
+}
+
+/// The lower bound, recomputed on the graphs the settings name, and its ratio.
+fn lower_bound(cell: &Cell, table: &CandidateTable, plan: &Plan, totals: &mut dyn FnMut(String)) {
+    let s = &plan.settings;
+    let graphs: Vec<RobotGraph> = cell
+        .robots
+        .iter()
+        .map(|r| RobotGraph::new(cell, r, table, s.move_model, s.alternatives, s.roomy_m))
+        .collect();
+    match allocate::lower_bound(cell, table, &graphs) {
+        Ok(lb) => {
+            if (plan.lower_bound_s - lb).abs() > 1e-6 * (1.0 + lb) {
+                totals(format!(
+                    "states the lower bound {:.6} s; recomputed {lb:.6} s",
+                    plan.lower_bound_s
+                ));
+            }
+        }
+        Err(e) => totals(format!("the lower bound cannot be recomputed: {e}")),
+    }
+    let ratio = document::ratio(plan.cycle_time_s, plan.lower_bound_s);
+    if (plan.ratio_to_lower_bound - ratio).abs() > 1e-9 * (1.0 + ratio) {
+        totals(format!(
+            "states the ratio {:.6} to the lower bound; its cycle time and bound give {ratio:.6}",
+            plan.ratio_to_lower_bound
+        ));
+    }
+}
+
+/// The coordination record against the programs and the tracks before coordination.
+fn coordination(plan: &Plan, robots: &[(&Robot, &RobotPlan)], out: &mut Vec<Violation>) {
+    let c = &plan.coordination;
+    let mut totals = |detail: String| out.push(Violation::plan(ViolationKind::Totals, detail));
+    if c.strategy != plan.settings.coordination {
+        totals(format!(
+            "coordination says `{:?}`, the settings `{:?}`",
+            c.strategy, plan.settings.coordination
+        ));
+    }
+    let waits: usize = plan.robots.iter().map(|r| r.waits.len()).sum();
+    let changed = plan
+        .robots
+        .iter()
+        .flat_map(|r| &r.tasks)
+        .filter(|v| v.perturbation_rad.is_some())
+        .count();
+    if c.waits != waits || c.poses_changed != changed {
+        totals(format!(
+            "coordination states {} waits and {} poses changed; the programs have {waits} and {changed}",
+            c.waits, c.poses_changed
+        ));
+    }
+    let names: Vec<&str> = plan.robots.iter().map(|r| r.name.as_str()).collect();
+    let mut priority = c.priority.clone();
+    priority.sort();
+    priority.dedup();
+    if priority.len() != c.priority.len() || c.priority.iter().any(|p| !names.contains(&p.as_str())) {
+        totals(format!(
+            "the priority order {:?} is not an order of the plan's robots",
+            c.priority
+        ));
+    }
+    for rp in &plan.robots {
+        for w in &rp.waits {
+            if let Some(o) = &w.for_robot
+                && (o == &rp.name || !names.contains(&o.as_str()))
+            {
+                totals(format!(
+                    "{} waits for `{o}`, not another robot of the plan",
+                    rp.name
+                ));
+            }
+        }
+    }
+    if c.strategy != crate::coord::Coordination::None && !c.conflicts_after.is_empty() {
+        totals(format!(
+            "{} conflicts left, but the strategy resolves conflicts",
+            c.conflicts_after.len()
+        ));
+    }
+    tracks(plan, robots, &mut totals);
+    for x in c.conflicts_before.iter().chain(&c.conflicts_after) {
+        if let Some(why) = conflict_problem(plan, x) {
+            totals(format!(
+                "the conflict of {} and {} at {:.2} s: {why}",
+                x.robots[0], x.robots[1], x.start_s
+            ));
+        }
+    }
+}
+
+/// The tracks before coordination: one per robot in plan order, from home to home, and the
+/// uncoordinated cycle time the longest of them.
+fn tracks(plan: &Plan, robots: &[(&Robot, &RobotPlan)], totals: &mut dyn FnMut(String)) {
+    let c = &plan.coordination;
+    let order: Vec<&str> = c.uncoordinated_probe.iter().map(|t| t.robot.as_str()).collect();
+    let names: Vec<&str> = plan.robots.iter().map(|r| r.name.as_str()).collect();
+    if order != names {
+        totals(format!(
+            "tracks before coordination for {order:?}; the plan's robots are {names:?}"
+        ));
+        return;
+    }
+    for (robot, rp) in robots {
+        let Some(track) = c.uncoordinated_probe.iter().find(|t| t.robot == rp.name) else {
+            continue;
+        };
+        let home = robot.tcp_pose(&rp.home).translation;
+        let off = |p: Option<&[f64; 3]>| p.is_some_and(|p| (DVec3::from(*p) - home).length() > 1e-3);
+        if off(track.xyz.first()) || off(track.xyz.last()) {
+            totals(format!(
+                "{}'s track before coordination does not start and end at home",
+                rp.name
+            ));
+        }
+    }
+    let u = c.uncoordinated_cycle_time_s;
+    let span = |t: &ProbeTrack, less: usize| t.xyz.len().saturating_sub(less) as f64 * t.dt_s;
+    let upper = c
+        .uncoordinated_probe
+        .iter()
+        .map(|t| span(t, 1))
+        .fold(0.0, f64::max);
+    let lower = c
+        .uncoordinated_probe
+        .iter()
+        .map(|t| span(t, 2))
+        .fold(0.0, f64::max);
+    if c.uncoordinated_probe.iter().all(|t| !t.xyz.is_empty()) && !(u <= upper + 1e-9 && u > lower - 1e-9) {
+        totals(format!(
+            "the uncoordinated cycle time {u:.6} s does not fit its tracks ({lower:.1}–{upper:.1} s)"
+        ));
+    }
+}
+
+/// What is wrong with a conflict: its robots, its activities (legs and stops as the final
+/// programs name them; coordination keeps every robot's order of visits), its scenario, its
+/// times, its tool positions against the tracks.
+fn conflict_problem(plan: &Plan, x: &ConflictOut) -> Option<String> {
+    if x.robots[0] == x.robots[1] {
+        return Some("a robot in conflict with itself".into());
+    }
+    if x.end_s < x.start_s
+        || x.start_s
+            > plan
+                .coordination
+                .uncoordinated_cycle_time_s
+                .max(plan.cycle_time_s)
+                + 1e-6
+    {
+        return Some(format!(
+            "the interval {:.6}–{:.6} s is out of place",
+            x.start_s, x.end_s
+        ));
+    }
+    let both_working = x
+        .activity
+        .iter()
+        .all(|a| matches!(a, ActivityOut::Working { .. }));
+    if x.scenario != if both_working { 1 } else { 2 } {
+        return Some(format!("scenario {} does not match the activities", x.scenario));
+    }
+    for side in 0..2 {
+        let rp = plan.robots.iter().find(|r| r.name == x.robots[side])?;
+        let fits = match &x.activity[side] {
+            ActivityOut::Moving { leg, from, to } | ActivityOut::Waiting { leg, from, to, .. } => {
+                rp.legs.get(*leg).is_some_and(|l| &l.from == from && &l.to == to)
+            }
+            ActivityOut::Working { task } => rp.tasks.iter().any(|v| &v.task == task),
+        };
+        if !fits {
+            return Some(format!("{}'s activity is not one of its program", rp.name));
+        }
+        if let Some(track) = plan
+            .coordination
+            .uncoordinated_probe
+            .iter()
+            .find(|t| t.robot == rp.name)
+            && let Some(p) = track_at(track, x.start_s)
+            && (p - DVec3::from(x.probe_xyz[side])).length() > TRACK_TOL
+        {
+            return Some(format!(
+                "{}'s tool position {:?} is not where its track puts it then",
+                rp.name, x.probe_xyz[side]
+            ));
+        }
+    }
+    None
+}
+
+/// The track's position at `t`, linearly interpolated (held after its end).
+fn track_at(track: &ProbeTrack, t: f64) -> Option<DVec3> {
+    let n = track.xyz.len();
+    if n == 0 {
+        return None;
+    }
+    let f = (t / track.dt_s).max(0.0);
+    let i = (f.floor() as usize).min(n - 1);
+    let j = (i + 1).min(n - 1);
+    let w = (f - i as f64).clamp(0.0, 1.0);
+    let (a, b) = (DVec3::from(track.xyz[i]), DVec3::from(track.xyz[j]));
+    Some(a + (b - a) * w)
+}
