@@ -3,9 +3,9 @@
 //! playback of the cell (the project's own WebGL2 viewer, `viewer.js`). One file with no
 //! outside references: it opens offline in any browser.
 //!
-//! The pages are written with [`maud`] templates, which escape every spliced value; only the
-//! report's own style sheet and script, the SVG charts of [`charts`] (escaped as they are
-//! built) and the embedded JSON data (escaped for a script element) go in as they are.
+//! The pages are [`maud`] templates (like the SVG charts of [`charts`]), which escape every
+//! spliced value; only the report's own style sheet and script and the embedded JSON data
+//! (escaped for a script element) go in as they are.
 use super::charts::{self, Marks, StrategyBar, Track};
 use super::playback::{Doing, intervals, probe_track};
 use super::scene::{Scene, SceneRobot, robot_colour};
@@ -194,7 +194,7 @@ pub fn plan_html(rep: &PlanReport) -> Result<String, String> {
                     (playback_section(t_end))
                     section id="gantt-section" {
                         h2 { "Gantt chart" }
-                        (PreEscaped(charts::gantt(plan)))
+                        (charts::gantt(plan))
                     }
                     (time_position_section(plan, &tracks, axis, t_end))
                     (coordination_section(plan))
@@ -304,9 +304,7 @@ fn time_position_section(plan: &Plan, tracks: &ChartTracks, axis: usize, t_end: 
         (title, Marks::Conflicts(&c.conflicts_after))
     };
     let chart = |id, title: &str, tracks: &[Track], marks| {
-        PreEscaped(charts::time_position(
-            id, title, tracks, axis_name, axis, marks, t_end,
-        ))
+        charts::time_position(id, title, tracks, axis_name, axis, marks, t_end)
     };
     html! {
         section id="timepos-section" {
@@ -802,7 +800,7 @@ pub fn compare_html(
                     p class="sub" { (intro) }
                     section id="bars-section" {
                         h2 { "Time per robot and cycle time (paper 000 Fig. 10)" }
-                        (PreEscaped(charts::strategy_bars(bars, bound)))
+                        (charts::strategy_bars(bars, bound))
                     }
                     section id="table-section" {
                         h2 { "Strategies (paper 000 Table 3)" }
