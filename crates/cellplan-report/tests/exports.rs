@@ -269,3 +269,19 @@ fn the_csv_export_carries_joints_probe_poses_and_the_program() {
         assert_eq!(&records[records.len() - 1][1], "home");
     }
 }
+
+/// The cell drawing escapes the names it writes (robot names come from the cell file), in the
+/// legend too.
+#[test]
+fn the_cell_drawing_escapes_robot_names() {
+    let path = cellplan_optical::testing::example_copy("svg-test", "svg-2r", 2, |text| {
+        text.replace("name = \"R2\"", "name = \"R<2>&\"")
+    });
+    let cell = cellplan_optical::load(&path, &cellplan_model::LoadOptions::default()).unwrap();
+    let svg = cellplan_report::svg::render(&cell, None);
+    assert!(
+        svg.contains("δ R&lt;2&gt;&amp; (only R&lt;2&gt;&amp;)"),
+        "the legend escapes"
+    );
+    assert!(!svg.contains("R<2>") && !svg.contains(">&<"));
+}
