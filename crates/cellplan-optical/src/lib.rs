@@ -7,6 +7,8 @@
 #![allow(clippy::result_large_err)]
 
 pub mod probe;
+#[cfg(feature = "testing")]
+pub mod testing;
 
 use cellplan_geom::{CollisionWorld, DQuat, Pose};
 use cellplan_model::process::{ColumnUnit, TaskColumn};

@@ -11,33 +11,14 @@ use cellplan_core::verify::{VerifySettings, ViolationKind, verify};
 use cellplan_model::robot::Scratch;
 use cellplan_model::{Cell, LoadOptions, TaskId};
 use cellplan_optical::load;
+use cellplan_optical::testing::{example_copy, repo_root, scratch_dir};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
 /// The two-robot example with only its first `n` MPs, written to a temporary folder.
 fn small_cell(n: usize) -> PathBuf {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../..")
-        .canonicalize()
-        .unwrap();
-    let example = root.join("examples/autobody-2r");
-    let dir = std::env::temp_dir().join(format!("cellplan-plan-test-{}-{n}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let text = std::fs::read_to_string(example.join("cell.toml")).unwrap();
-    let text = text
-        .replace("../../data", &root.join("data").display().to_string())
-        .replace("name = \"autobody-2r\"", "name = \"autobody-2r-small\"");
-    std::fs::write(dir.join("cell.toml"), text).unwrap();
-    let tasks = std::fs::read_to_string(example.join("tasks.csv")).unwrap();
-    let mut lines = tasks.lines().filter(|l| !l.starts_with('#'));
-    let mut out = String::new();
-    for l in lines.by_ref().take(n + 1) {
-        out += l;
-        out += "\n";
-    }
-    std::fs::write(dir.join("tasks.csv"), out).unwrap();
-    dir.join("cell.toml")
+    example_copy(&format!("plan-test-{n}"), "autobody-2r-small", n, |text| text)
 }
 
 struct Fixture {
@@ -514,13 +495,8 @@ fn edited_plans_are_refused_or_caught() {
 /// 6 s, two take 3 s).
 #[test]
 fn allocation_strategies_give_the_known_answers_on_a_hand_made_cell() {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../..")
-        .canonicalize()
-        .unwrap();
-    let fanuc = root.join("data/robots/fanuc_r2000ic");
-    let dir = std::env::temp_dir().join(format!("cellplan-plan-known-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let fanuc = repo_root().join("data/robots/fanuc_r2000ic");
+    let dir = scratch_dir("plan-known");
     let robot = |name: &str, y: i32| {
         format!(
             r#"

@@ -4,10 +4,13 @@
 //! Charts that share the plan's clock carry `data-t0`, `data-t1`, `data-x0`, `data-x1` (the
 //! time range and the horizontal pixel range it maps to) and a `line.cursor`, so the page's
 //! script can move a time cursor over them and turn a click into a time.
+//!
+//! They are [`maud`] templates for the HTML page (every name spliced in is escaped); empty SVG
+//! elements are written with an end tag (`<line …></line>`), which HTML reads like `<line …/>`.
 use super::playback::{Doing, intervals};
 use super::svg::ROBOT_COLOURS;
-use crate::escape;
-use cellplan_core::document::{ConflictOut, Plan};
+use cellplan_core::document::{ConflictOut, Plan, RobotPlan};
+use maud::{Markup, html};
 use std::fmt::Write;
 
 /// Width of every chart (SVG user units, drawn at 100 % of the page column).
@@ -18,6 +21,16 @@ const WAIT_COLOUR: &str = "#d62728";
 
 fn colour(r: usize) -> &'static str {
     ROBOT_COLOURS[r % ROBOT_COLOURS.len()]
+}
+
+/// A coordinate with one decimal.
+fn f1(v: f64) -> String {
+    format!("{v:.1}")
+}
+
+/// A coordinate or a time with two decimals.
+fn f2(v: f64) -> String {
+    format!("{v:.2}")
 }
 
 /// A step of 1, 2 or 5 × 10^k that cuts `span` into about `target` pieces.
@@ -65,24 +78,17 @@ impl Axis {
 }
 
 /// Ticks and labels of a time axis at the bottom (`y`) and vertical grid lines up to `top`.
-fn time_axis(s: &mut String, x: Axis, top: f64, y: f64) {
+fn time_axis(x: Axis, top: f64, y: f64) -> Markup {
     let step = nice_step(x.d1 - x.d0, 12);
-    for k in 0..=ticks(0.0, x.d1, step) {
-        let t = k as f64 * step;
-        let px = x.at(t);
-        let _ = write!(
-            s,
-            r##"<line x1="{px:.1}" y1="{top:.1}" x2="{px:.1}" y2="{y:.1}" class="grid"/><text x="{px:.1}" y="{:.1}" class="tick" text-anchor="middle">{}</text>"##,
-            y + 14.0,
-            trim(t)
-        );
+    html! {
+        @for k in 0..=ticks(0.0, x.d1, step) {
+            @let t = k as f64 * step;
+            @let px = f1(x.at(t));
+            line x1=(px) y1=(f1(top)) x2=(px) y2=(f1(y)) class="grid" {}
+            text x=(px) y=(f1(y + 14.0)) class="tick" text-anchor="middle" { (trim(t)) }
+        }
+        text x=(f1((x.p0 + x.p1) / 2.0)) y=(f1(y + 30.0)) class="label" text-anchor="middle" { "time (s)" }
     }
-    let _ = write!(
-        s,
-        r##"<text x="{:.1}" y="{:.1}" class="label" text-anchor="middle">time (s)</text>"##,
-        (x.p0 + x.p1) / 2.0,
-        y + 30.0
-    );
 }
 
 /// A number without trailing zeros.
@@ -93,35 +99,25 @@ fn trim(v: f64) -> String {
 
 /// Ticks, labels and horizontal grid lines of a vertical value axis on the left, and its
 /// label turned along it.
-fn value_axis(s: &mut String, y: Axis, label: &str) {
+fn value_axis(y: Axis, label: &str) -> Markup {
     let step = nice_step(y.d1 - y.d0, 6);
     let first = (y.d0 / step).ceil() * step;
-    for k in 0..=ticks(first, y.d1, step) {
-        let v = first + k as f64 * step;
-        let py = y.at(v);
-        let _ = write!(
-            s,
-            r#"<line x1="{LEFT}" y1="{py:.1}" x2="{:.1}" y2="{py:.1}" class="grid"/><text x="{:.1}" y="{:.1}" class="tick" text-anchor="end">{}</text>"#,
-            WIDTH - RIGHT,
-            LEFT - 6.0,
-            py + 4.0,
-            trim(v)
-        );
+    html! {
+        @for k in 0..=ticks(first, y.d1, step) {
+            @let v = first + k as f64 * step;
+            @let py = y.at(v);
+            line x1=(LEFT) y1=(f1(py)) x2=(f1(WIDTH - RIGHT)) y2=(f1(py)) class="grid" {}
+            text x=(f1(LEFT - 6.0)) y=(f1(py + 4.0)) class="tick" text-anchor="end" { (trim(v)) }
+        }
+        text transform={ "translate(16 " (f1((y.p0 + y.p1) / 2.0)) ") rotate(-90)" } class="label" text-anchor="middle" {
+            (label)
+        }
     }
-    let _ = write!(
-        s,
-        r#"<text transform="translate(16 {:.1}) rotate(-90)" class="label" text-anchor="middle">{}</text>"#,
-        (y.p0 + y.p1) / 2.0,
-        escape(label)
-    );
 }
 
-/// The cursor line and the chart's time-mapping attributes.
-fn clock_attrs(x: Axis) -> String {
-    format!(
-        r#"data-t0="{}" data-t1="{}" data-x0="{}" data-x1="{}""#,
-        x.d0, x.d1, x.p0, x.p1
-    )
+/// The `viewBox` of a chart `height` units high.
+fn view_box(height: f64) -> String {
+    format!("0 0 {WIDTH} {height:.0}")
 }
 
 /// The time range every chart of a plan shares: 0 to the cycle time (or the longest
@@ -143,7 +139,7 @@ pub fn time_range(plan: &Plan) -> f64 {
 
 /// Gantt chart: a row per robot with its moving, measuring and waiting intervals (each with a
 /// tooltip), the cycle time and the lower bound.
-pub fn gantt(plan: &Plan) -> String {
+pub fn gantt(plan: &Plan) -> Markup {
     let row = 30.0;
     let top = 26.0;
     let height = top + row * plan.robots.len() as f64 + 44.0;
@@ -154,105 +150,93 @@ pub fn gantt(plan: &Plan) -> String {
         p1: WIDTH - RIGHT,
     };
     let bottom = top + row * plan.robots.len() as f64;
-    let mut s = format!(
-        r#"<svg id="gantt" class="chart clock" viewBox="0 0 {WIDTH} {height:.0}" {} xmlns="http://www.w3.org/2000/svg" role="img" aria-label="Gantt chart of every robot's activities">"#,
-        clock_attrs(x)
-    );
-    time_axis(&mut s, x, top - 6.0, bottom);
-    for (r, rp) in plan.robots.iter().enumerate() {
-        let y = top + row * r as f64;
-        let _ = write!(
-            s,
-            r#"<text x="{:.1}" y="{:.1}" class="name" text-anchor="end">{}</text>"#,
-            LEFT - 8.0,
-            y + row / 2.0 + 4.0,
-            escape(&rp.name)
-        );
-        for iv in intervals(rp) {
-            let (fill, opacity, what) = match iv.doing {
-                Doing::Moving => (colour(r), 0.35, "moving".to_string()),
-                Doing::Measuring(k) => (colour(r), 1.0, format!("measuring {}", rp.tasks[k].task)),
-                Doing::Waiting(k) => {
-                    let w = &rp.waits[k];
-                    let whom = w
-                        .for_robot
-                        .as_deref()
-                        .map(|f| format!(" for {f}"))
-                        .unwrap_or_default();
-                    (
-                        WAIT_COLOUR,
-                        0.9,
-                        format!("waiting ({}){whom} at {}", w.reason, rp.wait_place(w)),
-                    )
-                }
-            };
-            let _ = write!(
-                s,
-                r#"<rect class="{}" x="{:.2}" y="{:.1}" width="{:.2}" height="{:.1}" fill="{fill}" fill-opacity="{opacity}"><title>{} {}: {:.2}–{:.2} s</title></rect>"#,
-                iv.doing.word(),
-                x.at(iv.start),
-                y + 4.0,
-                (x.at(iv.end) - x.at(iv.start)).max(0.5),
-                row - 8.0,
-                escape(&rp.name),
-                escape(&what),
-                iv.start,
-                iv.end
-            );
+    let legend_items = [
+        ("moving", "#888", 0.35),
+        ("measuring", "#888", 1.0),
+        ("waiting for another robot", WAIT_COLOUR, 0.9),
+    ];
+    html! {
+        svg id="gantt" class="chart clock" viewBox=(view_box(height))
+            data-t0=(x.d0) data-t1=(x.d1) data-x0=(x.p0) data-x1=(x.p1)
+            xmlns="http://www.w3.org/2000/svg" role="img" aria-label="Gantt chart of every robot's activities" {
+            (time_axis(x, top - 6.0, bottom))
+            @for (r, rp) in plan.robots.iter().enumerate() {
+                (gantt_row(x, r, rp, top + row * r as f64, row))
+            }
+            (gantt_marks(plan, x, top, bottom))
+            (legend(LEFT, height - 6.0, &legend_items))
+            line class="cursor" x1=(LEFT) y1=(f1(top - 6.0)) x2=(LEFT) y2=(f1(bottom)) {}
         }
     }
-    for (t, class, label) in [
-        (
-            plan.cycle_time_s,
-            "cycle",
-            format!("cycle {:.2} s", plan.cycle_time_s),
-        ),
-        (
-            plan.lower_bound_s,
-            "bound",
-            format!("lower bound {:.2} s", plan.lower_bound_s),
-        ),
-    ] {
-        if t > 0.0 && t <= x.d1 + 1e-9 {
-            let px = x.at(t);
-            let _ = write!(
-                s,
-                r#"<line x1="{px:.1}" y1="{:.1}" x2="{px:.1}" y2="{bottom:.1}" class="{class}"/><text x="{px:.1}" y="{:.1}" class="tick {class}" text-anchor="{}">{label}</text>"#,
-                top - 8.0,
-                top - 12.0,
-                if class == "cycle" { "end" } else { "start" }
-            );
-        }
-    }
-    legend(
-        &mut s,
-        LEFT,
-        height - 6.0,
-        &[
-            ("moving", "#888", 0.35),
-            ("measuring", "#888", 1.0),
-            ("waiting for another robot", WAIT_COLOUR, 0.9),
-        ],
-    );
-    let _ = write!(
-        s,
-        r#"<line class="cursor" x1="{LEFT}" y1="{:.1}" x2="{LEFT}" y2="{bottom:.1}"/></svg>"#,
-        top - 6.0
-    );
-    s
 }
 
-fn legend(s: &mut String, x0: f64, y: f64, items: &[(&str, &str, f64)]) {
-    let mut x = x0;
-    for (label, fill, opacity) in items {
-        let _ = write!(
-            s,
-            r#"<rect x="{x:.1}" y="{:.1}" width="14" height="10" fill="{fill}" fill-opacity="{opacity}"/><text x="{:.1}" y="{y:.1}" class="tick">{}</text>"#,
-            y - 9.0,
-            x + 18.0,
-            escape(label)
-        );
-        x += 30.0 + 6.5 * label.chars().count() as f64;
+/// A robot's row of the Gantt chart: its name and a bar per interval, with a tooltip.
+fn gantt_row(x: Axis, r: usize, rp: &RobotPlan, y: f64, row: f64) -> Markup {
+    html! {
+        text x=(f1(LEFT - 8.0)) y=(f1(y + row / 2.0 + 4.0)) class="name" text-anchor="end" { (rp.name) }
+        @for iv in intervals(rp) {
+            @let (fill, opacity, what) = interval_look(r, rp, iv.doing);
+            rect class=(iv.doing.word()) x=(f2(x.at(iv.start))) y=(f1(y + 4.0))
+                width=(f2((x.at(iv.end) - x.at(iv.start)).max(0.5))) height=(f1(row - 8.0))
+                fill=(fill) fill-opacity=(opacity) {
+                title { (rp.name) " " (what) ": " (f2(iv.start)) "–" (f2(iv.end)) " s" }
+            }
+        }
+    }
+}
+
+/// The fill, opacity and tooltip words of an interval of robot `r`.
+fn interval_look(r: usize, rp: &RobotPlan, doing: Doing) -> (&'static str, f64, String) {
+    match doing {
+        Doing::Moving => (colour(r), 0.35, "moving".to_string()),
+        Doing::Measuring(k) => (colour(r), 1.0, format!("measuring {}", rp.tasks[k].task)),
+        Doing::Waiting(k) => {
+            let w = &rp.waits[k];
+            let whom = w
+                .for_robot
+                .as_deref()
+                .map(|f| format!(" for {f}"))
+                .unwrap_or_default();
+            (
+                WAIT_COLOUR,
+                0.9,
+                format!("waiting ({}){whom} at {}", w.reason, rp.wait_place(w)),
+            )
+        }
+    }
+}
+
+/// The cycle time and the lower bound as vertical lines over the Gantt rows.
+fn gantt_marks(plan: &Plan, x: Axis, top: f64, bottom: f64) -> Markup {
+    let marks = [
+        (plan.cycle_time_s, "cycle", "cycle", "end"),
+        (plan.lower_bound_s, "bound", "lower bound", "start"),
+    ];
+    html! {
+        @for (t, class, label, anchor) in marks {
+            @if t > 0.0 && t <= x.d1 + 1e-9 {
+                @let px = f1(x.at(t));
+                line x1=(px) y1=(f1(top - 8.0)) x2=(px) y2=(f1(bottom)) class=(class) {}
+                text x=(px) y=(f1(top - 12.0)) class={ "tick " (class) } text-anchor=(anchor) {
+                    (label) " " (f2(t)) " s"
+                }
+            }
+        }
+    }
+}
+
+/// Legend entries from `x0` along `y`: a swatch and a label each.
+fn legend(x0: f64, y: f64, items: &[(&str, &str, f64)]) -> Markup {
+    let xs = items.iter().scan(x0, |x, (label, _, _)| {
+        let here = *x;
+        *x += 30.0 + 6.5 * label.chars().count() as f64;
+        Some(here)
+    });
+    html! {
+        @for (x, (label, fill, opacity)) in xs.zip(items) {
+            rect x=(f1(x)) y=(f1(y - 9.0)) width="14" height="10" fill=(fill) fill-opacity=(opacity) {}
+            text x=(f1(x + 18.0)) y=(f1(y)) class="tick" { (label) }
+        }
     }
 }
 
@@ -284,7 +268,7 @@ pub fn time_position(
     axis: usize,
     marks: Marks,
     t_end: f64,
-) -> String {
+) -> Markup {
     let (top, plot_h) = (30.0, 300.0);
     let height = top + plot_h + 64.0;
     let (mut lo, mut hi) = tracks
@@ -309,125 +293,134 @@ pub fn time_position(
         p0: LEFT,
         p1: WIDTH - RIGHT,
     };
-    let mut s = format!(
-        r#"<svg id="{id}" class="chart clock timepos" viewBox="0 0 {WIDTH} {height:.0}" {} xmlns="http://www.w3.org/2000/svg" role="img" aria-label="{}">"#,
-        clock_attrs(x),
-        escape(title)
-    );
-    let _ = write!(
-        s,
-        r#"<text x="{LEFT}" y="16" class="title">{}</text>"#,
-        escape(title)
-    );
-    time_axis(&mut s, x, top, top + plot_h);
-    value_axis(&mut s, y, &format!("probe {} (m)", axis_name));
-    // Marks under the lines.
-    match marks {
-        Marks::Conflicts(conflicts) => {
-            for (k, c) in conflicts.iter().enumerate() {
-                let (a, b) = (c.probe_xyz[0][axis], c.probe_xyz[1][axis]);
-                let (x0, x1) = (x.at(c.start_s), x.at(c.end_s.max(c.start_s)));
-                let (y0, y1) = (y.at(a.max(b) + pad * 0.5), y.at(a.min(b) - pad * 0.5));
-                let _ = write!(
-                    s,
-                    r#"<g class="conflict"><rect x="{:.1}" y="{y0:.1}" width="{:.1}" height="{:.1}" rx="6"/><text x="{:.1}" y="{:.1}" class="tick conflict-label">C{}</text><title>C{}: {} &amp; {}, {:.2}–{:.2} s, scenario {} — {} / {}</title></g>"#,
-                    x0 - 3.0,
-                    (x1 - x0) + 6.0,
-                    (y1 - y0).max(6.0),
-                    x0,
-                    y0 - 4.0,
-                    k + 1,
-                    k + 1,
-                    escape(&c.robots[0]),
-                    escape(&c.robots[1]),
-                    c.start_s,
-                    c.end_s,
-                    c.scenario,
-                    escape(&c.activity[0].text("measuring")),
-                    escape(&c.activity[1].text("measuring"))
-                );
+    let chart = TimePosition { x, y, pad, axis };
+    html! {
+        svg id=(id) class="chart clock timepos" viewBox=(view_box(height))
+            data-t0=(x.d0) data-t1=(x.d1) data-x0=(x.p0) data-x1=(x.p1)
+            xmlns="http://www.w3.org/2000/svg" role="img" aria-label=(title) {
+            text x=(LEFT) y="16" class="title" { (title) }
+            (time_axis(x, top, top + plot_h))
+            (value_axis(y, &format!("probe {axis_name} (m)")))
+            // Marks under the lines.
+            @match marks {
+                Marks::Conflicts(conflicts) => (chart.conflicts(conflicts)),
+                Marks::Resolution(plan) => (chart.resolution(plan, tracks)),
             }
+            @for tr in tracks {
+                path class="track" d=(chart.track_path(tr)) stroke=(colour(tr.robot)) { title { (tr.name) } }
+            }
+            (track_legend(tracks, &marks, height))
+            line class="cursor" x1=(LEFT) y1=(top) x2=(LEFT) y2=(f1(top + plot_h)) {}
         }
-        Marks::Resolution(plan) => {
-            for rp in &plan.robots {
-                let Some(track) = tracks.iter().find(|t| t.name == rp.name) else {
-                    continue;
-                };
-                let at = |t: f64| {
-                    let k = track.points.partition_point(|p| p.0 <= t).saturating_sub(1);
-                    track.points.get(k).map_or(0.0, |p| p.1)
-                };
-                for w in &rp.waits {
-                    let py = y.at(at(w.start_s));
-                    let _ = write!(
-                        s,
-                        r#"<g class="wait"><rect x="{:.1}" y="{:.1}" width="{:.1}" height="12" rx="3"/><title>{} waits {:.2} s at {} ({})</title></g>"#,
-                        x.at(w.start_s),
-                        py - 6.0,
-                        (x.at(w.start_s + w.duration_s) - x.at(w.start_s)).max(2.0),
-                        escape(&rp.name),
-                        w.duration_s,
-                        escape(&rp.wait_place(w)),
-                        w.reason
-                    );
-                }
-                for v in rp.tasks.iter().filter(|v| v.perturbation_rad.is_some()) {
-                    let (px, py) = (x.at(v.arrive_s), y.at(v.tcp.xyz[axis]));
-                    let _ = write!(
-                        s,
-                        r#"<g class="perturbed"><path d="M{:.1} {py:.1} l6 -6 l6 6 l-6 6 z"/><title>{}: probe orientation at {} perturbed</title></g>"#,
-                        px - 6.0,
-                        escape(&rp.name),
-                        escape(&v.task)
-                    );
+    }
+}
+
+/// The axes of a time–position chart, the padding of its value range, and the axis (0: x,
+/// 1: y) of the probe position it draws.
+struct TimePosition {
+    x: Axis,
+    y: Axis,
+    pad: f64,
+    axis: usize,
+}
+
+impl TimePosition {
+    /// A box per conflict over its time and the two probes' positions, labelled `C1`, `C2`…
+    fn conflicts(&self, conflicts: &[ConflictOut]) -> Markup {
+        let (x, y, pad) = (self.x, self.y, self.pad);
+        html! {
+            @for (k, c) in conflicts.iter().enumerate() {
+                @let (a, b) = (c.probe_xyz[0][self.axis], c.probe_xyz[1][self.axis]);
+                @let (x0, x1) = (x.at(c.start_s), x.at(c.end_s.max(c.start_s)));
+                @let (y0, y1) = (y.at(a.max(b) + pad * 0.5), y.at(a.min(b) - pad * 0.5));
+                g class="conflict" {
+                    rect x=(f1(x0 - 3.0)) y=(f1(y0)) width=(f1((x1 - x0) + 6.0)) height=(f1((y1 - y0).max(6.0))) rx="6" {}
+                    text x=(f1(x0)) y=(f1(y0 - 4.0)) class="tick conflict-label" { "C" (k + 1) }
+                    title {
+                        "C" (k + 1) ": " (c.robots[0]) " & " (c.robots[1]) ", " (f2(c.start_s)) "–"
+                        (f2(c.end_s)) " s, scenario " (c.scenario) " — " (c.activity[0].text("measuring")) " / "
+                        (c.activity[1].text("measuring"))
+                    }
                 }
             }
         }
     }
-    for tr in tracks {
+
+    /// The plan's waits (on the waiting robot's track) and its perturbed poses.
+    fn resolution(&self, plan: &Plan, tracks: &[Track]) -> Markup {
+        let (x, y) = (self.x, self.y);
+        html! {
+            @for rp in &plan.robots {
+                @if let Some(track) = tracks.iter().find(|t| t.name == rp.name) {
+                    @for w in &rp.waits {
+                        @let py = y.at(track_at(track, w.start_s));
+                        g class="wait" {
+                            rect x=(f1(x.at(w.start_s))) y=(f1(py - 6.0))
+                                width=(f1((x.at(w.start_s + w.duration_s) - x.at(w.start_s)).max(2.0)))
+                                height="12" rx="3" {}
+                            title { (rp.name) " waits " (f2(w.duration_s)) " s at " (rp.wait_place(w)) " (" (w.reason) ")" }
+                        }
+                    }
+                    @for v in rp.tasks.iter().filter(|v| v.perturbation_rad.is_some()) {
+                        @let (px, py) = (x.at(v.arrive_s), y.at(v.tcp.xyz[self.axis]));
+                        g class="perturbed" {
+                            path d={ "M" (f1(px - 6.0)) " " (f1(py)) " l6 -6 l6 6 l-6 6 z" } {}
+                            title { (rp.name) ": probe orientation at " (v.task) " perturbed" }
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    /// The SVG path of a track.
+    fn track_path(&self, tr: &Track) -> String {
         let mut d = String::new();
         for (k, &(t, p)) in tr.points.iter().enumerate() {
             let _ = write!(
                 d,
                 "{}{:.1} {:.1}",
                 if k == 0 { "M" } else { " L" },
-                x.at(t),
-                y.at(p)
+                self.x.at(t),
+                self.y.at(p)
             );
         }
-        let _ = write!(
-            s,
-            r#"<path class="track" d="{d}" stroke="{}"><title>{}</title></path>"#,
-            colour(tr.robot),
-            escape(tr.name)
-        );
+        d
     }
-    let mut lx = LEFT;
-    for tr in tracks {
-        let _ = write!(
-            s,
-            r#"<line x1="{lx:.1}" y1="{:.1}" x2="{:.1}" y2="{:.1}" stroke="{}" stroke-width="3"/><text x="{:.1}" y="{:.1}" class="tick">{}</text>"#,
-            height - 10.0,
-            lx + 18.0,
-            height - 10.0,
-            colour(tr.robot),
-            lx + 22.0,
-            height - 6.0,
-            escape(tr.name)
-        );
-        lx += 40.0 + 7.0 * tr.name.chars().count() as f64;
-    }
+}
+
+/// The track's position at time `t` (its last point at or before `t`).
+fn track_at(track: &Track, t: f64) -> f64 {
+    let k = track.points.partition_point(|p| p.0 <= t).saturating_sub(1);
+    track.points.get(k).map_or(0.0, |p| p.1)
+}
+
+/// The legend of a time–position chart: a line per robot, then what the marks mean.
+fn track_legend(tracks: &[Track], marks: &Marks, height: f64) -> Markup {
+    let xs: Vec<f64> = tracks
+        .iter()
+        .scan(LEFT, |lx, tr| {
+            let here = *lx;
+            *lx += 40.0 + 7.0 * tr.name.chars().count() as f64;
+            Some(here)
+        })
+        .collect();
+    let end = tracks
+        .last()
+        .zip(xs.last())
+        .map_or(LEFT, |(tr, lx)| lx + 40.0 + 7.0 * tr.name.chars().count() as f64);
     let extra: &[(&str, &str, f64)] = match marks {
         Marks::Conflicts(_) => &[("conflict (robots closer than the clearance)", WAIT_COLOUR, 0.35)],
         Marks::Resolution(_) => &[("wait", WAIT_COLOUR, 0.8), ("perturbed pose ◆", "#000", 0.0)],
     };
-    legend(&mut s, lx + 10.0, height - 6.0, extra);
-    let _ = write!(
-        s,
-        r#"<line class="cursor" x1="{LEFT}" y1="{top}" x2="{LEFT}" y2="{:.1}"/></svg>"#,
-        top + plot_h
-    );
-    s
+    html! {
+        @for (tr, lx) in tracks.iter().zip(&xs) {
+            line x1=(f1(*lx)) y1=(f1(height - 10.0)) x2=(f1(lx + 18.0)) y2=(f1(height - 10.0))
+                stroke=(colour(tr.robot)) stroke-width="3" {}
+            text x=(f1(lx + 22.0)) y=(f1(height - 6.0)) class="tick" { (tr.name) }
+        }
+        (legend(end + 10.0, height - 6.0, extra))
+    }
 }
 
 /// One strategy's result for the bar chart.
@@ -444,7 +437,7 @@ pub struct StrategyBar {
 
 /// Bar chart like paper 000 Fig. 10: per strategy a group of bars, one per robot, and the cycle
 /// time marked above each group (with its spread when given); `bound` draws a dashed line.
-pub fn strategy_bars(bars: &[StrategyBar], bound: Option<f64>) -> String {
+pub fn strategy_bars(bars: &[StrategyBar], bound: Option<f64>) -> Markup {
     let (top, plot_h) = (20.0, 260.0);
     let height = top + plot_h + 120.0;
     let t_max = bars
@@ -464,69 +457,52 @@ pub fn strategy_bars(bars: &[StrategyBar], bound: Option<f64>) -> String {
         p0: top + plot_h,
         p1: top,
     };
-    let mut s = format!(
-        r#"<svg id="strategy-bars" class="chart" viewBox="0 0 {WIDTH} {height:.0}" xmlns="http://www.w3.org/2000/svg" role="img" aria-label="time per robot and cycle time per strategy">"#
-    );
-    value_axis(&mut s, y, "time (s)");
     let group = (WIDTH - LEFT - RIGHT) / bars.len().max(1) as f64;
-    for (g, b) in bars.iter().enumerate() {
-        let x0 = LEFT + group * g as f64;
-        let n = b.robots.len().max(1) as f64;
-        let w = (group * 0.8) / n;
-        for (r, (name, t)) in b.robots.iter().enumerate() {
-            let px = x0 + group * 0.1 + w * r as f64;
-            let _ = write!(
-                s,
-                r#"<rect class="bar" x="{px:.1}" y="{:.1}" width="{:.1}" height="{:.1}" fill="{}"><title>{}: {} {:.2} s</title></rect>"#,
-                y.at(*t),
-                (w - 1.0).max(1.0),
-                y.at(0.0) - y.at(*t),
-                colour(r),
-                escape(&b.label),
-                escape(name),
-                t
-            );
+    html! {
+        svg id="strategy-bars" class="chart" viewBox=(view_box(height))
+            xmlns="http://www.w3.org/2000/svg" role="img" aria-label="time per robot and cycle time per strategy" {
+            (value_axis(y, "time (s)"))
+            @for (g, b) in bars.iter().enumerate() {
+                (bar_group(b, y, LEFT + group * g as f64, group, top + plot_h))
+            }
+            @if let Some(lb) = bound {
+                @let py = f1(y.at(lb));
+                line class="bound" x1=(LEFT) y1=(py) x2=(f1(WIDTH - RIGHT)) y2=(py) {}
+                text x=(f1(WIDTH - RIGHT)) y=(f1(y.at(lb) - 4.0)) class="tick bound" text-anchor="end" {
+                    "lower bound " (f2(lb)) " s"
+                }
+            }
         }
-        let py = y.at(b.cycle_time_s);
-        let _ = write!(
-            s,
-            r#"<line class="cycle" x1="{:.1}" y1="{py:.1}" x2="{:.1}" y2="{py:.1}"/><text x="{:.1}" y="{:.1}" class="tick" text-anchor="middle">{:.2}</text>"#,
-            x0 + group * 0.05,
-            x0 + group * 0.95,
-            x0 + group / 2.0,
-            py - 5.0 - if b.spread_s.is_some() { 8.0 } else { 0.0 },
-            b.cycle_time_s
-        );
-        if let Some(sd) = b.spread_s {
-            let (a, c) = (y.at(b.cycle_time_s - sd), y.at(b.cycle_time_s + sd));
-            let cx = x0 + group / 2.0;
-            let _ = write!(
-                s,
-                r#"<path class="spread" d="M{cx:.1} {a:.1} V{c:.1} M{:.1} {a:.1} h8 M{:.1} {c:.1} h8"/>"#,
-                cx - 4.0,
-                cx - 4.0
-            );
+    }
+}
+
+/// One strategy's group of bars from `x0`, `group` wide: a bar per robot, the cycle time (and
+/// its spread) above them, and the label under the plot's `bottom`.
+fn bar_group(b: &StrategyBar, y: Axis, x0: f64, group: f64, bottom: f64) -> Markup {
+    let n = b.robots.len().max(1) as f64;
+    let w = (group * 0.8) / n;
+    let py = y.at(b.cycle_time_s);
+    let cx = x0 + group / 2.0;
+    html! {
+        @for (r, (name, t)) in b.robots.iter().enumerate() {
+            rect class="bar" x=(f1(x0 + group * 0.1 + w * r as f64)) y=(f1(y.at(*t)))
+                width=(f1((w - 1.0).max(1.0))) height=(f1(y.at(0.0) - y.at(*t))) fill=(colour(r)) {
+                title { (b.label) ": " (name) " " (f2(*t)) " s" }
+            }
         }
-        let _ = write!(
-            s,
-            r#"<text transform="translate({:.1} {:.1}) rotate(30)" class="tick">{}</text>"#,
-            x0 + group * 0.2,
-            top + plot_h + 14.0,
-            escape(&b.label)
-        );
+        line class="cycle" x1=(f1(x0 + group * 0.05)) y1=(f1(py)) x2=(f1(x0 + group * 0.95)) y2=(f1(py)) {}
+        text x=(f1(cx)) y=(f1(py - 5.0 - if b.spread_s.is_some() { 8.0 } else { 0.0 }))
+            class="tick" text-anchor="middle" { (f2(b.cycle_time_s)) }
+        @if let Some(sd) = b.spread_s {
+            @let (a, c) = (f1(y.at(b.cycle_time_s - sd)), f1(y.at(b.cycle_time_s + sd)));
+            path class="spread" d={
+                "M" (f1(cx)) " " (a) " V" (c) " M" (f1(cx - 4.0)) " " (a) " h8 M" (f1(cx - 4.0)) " " (c) " h8"
+            } {}
+        }
+        text transform={ "translate(" (f1(x0 + group * 0.2)) " " (f1(bottom + 14.0)) ") rotate(30)" } class="tick" {
+            (b.label)
+        }
     }
-    if let Some(lb) = bound {
-        let py = y.at(lb);
-        let _ = write!(
-            s,
-            r#"<line class="bound" x1="{LEFT}" y1="{py:.1}" x2="{:.1}" y2="{py:.1}"/><text x="{:.1}" y="{:.1}" class="tick bound" text-anchor="end">lower bound {lb:.2} s</text>"#,
-            WIDTH - RIGHT,
-            WIDTH - RIGHT,
-            py - 4.0
-        );
-    }
-    s.push_str("</svg>");
-    s
 }
 
 #[cfg(test)]
@@ -548,7 +524,7 @@ mod tests {
             name: "R1",
             points: vec![(0.0, 1e17), (1.0, -1e17), (2.0, f64::NAN)],
         }];
-        let svg = time_position("t", "title", &tracks, "y", 1, Marks::Conflicts(&[]), 1e300);
+        let svg = time_position("t", "title", &tracks, "y", 1, Marks::Conflicts(&[]), 1e300).into_string();
         assert!(svg.ends_with("</svg>") && svg.matches("class=\"tick\"").count() < 500);
     }
 
@@ -568,7 +544,7 @@ mod tests {
                 spread_s: Some(0.5),
             },
         ];
-        let svg = strategy_bars(&bars, Some(2.5));
+        let svg = strategy_bars(&bars, Some(2.5)).into_string();
         assert_eq!(svg.matches(r#"class="bar""#).count(), 4);
         assert!(svg.contains("a &lt;b&gt;"));
         assert!(svg.contains("lower bound 2.50 s"));

@@ -2,17 +2,20 @@
 //! chart, time–position charts before and after coordination (paper 000 Fig. 7/8), and the 3D
 //! playback of the cell (the project's own WebGL2 viewer, `viewer.js`). One file with no
 //! outside references: it opens offline in any browser.
+//!
+//! The pages are [`maud`] templates (like the SVG charts of [`charts`]), which escape every
+//! spliced value; only the report's own style sheet and script and the embedded JSON data
+//! (escaped for a script element) go in as they are.
 use super::charts::{self, Marks, StrategyBar, Track};
 use super::playback::{Doing, intervals, probe_track};
-use super::scene::{Scene, robot_colour};
-use crate::escape;
+use super::scene::{Scene, SceneRobot, robot_colour};
 use base64::Engine;
-use cellplan_core::document::Plan;
+use cellplan_core::document::{ConflictOut, Plan, RobotPlan};
 use cellplan_core::verify;
 use cellplan_geom::{DVec3, Pose};
 use cellplan_model::Cell;
+use maud::{DOCTYPE, Markup, PreEscaped, html};
 use serde_json::{Value, json};
-use std::fmt::Write;
 
 const CSS: &str = include_str!("report.css");
 const VIEWER: &str = include_str!("viewer.js");
@@ -72,35 +75,50 @@ pub fn long_axis(cell: &Cell) -> usize {
     if extent(1) > extent(0) { 1 } else { 0 }
 }
 
-/// The report page of a plan.
-///
-/// Fails (with a sentence) when the plan does not fit the cell: a robot missing, or other
-/// joints.
-pub fn plan_html(rep: &PlanReport) -> Result<String, String> {
-    let (plan, cell, scene) = (rep.plan, rep.cell, rep.scene);
-    let order = scene.match_plan(plan)?;
-    let axis = long_axis(cell);
-    let axis_name = ["x", "y"][axis];
-    let t_end = charts::time_range(plan);
+/// A serde enum's wire name (`"balanced"`, `"pose-perturbation"`).
+fn json_word<T: serde::Serialize>(v: &T) -> String {
+    match serde_json::to_value(v) {
+        Ok(Value::String(s)) => s,
+        Ok(other) => other.to_string(),
+        Err(_) => String::new(),
+    }
+}
 
-    // Probe tracks of the plan, thinned for the charts.
-    let tracks_full: Vec<Vec<(f64, [f64; 3])>> = plan
-        .robots
-        .iter()
-        .zip(&order)
-        .map(|(rp, &k)| probe_track(&scene.robots[k], rp))
-        .collect();
-    let thin = |points: &[(f64, f64)]| -> Vec<(f64, f64)> {
-        let step = points.len().div_ceil(CHART_POINTS).max(1);
-        let mut v: Vec<(f64, f64)> = points.iter().step_by(step).copied().collect();
-        if let Some(&last) = points.last()
-            && v.last() != Some(&last)
-        {
-            v.push(last);
+/// `<head>` of every page: the title and the report's style sheet.
+fn head(title: &str) -> Markup {
+    html! {
+        head {
+            meta charset="utf-8";
+            meta name="viewport" content="width=device-width, initial-scale=1";
+            title { (title) }
+            style { (PreEscaped(CSS)) }
         }
-        v
-    };
-    let after: Vec<Track> = plan
+    }
+}
+
+/// The chart tracks of a plan: each robot's probe position along `axis` over time, thinned
+/// for the charts.
+struct ChartTracks<'a> {
+    /// The probe tracks before coordination (robots the plan recorded them for).
+    before: Vec<Track<'a>>,
+    /// The probe tracks of the plan.
+    after: Vec<Track<'a>>,
+}
+
+/// At most [`CHART_POINTS`] of `points`, evenly, always keeping the last.
+fn thin(points: &[(f64, f64)]) -> Vec<(f64, f64)> {
+    let step = points.len().div_ceil(CHART_POINTS).max(1);
+    let mut v: Vec<(f64, f64)> = points.iter().step_by(step).copied().collect();
+    if let Some(&last) = points.last()
+        && v.last() != Some(&last)
+    {
+        v.push(last);
+    }
+    v
+}
+
+fn chart_tracks<'a>(plan: &'a Plan, tracks_full: &[Vec<(f64, [f64; 3])>], axis: usize) -> ChartTracks<'a> {
+    let after = plan
         .robots
         .iter()
         .enumerate()
@@ -115,7 +133,7 @@ pub fn plan_html(rep: &PlanReport) -> Result<String, String> {
             ),
         })
         .collect();
-    let before: Vec<Track> = plan
+    let before = plan
         .coordination
         .uncoordinated_probe
         .iter()
@@ -134,457 +152,598 @@ pub fn plan_html(rep: &PlanReport) -> Result<String, String> {
             })
         })
         .collect();
-
-    let mut page = String::with_capacity(1 << 20);
-    let title = format!("cellplan — {}", plan.cell);
-    let _ = write!(
-        page,
-        r#"<!DOCTYPE html><html lang="en"><head><meta charset="utf-8"><meta name="viewport" content="width=device-width, initial-scale=1"><title>{}</title><style>{CSS}</style></head><body><main>"#,
-        escape(&title)
-    );
-    let _ = write!(
-        page,
-        r#"<h1>{}</h1><p class="sub">Plan of cell <b>{}</b> ({}){} — {} allocation, {} coordination, seed {}.</p>"#,
-        escape(&title),
-        escape(&plan.cell),
-        escape(&plan.cell_file),
-        rep.plan_file
-            .map(|f| format!(", plan <code>{}</code>", escape(f)))
-            .unwrap_or_default(),
-        escape(&json_word(&plan.settings.allocation)),
-        escape(&json_word(&plan.settings.coordination)),
-        plan.settings.seed
-    );
-    summary(&mut page, rep);
-
-    // 3D playback.
-    let _ = write!(
-        page,
-        r#"<section id="viewer-section"><h2>Playback</h2><div class="viewer"><canvas id="view" aria-label="3D view of the cell"></canvas><div id="viewer-msg"></div></div><div class="controls"><button id="play" type="button">▶ play</button><input id="time" type="range" min="0" max="{t_end}" step="0.01" value="0" aria-label="time"><span id="clock">0.00 s</span><label>speed <select id="speed"><option value="0.5">0.5×</option><option value="1" selected>1×</option><option value="2">2×</option><option value="4">4×</option></select></label></div><div class="controls"><label><input type="checkbox" id="show-paths"> probe paths</label><label><input type="checkbox" id="show-before"> paths before coordination</label><label><input type="checkbox" id="show-conflicts"> conflicts before coordination</label><label><input type="checkbox" id="show-normals"> MPs and normals</label><button id="reset-view" type="button">reset view</button></div><div id="status"></div><p class="hint">Drag to turn, shift-drag or right-drag to pan, wheel to zoom; space plays and pauses; click a chart to jump to that time. MPs and paths are coloured by robot; red: unmeasured MPs and where conflicts were before coordination.</p></section>"#
-    );
-
-    let _ = write!(
-        page,
-        r#"<section id="gantt-section"><h2>Gantt chart</h2>{}</section>"#,
-        charts::gantt(plan)
-    );
-    let conflicts = if plan.coordination.conflicts_after.is_empty() {
-        &plan.coordination.conflicts_before
-    } else {
-        &plan.coordination.conflicts_after
-    };
-    let _ = write!(
-        page,
-        r#"<section id="timepos-section"><h2>Probe position over time (paper 000 Fig. 7/8)</h2>"#
-    );
-    if !before.is_empty() {
-        page.push_str(&charts::time_position(
-            "timepos-before",
-            &format!(
-                "Before coordination: {} conflict(s), cycle {:.2} s",
-                plan.coordination.conflicts_before.len(),
-                plan.coordination.uncoordinated_cycle_time_s
-            ),
-            &before,
-            axis_name,
-            axis,
-            Marks::Conflicts(&plan.coordination.conflicts_before),
-            t_end,
-        ));
-    }
-    let after_title = if plan.coordination.conflicts_after.is_empty() {
-        format!(
-            "After coordination ({}): {} wait(s), {} pose(s) changed, cycle {:.2} s",
-            json_word(&plan.coordination.strategy),
-            plan.coordination.waits,
-            plan.coordination.poses_changed,
-            plan.cycle_time_s
-        )
-    } else {
-        format!(
-            "Not coordinated: {} conflict(s) left, cycle {:.2} s",
-            plan.coordination.conflicts_after.len(),
-            plan.cycle_time_s
-        )
-    };
-    page.push_str(&charts::time_position(
-        "timepos-after",
-        &after_title,
-        &after,
-        axis_name,
-        axis,
-        if plan.coordination.conflicts_after.is_empty() {
-            Marks::Resolution(plan)
-        } else {
-            Marks::Conflicts(&plan.coordination.conflicts_after)
-        },
-        t_end,
-    ));
-    page.push_str("</section>");
-    details(&mut page, plan);
-
-    let _ = write!(
-        page,
-        r#"<footer>Written by cellplan {} from the plan document (format {} v{}); the 3D view is drawn with the project's own WebGL2 code, from the cell's meshes ({} distinct, {} triangles drawn).</footer></main>"#,
-        env!("CARGO_PKG_VERSION"),
-        escape(&plan.format),
-        plan.version,
-        scene.geometries.len(),
-        scene.drawn_triangles()
-    );
-    let data = viewer_data(plan, cell, scene, &order, &tracks_full, conflicts, t_end);
-    // Names come from the cell file: `<`, `>` and `&` only occur inside JSON strings, where
-    // their \u escapes read the same, and keep the HTML parser out of the script element's
-    // text (`</script>`, `<!--`).
-    let data = data
-        .to_string()
-        .replace('<', "\\u003c")
-        .replace('>', "\\u003e")
-        .replace('&', "\\u0026");
-    let _ = write!(
-        page,
-        r#"<script id="cellplan-data" type="application/json">{data}</script><script>{VIEWER}</script></body></html>"#
-    );
-    Ok(page)
+    ChartTracks { before, after }
 }
 
-/// A serde enum's wire name (`"balanced"`, `"pose-perturbation"`).
-fn json_word<T: serde::Serialize>(v: &T) -> String {
-    match serde_json::to_value(v) {
-        Ok(Value::String(s)) => s,
-        Ok(other) => other.to_string(),
-        Err(_) => String::new(),
-    }
-}
-
-fn figure(page: &mut String, value: &str, label: &str, class: &str) {
-    let _ = write!(
-        page,
-        r#"<div class="figure"><b class="{class}">{value}</b><span>{label}</span></div>"#
-    );
-}
-
-fn summary(page: &mut String, rep: &PlanReport) {
-    let plan = rep.plan;
-    page.push_str(r#"<section id="summary"><h2>Summary</h2><div class="figures">"#);
-    figure(page, &format!("{:.2} s", plan.cycle_time_s), "cycle time", "");
-    figure(
-        page,
-        &format!("{:.2} s", plan.delta_t_s),
-        "Δt (longest − shortest)",
-        "",
-    );
-    figure(
-        page,
-        &format!("{:.2} s", plan.lower_bound_s),
-        &format!("lower bound (cycle ×{:.2})", plan.ratio_to_lower_bound),
-        "",
-    );
-    figure(
-        page,
-        &format!("{:.2} s", plan.coordination.uncoordinated_cycle_time_s),
-        "cycle before coordination",
-        "",
-    );
-    figure(
-        page,
-        &format!(
-            "{} / {}",
-            plan.coordination.conflicts_before.len(),
-            plan.stats.conflicts_resolved
-        ),
-        "conflicts found / resolved",
-        "",
-    );
-    figure(
-        page,
-        &format!(
-            "{} / {}",
-            plan.coordination.waits, plan.coordination.poses_changed
-        ),
-        "waits / poses changed",
-        "",
-    );
-    let (verdict, class, label) = match rep.verification {
-        Some(v) if v.ok => ("verified".to_string(), "ok", "cellplan verify, now".to_string()),
-        Some(v) => (
-            format!("{} violation(s)", v.violations.len()),
-            "bad",
-            "cellplan verify, now".to_string(),
-        ),
-        None if plan.verified => ("verified".into(), "ok", "when planned".into()),
-        None => ("not verified".into(), "bad", "written with --no-verify".into()),
-    };
-    figure(page, &verdict, &label, class);
-    figure(page, &format!("{:.1} s", plan.compute_s.total), "compute", "");
-    page.push_str("</div>");
-    page.push_str(
-        r#"<table id="robots"><tr><th>robot</th><th>MPs</th><th>moving s</th><th>measuring s</th><th>waiting s</th><th>total s</th><th class="text">MPs in order</th></tr>"#,
-    );
-    for (r, rp) in plan.robots.iter().enumerate() {
-        let c = robot_colour(r).map(|x| (x * 255.0).round() as u8);
-        let _ = write!(
-            page,
-            r#"<tr><td><span class="swatch" style="background:rgb({},{},{})"></span>{}</td><td>{}</td><td>{:.2}</td><td>{:.2}</td><td>{:.2}</td><td>{:.2}</td><td class="text">{}</td></tr>"#,
-            c[0],
-            c[1],
-            c[2],
-            escape(&rp.name),
-            rp.tasks.len(),
-            rp.motion_s,
-            rp.measuring_s,
-            rp.waiting_s,
-            rp.total_s,
-            escape(
-                &rp.tasks
-                    .iter()
-                    .map(|v| v.task.as_str())
-                    .collect::<Vec<_>>()
-                    .join(" → ")
-            )
-        );
-    }
-    page.push_str("</table>");
-    if let Some(v) = rep.verification
-        && !v.ok
-    {
-        page.push_str(r#"<h3 class="bad">Violations</h3><table><tr><th>what</th><th>robots</th><th>time s</th><th>MP</th><th class="text">detail</th></tr>"#);
-        for x in &v.violations {
-            let _ = write!(
-                page,
-                r#"<tr><td>{:?}</td><td>{}</td><td>{}</td><td>{}</td><td class="text">{}</td></tr>"#,
-                x.kind,
-                escape(
-                    &[x.robot.as_deref(), x.other.as_deref()]
-                        .into_iter()
-                        .flatten()
-                        .collect::<Vec<_>>()
-                        .join(" & ")
-                ),
-                x.time_s.map(|t| format!("{t:.2}")).unwrap_or_default(),
-                escape(x.task.as_deref().unwrap_or("")),
-                escape(&x.detail)
-            );
-        }
-        page.push_str("</table>");
-    }
-    page.push_str("</section>");
-}
-
-fn details(page: &mut String, plan: &Plan) {
+/// The conflicts the page marks: those left after coordination, else those found before it.
+fn shown_conflicts(plan: &Plan) -> &[ConflictOut] {
     let c = &plan.coordination;
-    page.push_str(r#"<section id="coordination"><h2>Coordination</h2>"#);
-    let _ = write!(
-        page,
-        "<p>Strategy <b>{}</b>{}; {} conflict(s) in the programs before coordination, {} resolution(s), {:.1} s of compute.</p>",
-        escape(&json_word(&c.strategy)),
-        if c.priority.is_empty() {
-            String::new()
-        } else {
-            format!(", priority {}", escape(&c.priority.join(" > ")))
-        },
-        c.conflicts_before.len(),
-        plan.stats.conflicts_resolved,
-        plan.compute_s.coordination
-    );
-    let list = if c.conflicts_after.is_empty() {
+    if c.conflicts_after.is_empty() {
         &c.conflicts_before
     } else {
         &c.conflicts_after
-    };
-    if !list.is_empty() {
-        page.push_str(r#"<table id="conflicts"><tr><th>#</th><th>robots</th><th>from s</th><th>to s</th><th>scenario</th><th class="text">what they were doing</th></tr>"#);
-        for (k, x) in list.iter().enumerate() {
-            let _ = write!(
-                page,
-                r#"<tr><td>C{}</td><td>{} &amp; {}</td><td>{:.2}</td><td>{:.2}</td><td>{}</td><td class="text">{}: {}; {}: {}</td></tr>"#,
-                k + 1,
-                escape(&x.robots[0]),
-                escape(&x.robots[1]),
-                x.start_s,
-                x.end_s,
-                if x.scenario == 1 {
-                    "1: both measuring"
-                } else {
-                    "2: moving"
-                },
-                escape(&x.robots[0]),
-                escape(&x.activity[0].text("measuring")),
-                escape(&x.robots[1]),
-                escape(&x.activity[1].text("measuring"))
-            );
-        }
-        page.push_str("</table>");
     }
+}
+
+/// The report page of a plan.
+///
+/// Fails (with a sentence) when the plan does not fit the cell: a robot missing, or other
+/// joints.
+pub fn plan_html(rep: &PlanReport) -> Result<String, String> {
+    let (plan, cell, scene) = (rep.plan, rep.cell, rep.scene);
+    let order = scene.match_plan(plan)?;
+    let axis = long_axis(cell);
+    let t_end = charts::time_range(plan);
+    let tracks_full: Vec<Vec<(f64, [f64; 3])>> = plan
+        .robots
+        .iter()
+        .zip(&order)
+        .map(|(rp, &k)| probe_track(&scene.robots[k], rp))
+        .collect();
+    let tracks = chart_tracks(plan, &tracks_full, axis);
+    let data = viewer_data(plan, cell, scene, &order, &tracks_full, t_end);
+    let title = format!("cellplan — {}", plan.cell);
+    let page = html! {
+        (DOCTYPE)
+        html lang="en" {
+            (head(&title))
+            body {
+                main {
+                    (heading(rep, &title))
+                    (summary(rep))
+                    (playback_section(t_end))
+                    section id="gantt-section" {
+                        h2 { "Gantt chart" }
+                        (charts::gantt(plan))
+                    }
+                    (time_position_section(plan, &tracks, axis, t_end))
+                    (coordination_section(plan))
+                    (unmeasured_section(plan))
+                    (settings_section(plan))
+                    (plan_footer(plan, scene))
+                }
+                script id="cellplan-data" type="application/json" { (PreEscaped(script_json(&data))) }
+                script { (PreEscaped(VIEWER)) }
+            }
+        }
+    };
+    Ok(page.into_string())
+}
+
+/// JSON to embed in a `<script>` element. Names come from the cell file: `<`, `>` and `&` only
+/// occur inside JSON strings, where their \u escapes read the same, and keep the HTML parser
+/// out of the script element's text (`</script>`, `<!--`).
+fn script_json(data: &Value) -> String {
+    data.to_string()
+        .replace('<', "\\u003c")
+        .replace('>', "\\u003e")
+        .replace('&', "\\u0026")
+}
+
+/// The page's title and the line under it: cell, plan file and settings.
+fn heading(rep: &PlanReport, title: &str) -> Markup {
+    let plan = rep.plan;
+    html! {
+        h1 { (title) }
+        p class="sub" {
+            "Plan of cell " b { (plan.cell) } " (" (plan.cell_file) ")"
+            @if let Some(file) = rep.plan_file {
+                ", plan " code { (file) }
+            }
+            " — " (json_word(&plan.settings.allocation)) " allocation, "
+            (json_word(&plan.settings.coordination)) " coordination, seed "
+            (plan.settings.seed) "."
+        }
+    }
+}
+
+/// The 3D view with its time slider, speed, layer switches and hint.
+fn playback_section(t_end: f64) -> Markup {
+    html! {
+        section id="viewer-section" {
+            h2 { "Playback" }
+            div class="viewer" {
+                canvas id="view" aria-label="3D view of the cell" {}
+                div id="viewer-msg" {}
+            }
+            div class="controls" {
+                button id="play" type="button" { "▶ play" }
+                input id="time" type="range" min="0" max=(t_end) step="0.01" value="0" aria-label="time";
+                span id="clock" { "0.00 s" }
+                label {
+                    "speed "
+                    select id="speed" {
+                        option value="0.5" { "0.5×" }
+                        option value="1" selected { "1×" }
+                        option value="2" { "2×" }
+                        option value="4" { "4×" }
+                    }
+                }
+            }
+            div class="controls" {
+                label { input type="checkbox" id="show-paths"; " probe paths" }
+                label { input type="checkbox" id="show-before"; " paths before coordination" }
+                label { input type="checkbox" id="show-conflicts"; " conflicts before coordination" }
+                label { input type="checkbox" id="show-normals"; " MPs and normals" }
+                button id="reset-view" type="button" { "reset view" }
+            }
+            div id="status" {}
+            p class="hint" {
+                "Drag to turn, shift-drag or right-drag to pan, wheel to zoom; space plays and \
+                 pauses; click a chart to jump to that time. MPs and paths are coloured by robot; \
+                 red: unmeasured MPs and where conflicts were before coordination."
+            }
+        }
+    }
+}
+
+/// The time–position charts before (when the plan kept the tracks) and after coordination.
+fn time_position_section(plan: &Plan, tracks: &ChartTracks, axis: usize, t_end: f64) -> Markup {
+    let c = &plan.coordination;
+    let axis_name = ["x", "y"][axis];
+    let before_title = format!(
+        "Before coordination: {} conflict(s), cycle {:.2} s",
+        c.conflicts_before.len(),
+        c.uncoordinated_cycle_time_s
+    );
+    let (after_title, after_marks) = if c.conflicts_after.is_empty() {
+        let title = format!(
+            "After coordination ({}): {} wait(s), {} pose(s) changed, cycle {:.2} s",
+            json_word(&c.strategy),
+            c.waits,
+            c.poses_changed,
+            plan.cycle_time_s
+        );
+        (title, Marks::Resolution(plan))
+    } else {
+        let title = format!(
+            "Not coordinated: {} conflict(s) left, cycle {:.2} s",
+            c.conflicts_after.len(),
+            plan.cycle_time_s
+        );
+        (title, Marks::Conflicts(&c.conflicts_after))
+    };
+    let chart = |id, title: &str, tracks: &[Track], marks| {
+        charts::time_position(id, title, tracks, axis_name, axis, marks, t_end)
+    };
+    html! {
+        section id="timepos-section" {
+            h2 { "Probe position over time (paper 000 Fig. 7/8)" }
+            @if !tracks.before.is_empty() {
+                (chart("timepos-before", &before_title, &tracks.before, Marks::Conflicts(&c.conflicts_before)))
+            }
+            (chart("timepos-after", &after_title, &tracks.after, after_marks))
+        }
+    }
+}
+
+/// The page's last line: version, document format and what the 3D view draws.
+fn plan_footer(plan: &Plan, scene: &Scene) -> Markup {
+    html! {
+        footer {
+            "Written by cellplan " (env!("CARGO_PKG_VERSION")) " from the plan document (format "
+            (plan.format) " v" (plan.version) "); the 3D view is drawn with the project's own \
+            WebGL2 code, from the cell's meshes (" (scene.geometries.len()) " distinct, "
+            (scene.drawn_triangles()) " triangles drawn)."
+        }
+    }
+}
+
+/// One headline figure: a value over its label.
+fn figure(value: impl maud::Render, label: impl maud::Render, class: &str) -> Markup {
+    html! {
+        div class="figure" { b class=(class) { (value) } span { (label) } }
+    }
+}
+
+/// The summary: headline figures, the robot table, and the verifier's violations if any.
+fn summary(rep: &PlanReport) -> Markup {
+    html! {
+        section id="summary" {
+            h2 { "Summary" }
+            (figures(rep))
+            (robot_table(rep.plan))
+            @if let Some(v) = rep.verification && !v.ok {
+                (violation_table(v))
+            }
+        }
+    }
+}
+
+/// The verifier's verdict as a figure: its value, class and label.
+fn verdict(rep: &PlanReport) -> (String, &'static str, &'static str) {
+    match rep.verification {
+        Some(v) if v.ok => ("verified".into(), "ok", "cellplan verify, now"),
+        Some(v) => (
+            format!("{} violation(s)", v.violations.len()),
+            "bad",
+            "cellplan verify, now",
+        ),
+        None if rep.plan.verified => ("verified".into(), "ok", "when planned"),
+        None => ("not verified".into(), "bad", "written with --no-verify"),
+    }
+}
+
+fn figures(rep: &PlanReport) -> Markup {
+    let plan = rep.plan;
+    let c = &plan.coordination;
+    let seconds = |v: f64| format!("{v:.2} s");
+    let (verdict, class, label) = verdict(rep);
+    html! {
+        div class="figures" {
+            (figure(seconds(plan.cycle_time_s), "cycle time", ""))
+            (figure(seconds(plan.delta_t_s), "Δt (longest − shortest)", ""))
+            (figure(
+                seconds(plan.lower_bound_s),
+                format_args!("lower bound (cycle ×{:.2})", plan.ratio_to_lower_bound),
+                "",
+            ))
+            (figure(seconds(c.uncoordinated_cycle_time_s), "cycle before coordination", ""))
+            (figure(
+                format_args!("{} / {}", c.conflicts_before.len(), plan.stats.conflicts_resolved),
+                "conflicts found / resolved",
+                "",
+            ))
+            (figure(format_args!("{} / {}", c.waits, c.poses_changed), "waits / poses changed", ""))
+            (figure(verdict, label, class))
+            (figure(format_args!("{:.1} s", plan.compute_s.total), "compute", ""))
+        }
+    }
+}
+
+/// Per robot: its colour, MPs, times, and MPs in order.
+fn robot_table(plan: &Plan) -> Markup {
+    html! {
+        table id="robots" {
+            tr {
+                th { "robot" } th { "MPs" } th { "moving s" } th { "measuring s" }
+                th { "waiting s" } th { "total s" } th class="text" { "MPs in order" }
+            }
+            @for (r, rp) in plan.robots.iter().enumerate() {
+                @let c = robot_colour(r).map(|x| (x * 255.0).round() as u8);
+                @let order = rp.tasks.iter().map(|v| v.task.as_str()).collect::<Vec<_>>();
+                tr {
+                    td {
+                        span class="swatch" style={ "background:rgb(" (c[0]) "," (c[1]) "," (c[2]) ")" } {}
+                        (rp.name)
+                    }
+                    td { (rp.tasks.len()) }
+                    td { (format_args!("{:.2}", rp.motion_s)) }
+                    td { (format_args!("{:.2}", rp.measuring_s)) }
+                    td { (format_args!("{:.2}", rp.waiting_s)) }
+                    td { (format_args!("{:.2}", rp.total_s)) }
+                    td class="text" { (order.join(" → ")) }
+                }
+            }
+        }
+    }
+}
+
+fn violation_table(v: &verify::Report) -> Markup {
+    html! {
+        h3 class="bad" { "Violations" }
+        table {
+            tr {
+                th { "what" } th { "robots" } th { "time s" } th { "MP" }
+                th class="text" { "detail" }
+            }
+            @for x in &v.violations {
+                @let robots = [x.robot.as_deref(), x.other.as_deref()].into_iter().flatten().collect::<Vec<_>>();
+                tr {
+                    td { (format_args!("{:?}", x.kind)) }
+                    td { (robots.join(" & ")) }
+                    td { @if let Some(t) = x.time_s { (format_args!("{t:.2}")) } }
+                    td { (x.task.as_deref().unwrap_or("")) }
+                    td class="text" { (x.detail) }
+                }
+            }
+        }
+    }
+}
+
+/// The coordination: strategy, priority, the conflicts and the waits.
+fn coordination_section(plan: &Plan) -> Markup {
+    let c = &plan.coordination;
+    html! {
+        section id="coordination" {
+            h2 { "Coordination" }
+            p {
+                "Strategy " b { (json_word(&c.strategy)) }
+                @if !c.priority.is_empty() { ", priority " (c.priority.join(" > ")) }
+                "; " (c.conflicts_before.len()) " conflict(s) in the programs before coordination, "
+                (plan.stats.conflicts_resolved) " resolution(s), " (format_args!("{:.1}", plan.compute_s.coordination))
+                " s of compute."
+            }
+            @let conflicts = shown_conflicts(plan);
+            @if !conflicts.is_empty() { (conflict_table(conflicts)) }
+            (wait_table(plan))
+        }
+    }
+}
+
+fn conflict_table(list: &[ConflictOut]) -> Markup {
+    html! {
+        table id="conflicts" {
+            tr {
+                th { "#" } th { "robots" } th { "from s" } th { "to s" } th { "scenario" }
+                th class="text" { "what they were doing" }
+            }
+            @for (k, x) in list.iter().enumerate() {
+                tr {
+                    td { "C" (k + 1) }
+                    td { (x.robots[0]) " & " (x.robots[1]) }
+                    td { (format_args!("{:.2}", x.start_s)) }
+                    td { (format_args!("{:.2}", x.end_s)) }
+                    td { @if x.scenario == 1 { "1: both measuring" } @else { "2: moving" } }
+                    td class="text" {
+                        (x.robots[0]) ": " (x.activity[0].text("measuring")) "; " (x.robots[1]) ": " (x.activity[1].text("measuring"))
+                    }
+                }
+            }
+        }
+    }
+}
+
+fn wait_table(plan: &Plan) -> Markup {
     let waits: Vec<_> = plan
         .robots
         .iter()
         .flat_map(|r| r.waits.iter().map(move |w| (r, w)))
         .collect();
-    if !waits.is_empty() {
-        page.push_str(r#"<table id="waits"><tr><th>robot</th><th class="text">where</th><th>from s</th><th>for s</th><th>reason</th><th>lets pass</th></tr>"#);
-        for (r, w) in waits {
-            let _ = write!(
-                page,
-                r#"<tr><td>{}</td><td class="text">{}</td><td>{:.2}</td><td>{:.2}</td><td>{}</td><td>{}</td></tr>"#,
-                escape(&r.name),
-                escape(&r.wait_place(w)),
-                w.start_s,
-                w.duration_s,
-                w.reason,
-                escape(w.for_robot.as_deref().unwrap_or(""))
-            );
-        }
-        page.push_str("</table>");
-    }
-    page.push_str("</section>");
-    if !plan.unmeasured.is_empty() {
-        page.push_str(r#"<section id="unmeasured"><h2 class="bad">Unmeasured MPs</h2><table><tr><th>MP</th><th class="text">furthest check any probe pose passed</th></tr>"#);
-        for u in &plan.unmeasured {
-            let _ = write!(
-                page,
-                r#"<tr><td>{}</td><td class="text">{}</td></tr>"#,
-                escape(&u.task),
-                escape(&u.reason)
-            );
-        }
-        page.push_str("</table></section>");
-    }
-    page.push_str(r#"<section id="settings"><h2>Settings</h2><table>"#);
-    if let Ok(Value::Object(map)) = serde_json::to_value(&plan.settings) {
-        for (k, v) in map {
-            let v = match v {
-                Value::String(s) => s,
-                Value::Null => "—".into(),
-                other => other.to_string(),
-            };
-            let _ = write!(
-                page,
-                r#"<tr><td>{}</td><td class="text">{}</td></tr>"#,
-                escape(&k),
-                escape(&v)
-            );
+    html! {
+        @if !waits.is_empty() {
+            table id="waits" {
+                tr {
+                    th { "robot" } th class="text" { "where" } th { "from s" } th { "for s" }
+                    th { "reason" } th { "lets pass" }
+                }
+                @for (r, w) in waits {
+                    tr {
+                        td { (r.name) }
+                        td class="text" { (r.wait_place(w)) }
+                        td { (format_args!("{:.2}", w.start_s)) }
+                        td { (format_args!("{:.2}", w.duration_s)) }
+                        td { (w.reason) }
+                        td { (w.for_robot.as_deref().unwrap_or("")) }
+                    }
+                }
+            }
         }
     }
-    page.push_str("</table></section>");
 }
 
+/// The MPs no robot measures, with the furthest check any probe pose passed.
+fn unmeasured_section(plan: &Plan) -> Markup {
+    html! {
+        @if !plan.unmeasured.is_empty() {
+            section id="unmeasured" {
+                h2 class="bad" { "Unmeasured MPs" }
+                table {
+                    tr { th { "MP" } th class="text" { "furthest check any probe pose passed" } }
+                    @for u in &plan.unmeasured {
+                        tr { td { (u.task) } td class="text" { (u.reason) } }
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// The plan's settings as a table of their wire names and values.
+fn settings_section(plan: &Plan) -> Markup {
+    let rows: Vec<(String, String)> = match serde_json::to_value(&plan.settings) {
+        Ok(Value::Object(map)) => map
+            .into_iter()
+            .map(|(k, v)| {
+                let v = match v {
+                    Value::String(s) => s,
+                    Value::Null => "—".into(),
+                    other => other.to_string(),
+                };
+                (k, v)
+            })
+            .collect(),
+        _ => Vec::new(),
+    };
+    html! {
+        section id="settings" {
+            h2 { "Settings" }
+            table {
+                @for (k, v) in &rows {
+                    tr { td { (k) } td class="text" { (v) } }
+                }
+            }
+        }
+    }
+}
+
+/// The smallest box around everything the viewer draws: robot bases, probe paths and MPs.
+struct Bounds {
+    lo: DVec3,
+    hi: DVec3,
+}
+
+impl Bounds {
+    fn new() -> Self {
+        Bounds {
+            lo: DVec3::splat(f64::INFINITY),
+            hi: DVec3::splat(f64::NEG_INFINITY),
+        }
+    }
+
+    fn grow(&mut self, p: DVec3) {
+        self.lo = self.lo.min(p);
+        self.hi = self.hi.max(p);
+    }
+
+    /// `[lo, hi]` with a margin of 0.3 m, down to the floor (or a 2 m box when empty).
+    fn json(&self) -> Value {
+        let (mut lo, mut hi) = (self.lo, self.hi);
+        if !lo.is_finite() {
+            (lo, hi) = (DVec3::splat(-1.0), DVec3::splat(1.0));
+        }
+        lo = lo.min(DVec3::new(lo.x, lo.y, 0.0)) - DVec3::splat(0.3);
+        hi += DVec3::splat(0.3);
+        json!([[lo.x, lo.y, lo.z], [hi.x, hi.y, hi.z]])
+    }
+}
+
+/// The data the viewer script reads: meshes, robots with their samples, MPs, conflicts, the
+/// bounds of the scene and where to look from.
 fn viewer_data(
     plan: &Plan,
     cell: &Cell,
     scene: &Scene,
     order: &[usize],
     tracks: &[Vec<(f64, [f64; 3])>],
-    conflicts: &[cellplan_core::document::ConflictOut],
     t_end: f64,
 ) -> Value {
-    let geometries: Vec<Value> = scene
+    let mut bounds = Bounds::new();
+    let robots: Vec<Value> = plan
+        .robots
+        .iter()
+        .zip(order)
+        .enumerate()
+        .map(|(r, (rp, &k))| robot_json(plan, r, rp, &scene.robots[k], &tracks[r], &mut bounds))
+        .collect();
+    let tasks = tasks_json(plan, cell, &mut bounds);
+    let conflicts: Vec<Value> = shown_conflicts(plan)
+        .iter()
+        .map(|c| json!({"robots": c.robots, "start": c.start_s, "end": c.end_s, "p": c.probe_xyz}))
+        .collect();
+    json!({
+        "t_end": t_end,
+        "cycle": plan.cycle_time_s,
+        "geometries": geometries_json(scene),
+        "statics": statics_json(scene),
+        "robots": robots,
+        "tasks": tasks,
+        "conflicts": conflicts,
+        "bounds": bounds.json(),
+        "camera_azimuth": camera_azimuth(cell),
+    })
+}
+
+/// Every distinct mesh: positions and indices as base64 of little-endian f32 and u32.
+fn geometries_json(scene: &Scene) -> Vec<Value> {
+    scene
         .geometries
         .iter()
         .map(|g| {
             let flat: Vec<f32> = g.positions.iter().flatten().copied().collect();
             json!({"p": b64_f32(&flat), "i": b64_u32(&g.indices)})
         })
-        .collect();
-    let statics: Vec<Value> = scene
+        .collect()
+}
+
+/// The part and fixtures: mesh, pose and colour.
+fn statics_json(scene: &Scene) -> Vec<Value> {
+    scene
         .statics
         .iter()
         .map(|s| json!({"name": s.name, "g": s.placed.geometry, "pose": pose_json(&s.placed.pose), "colour": s.colour}))
-        .collect();
-    let mut lo = DVec3::splat(f64::INFINITY);
-    let mut hi = DVec3::splat(f64::NEG_INFINITY);
-    let mut grow = |p: DVec3| {
-        lo = lo.min(p);
-        hi = hi.max(p);
-    };
-    let robots: Vec<Value> = plan
-        .robots
+        .collect()
+}
+
+/// One robot for the viewer: its chain, samples (times and joints), probe path now and before
+/// coordination, and what it does when.
+fn robot_json(
+    plan: &Plan,
+    r: usize,
+    rp: &RobotPlan,
+    sr: &SceneRobot,
+    track: &[(f64, [f64; 3])],
+    bounds: &mut Bounds,
+) -> Value {
+    bounds.grow(sr.base.translation);
+    let times: Vec<f32> = rp.trajectory.iter().map(|s| s.t as f32).collect();
+    let q: Vec<f32> = rp
+        .trajectory
         .iter()
-        .zip(order)
-        .enumerate()
-        .map(|(r, (rp, &k))| {
-            let sr = &scene.robots[k];
-            grow(sr.base.translation);
-            let times: Vec<f32> = rp.trajectory.iter().map(|s| s.t as f32).collect();
-            let q: Vec<f32> = rp
-                .trajectory
-                .iter()
-                .flat_map(|s| s.q.iter().map(|&v| v as f32))
-                .collect();
-            let path: Vec<f32> = tracks[r]
-                .iter()
-                .flat_map(|(_, p)| {
-                    grow(DVec3::from(*p));
-                    p.map(|v| v as f32)
-                })
-                .collect();
-            let before: Vec<f32> = plan
-                .coordination
-                .uncoordinated_probe
-                .iter()
-                .find(|b| b.robot == rp.name)
-                .map(|b| b.xyz.iter().flat_map(|p| p.map(|v| v as f32)).collect())
-                .unwrap_or_default();
-            let links: Vec<Value> = sr
-                .parts
-                .iter()
-                .enumerate()
-                .map(|(i, parts)| {
-                    let joint = sr.joint_of(i);
-                    let axis = joint.map_or(cellplan_geom::DVec3::Z, |(_, jt)| jt.axis);
-                    json!({
-                        "o": pose_json(&sr.model.chain.links[i].origin),
-                        "j": joint.map_or(-1, |(j, _)| j as i64),
-                        "axis": [axis.x, axis.y, axis.z],
-                        "prismatic": joint.is_some_and(|(_, jt)| !jt.is_rotational()),
-                        "parts": parts.iter().map(|p| json!({"g": p.geometry, "pose": pose_json(&p.pose)})).collect::<Vec<_>>(),
-                    })
-                })
-                .collect();
-            let iv: Vec<Value> = intervals(rp)
-                .iter()
-                .map(|i| {
-                    let what = match i.doing {
-                        Doing::Moving => "moving".to_string(),
-                        Doing::Measuring(v) => format!("measuring {}", rp.tasks[v].task),
-                        Doing::Waiting(w) => format!(
-                            "waiting{}",
-                            rp.waits[w]
-                                .for_robot
-                                .as_deref()
-                                .map(|f| format!(" for {f}"))
-                                .unwrap_or_default()
-                        ),
-                    };
-                    json!([round6(i.start), round6(i.end), what])
-                })
-                .collect();
-            json!({
-                "name": rp.name,
-                "colour": robot_colour(r),
-                "base": pose_json(&sr.base),
-                "tcp": pose_json(&sr.tcp),
-                "links": links,
-                "dof": rp.joints.len(),
-                "t": b64_f32(&times),
-                "q": b64_f32(&q),
-                "path": b64_f32(&path),
-                "before": b64_f32(&before),
-                "intervals": iv,
-            })
+        .flat_map(|s| s.q.iter().map(|&v| v as f32))
+        .collect();
+    let path: Vec<f32> = track
+        .iter()
+        .flat_map(|(_, p)| {
+            bounds.grow(DVec3::from(*p));
+            p.map(|v| v as f32)
         })
         .collect();
+    let before: Vec<f32> = plan
+        .coordination
+        .uncoordinated_probe
+        .iter()
+        .find(|b| b.robot == rp.name)
+        .map(|b| b.xyz.iter().flat_map(|p| p.map(|v| v as f32)).collect())
+        .unwrap_or_default();
+    json!({
+        "name": rp.name,
+        "colour": robot_colour(r),
+        "base": pose_json(&sr.base),
+        "tcp": pose_json(&sr.tcp),
+        "links": links_json(sr),
+        "dof": rp.joints.len(),
+        "t": b64_f32(&times),
+        "q": b64_f32(&q),
+        "path": b64_f32(&path),
+        "before": b64_f32(&before),
+        "intervals": intervals_json(rp),
+    })
+}
+
+/// A robot's links: origin, joint (index, axis, kind) and the meshes drawn on it.
+fn links_json(sr: &SceneRobot) -> Vec<Value> {
+    sr.parts
+        .iter()
+        .enumerate()
+        .map(|(i, parts)| {
+            let joint = sr.joint_of(i);
+            let axis = joint.map_or(DVec3::Z, |(_, jt)| jt.axis);
+            json!({
+                "o": pose_json(&sr.model.chain.links[i].origin),
+                "j": joint.map_or(-1, |(j, _)| j as i64),
+                "axis": [axis.x, axis.y, axis.z],
+                "prismatic": joint.is_some_and(|(_, jt)| !jt.is_rotational()),
+                "parts": parts.iter().map(|p| json!({"g": p.geometry, "pose": pose_json(&p.pose)})).collect::<Vec<_>>(),
+            })
+        })
+        .collect()
+}
+
+/// A robot's intervals as `[start, end, what it does]`.
+fn intervals_json(rp: &RobotPlan) -> Vec<Value> {
+    intervals(rp)
+        .iter()
+        .map(|i| {
+            let what = match i.doing {
+                Doing::Moving => "moving".to_string(),
+                Doing::Measuring(v) => format!("measuring {}", rp.tasks[v].task),
+                Doing::Waiting(w) => format!(
+                    "waiting{}",
+                    rp.waits[w]
+                        .for_robot
+                        .as_deref()
+                        .map(|f| format!(" for {f}"))
+                        .unwrap_or_default()
+                ),
+            };
+            json!([round6(i.start), round6(i.end), what])
+        })
+        .collect()
+}
+
+/// The cell's MPs: position, normal and the robot that measures each (-1: none).
+fn tasks_json(plan: &Plan, cell: &Cell, bounds: &mut Bounds) -> Vec<Value> {
     let robot_of = |name: &str| {
         plan.robots
             .iter()
             .position(|rp| rp.tasks.iter().any(|v| v.task == name))
             .map_or(-1, |r| r as i64)
     };
-    let tasks: Vec<Value> = cell
-        .tasks
+    cell.tasks
         .iter()
         .map(|t| {
-            grow(t.position);
+            bounds.grow(t.position);
             let p = [t.position.x, t.position.y, t.position.z].map(round6);
             let n = [t.normal.x, t.normal.y, t.normal.z].map(round6);
             json!({
@@ -594,39 +753,22 @@ fn viewer_data(
                 "r": robot_of(&t.name),
             })
         })
-        .collect();
-    let conflicts: Vec<Value> = conflicts
-        .iter()
-        .map(|c| json!({"robots": c.robots, "start": c.start_s, "end": c.end_s, "p": c.probe_xyz}))
-        .collect();
-    if !lo.is_finite() {
-        (lo, hi) = (DVec3::splat(-1.0), DVec3::splat(1.0));
-    }
-    lo = lo.min(DVec3::new(lo.x, lo.y, 0.0)) - DVec3::splat(0.3);
-    hi += DVec3::splat(0.3);
-    // Look from the robots' side of the MPs, a little from the front.
+        .collect()
+}
+
+/// The camera's azimuth: look from the robots' side of the MPs, a little from the front.
+fn camera_azimuth(cell: &Cell) -> f64 {
     let centroid = |v: &mut dyn Iterator<Item = DVec3>| {
         let (s, n) = v.fold((DVec3::ZERO, 0usize), |(s, n), p| (s + p, n + 1));
         s / n.max(1) as f64
     };
     let from = centroid(&mut cell.robots.iter().map(|r| r.base.translation))
         - centroid(&mut cell.tasks.iter().map(|t| t.position));
-    let azimuth = if from.x.hypot(from.y) > 1e-6 {
+    if from.x.hypot(from.y) > 1e-6 {
         from.y.atan2(from.x) - 0.55
     } else {
         0.8
-    };
-    json!({
-        "t_end": t_end,
-        "cycle": plan.cycle_time_s,
-        "geometries": geometries,
-        "statics": statics,
-        "robots": robots,
-        "tasks": tasks,
-        "conflicts": conflicts,
-        "bounds": [[lo.x, lo.y, lo.z], [hi.x, hi.y, hi.z]],
-        "camera_azimuth": azimuth,
-    })
+    }
 }
 
 /// One strategy's row in a comparison report.
@@ -647,44 +789,80 @@ pub fn compare_html(
     bars: &[StrategyBar],
     bound: Option<f64>,
 ) -> String {
-    let mut page = String::new();
-    let _ = write!(
-        page,
-        r#"<!DOCTYPE html><html lang="en"><head><meta charset="utf-8"><meta name="viewport" content="width=device-width, initial-scale=1"><title>{}</title><style>{CSS}</style></head><body><main><h1>{}</h1><p class="sub">{}</p><section id="bars-section"><h2>Time per robot and cycle time (paper 000 Fig. 10)</h2>{}</section><section id="table-section"><h2>Strategies (paper 000 Table 3)</h2><table id="strategies"><tr>"#,
-        escape(title),
-        escape(title),
-        escape(intro),
-        charts::strategy_bars(bars, bound)
-    );
-    for (k, h) in header.iter().enumerate() {
-        let _ = write!(
-            page,
-            "<th{}>{}</th>",
-            if k == 0 { r#" class="text""# } else { "" },
-            escape(h)
-        );
-    }
-    page.push_str("</tr>");
-    for row in rows {
-        page.push_str("<tr>");
-        for (k, c) in row.cells.iter().enumerate() {
-            let text = if row.ours {
-                format!("<b>{}</b>", escape(c))
-            } else {
-                escape(c)
-            };
-            let _ = write!(
-                page,
-                "<td{}>{text}</td>",
-                if k == 0 { r#" class="text""# } else { "" }
-            );
+    let first = |k: usize| (k == 0).then_some("text");
+    html! {
+        (DOCTYPE)
+        html lang="en" {
+            (head(title))
+            body {
+                main {
+                    h1 { (title) }
+                    p class="sub" { (intro) }
+                    section id="bars-section" {
+                        h2 { "Time per robot and cycle time (paper 000 Fig. 10)" }
+                        (charts::strategy_bars(bars, bound))
+                    }
+                    section id="table-section" {
+                        h2 { "Strategies (paper 000 Table 3)" }
+                        table id="strategies" {
+                            tr { @for (k, h) in header.iter().enumerate() { th class=[first(k)] { (h) } } }
+                            @for row in rows {
+                                tr {
+                                    @for (k, c) in row.cells.iter().enumerate() {
+                                        td class=[first(k)] { @if row.ours { b { (c) } } @else { (c) } }
+                                    }
+                                }
+                            }
+                        }
+                    }
+                    footer { "Written by cellplan " (env!("CARGO_PKG_VERSION")) "." }
+                }
+            }
         }
-        page.push_str("</tr>");
     }
-    let _ = write!(
-        page,
-        r#"</table></section><footer>Written by cellplan {}.</footer></main></body></html>"#,
-        env!("CARGO_PKG_VERSION")
-    );
-    page
+    .into_string()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Text from outside (cell, robot and strategy names, labels) is escaped wherever the page
+    /// puts it.
+    #[test]
+    fn the_compare_page_escapes_what_it_is_given() {
+        let page = compare_html(
+            "cell <a>",
+            "MPs & \"robots\"",
+            &["<th>".into(), "x".into()],
+            &[CompareRow {
+                cells: vec!["</td>".into(), "1".into()],
+                ours: true,
+            }],
+            &[StrategyBar {
+                label: "<b>".into(),
+                robots: vec![("R&1".into(), 1.0)],
+                cycle_time_s: 1.0,
+                spread_s: None,
+            }],
+            None,
+        );
+        assert!(page.starts_with("<!DOCTYPE html><html lang=\"en\"><head><meta charset=\"utf-8\">"));
+        assert!(page.contains("<title>cell &lt;a&gt;</title>"));
+        assert!(page.contains("<h1>cell &lt;a&gt;</h1><p class=\"sub\">MPs &amp; &quot;robots&quot;</p>"));
+        assert!(page.contains("<tr><th class=\"text\">&lt;th&gt;</th><th>x</th></tr>"));
+        assert!(page.contains("<tr><td class=\"text\"><b>&lt;/td&gt;</b></td><td><b>1</b></td></tr>"));
+        assert!(page.contains("<title>&lt;b&gt;: R&amp;1 1.00 s</title>"));
+        assert!(page.ends_with("</footer></main></body></html>"));
+    }
+
+    /// The data for the viewer cannot end its script element or open a comment, and reads back
+    /// the same.
+    #[test]
+    fn script_json_keeps_markup_out_and_reads_back() {
+        let data = json!({"name": "</script><!-- & -->"});
+        let text = script_json(&data);
+        assert!(!text.contains(['<', '>', '&']), "{text}");
+        assert_eq!(serde_json::from_str::<Value>(&text).unwrap(), data);
+    }
 }

@@ -291,11 +291,12 @@ pub fn render(cell: &Cell, table: Option<&CandidateTable>) -> String {
     let mut entry = |colour: &str, label: &str| {
         let _ = write!(
             legend,
-            "<circle cx=\"{:.1}\" cy=\"{:.1}\" r=\"5\" fill=\"{colour}\"/><text x=\"{:.1}\" y=\"{:.1}\" class=\"legend\">{label}</text>",
+            "<circle cx=\"{:.1}\" cy=\"{:.1}\" r=\"5\" fill=\"{colour}\"/><text x=\"{:.1}\" y=\"{:.1}\" class=\"legend\">{}</text>",
             x,
             y_offset - 4.0,
             x + 9.0,
-            y_offset
+            y_offset,
+            escape(label)
         );
         x += 20.0 + 7.0 * label.chars().count() as f64;
     };
