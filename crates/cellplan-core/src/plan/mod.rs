@@ -140,7 +140,7 @@ pub enum PlanError {
     #[error("the robots' task caps cannot hold every task they can do: {reason}")]
     CapsTooSmall {
         /// The solver's finding.
-        reason: String,
+        reason: cellplan_solve::minmax::MinMaxError,
     },
     /// A strategy the process does not support.
     #[error("{what} needs something the `{process}` process does not define")]
