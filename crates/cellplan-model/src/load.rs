@@ -82,8 +82,8 @@ impl Ctx<'_> {
     }
 
     fn pose(&self, spec: &Spanned<PoseSpec>) -> Result<Pose, InputError> {
-        pose_from_spec(spec.get_ref(), self.to_m, self.to_rad).map_err(|m| {
-            self.err(spec.span(), m).hint(
+        pose_from_spec(spec.get_ref(), self.to_m, self.to_rad).map_err(|e| {
+            self.err(spec.span(), e.to_string()).hint(
                 "a pose is { xyz = [x, y, z] } plus at most one of rpy = [r, p, y], quat = [x, y, z, w], matrix = [[..], [..], [..]] (rows)",
             )
         })
