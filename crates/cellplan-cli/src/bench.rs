@@ -360,10 +360,10 @@ pub fn generate(args: &BenchArgs) -> Result<String, BenchError> {
     for v in &mut p.vehicles {
         let k = v.costs.n();
         let data = v.costs.data().iter().map(|&c| round(c)).collect();
-        v.costs = cellplan_solve::CostMatrix::new(k, data).map_err(BenchError::Failed)?;
+        v.costs = cellplan_solve::CostMatrix::new(k, data).map_err(|e| BenchError::Failed(e.to_string()))?;
     }
     p.service.iter_mut().for_each(|s| *s = round(*s));
-    p.validate().map_err(BenchError::Failed)?;
+    p.validate().map_err(|e| BenchError::Failed(e.to_string()))?;
     let mut buf = Vec::new();
     write_minmax(&p, &stem(out), &mut buf).map_err(|e| BenchError::Failed(e.to_string()))?;
     cellplan_model::io::write_atomic(out, &buf)

@@ -123,11 +123,7 @@ pub fn run(args: &CompareArgs) -> Result<(), Failure> {
         // The balanced run, for ours.
         let mut balanced = None;
         for allocation in ALLOCATIONS {
-            pb.set_message(format!(
-                "case {}/{cases}: planning with {}",
-                case + 1,
-                allocation.name()
-            ));
+            pb.set_message(format!("case {}/{cases}: planning with {}", case + 1, allocation));
             let settings = PlanSettings {
                 allocation,
                 seed: args.seed,
@@ -149,8 +145,8 @@ pub fn run(args: &CompareArgs) -> Result<(), Failure> {
                 pb.set_message(format!(
                     "case {}/{cases}: {} + {}",
                     case + 1,
-                    allocation.name(),
-                    strategy.name()
+                    allocation,
+                    strategy
                 ));
                 let cs = CoordSettings {
                     strategy,
@@ -382,8 +378,8 @@ fn ours(
 fn failed(case: usize, allocation: Allocation, coordination: Coordination, error: String) -> Row {
     Row {
         case,
-        allocation: allocation.name().into(),
-        coordination: coordination.name().into(),
+        allocation: allocation.to_string(),
+        coordination: coordination.to_string(),
         robots: Vec::new(),
         cycle_time_s: f64::NAN,
         delta_t_s: f64::NAN,
@@ -404,8 +400,8 @@ fn failed(case: usize, allocation: Allocation, coordination: Coordination, error
 fn row_of(case: usize, doc: &output::Plan, verified: bool, compute_s: f64, coord_s: f64) -> Row {
     Row {
         case,
-        allocation: doc.settings.allocation.name().into(),
-        coordination: doc.settings.coordination.name().into(),
+        allocation: doc.settings.allocation.to_string(),
+        coordination: doc.settings.coordination.to_string(),
         robots: doc
             .robots
             .iter()

@@ -302,8 +302,8 @@ fn run_gen_tasks(args: &GenTasksArgs) -> Result<(), Failure> {
         opts.region[axis] = (lo, hi);
     }
     opts.facing = args.facing.map(|d| (d, args.max_angle.to_radians()));
-    let mut tasks = sample_tasks(&mesh, &opts).map_err(|m| {
-        InputError::new(&args.mesh, m)
+    let mut tasks = sample_tasks(&mesh, &opts).map_err(|e| {
+        InputError::new(&args.mesh, e.to_string())
             .hint("widen `--region`, loosen `--facing`/`--max-angle`, or ask for fewer points")
     })?;
     if let Some(offset) = args.translate {

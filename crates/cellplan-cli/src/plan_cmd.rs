@@ -259,10 +259,7 @@ pub fn run(args: &PlanArgs) -> Result<(), Failure> {
 fn render(doc: &output::Plan, working: &str) -> String {
     let mut s = format!(
         "{} — allocation {}, coordination {}, seed {}\n\n",
-        doc.cell,
-        doc.settings.allocation.name(),
-        doc.settings.coordination.name(),
-        doc.settings.seed
+        doc.cell, doc.settings.allocation, doc.settings.coordination, doc.settings.seed
     );
     s += &format!(
         "{:<10} {:>6} {:>10} {:>12} {:>10} {:>9}\n",

@@ -17,16 +17,4 @@ pub mod plan;
 pub mod verify;
 
 pub use candidates::{Candidate, CandidateTable};
-
-/// Writes the serde name of a unit enum variant: the one spelling of a name that serde, clap
-/// and `Display` share.
-pub(crate) fn write_serde_name<T: serde::Serialize>(
-    v: &T,
-    f: &mut std::fmt::Formatter<'_>,
-) -> std::fmt::Result {
-    match serde_json::to_value(v) {
-        Ok(serde_json::Value::String(s)) => f.write_str(&s),
-        _ => Err(std::fmt::Error),
-    }
-}
 pub use document::Plan;

@@ -496,80 +496,82 @@ impl Loader<'_> {
             urdf_rs::Geometry::Sphere { radius } => {
                 vec![(ShapeSpec::Sphere { radius: *radius }, Pose::IDENTITY)]
             }
-            urdf_rs::Geometry::Capsule { radius, length } => {
-                // A capsule along z: a cylinder and two end spheres.
-                let h = length * 0.5;
-                vec![
-                    (
-                        ShapeSpec::Cylinder {
-                            radius: *radius,
-                            half_height: h,
-                        },
-                        Pose::IDENTITY,
-                    ),
-                    (
-                        ShapeSpec::Sphere { radius: *radius },
-                        Pose::translation(0.0, 0.0, h),
-                    ),
-                    (
-                        ShapeSpec::Sphere { radius: *radius },
-                        Pose::translation(0.0, 0.0, -h),
-                    ),
-                ]
-            }
+            urdf_rs::Geometry::Capsule { radius, length } => capsule(*radius, *length),
             urdf_rs::Geometry::Mesh { filename, scale } => {
                 let line = mesh_lines
                     .get(&(link, filename.as_str()))
                     .copied()
                     .or_else(|| line_of(self.text, filename));
-                let file = self.resolve(link, filename, line)?;
-                let mesh = match meshes.get(&file) {
-                    Some(m) => m.clone(),
-                    None => {
-                        let mesh_err = |source| KinError::Mesh {
-                            urdf: self.path.to_path_buf(),
-                            line,
-                            link: link.to_string(),
-                            source: Box::new(source),
-                        };
-                        if !file.is_file() {
-                            return Err(mesh_err(MeshError::Io {
-                                path: file.clone(),
-                                source: std::io::Error::new(
-                                    std::io::ErrorKind::NotFound,
-                                    format!("no such file (from \"{filename}\")"),
-                                ),
-                            }));
-                        }
-                        let m = Arc::new(load_mesh(&file).map_err(mesh_err)?);
-                        meshes.insert(file, m.clone());
-                        m
-                    }
-                };
+                let mesh = self.mesh(link, filename, line, meshes)?;
                 let mesh = match scale {
                     Some(s) if s.0 != [1.0, 1.0, 1.0] => Arc::new(scale_mesh(&mesh, DVec3::from_array(s.0))),
                     _ => mesh,
                 };
-                // Metres from here on: a mesh reaching beyond MAX_LENGTH_M has the wrong unit.
-                let reach = mesh
-                    .vertices
-                    .iter()
-                    .map(|v| v.abs().max_element())
-                    .fold(0.0, f64::max);
-                if reach > MAX_LENGTH_M {
-                    return Err(self.err(
-                        line,
-                        format!(
-                            "collision mesh \"{filename}\" of link '{link}' reaches {reach:e} m from \
-                             its origin once scaled, beyond {MAX_LENGTH_M:e} m — is the unit right?"
-                        ),
-                        "URDF meshes are in metres: give a mesh in millimetres \
-                         scale=\"0.001 0.001 0.001\"",
-                    ));
-                }
+                self.check_mesh_reach(&mesh, link, filename, line)?;
                 vec![(ShapeSpec::Mesh(mesh), Pose::IDENTITY)]
             }
         })
+    }
+
+    /// The mesh file `filename` of `link` (named on `line`), loaded once per file through
+    /// `meshes`; a missing file is a mesh error naming the URI.
+    fn mesh(
+        &self,
+        link: &str,
+        filename: &str,
+        line: Option<usize>,
+        meshes: &mut HashMap<PathBuf, Arc<Mesh>>,
+    ) -> Result<Arc<Mesh>, KinError> {
+        let file = self.resolve(link, filename, line)?;
+        if let Some(m) = meshes.get(&file) {
+            return Ok(m.clone());
+        }
+        let mesh_err = |source| KinError::Mesh {
+            urdf: self.path.to_path_buf(),
+            line,
+            link: link.to_string(),
+            source: Box::new(source),
+        };
+        if !file.is_file() {
+            return Err(mesh_err(MeshError::Io {
+                path: file.clone(),
+                source: std::io::Error::new(
+                    std::io::ErrorKind::NotFound,
+                    format!("no such file (from \"{filename}\")"),
+                ),
+            }));
+        }
+        let m = Arc::new(load_mesh(&file).map_err(mesh_err)?);
+        meshes.insert(file, m.clone());
+        Ok(m)
+    }
+
+    /// Refuses a scaled collision mesh reaching beyond [`MAX_LENGTH_M`] from its origin (metres
+    /// from here on: such a mesh has the wrong unit).
+    fn check_mesh_reach(
+        &self,
+        mesh: &Mesh,
+        link: &str,
+        filename: &str,
+        line: Option<usize>,
+    ) -> Result<(), KinError> {
+        let reach = mesh
+            .vertices
+            .iter()
+            .map(|v| v.abs().max_element())
+            .fold(0.0, f64::max);
+        if reach > MAX_LENGTH_M {
+            return Err(self.err(
+                line,
+                format!(
+                    "collision mesh \"{filename}\" of link '{link}' reaches {reach:e} m from \
+                     its origin once scaled, beyond {MAX_LENGTH_M:e} m — is the unit right?"
+                ),
+                "URDF meshes are in metres: give a mesh in millimetres \
+                 scale=\"0.001 0.001 0.001\"",
+            ));
+        }
+        Ok(())
     }
 
     /// The file a mesh URI names.
@@ -661,6 +663,22 @@ fn mesh_lines(doc: &xml::Document) -> HashMap<(&str, &str), usize> {
 fn line_of(text: &str, needle: &str) -> Option<usize> {
     text.find(needle)
         .map(|i| text[..i].bytes().filter(|&b| b == b'\n').count() + 1)
+}
+
+/// A capsule along z of `radius` and cylinder `length`: a cylinder and two end spheres.
+fn capsule(radius: f64, length: f64) -> Vec<(ShapeSpec, Pose)> {
+    let h = length * 0.5;
+    vec![
+        (
+            ShapeSpec::Cylinder {
+                radius,
+                half_height: h,
+            },
+            Pose::IDENTITY,
+        ),
+        (ShapeSpec::Sphere { radius }, Pose::translation(0.0, 0.0, h)),
+        (ShapeSpec::Sphere { radius }, Pose::translation(0.0, 0.0, -h)),
+    ]
 }
 
 /// The pose of a URDF `<origin xyz rpy>`: `Rz(yaw) · Ry(pitch) · Rx(roll)` then translation.

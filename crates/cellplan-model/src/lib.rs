@@ -12,6 +12,7 @@ pub mod cell;
 pub mod error;
 pub mod io;
 pub mod load;
+pub mod names;
 pub mod pose;
 pub mod process;
 pub mod robot;

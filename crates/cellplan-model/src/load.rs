@@ -6,12 +6,12 @@ use crate::pose::pose_from_spec;
 use crate::process::{Process, ProcessInput, Registry, key_span};
 use crate::robot::{BodyFrame, IkKind, Robot, RobotId, Scratch, Tool};
 use crate::self_pairs::{SelfPairs, cached_self_pairs, geometry_key, non_adjacent_pairs};
-use crate::spec::{CellSpec, OpwSpec, PlanningSpec, PoseSpec, ShapeEntry};
+use crate::spec::{CellSpec, OpwSpec, PlanningSpec, PoseSpec, RobotSpec, ShapeEntry};
 use crate::tasks::read_tasks;
 use crate::{InputError, error::line_of};
 use cellplan_geom::{BodyContact, CollisionWorld, DVec3, GroupBody, MeshError, Pose, ShapeSpec, load_mesh};
 use cellplan_kin::{
-    DlsIk, DlsParams, IkSolver, JointKind, KinError, OpwIk, OpwParameters, RobotModel, load_urdf,
+    Chain, DlsIk, DlsParams, IkSolver, JointKind, KinError, OpwIk, OpwParameters, RobotModel, load_urdf,
 };
 use std::collections::{BTreeMap, HashMap};
 use std::ops::Range;
@@ -82,8 +82,8 @@ impl Ctx<'_> {
     }
 
     fn pose(&self, spec: &Spanned<PoseSpec>) -> Result<Pose, InputError> {
-        pose_from_spec(spec.get_ref(), self.to_m, self.to_rad).map_err(|m| {
-            self.err(spec.span(), m).hint(
+        pose_from_spec(spec.get_ref(), self.to_m, self.to_rad).map_err(|e| {
+            self.err(spec.span(), e.to_string()).hint(
                 "a pose is { xyz = [x, y, z] } plus at most one of rpy = [r, p, y], quat = [x, y, z, w], matrix = [[..], [..], [..]] (rows)",
             )
         })
@@ -91,21 +91,13 @@ impl Ctx<'_> {
 }
 
 /// Loads and checks a cell file; its process is found in `registry` by `[process] kind`.
+///
+/// The steps: read and parse the file, find the process, read `[planning]`, the tools, the
+/// static objects and the robots, put the robots' bodies into the collision world, read the
+/// tasks and build the process, check that every robot stands clear at home, and find the
+/// self-collision pairs.
 pub fn load(path: &Path, registry: &Registry, opts: &LoadOptions) -> Result<Cell, InputError> {
-    let text = read_bounded(path, MAX_CELL_FILE).map_err(|e| {
-        InputError::new(path, format!("cannot read the cell file: {e}"))
-            .hint("give the path of a cell TOML file, e.g. examples/autobody-4r/cell.toml")
-    })?;
-    let spec: CellSpec = toml::from_str(&text).map_err(|e| {
-        let span = e.span().unwrap_or(0..0);
-        InputError::at_span(
-            path,
-            &text,
-            span,
-            format!("invalid cell file: {}", e.message().trim()),
-        )
-        .hint("docs/cell-format.md lists every key and its type")
-    })?;
+    let (text, spec) = read_spec(path)?;
     let ctx = Ctx {
         path,
         dir: path.parent().map(Path::to_path_buf).unwrap_or_default(),
@@ -122,14 +114,70 @@ pub fn load(path: &Path, registry: &Registry, opts: &LoadOptions) -> Result<Cell
         ctx.key_span(&process_span, "kind"),
     )?;
     let planning = planning(&ctx, spec.planning.as_ref())?;
+    let tools = tools(&ctx, &spec)?;
+    let mut world = CollisionWorld::new();
+    let objects = objects(&ctx, &spec, &mut world)?;
+    let (mut robots, source) = robots(&ctx, &spec, &tools)?;
+    add_robot_bodies(&mut world, &mut robots);
+    exempt_robot_bases(&mut world, &robots);
 
-    // Tools.
+    let tasks_path = ctx.resolve(&spec.tasks.get_ref().file);
+    let tasks = read_tasks(&tasks_path, ctx.to_m, ctx.to_rad, entry.task_columns)?;
+    let process: std::sync::Arc<dyn Process> = (entry.build)(&ProcessInput {
+        path,
+        text: &text,
+        span: process_span,
+        to_m: ctx.to_m,
+        to_rad: ctx.to_rad,
+        tasks: &tasks,
+        tasks_path: &tasks_path,
+    })?;
+
+    check_homes(&ctx, &spec, &world, &robots, planning.clearance)?;
+    let pending_cache = find_self_pairs(&mut world, &mut robots, opts);
+    Ok(Cell {
+        name: cell_name(&spec, path),
+        path: path.to_path_buf(),
+        units: spec.units,
+        process,
+        planning,
+        robots,
+        objects,
+        tasks,
+        world,
+        tasks_path,
+        source,
+        pending_cache,
+    })
+}
+
+/// Reads the cell file (at most [`MAX_CELL_FILE`] bytes) and parses it as TOML.
+fn read_spec(path: &Path) -> Result<(String, CellSpec), InputError> {
+    let text = read_bounded(path, MAX_CELL_FILE).map_err(|e| {
+        InputError::new(path, format!("cannot read the cell file: {e}"))
+            .hint("give the path of a cell TOML file, e.g. examples/autobody-4r/cell.toml")
+    })?;
+    let spec: CellSpec = toml::from_str(&text).map_err(|e| {
+        let span = e.span().unwrap_or(0..0);
+        InputError::at_span(
+            path,
+            &text,
+            span,
+            format!("invalid cell file: {}", e.message().trim()),
+        )
+        .hint("docs/cell-format.md lists every key and its type")
+    })?;
+    Ok((text, spec))
+}
+
+/// Reads `[tools]`: each tool's TCP and shapes, by name.
+fn tools(ctx: &Ctx, spec: &CellSpec) -> Result<BTreeMap<String, Tool>, InputError> {
     let mut tools = BTreeMap::new();
     for (name, tool) in &spec.tools {
         let tcp = ctx.pose(&tool.get_ref().tcp)?;
         let mut shapes = Vec::new();
         for entry in &tool.get_ref().shapes {
-            shapes.push(shape(&ctx, entry, tool.span(), &format!("tool `{name}`"))?);
+            shapes.push(shape(ctx, entry, tool.span(), &format!("tool `{name}`"))?);
         }
         tools.insert(
             name.clone(),
@@ -140,9 +188,11 @@ pub fn load(path: &Path, registry: &Registry, opts: &LoadOptions) -> Result<Cell
             },
         );
     }
+    Ok(tools)
+}
 
-    // Static objects.
-    let mut world = CollisionWorld::new();
+/// Reads `[[objects]]` (named, each name once) and adds each to `world` as a static body.
+fn objects(ctx: &Ctx, spec: &CellSpec, world: &mut CollisionWorld) -> Result<Vec<Object>, InputError> {
     let mut objects: Vec<Object> = Vec::new();
     for entry in &spec.objects {
         let span = entry.span();
@@ -157,7 +207,7 @@ pub fn load(path: &Path, registry: &Registry, opts: &LoadOptions) -> Result<Cell
                 format!("object name `{name}` is used twice"),
             ));
         }
-        let (shape, local) = shape(&ctx, e, span, &format!("object `{name}`"))?;
+        let (shape, local) = shape(ctx, e, span, &format!("object `{name}`"))?;
         let id = world.add_static(&name, &shape, local);
         objects.push(Object {
             name,
@@ -166,25 +216,36 @@ pub fn load(path: &Path, registry: &Registry, opts: &LoadOptions) -> Result<Cell
             id,
         });
     }
+    Ok(objects)
+}
 
-    // Robots.
+/// Reads `[[robots]]` (at least one; URDF models shared by robots that name the same one), with
+/// the cell file's text and the span of each robot's `base`.
+fn robots(
+    ctx: &Ctx,
+    spec: &CellSpec,
+    tools: &BTreeMap<String, Tool>,
+) -> Result<(Vec<Robot>, Source), InputError> {
     let mut models: HashMap<String, Arc<RobotModel>> = HashMap::new();
     let mut robots: Vec<Robot> = Vec::new();
     let mut source = Source {
-        text: text.clone(),
+        text: ctx.text.to_string(),
         ..Source::default()
     };
     for entry in &spec.robots {
-        let robot = robot(&ctx, entry, RobotId(robots.len()), &tools, &mut models, &robots)?;
+        let robot = robot(ctx, entry, RobotId(robots.len()), tools, &mut models, &robots)?;
         source.robot_base.push(entry.get_ref().base.span());
         robots.push(robot);
     }
     if robots.is_empty() {
-        return Err(InputError::new(path, "the cell has no robots").hint("add a [[robots]] table"));
+        return Err(InputError::new(ctx.path, "the cell has no robots").hint("add a [[robots]] table"));
     }
+    Ok((robots, source))
+}
 
-    // Bodies into the world.
-    for robot in &mut robots {
+/// Adds each robot to `world` as a group: its links that have collision shapes, then its tool.
+fn add_robot_bodies(world: &mut CollisionWorld, robots: &mut [Robot]) {
+    for robot in robots {
         let mut bodies = Vec::new();
         let mut frames = Vec::new();
         for (i, shapes) in robot.model.collision.iter().enumerate() {
@@ -206,9 +267,12 @@ pub fn load(path: &Path, registry: &Registry, opts: &LoadOptions) -> Result<Cell
         robot.group = world.add_group(&robot.name, bodies);
         robot.bodies = frames;
     }
-    // A robot's base (the bodies before its first joint) never moves: it stands on its floor or
-    // pedestal, so it is left out of the static checks.
-    for robot in &robots {
+}
+
+/// Leaves each robot's base (the bodies before its first joint) out of the static checks: it
+/// never moves, standing on its floor or pedestal.
+fn exempt_robot_bases(world: &mut CollisionWorld, robots: &[Robot]) {
+    for robot in robots {
         let chain = &robot.model.chain;
         let first_moving = chain
             .links
@@ -224,22 +288,17 @@ pub fn load(path: &Path, registry: &Registry, opts: &LoadOptions) -> Result<Cell
             .collect();
         world.set_static_exempt(robot.group, &fixed);
     }
+}
 
-    let clearance = planning.clearance;
-    let tasks_path = ctx.resolve(&spec.tasks.get_ref().file);
-    let tasks = read_tasks(&tasks_path, ctx.to_m, ctx.to_rad, entry.task_columns)?;
-    let process: std::sync::Arc<dyn Process> = (entry.build)(&ProcessInput {
-        path,
-        text: &text,
-        span: process_span,
-        to_m: ctx.to_m,
-        to_rad: ctx.to_rad,
-        tasks: &tasks,
-        tasks_path: &tasks_path,
-    })?;
-
-    // Every robot must stand clear at home: of the scene (by the clearance), of itself (every
-    // non-adjacent pair) and of the other robots.
+/// Refuses a robot that does not stand clear at home: of the scene (by the clearance), of
+/// itself (every non-adjacent pair) and of the other robots.
+fn check_homes(
+    ctx: &Ctx,
+    spec: &CellSpec,
+    world: &CollisionWorld,
+    robots: &[Robot],
+    clearance: f64,
+) -> Result<(), InputError> {
     let mut home_poses: Vec<Vec<Pose>> = Vec::new();
     for (i, robot) in robots.iter().enumerate() {
         let mut scratch = Scratch::default();
@@ -254,7 +313,7 @@ pub fn load(path: &Path, registry: &Registry, opts: &LoadOptions) -> Result<Cell
             .group_vs_static(robot.group, &scratch.bodies, clearance)
             .or(self_contact)
         {
-            let what = describe_contact(&world, robot, None, contact);
+            let what = describe_contact(world, robot, None, contact);
             return Err(ctx
                 .err(home_span, format!("robot `{}` collides at its home configuration: {what}", robot.name))
                 .hint("move the robot's `base` or change its `home` so that it stands clear (by the `[planning] clearance` from static objects)"));
@@ -263,7 +322,7 @@ pub fn load(path: &Path, registry: &Registry, opts: &LoadOptions) -> Result<Cell
             if let Some(contact) =
                 world.group_vs_group(robot.group, &scratch.bodies, other.group, &home_poses[j], 0.0)
             {
-                let what = describe_contact(&world, robot, Some(other), contact);
+                let what = describe_contact(world, robot, Some(other), contact);
                 return Err(ctx
                     .err(
                         entry.get_ref().base.span(),
@@ -277,18 +336,26 @@ pub fn load(path: &Path, registry: &Registry, opts: &LoadOptions) -> Result<Cell
         }
         home_poses.push(scratch.bodies.clone());
     }
+    Ok(())
+}
 
-    // Self-collision pairs, sampled once per distinct robot geometry (or read from the cache).
+/// Sets each robot's self-collision pairs, sampled once per distinct robot geometry (or read
+/// from the cache); returns the cache entries still to be written.
+fn find_self_pairs(
+    world: &mut CollisionWorld,
+    robots: &mut [Robot],
+    opts: &LoadOptions,
+) -> Vec<crate::self_pairs::PendingCache> {
     let mut sampled: HashMap<u64, SelfPairs> = HashMap::new();
     let mut pending_cache = Vec::new();
-    for robot in &mut robots {
+    for robot in robots {
         let key = geometry_key(robot, opts.self_pair_samples, opts.seed);
         let pairs = match sampled.get(&key) {
             Some(p) => p.clone(),
             None => {
                 let (p, pending) = cached_self_pairs(
                     robot,
-                    &world,
+                    world,
                     opts.self_pair_samples,
                     opts.seed,
                     opts.cache_dir.as_deref(),
@@ -301,8 +368,12 @@ pub fn load(path: &Path, registry: &Registry, opts: &LoadOptions) -> Result<Cell
         world.set_self_pairs(robot.group, pairs.pairs.clone());
         robot.self_pairs = pairs.pairs;
     }
+    pending_cache
+}
 
-    let name = spec.name.clone().unwrap_or_else(|| {
+/// The cell's `name`, else the name of the folder holding the cell file, else `cell`.
+fn cell_name(spec: &CellSpec, path: &Path) -> String {
+    spec.name.clone().unwrap_or_else(|| {
         path.canonicalize()
             .ok()
             .and_then(|p| {
@@ -311,20 +382,6 @@ pub fn load(path: &Path, registry: &Registry, opts: &LoadOptions) -> Result<Cell
                     .map(|n| n.to_string_lossy().into_owned())
             })
             .unwrap_or_else(|| "cell".into())
-    });
-    Ok(Cell {
-        name,
-        path: path.to_path_buf(),
-        units: spec.units,
-        process,
-        planning,
-        robots,
-        objects,
-        tasks,
-        world,
-        tasks_path,
-        source,
-        pending_cache,
     })
 }
 
@@ -487,9 +544,11 @@ fn kin_error(ctx: &Ctx, span: Range<usize>, robot: &str, e: KinError) -> InputEr
     }
 }
 
+/// Reads one `[[robots]]` entry in named steps: its name (once in the cell), URDF model, inverse
+/// kinematics, base, home, tool, joint velocity and acceleration limits, and reach.
 fn robot(
     ctx: &Ctx,
-    entry: &Spanned<crate::spec::RobotSpec>,
+    entry: &Spanned<RobotSpec>,
     id: RobotId,
     tools: &BTreeMap<String, Tool>,
     models: &mut HashMap<String, Arc<RobotModel>>,
@@ -503,7 +562,47 @@ fn robot(
             format!("robot name `{}` is used twice", r.name),
         ));
     }
-    // The URDF model, shared by robots that name the same file, packages and tip.
+    let model = robot_model(ctx, entry, models)?;
+    let chain = &model.chain;
+    let (ik, ik_kind) = ik_solver(ctx, entry, &model)?;
+    let base = ctx.pose(&r.base)?;
+    let home = home(ctx, r, chain)?;
+    let tool = robot_tool(ctx, r, tools)?;
+    let max_velocity = max_velocity(ctx, entry, chain)?;
+    let max_acceleration = match joint_limits(ctx, r, chain, &r.max_acceleration, "max_acceleration")? {
+        Some(a) => a,
+        None => max_velocity
+            .iter()
+            .map(|v| v / DEFAULT_ACCELERATION_TIME)
+            .collect(),
+    };
+    let reach = reach(chain, &tool);
+    Ok(Robot {
+        id,
+        name: r.name.clone(),
+        model,
+        base,
+        home,
+        tool,
+        ik,
+        ik_kind,
+        max_velocity,
+        max_acceleration,
+        group: cellplan_geom::GroupId(u32::MAX),
+        bodies: Vec::new(),
+        self_pairs: Vec::new(),
+        reach,
+    })
+}
+
+/// The robot's URDF model (loaded once per file, packages and tip, and shared through
+/// `models`); refuses a missing file and a chain without a movable joint.
+fn robot_model(
+    ctx: &Ctx,
+    entry: &Spanned<RobotSpec>,
+    models: &mut HashMap<String, Arc<RobotModel>>,
+) -> Result<Arc<RobotModel>, InputError> {
+    let r = entry.get_ref();
     let urdf = ctx.resolve(r.urdf.get_ref());
     let packages: BTreeMap<String, PathBuf> = r
         .packages
@@ -524,15 +623,13 @@ fn robot(
             }
             let m = Arc::new(
                 load_urdf(&urdf, &packages, r.tip.as_deref())
-                    .map_err(|e| kin_error(ctx, span.clone(), &r.name, e))?,
+                    .map_err(|e| kin_error(ctx, entry.span(), &r.name, e))?,
             );
             models.insert(key, m.clone());
             m
         }
     };
-    let chain = &model.chain;
-    let dof = chain.dof();
-    if dof == 0 {
+    if model.chain.dof() == 0 {
         return Err(ctx
             .err(
                 r.urdf.span(),
@@ -542,101 +639,90 @@ fn robot(
                 "check the URDF and the robot's `tip`: the chain runs from the URDF root to the tip link",
             ));
     }
-    let joint_scale = |j: usize| match chain.joints[j].kind {
+    Ok(model)
+}
+
+/// Factor from file units to SI for joint `j`: the length unit for a prismatic joint, else the
+/// angle unit.
+fn joint_scale(ctx: &Ctx, chain: &Chain, j: usize) -> f64 {
+    match chain.joints[j].kind {
         JointKind::Prismatic => ctx.to_m,
         _ => ctx.to_rad,
-    };
+    }
+}
 
-    // Inverse kinematics.
-    let (ik, ik_kind): (Arc<dyn IkSolver>, IkKind) = match &r.opw {
-        Some(opw) => {
-            let params = match opw.get_ref() {
-                OpwSpec::File(rel) => {
-                    let file = ctx.resolve(rel);
-                    let text = read_bounded(&file, 1 << 20).map_err(|e| {
-                        ctx.err(
-                            opw.span(),
-                            format!("cannot read OPW parameters {}: {e}", file.display()),
-                        )
-                        .hint("`opw` is a path relative to the cell file, or an inline table")
-                    })?;
-                    OpwParameters::from_ros_yaml(&text).map_err(|(line, m)| {
-                        InputError::at_line(&file, line, m)
-                            .hint("expected a ROS-Industrial opw_parameters yaml")
-                    })?
-                }
-                OpwSpec::Inline(p) => OpwParameters {
-                    a1: p.a1 * ctx.to_m,
-                    a2: p.a2 * ctx.to_m,
-                    b: p.b * ctx.to_m,
-                    c1: p.c1 * ctx.to_m,
-                    c2: p.c2 * ctx.to_m,
-                    c3: p.c3 * ctx.to_m,
-                    c4: p.c4 * ctx.to_m,
-                    offsets: p.offsets.map(|o| o * ctx.to_rad),
-                    sign_corrections: p.sign_corrections,
-                },
-            };
-            if dof != 6 {
-                return Err(ctx
-                    .err(
-                        opw.span(),
-                        format!(
-                            "OPW needs a 6-joint arm; the chain of `{}` has {dof} joints",
-                            r.name
-                        ),
-                    )
-                    .hint("remove `opw` to use the numeric IK"));
-            }
-            let solver = OpwIk::for_robot(&model, params).map_err(|e| match e {
-                KinError::Opw { message, .. } => ctx
-                    .err(opw.span(), format!("robot `{}`: {message}", r.name))
-                    .hint("the OPW parameters must describe this URDF (same robot model and tip link)"),
-                other => kin_error(ctx, span.clone(), &r.name, other),
+/// The robot's inverse kinematics: analytic OPW when `opw` is given (a 6-joint arm only), else
+/// the numeric solver.
+fn ik_solver(
+    ctx: &Ctx,
+    entry: &Spanned<RobotSpec>,
+    model: &Arc<RobotModel>,
+) -> Result<(Arc<dyn IkSolver>, IkKind), InputError> {
+    let r = entry.get_ref();
+    let dof = model.chain.dof();
+    let Some(opw) = &r.opw else {
+        return Ok((
+            Arc::new(DlsIk::new(&model.chain, DlsParams::default())),
+            IkKind::Numeric,
+        ));
+    };
+    let params = opw_parameters(ctx, opw)?;
+    if dof != 6 {
+        return Err(ctx
+            .err(
+                opw.span(),
+                format!(
+                    "OPW needs a 6-joint arm; the chain of `{}` has {dof} joints",
+                    r.name
+                ),
+            )
+            .hint("remove `opw` to use the numeric IK"));
+    }
+    let solver = OpwIk::for_robot(model, params).map_err(|e| match e {
+        KinError::Opw { message, .. } => ctx
+            .err(opw.span(), format!("robot `{}`: {message}", r.name))
+            .hint("the OPW parameters must describe this URDF (same robot model and tip link)"),
+        other => kin_error(ctx, entry.span(), &r.name, other),
+    })?;
+    Ok((Arc::new(solver), IkKind::Opw))
+}
+
+/// The OPW parameters: read from a ROS-Industrial yaml file, or inline in file units.
+fn opw_parameters(ctx: &Ctx, opw: &Spanned<OpwSpec>) -> Result<OpwParameters, InputError> {
+    Ok(match opw.get_ref() {
+        OpwSpec::File(rel) => {
+            let file = ctx.resolve(rel);
+            let text = read_bounded(&file, 1 << 20).map_err(|e| {
+                ctx.err(
+                    opw.span(),
+                    format!("cannot read OPW parameters {}: {e}", file.display()),
+                )
+                .hint("`opw` is a path relative to the cell file, or an inline table")
             })?;
-            (Arc::new(solver), IkKind::Opw)
+            OpwParameters::from_ros_yaml(&text).map_err(|(line, m)| {
+                InputError::at_line(&file, line, m).hint("expected a ROS-Industrial opw_parameters yaml")
+            })?
         }
-        None => (Arc::new(DlsIk::new(chain, DlsParams::default())), IkKind::Numeric),
-    };
+        OpwSpec::Inline(p) => OpwParameters {
+            a1: p.a1 * ctx.to_m,
+            a2: p.a2 * ctx.to_m,
+            b: p.b * ctx.to_m,
+            c1: p.c1 * ctx.to_m,
+            c2: p.c2 * ctx.to_m,
+            c3: p.c3 * ctx.to_m,
+            c4: p.c4 * ctx.to_m,
+            offsets: p.offsets.map(|o| o * ctx.to_rad),
+            sign_corrections: p.sign_corrections,
+        },
+    })
+}
 
-    let base = ctx.pose(&r.base)?;
-
-    // Home: given, else zero where that is within limits, else mid-range.
-    let home = match &r.home {
-        Some(h) => {
-            if h.get_ref().len() != dof {
-                return Err(ctx.err(
-                    h.span(),
-                    format!(
-                        "`home` has {} values but `{}` has {dof} joints",
-                        h.get_ref().len(),
-                        r.name
-                    ),
-                ));
-            }
-            let q: Vec<f64> = h
-                .get_ref()
-                .iter()
-                .enumerate()
-                .map(|(j, v)| v * joint_scale(j))
-                .collect();
-            for (j, joint) in chain.joints.iter().enumerate() {
-                if !(joint.lower - 1e-9..=joint.upper + 1e-9).contains(&q[j]) {
-                    return Err(ctx
-                        .err(
-                            h.span(),
-                            format!("`home` puts joint `{}` outside its limits", joint.name),
-                        )
-                        .hint(format!(
-                            "its range is [{:.4}, {:.4}] in file units",
-                            joint.lower / joint_scale(j),
-                            joint.upper / joint_scale(j)
-                        )));
-                }
-            }
-            q
-        }
-        None => chain
+/// The home configuration: given (one value per joint, within limits), else zero where that is
+/// within limits, else mid-range.
+fn home(ctx: &Ctx, r: &RobotSpec, chain: &Chain) -> Result<Vec<f64>, InputError> {
+    let dof = chain.dof();
+    let Some(h) = &r.home else {
+        return Ok(chain
             .joints
             .iter()
             .map(|j| {
@@ -646,82 +732,122 @@ fn robot(
                     (j.lower + j.upper) / 2.0
                 }
             })
-            .collect(),
+            .collect());
     };
-
-    let tool = match &r.tool {
-        Some(name) => tools.get(name.get_ref()).cloned().ok_or_else(|| {
-            let known: Vec<&str> = tools.keys().map(String::as_str).collect();
-            ctx.err(name.span(), format!("no tool named `{}`", name.get_ref()))
+    if h.get_ref().len() != dof {
+        return Err(ctx.err(
+            h.span(),
+            format!(
+                "`home` has {} values but `{}` has {dof} joints",
+                h.get_ref().len(),
+                r.name
+            ),
+        ));
+    }
+    let q: Vec<f64> = h
+        .get_ref()
+        .iter()
+        .enumerate()
+        .map(|(j, v)| v * joint_scale(ctx, chain, j))
+        .collect();
+    for (j, joint) in chain.joints.iter().enumerate() {
+        if !(joint.lower - 1e-9..=joint.upper + 1e-9).contains(&q[j]) {
+            return Err(ctx
+                .err(
+                    h.span(),
+                    format!("`home` puts joint `{}` outside its limits", joint.name),
+                )
                 .hint(format!(
-                    "tools defined under [tools]: {}",
-                    if known.is_empty() {
-                        "none".into()
-                    } else {
-                        known.join(", ")
-                    }
-                ))
-        })?,
-        None => Tool {
+                    "its range is [{:.4}, {:.4}] in file units",
+                    joint.lower / joint_scale(ctx, chain, j),
+                    joint.upper / joint_scale(ctx, chain, j)
+                )));
+        }
+    }
+    Ok(q)
+}
+
+/// The robot's tool from `[tools]` by name, else the bare flange.
+fn robot_tool(ctx: &Ctx, r: &RobotSpec, tools: &BTreeMap<String, Tool>) -> Result<Tool, InputError> {
+    let Some(name) = &r.tool else {
+        return Ok(Tool {
             name: "flange".into(),
             tcp: Pose::IDENTITY,
             shapes: Vec::new(),
-        },
+        });
     };
-
-    let limits = |given: &Option<Spanned<Vec<f64>>>, key: &str| -> Result<Option<Vec<f64>>, InputError> {
-        let Some(v) = given else { return Ok(None) };
-        if v.get_ref().len() != dof {
-            return Err(ctx.err(
-                v.span(),
-                format!(
-                    "`{key}` has {} values but `{}` has {dof} joints",
-                    v.get_ref().len(),
-                    r.name
-                ),
-            ));
-        }
-        v.get_ref()
-            .iter()
-            .enumerate()
-            .map(|(j, &x)| {
-                if x.is_finite() && x > 0.0 {
-                    Ok(x * joint_scale(j))
+    tools.get(name.get_ref()).cloned().ok_or_else(|| {
+        let known: Vec<&str> = tools.keys().map(String::as_str).collect();
+        ctx.err(name.span(), format!("no tool named `{}`", name.get_ref()))
+            .hint(format!(
+                "tools defined under [tools]: {}",
+                if known.is_empty() {
+                    "none".into()
                 } else {
-                    Err(ctx.err(v.span(), format!("`{key}` values must be positive")))
+                    known.join(", ")
                 }
-            })
-            .collect::<Result<Vec<_>, _>>()
-            .map(Some)
-    };
-    let max_velocity = match limits(&r.max_velocity, "max_velocity")? {
-        Some(v) => v,
-        None => {
-            if let Some(j) = chain
-                .joints
-                .iter()
-                .find(|j| !(j.max_velocity.is_finite() && j.max_velocity > 0.0))
-            {
-                return Err(ctx
-                    .err(
-                        ctx.key_span(&span, "urdf"),
-                        format!("joint `{}` has no velocity limit in the URDF", j.name),
-                    )
-                    .hint("give `max_velocity` for the robot in the cell file"));
-            }
-            chain.joints.iter().map(|j| j.max_velocity).collect()
-        }
-    };
-    let max_acceleration = match limits(&r.max_acceleration, "max_acceleration")? {
-        Some(a) => a,
-        None => max_velocity
-            .iter()
-            .map(|v| v / DEFAULT_ACCELERATION_TIME)
-            .collect(),
-    };
+            ))
+    })
+}
 
-    // Upper bound of the TCP's distance from the base: link offsets, prismatic strokes, TCP.
-    let reach = chain
+/// Per-joint limits given under `key` (one positive value per joint, in file units), in SI.
+fn joint_limits(
+    ctx: &Ctx,
+    r: &RobotSpec,
+    chain: &Chain,
+    given: &Option<Spanned<Vec<f64>>>,
+    key: &str,
+) -> Result<Option<Vec<f64>>, InputError> {
+    let dof = chain.dof();
+    let Some(v) = given else { return Ok(None) };
+    if v.get_ref().len() != dof {
+        return Err(ctx.err(
+            v.span(),
+            format!(
+                "`{key}` has {} values but `{}` has {dof} joints",
+                v.get_ref().len(),
+                r.name
+            ),
+        ));
+    }
+    v.get_ref()
+        .iter()
+        .enumerate()
+        .map(|(j, &x)| {
+            if x.is_finite() && x > 0.0 {
+                Ok(x * joint_scale(ctx, chain, j))
+            } else {
+                Err(ctx.err(v.span(), format!("`{key}` values must be positive")))
+            }
+        })
+        .collect::<Result<Vec<_>, _>>()
+        .map(Some)
+}
+
+/// Joint velocity limits: `max_velocity`, else the URDF's (refused where a joint has none).
+fn max_velocity(ctx: &Ctx, entry: &Spanned<RobotSpec>, chain: &Chain) -> Result<Vec<f64>, InputError> {
+    let r = entry.get_ref();
+    if let Some(v) = joint_limits(ctx, r, chain, &r.max_velocity, "max_velocity")? {
+        return Ok(v);
+    }
+    if let Some(j) = chain
+        .joints
+        .iter()
+        .find(|j| !(j.max_velocity.is_finite() && j.max_velocity > 0.0))
+    {
+        return Err(ctx
+            .err(
+                ctx.key_span(&entry.span(), "urdf"),
+                format!("joint `{}` has no velocity limit in the URDF", j.name),
+            )
+            .hint("give `max_velocity` for the robot in the cell file"));
+    }
+    Ok(chain.joints.iter().map(|j| j.max_velocity).collect())
+}
+
+/// Upper bound of the TCP's distance from the base: link offsets, prismatic strokes, TCP.
+fn reach(chain: &Chain, tool: &Tool) -> f64 {
+    chain
         .links
         .iter()
         .map(|l| l.origin.translation.length())
@@ -732,22 +858,5 @@ fn robot(
             .filter(|j| j.kind == JointKind::Prismatic)
             .map(|j| j.lower.abs().max(j.upper.abs()))
             .sum::<f64>()
-        + tool.tcp.translation.length();
-
-    Ok(Robot {
-        id,
-        name: r.name.clone(),
-        model,
-        base,
-        home,
-        tool,
-        ik,
-        ik_kind,
-        max_velocity,
-        max_acceleration,
-        group: cellplan_geom::GroupId(u32::MAX),
-        bodies: Vec::new(),
-        self_pairs: Vec::new(),
-        reach,
-    })
+        + tool.tcp.translation.length()
 }

@@ -24,32 +24,61 @@ pub fn quat_to_rpy(q: DQuat) -> [f64; 3] {
     }
 }
 
+/// Why a pose spec is not a pose.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum PoseError {
+    /// `xyz` (in metres) is not finite.
+    #[error("the translation `xyz` is not finite")]
+    Translation,
+    /// More than one of `rpy`, `quat`, `matrix`.
+    #[error("give the rotation once: one of `rpy`, `quat` or `matrix`")]
+    RotationTwice,
+    /// `rpy` is not finite.
+    #[error("`rpy` is not finite")]
+    Rpy,
+    /// `quat` is not of unit length.
+    #[error("`quat` must be a unit quaternion [x, y, z, w]; its length is {length:.6}")]
+    Quat {
+        /// Its length.
+        length: f64,
+    },
+    /// `matrix` is not orthonormal.
+    #[error(
+        "`matrix` is not a rotation: its rows are not orthonormal (RᵀR differs from I by {deviation:.2e})"
+    )]
+    NotOrthonormal {
+        /// Largest entry of |RᵀR − I|.
+        deviation: f64,
+    },
+    /// `matrix` is orthonormal but mirrors.
+    #[error("`matrix` is a reflection (determinant -1), not a rotation")]
+    Reflection,
+}
+
 /// Converts a pose spec with file units (metres per length unit, radians per angle unit).
 /// Errors say what is wrong with the rotation.
-pub fn pose_from_spec(spec: &PoseSpec, to_m: f64, to_rad: f64) -> Result<Pose, String> {
+pub fn pose_from_spec(spec: &PoseSpec, to_m: f64, to_rad: f64) -> Result<Pose, PoseError> {
     let t = DVec3::from_array(spec.xyz) * to_m;
     if !t.is_finite() {
-        return Err("the translation `xyz` is not finite".into());
+        return Err(PoseError::Translation);
     }
     let given = [spec.rpy.is_some(), spec.quat.is_some(), spec.matrix.is_some()]
         .iter()
         .filter(|&&b| b)
         .count();
     if given > 1 {
-        return Err("give the rotation once: one of `rpy`, `quat` or `matrix`".into());
+        return Err(PoseError::RotationTwice);
     }
     let rotation = if let Some(rpy) = spec.rpy {
         if rpy.iter().any(|v| !v.is_finite()) {
-            return Err("`rpy` is not finite".into());
+            return Err(PoseError::Rpy);
         }
         rpy_to_quat([rpy[0] * to_rad, rpy[1] * to_rad, rpy[2] * to_rad])
     } else if let Some(q) = spec.quat {
         let q = DQuat::from_xyzw(q[0], q[1], q[2], q[3]);
         let n = q.length();
         if !n.is_finite() || (n - 1.0).abs() > 1e-3 {
-            return Err(format!(
-                "`quat` must be a unit quaternion [x, y, z, w]; its length is {n:.6}"
-            ));
+            return Err(PoseError::Quat { length: n });
         }
         q / n
     } else if let Some(rows) = spec.matrix {
@@ -59,12 +88,10 @@ pub fn pose_from_spec(spec: &PoseSpec, to_m: f64, to_rad: f64) -> Result<Pose, S
             .iter()
             .fold(0.0f64, |a, v| a.max(v.abs()));
         if !err.is_finite() || err > 1e-6 {
-            return Err(format!(
-                "`matrix` is not a rotation: its rows are not orthonormal (RᵀR differs from I by {err:.2e})"
-            ));
+            return Err(PoseError::NotOrthonormal { deviation: err });
         }
         if m.determinant() < 0.0 {
-            return Err("`matrix` is a reflection (determinant -1), not a rotation".into());
+            return Err(PoseError::Reflection);
         }
         DQuat::from_mat3(&m).normalize()
     } else {
@@ -109,6 +136,7 @@ mod tests {
         assert!(
             pose_from_spec(&skew, 1.0, 1.0)
                 .unwrap_err()
+                .to_string()
                 .contains("orthonormal")
         );
         let mirror = PoseSpec {
@@ -118,6 +146,7 @@ mod tests {
         assert!(
             pose_from_spec(&mirror, 1.0, 1.0)
                 .unwrap_err()
+                .to_string()
                 .contains("reflection")
         );
         let long = PoseSpec {
@@ -127,6 +156,7 @@ mod tests {
         assert!(
             pose_from_spec(&long, 1.0, 1.0)
                 .unwrap_err()
+                .to_string()
                 .contains("unit quaternion")
         );
         let both = PoseSpec {

@@ -32,10 +32,31 @@ impl GenOptions {
     }
 }
 
+/// Why [`sample_tasks`] found too few points.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum TaskGenError {
+    /// The mesh has no vertices.
+    #[error("the mesh is empty")]
+    Empty,
+    /// The mesh's triangles have no area.
+    #[error("the mesh has no area")]
+    NoArea,
+    /// Fewer points qualify than asked for.
+    #[error(
+        "only {found} surface points in the region face outwards as asked, fewer than the {wanted} wanted"
+    )]
+    TooFew {
+        /// Points that qualify.
+        found: usize,
+        /// Points asked for.
+        wanted: usize,
+    },
+}
+
 /// Points and outward normals on `mesh` (mesh units and frame), named `M1`, `M2`, ... in order
 /// along the mesh's longest axis. Errors say why too few points qualify.
-pub fn sample_tasks(mesh: &Mesh, opts: &GenOptions) -> Result<Vec<Task>, String> {
-    let (lo, hi) = mesh.aabb().ok_or("the mesh is empty")?;
+pub fn sample_tasks(mesh: &Mesh, opts: &GenOptions) -> Result<Vec<Task>, TaskGenError> {
+    let (lo, hi) = mesh.aabb().ok_or(TaskGenError::Empty)?;
     let diagonal = (hi - lo).length();
     let centre = (lo + hi) / 2.0;
     let mut world = CollisionWorld::new();
@@ -49,7 +70,7 @@ pub fn sample_tasks(mesh: &Mesh, opts: &GenOptions) -> Result<Vec<Task>, String>
         cumulative.push(total);
     }
     if total <= 0.0 {
-        return Err("the mesh has no area".into());
+        return Err(TaskGenError::NoArea);
     }
     let mut rng = ChaCha8Rng::seed_from_u64(opts.seed);
     let pool_size = (opts.count * 60).max(3000);
@@ -95,11 +116,10 @@ pub fn sample_tasks(mesh: &Mesh, opts: &GenOptions) -> Result<Vec<Task>, String>
         pool.push((p, outward));
     }
     if pool.len() < opts.count {
-        return Err(format!(
-            "only {} surface points in the region face outwards as asked, fewer than the {} wanted",
-            pool.len(),
-            opts.count
-        ));
+        return Err(TaskGenError::TooFew {
+            found: pool.len(),
+            wanted: opts.count,
+        });
     }
     // Farthest-point selection from a seeded first point.
     let mut chosen = vec![rng.random_range(0..pool.len())];

@@ -2,10 +2,12 @@
 //! process shares and those its process adds ([`TaskColumn`]).
 use crate::InputError;
 use crate::io::read_bounded;
+use crate::names::serde_name;
 use crate::process::{ColumnUnit, TaskColumn};
 use cellplan_geom::DVec3;
 use serde::Serialize;
 use std::collections::HashMap;
+use std::fmt;
 use std::path::Path;
 
 /// Largest task file read (bytes).
@@ -38,28 +40,28 @@ pub enum Feature {
 }
 
 impl Feature {
-    const ALL: [(&'static str, Feature); 6] = [
-        ("surface", Feature::Surface),
-        ("hole", Feature::Hole),
-        ("slot", Feature::Slot),
-        ("edge", Feature::Edge),
-        ("thread", Feature::Thread),
-        ("stud", Feature::Stud),
+    /// Every feature type.
+    const ALL: [Feature; 6] = [
+        Feature::Surface,
+        Feature::Hole,
+        Feature::Slot,
+        Feature::Edge,
+        Feature::Thread,
+        Feature::Stud,
     ];
 
-    /// Name as in the task file.
-    pub fn name(self) -> &'static str {
-        Self::ALL
-            .iter()
-            .find(|(_, f)| *f == self)
-            .map_or("surface", |(n, _)| n)
-    }
-
+    /// The feature named `s` (as in the task file, any case).
     fn parse(s: &str) -> Option<Feature> {
         Self::ALL
-            .iter()
-            .find(|(n, _)| n.eq_ignore_ascii_case(s))
-            .map(|&(_, f)| f)
+            .into_iter()
+            .find(|f| serde_name(f).eq_ignore_ascii_case(s))
+    }
+}
+
+/// The name as in the task file (the serde name).
+impl fmt::Display for Feature {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.pad(serde_name(self))
     }
 }
 
@@ -236,8 +238,10 @@ pub fn parse_tasks(
         let feature = match feature_col.and_then(|i| record.get(i)).filter(|s| !s.is_empty()) {
             None => Feature::default(),
             Some(v) => Feature::parse(v).ok_or_else(|| {
-                err(format!("unknown feature `{v}`"))
-                    .hint("use one of surface, hole, slot, edge, thread, stud")
+                err(format!("unknown feature `{v}`")).hint(format!(
+                    "use one of {}",
+                    Feature::ALL.map(|f| serde_name(&f)).join(", ")
+                ))
             })?,
         };
         tasks.push(Task {
@@ -277,7 +281,7 @@ pub fn tasks_to_csv(tasks: &[Task], to_m: f64, to_rad: f64, columns: &[TaskColum
             format!("{:.6}", n.x),
             format!("{:.6}", n.y),
             format!("{:.6}", n.z),
-            t.feature.name().to_string(),
+            t.feature.to_string(),
         ];
         for (c, v) in columns.iter().zip(&t.values) {
             row.push(v.map_or(String::new(), |x| match c.unit {
@@ -299,6 +303,21 @@ mod tests {
         name: "tolerance",
         unit: ColumnUnit::Angle,
     }];
+
+    /// For every feature type: the serde name, `Display` and the name the task file reads agree.
+    #[test]
+    fn feature_names_are_the_serde_names() {
+        for f in Feature::ALL {
+            let json = serde_json::to_value(f).unwrap();
+            assert_eq!(json.as_str(), Some(f.to_string().as_str()));
+            assert_eq!(Feature::parse(&f.to_string()), Some(f));
+            assert_eq!(Feature::parse(&f.to_string().to_uppercase()), Some(f));
+        }
+        assert_eq!(
+            Feature::ALL.map(|f| f.to_string()).join(", "),
+            "surface, hole, slot, edge, thread, stud"
+        );
+    }
 
     fn parse(text: &str) -> Result<Vec<Task>, InputError> {
         parse_tasks(

@@ -105,7 +105,7 @@ pub fn document(strategy: Coordination) -> (Plan, coord::Coordinated) {
             ..CoordSettings::default()
         },
     )
-    .unwrap_or_else(|e| panic!("{}: {e}", strategy.name()));
+    .unwrap_or_else(|e| panic!("{}: {e}", strategy));
     (
         cellplan_core::document::build(&f.cell, &f.table, &f.outcome, &c, &f.settings, 0.0, 0.0),
         c,

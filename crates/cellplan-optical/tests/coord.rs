@@ -47,12 +47,12 @@ fn every_strategy_gives_a_verified_conflict_free_plan() {
     for strategy in Coordination::RESOLVING {
         let (doc, c) = document(strategy);
         let report = verify(&f.cell, &doc, &VerifySettings::default());
-        assert!(report.ok, "{}: {:#?}", strategy.name(), report.violations);
-        assert!(!c.before.is_empty(), "{}", strategy.name());
+        assert!(report.ok, "{}: {:#?}", strategy, report.violations);
+        assert!(!c.before.is_empty(), "{}", strategy);
         assert!(c.after.is_empty());
         assert!(c.resolved >= 1);
         // Resolving costs time or nothing; never less than the robots passing through each other.
-        assert!(doc.cycle_time_s >= free - 1e-9, "{}", strategy.name());
+        assert!(doc.cycle_time_s >= free - 1e-9, "{}", strategy);
         // The waits are in the document where the strategy made them.
         let waits: usize = doc.robots.iter().map(|r| r.waits.len()).sum();
         assert_eq!(waits > 0, c.programs.iter().any(|p| !p.waits.is_empty()));
@@ -72,12 +72,7 @@ fn best_is_no_worse_than_the_baselines_here() {
     let cycle = |s: Coordination| document(s).0.cycle_time_s;
     let best = cycle(Coordination::Best);
     for s in [Coordination::DelayStartup, Coordination::FixedPriority] {
-        assert!(
-            best <= cycle(s) + 1e-9,
-            "best {best} vs {} {}",
-            s.name(),
-            cycle(s)
-        );
+        assert!(best <= cycle(s) + 1e-9, "best {best} vs {} {}", s, cycle(s));
     }
 }
 

@@ -14,7 +14,7 @@ pub mod held_karp;
 pub mod io;
 pub mod problem;
 
-pub use error::ReadError;
+pub use error::{CostMatrixError, CoverError, Depot, GtspError, ReadError, TourError};
 pub use problem::{CostMatrix, Gtsp, SetCover, Tour};
 pub mod gtsp;
 pub use gtsp::{GtspMethod, GtspParams, Solution, solve as solve_gtsp};

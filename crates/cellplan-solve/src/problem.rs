@@ -1,5 +1,6 @@
 //! Problem data: [`CostMatrix`], the generalised TSP [`Gtsp`] with its [`Tour`], and
 //! [`SetCover`].
+use crate::error::{CostMatrixError, CoverError, Depot, GtspError, TourError};
 
 /// A dense `n × n` matrix of travel costs, row-major: `get(i, j)` is the cost of going from node
 /// `i` to node `j`. It may be asymmetric. Every entry is finite and non-negative.
@@ -12,23 +13,21 @@ pub struct CostMatrix {
 impl CostMatrix {
     /// A matrix of `n` nodes from `data` in row-major order. Fails unless `data.len() == n * n`
     /// and every entry is finite and non-negative.
-    pub fn new(n: usize, data: Vec<f64>) -> Result<Self, String> {
-        let want = n
-            .checked_mul(n)
-            .ok_or_else(|| format!("{n} nodes overflow n*n"))?;
+    pub fn new(n: usize, data: Vec<f64>) -> Result<Self, CostMatrixError> {
+        let want = n.checked_mul(n).ok_or(CostMatrixError::Overflow { n })?;
         if data.len() != want {
-            return Err(format!(
-                "a cost matrix of {n} nodes needs {want} entries (n*n), got {}",
-                data.len()
-            ));
+            return Err(CostMatrixError::Size {
+                n,
+                want,
+                got: data.len(),
+            });
         }
         if let Some(k) = data.iter().position(|c| !c.is_finite() || *c < 0.0) {
-            return Err(format!(
-                "cost ({}, {}) is {}; costs must be finite and non-negative",
-                k / n,
-                k % n,
-                data[k]
-            ));
+            return Err(CostMatrixError::Entry {
+                row: k / n,
+                col: k % n,
+                value: data[k],
+            });
         }
         Ok(CostMatrix { n, data })
     }
@@ -116,25 +115,27 @@ pub struct Gtsp {
 impl Gtsp {
     /// A GTSP without depots and with zero service times. Fails if a cluster is empty, names a
     /// node `>= costs.n()`, or shares a node with another cluster (or repeats one).
-    pub fn new(costs: CostMatrix, clusters: Vec<Vec<usize>>) -> Result<Self, String> {
+    pub fn new(costs: CostMatrix, clusters: Vec<Vec<usize>>) -> Result<Self, GtspError> {
         let n = costs.n();
         let mut owner: Vec<Option<usize>> = vec![None; n];
         for (k, cluster) in clusters.iter().enumerate() {
             if cluster.is_empty() {
-                return Err(format!(
-                    "cluster {k} is empty; every cluster needs at least one node"
-                ));
+                return Err(GtspError::EmptyCluster { cluster: k });
             }
             for &v in cluster {
                 if v >= n {
-                    return Err(format!(
-                        "cluster {k} names node {v}, but the cost matrix has only {n} nodes (0..{n})"
-                    ));
+                    return Err(GtspError::NodeOutOfRange {
+                        cluster: k,
+                        node: v,
+                        nodes: n,
+                    });
                 }
                 if let Some(other) = owner[v] {
-                    return Err(format!(
-                        "node {v} is in cluster {other} and again in cluster {k}; clusters must be disjoint"
-                    ));
+                    return Err(GtspError::SharedNode {
+                        node: v,
+                        first: other,
+                        second: k,
+                    });
                 }
                 owner[v] = Some(k);
             }
@@ -162,25 +163,26 @@ impl Gtsp {
 
     /// The same problem with fixed depots. Fails if a depot is out of range or in a cluster, or
     /// if `end` is given without `start`.
-    pub fn with_depots(mut self, start: Option<usize>, end: Option<usize>) -> Result<Self, String> {
+    pub fn with_depots(mut self, start: Option<usize>, end: Option<usize>) -> Result<Self, GtspError> {
         if start.is_none() && end.is_some() {
-            return Err(
-                "an end depot needs a start depot; give both, or only a start to return to it".into(),
-            );
+            return Err(GtspError::EndWithoutStart);
         }
         let owner = self.node_clusters();
-        for (what, d) in [("start", start), ("end", end)] {
+        for (which, d) in [(Depot::Start, start), (Depot::End, end)] {
             if let Some(d) = d {
                 if d >= self.costs.n() {
-                    return Err(format!(
-                        "{what} depot {d} is out of range; the cost matrix has {} nodes",
-                        self.costs.n()
-                    ));
+                    return Err(GtspError::DepotOutOfRange {
+                        which,
+                        depot: d,
+                        nodes: self.costs.n(),
+                    });
                 }
                 if let Some(k) = owner[d] {
-                    return Err(format!(
-                        "{what} depot {d} is in cluster {k}; depots must not belong to a cluster"
-                    ));
+                    return Err(GtspError::DepotInCluster {
+                        which,
+                        depot: d,
+                        cluster: k,
+                    });
                 }
             }
         }
@@ -191,19 +193,18 @@ impl Gtsp {
 
     /// The same problem with service times, one per node. Fails unless there are `costs.n()`
     /// values, all finite and non-negative.
-    pub fn with_service(mut self, service: Vec<f64>) -> Result<Self, String> {
+    pub fn with_service(mut self, service: Vec<f64>) -> Result<Self, GtspError> {
         if service.len() != self.costs.n() {
-            return Err(format!(
-                "{} service times given for {} nodes; give one per node",
-                service.len(),
-                self.costs.n()
-            ));
+            return Err(GtspError::ServiceCount {
+                given: service.len(),
+                nodes: self.costs.n(),
+            });
         }
         if let Some(v) = service.iter().position(|s| !s.is_finite() || *s < 0.0) {
-            return Err(format!(
-                "service time of node {v} is {}; it must be finite and non-negative",
-                service[v]
-            ));
+            return Err(GtspError::ServiceValue {
+                node: v,
+                value: service[v],
+            });
         }
         self.service = service;
         Ok(self)
@@ -254,29 +255,36 @@ impl Gtsp {
     }
 
     /// Ok if `tour` visits exactly one node of every cluster (in any order) and nothing else.
-    pub fn check(&self, tour: &Tour) -> Result<(), String> {
+    pub fn check(&self, tour: &Tour) -> Result<(), TourError> {
         let owner = self.node_clusters();
         let mut seen: Vec<Option<usize>> = vec![None; self.clusters.len()];
         for (pos, &v) in tour.nodes.iter().enumerate() {
             let Some(slot) = owner.get(v) else {
-                return Err(format!(
-                    "tour position {pos} is node {v}, out of range (the instance has {} nodes)",
-                    self.costs.n()
-                ));
+                return Err(TourError::OutOfRange {
+                    position: pos,
+                    node: v,
+                    nodes: self.costs.n(),
+                });
             };
             let Some(k) = *slot else {
-                return Err(format!("tour position {pos} is node {v}, which is in no cluster"));
+                return Err(TourError::NoCluster {
+                    position: pos,
+                    node: v,
+                });
             };
             if let Some(prev) = seen[k] {
-                return Err(format!(
-                    "cluster {k} is visited twice: node {} at position {prev} and node {v} at position {pos}",
-                    tour.nodes[prev]
-                ));
+                return Err(TourError::ClusterTwice {
+                    cluster: k,
+                    first_node: tour.nodes[prev],
+                    first_position: prev,
+                    node: v,
+                    position: pos,
+                });
             }
             seen[k] = Some(pos);
         }
         if let Some(k) = seen.iter().position(Option::is_none) {
-            return Err(format!("cluster {k} is not visited"));
+            return Err(TourError::ClusterMissing { cluster: k });
         }
         Ok(())
     }
@@ -319,18 +327,16 @@ impl SetCover {
 
     /// The total cost of `chosen` columns, or an error naming the first uncovered row or an
     /// out-of-range column.
-    pub fn cover_cost(&self, chosen: &[usize]) -> Result<f64, String> {
+    pub fn cover_cost(&self, chosen: &[usize]) -> Result<f64, CoverError> {
         let mut pick = vec![false; self.columns];
         for &c in chosen {
-            *pick.get_mut(c).ok_or_else(|| {
-                format!(
-                    "column {c} is out of range (the instance has {} columns)",
-                    self.columns
-                )
+            *pick.get_mut(c).ok_or(CoverError::ColumnOutOfRange {
+                column: c,
+                columns: self.columns,
             })? = true;
         }
         if let Some(r) = self.covers.iter().position(|cols| !cols.iter().any(|&c| pick[c])) {
-            return Err(format!("row {r} is not covered"));
+            return Err(CoverError::Uncovered { row: r });
         }
         Ok(pick
             .iter()

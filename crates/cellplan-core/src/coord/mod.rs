@@ -60,18 +60,14 @@ pub enum Coordination {
     Best,
 }
 
-impl Coordination {
-    /// Name as on the command line.
-    pub fn name(self) -> &'static str {
-        match self {
-            Coordination::None => "none",
-            Coordination::DelayStartup => "delay-startup",
-            Coordination::FixedPriority => "fixed-priority",
-            Coordination::PosePerturbation => "pose-perturbation",
-            Coordination::Best => "best",
-        }
+/// Name as on the command line and in the plan document (the serde name).
+impl std::fmt::Display for Coordination {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.pad(cellplan_model::names::serde_name(self))
     }
+}
 
+impl Coordination {
     /// Every strategy that resolves conflicts.
     pub const RESOLVING: [Coordination; 4] = [
         Coordination::DelayStartup,
@@ -661,5 +657,53 @@ fn permutations(v: &mut Vec<usize>, k: usize, out: &mut Vec<Vec<usize>>) {
         v.swap(k, i);
         permutations(v, k + 1, out);
         v.swap(k, i);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// For every coordination strategy: the serde name, `Display` and (with feature `clap`)
+    /// the command-line value agree.
+    #[test]
+    fn coordination_names_agree() {
+        let all = [
+            Coordination::None,
+            Coordination::DelayStartup,
+            Coordination::FixedPriority,
+            Coordination::PosePerturbation,
+            Coordination::Best,
+        ];
+        // A new strategy must be added to `all`.
+        for c in all {
+            match c {
+                Coordination::None
+                | Coordination::DelayStartup
+                | Coordination::FixedPriority
+                | Coordination::PosePerturbation
+                | Coordination::Best => {}
+            }
+        }
+        for c in all {
+            let name = c.to_string();
+            let json = serde_json::to_value(c).unwrap();
+            assert_eq!(json.as_str(), Some(name.as_str()));
+            assert_eq!(serde_json::from_value::<Coordination>(json).unwrap(), c);
+            #[cfg(feature = "clap")]
+            assert_eq!(clap::ValueEnum::to_possible_value(&c).unwrap().get_name(), name);
+        }
+        #[cfg(feature = "clap")]
+        assert_eq!(<Coordination as clap::ValueEnum>::value_variants(), all);
+        assert_eq!(
+            all.map(|c| c.to_string()),
+            [
+                "none",
+                "delay-startup",
+                "fixed-priority",
+                "pose-perturbation",
+                "best"
+            ]
+        );
     }
 }

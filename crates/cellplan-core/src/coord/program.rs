@@ -101,7 +101,7 @@ pub enum WaitReason {
 
 impl std::fmt::Display for WaitReason {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        crate::write_serde_name(self, f)
+        f.write_str(cellplan_model::names::serde_name(self))
     }
 }
 

@@ -15,6 +15,7 @@ use super::graph::RobotGraph;
 use super::{PlanError, PlanSettings};
 use crate::candidates::CandidateTable;
 use cellplan_model::Cell;
+use cellplan_model::names::serde_name;
 use cellplan_model::tasks::TaskId;
 use cellplan_solve::minmax::{self, MinMaxMethod, MinMaxParams, MinMaxProblem, Vehicle};
 use cellplan_solve::setcover::{self, ExactLimits, PenaltyParams};
@@ -36,14 +37,10 @@ pub enum Allocation {
     Balanced,
 }
 
-impl Allocation {
-    /// Name as on the command line and in the plan document.
-    pub fn name(self) -> &'static str {
-        match self {
-            Allocation::Proximity => "proximity",
-            Allocation::LocalRobust => "local-robust",
-            Allocation::Balanced => "balanced",
-        }
+/// Name as on the command line and in the plan document (the serde name).
+impl std::fmt::Display for Allocation {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.pad(serde_name(self))
     }
 }
 
@@ -389,4 +386,40 @@ fn tour_cost(g: &Gtsp, seed: u64) -> f64 {
         },
     )
     .cost
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// For every allocation strategy: the serde name, `Display` and (with feature `clap`) the
+    /// command-line value agree.
+    #[test]
+    fn allocation_names_agree() {
+        let all = [
+            Allocation::Proximity,
+            Allocation::LocalRobust,
+            Allocation::Balanced,
+        ];
+        // A new strategy must be added to `all`.
+        for a in all {
+            match a {
+                Allocation::Proximity | Allocation::LocalRobust | Allocation::Balanced => {}
+            }
+        }
+        for a in all {
+            let name = a.to_string();
+            let json = serde_json::to_value(a).unwrap();
+            assert_eq!(json.as_str(), Some(name.as_str()));
+            assert_eq!(serde_json::from_value::<Allocation>(json).unwrap(), a);
+            #[cfg(feature = "clap")]
+            assert_eq!(clap::ValueEnum::to_possible_value(&a).unwrap().get_name(), name);
+        }
+        #[cfg(feature = "clap")]
+        assert_eq!(<Allocation as clap::ValueEnum>::value_variants(), all);
+        assert_eq!(
+            all.map(|a| a.to_string()),
+            ["proximity", "local-robust", "balanced"]
+        );
+    }
 }

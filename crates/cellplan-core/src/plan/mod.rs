@@ -160,7 +160,7 @@ pub enum PlanError {
     #[error("the robots' task caps cannot hold every task they can do: {reason}")]
     CapsTooSmall {
         /// The solver's finding.
-        reason: String,
+        reason: cellplan_solve::minmax::MinMaxError,
     },
     /// A strategy the process does not support.
     #[error("{what} needs something the `{process}` process does not define")]
@@ -222,28 +222,25 @@ impl PlanError {
     }
 }
 
-/// The stages, for progress reports.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+/// The stages, for progress reports; serialized (and displayed) by their key in `compute_s`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
 pub enum Stage {
     /// Lower-bound move times between candidates.
     Costs,
     /// Allocation.
     Allocation,
     /// Sequencing with lazy motion planning.
+    #[serde(rename = "sequencing_motion")]
     Sequencing,
     /// Time parameterisation and assembly.
     Timing,
 }
 
-impl Stage {
-    /// Name in reports and in `compute_s`.
-    pub fn name(self) -> &'static str {
-        match self {
-            Stage::Costs => "costs",
-            Stage::Allocation => "allocation",
-            Stage::Sequencing => "sequencing_motion",
-            Stage::Timing => "timing",
-        }
+/// Name in reports and in `compute_s` (the serde name).
+impl std::fmt::Display for Stage {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.pad(cellplan_model::names::serde_name(self))
     }
 }
 
@@ -481,4 +478,31 @@ fn mixed_costs(graph: &RobotGraph, planned: &sequence::Planned) -> CostMatrix {
         data[b * n + a] = c;
     }
     CostMatrix::new(n, data).expect("same size as the graph")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// For every stage: the serde name and `Display` agree, and name a key of `compute_s`.
+    #[test]
+    fn stage_names_are_the_compute_keys() {
+        let all = [Stage::Costs, Stage::Allocation, Stage::Sequencing, Stage::Timing];
+        // A new stage must be added to `all` (and to `compute_s`).
+        for s in all {
+            match s {
+                Stage::Costs | Stage::Allocation | Stage::Sequencing | Stage::Timing => {}
+            }
+        }
+        let compute = serde_json::to_value(crate::document::ComputeTimes::default()).unwrap();
+        for s in all {
+            let name = s.to_string();
+            assert_eq!(serde_json::to_value(s).unwrap().as_str(), Some(name.as_str()));
+            assert!(compute.get(&name).is_some(), "`{name}` is not a key of compute_s");
+        }
+        assert_eq!(
+            all.map(|s| s.to_string()),
+            ["costs", "allocation", "sequencing_motion", "timing"]
+        );
+    }
 }

@@ -107,181 +107,243 @@ fn unescape(v: &str) -> String {
 
 /// Parses `text`; the error carries the line where the problem shows.
 pub(crate) fn parse(text: &str) -> Result<Document, XmlError> {
-    let mut sc = Scanner {
-        s: text.as_bytes(),
-        pos: 0,
-        line: 1,
+    let mut p = Parser {
+        sc: Scanner {
+            s: text.as_bytes(),
+            pos: 0,
+            line: 1,
+        },
+        elements: Vec::new(),
+        stack: Vec::new(),
+        root_closed: false,
     };
-    let mut elements: Vec<Element> = Vec::new();
-    let mut stack: Vec<usize> = Vec::new();
-    let mut root_closed = false;
     // A byte-order mark is allowed.
-    if sc.starts_with("\u{feff}") {
-        sc.pos += 3;
+    if p.sc.starts_with("\u{feff}") {
+        p.sc.pos += 3;
     }
-    while sc.pos < sc.s.len() {
+    while p.sc.pos < p.sc.s.len() {
+        p.step()?;
+    }
+    p.finish()
+}
+
+/// The state of [`parse`]: the scanner, the elements so far and the open ones.
+struct Parser<'a> {
+    sc: Scanner<'a>,
+    elements: Vec<Element>,
+    /// The open elements, innermost last.
+    stack: Vec<usize>,
+    root_closed: bool,
+}
+
+impl Parser<'_> {
+    /// Reads what starts at the current position: a comment, CDATA, a processing instruction,
+    /// a declaration, a closing or opening tag, or one byte of text.
+    fn step(&mut self) -> Result<(), XmlError> {
+        let sc = &mut self.sc;
         let line = sc.line;
         if sc.starts_with("<!--") {
-            sc.skip_past("-->", "comment", line)?;
+            sc.skip_past("-->", "comment", line)
         } else if sc.starts_with("<![CDATA[") {
-            if stack.is_empty() {
+            if self.stack.is_empty() {
                 return Err((line, "CDATA outside the root element".into()));
             }
-            sc.skip_past("]]>", "CDATA section", line)?;
+            sc.skip_past("]]>", "CDATA section", line)
         } else if sc.starts_with("<?") {
-            sc.skip_past("?>", "processing instruction", line)?;
+            sc.skip_past("?>", "processing instruction", line)
         } else if sc.starts_with("<!") {
-            // DOCTYPE, possibly with an internal subset in brackets.
-            let mut depth = 0i32;
-            loop {
-                match sc.peek() {
-                    None => return Err((line, "declaration `<!...` is never closed".into())),
-                    Some(b'[') => depth += 1,
-                    Some(b']') => depth -= 1,
-                    Some(b'>') if depth <= 0 => {
-                        sc.bump();
-                        break;
-                    }
-                    _ => {}
-                }
-                sc.bump();
-            }
+            self.declaration(line)
         } else if sc.starts_with("</") {
-            sc.advance(2);
-            let name = sc
-                .name()
-                .ok_or((line, "expected a tag name after `</`".to_string()))?;
-            sc.skip_ws();
-            if sc.peek() != Some(b'>') {
-                return Err((sc.line, format!("expected `>` to close `</{name}`")));
-            }
-            sc.bump();
-            let Some(open) = stack.pop() else {
-                return Err((line, format!("closing tag `</{name}>` without an opening tag")));
-            };
-            let e = &elements[open];
-            if e.name != name {
-                return Err((
-                    line,
-                    format!(
-                        "closing tag `</{name}>` does not match `<{}>` opened on line {}",
-                        e.name, e.line
-                    ),
-                ));
-            }
-            if stack.is_empty() {
-                root_closed = true;
-            }
+            self.close_tag(line)
         } else if sc.peek() == Some(b'<') {
-            sc.bump();
-            let name = sc
-                .name()
-                .ok_or((line, "expected a tag name after `<`".to_string()))?;
-            if root_closed || (stack.is_empty() && !elements.is_empty()) {
-                return Err((line, format!("element `<{name}>` after the root element ended")));
-            }
-            let mut attrs: Vec<(String, String)> = Vec::new();
-            let self_closing;
-            loop {
-                let had_ws = matches!(sc.peek(), Some(b' ' | b'\t' | b'\r' | b'\n'));
-                sc.skip_ws();
-                match sc.peek() {
-                    None => return Err((line, format!("tag `<{name}` is never closed"))),
-                    Some(b'>') => {
-                        sc.bump();
-                        self_closing = false;
-                        break;
-                    }
-                    Some(b'/') => {
-                        sc.bump();
-                        if sc.peek() != Some(b'>') {
-                            return Err((sc.line, format!("expected `>` after `/` in `<{name}`")));
-                        }
-                        sc.bump();
-                        self_closing = true;
-                        break;
-                    }
-                    _ => {}
-                }
-                let at = sc.line;
-                let Some(key) = sc.name() else {
-                    return Err((at, format!("unexpected character in tag `<{name}`")));
-                };
-                if !had_ws {
-                    return Err((
-                        at,
-                        format!("attribute `{key}` of `<{name}>` needs a space before it"),
-                    ));
-                }
-                sc.skip_ws();
-                if sc.peek() != Some(b'=') {
-                    return Err((at, format!("attribute `{key}` of `<{name}>` has no `=\"value\"`")));
-                }
-                sc.bump();
-                sc.skip_ws();
-                let quote = match sc.peek() {
-                    Some(q @ (b'"' | b'\'')) => q,
-                    _ => {
-                        return Err((
-                            sc.line,
-                            format!("value of attribute `{key}` of `<{name}>` must be quoted"),
-                        ));
-                    }
-                };
-                sc.bump();
-                let start = sc.pos;
-                while sc.peek().is_some_and(|b| b != quote) {
-                    if sc.peek() == Some(b'<') {
-                        return Err((sc.line, format!("`<` inside the value of attribute `{key}`")));
-                    }
-                    sc.bump();
-                }
-                if sc.peek().is_none() {
-                    return Err((at, format!("value of attribute `{key}` is never closed")));
-                }
-                let value = String::from_utf8_lossy(&sc.s[start..sc.pos]).into_owned();
-                sc.bump();
-                if attrs.iter().any(|(k, _)| *k == key) {
-                    return Err((at, format!("attribute `{key}` appears twice in `<{name}>`")));
-                }
-                attrs.push((key, unescape(&value)));
-            }
-            let idx = elements.len();
-            elements.push(Element {
-                name,
-                attrs,
-                line,
-                children: Vec::new(),
-            });
-            if let Some(&parent) = stack.last() {
-                elements[parent].children.push(idx);
-            }
-            if self_closing {
-                if stack.is_empty() {
-                    root_closed = true;
-                }
-            } else {
-                stack.push(idx);
-            }
+            self.open_tag(line)
         } else {
             let b = sc.peek().unwrap_or(b' ');
-            if stack.is_empty() && !b.is_ascii_whitespace() {
+            if self.stack.is_empty() && !b.is_ascii_whitespace() {
                 return Err((line, "text outside the root element".into()));
+            }
+            sc.bump();
+            Ok(())
+        }
+    }
+
+    /// Skips a `<!...>` declaration (DOCTYPE), possibly with an internal subset in brackets.
+    fn declaration(&mut self, line: usize) -> Result<(), XmlError> {
+        let sc = &mut self.sc;
+        let mut depth = 0i32;
+        loop {
+            match sc.peek() {
+                None => return Err((line, "declaration `<!...` is never closed".into())),
+                Some(b'[') => depth += 1,
+                Some(b']') => depth -= 1,
+                Some(b'>') if depth <= 0 => {
+                    sc.bump();
+                    return Ok(());
+                }
+                _ => {}
             }
             sc.bump();
         }
     }
-    if let Some(&open) = stack.last() {
-        let e = &elements[open];
-        return Err((
-            sc.line,
-            format!("element `<{}>` opened on line {} is never closed", e.name, e.line),
-        ));
+
+    /// Reads `</name>` and closes the innermost open element, which must be `name`.
+    fn close_tag(&mut self, line: usize) -> Result<(), XmlError> {
+        let sc = &mut self.sc;
+        sc.advance(2);
+        let name = sc
+            .name()
+            .ok_or((line, "expected a tag name after `</`".to_string()))?;
+        sc.skip_ws();
+        if sc.peek() != Some(b'>') {
+            return Err((sc.line, format!("expected `>` to close `</{name}`")));
+        }
+        sc.bump();
+        let Some(open) = self.stack.pop() else {
+            return Err((line, format!("closing tag `</{name}>` without an opening tag")));
+        };
+        let e = &self.elements[open];
+        if e.name != name {
+            return Err((
+                line,
+                format!(
+                    "closing tag `</{name}>` does not match `<{}>` opened on line {}",
+                    e.name, e.line
+                ),
+            ));
+        }
+        if self.stack.is_empty() {
+            self.root_closed = true;
+        }
+        Ok(())
     }
-    if elements.is_empty() {
-        return Err((1, "no XML element found".into()));
+
+    /// Reads `<name attr="value" ...>` or `<name ... />` and adds the element under the
+    /// innermost open one (opening it unless self-closing).
+    fn open_tag(&mut self, line: usize) -> Result<(), XmlError> {
+        self.sc.bump();
+        let name = self
+            .sc
+            .name()
+            .ok_or((line, "expected a tag name after `<`".to_string()))?;
+        if self.root_closed || (self.stack.is_empty() && !self.elements.is_empty()) {
+            return Err((line, format!("element `<{name}>` after the root element ended")));
+        }
+        let mut attrs: Vec<(String, String)> = Vec::new();
+        let self_closing = loop {
+            let had_ws = matches!(self.sc.peek(), Some(b' ' | b'\t' | b'\r' | b'\n'));
+            if let Some(closing) = self.tag_end(line, &name)? {
+                break closing;
+            }
+            let (key, at, value) = self.attribute(&name, had_ws)?;
+            if attrs.iter().any(|(k, _)| *k == key) {
+                return Err((at, format!("attribute `{key}` appears twice in `<{name}>`")));
+            }
+            attrs.push((key, unescape(&value)));
+        };
+        let idx = self.elements.len();
+        self.elements.push(Element {
+            name,
+            attrs,
+            line,
+            children: Vec::new(),
+        });
+        if let Some(&parent) = self.stack.last() {
+            self.elements[parent].children.push(idx);
+        }
+        if self_closing {
+            if self.stack.is_empty() {
+                self.root_closed = true;
+            }
+        } else {
+            self.stack.push(idx);
+        }
+        Ok(())
     }
-    Ok(Document { elements })
+
+    /// After white space: `Some(false)` past `>`, `Some(true)` past `/>`, `None` when an
+    /// attribute follows.
+    fn tag_end(&mut self, line: usize, name: &str) -> Result<Option<bool>, XmlError> {
+        let sc = &mut self.sc;
+        sc.skip_ws();
+        match sc.peek() {
+            None => Err((line, format!("tag `<{name}` is never closed"))),
+            Some(b'>') => {
+                sc.bump();
+                Ok(Some(false))
+            }
+            Some(b'/') => {
+                sc.bump();
+                if sc.peek() != Some(b'>') {
+                    return Err((sc.line, format!("expected `>` after `/` in `<{name}`")));
+                }
+                sc.bump();
+                Ok(Some(true))
+            }
+            _ => Ok(None),
+        }
+    }
+
+    /// One attribute `key="value"` of tag `name` (`had_ws`: white space came before it), as
+    /// (key, its line, raw value).
+    fn attribute(&mut self, name: &str, had_ws: bool) -> Result<(String, usize, String), XmlError> {
+        let sc = &mut self.sc;
+        let at = sc.line;
+        let Some(key) = sc.name() else {
+            return Err((at, format!("unexpected character in tag `<{name}`")));
+        };
+        if !had_ws {
+            return Err((
+                at,
+                format!("attribute `{key}` of `<{name}>` needs a space before it"),
+            ));
+        }
+        sc.skip_ws();
+        if sc.peek() != Some(b'=') {
+            return Err((at, format!("attribute `{key}` of `<{name}>` has no `=\"value\"`")));
+        }
+        sc.bump();
+        sc.skip_ws();
+        let quote = match sc.peek() {
+            Some(q @ (b'"' | b'\'')) => q,
+            _ => {
+                return Err((
+                    sc.line,
+                    format!("value of attribute `{key}` of `<{name}>` must be quoted"),
+                ));
+            }
+        };
+        sc.bump();
+        let start = sc.pos;
+        while sc.peek().is_some_and(|b| b != quote) {
+            if sc.peek() == Some(b'<') {
+                return Err((sc.line, format!("`<` inside the value of attribute `{key}`")));
+            }
+            sc.bump();
+        }
+        if sc.peek().is_none() {
+            return Err((at, format!("value of attribute `{key}` is never closed")));
+        }
+        let value = String::from_utf8_lossy(&sc.s[start..sc.pos]).into_owned();
+        sc.bump();
+        Ok((key, at, value))
+    }
+
+    /// The document, once every element is closed and there is one.
+    fn finish(self) -> Result<Document, XmlError> {
+        if let Some(&open) = self.stack.last() {
+            let e = &self.elements[open];
+            return Err((
+                self.sc.line,
+                format!("element `<{}>` opened on line {} is never closed", e.name, e.line),
+            ));
+        }
+        if self.elements.is_empty() {
+            return Err((1, "no XML element found".into()));
+        }
+        Ok(Document {
+            elements: self.elements,
+        })
+    }
 }
 
 #[cfg(test)]

@@ -87,7 +87,7 @@ fn parse_gtsplib_at(text: &str, path: &Path) -> Result<GtspInstance, ReadError> 
         clusters[set.id - 1] = Some(nodes);
     }
     let clusters: Vec<Vec<usize>> = clusters.into_iter().map(Option::unwrap_or_default).collect();
-    let gtsp = Gtsp::new(doc.costs, clusters).map_err(|e| ctx.invalid(Some(sl), e))?;
+    let gtsp = Gtsp::new(doc.costs, clusters).map_err(|e| ctx.invalid(Some(sl), e.to_string()))?;
     if let Some(v) = node_in_no_set(&gtsp) {
         return Err(ctx.invalid(
             Some(sl),
@@ -203,7 +203,7 @@ fn parse_glns(text: &str, ctx: Ctx<'_>) -> Result<GtspInstance, ReadError> {
     }
     let costs = read_glns_matrix(lines, ctx, n)?;
     let clusters = clusters.into_iter().map(Option::unwrap_or_default).collect();
-    let gtsp = Gtsp::new(costs, clusters).map_err(|e| ctx.invalid(None, e))?;
+    let gtsp = Gtsp::new(costs, clusters).map_err(|e| ctx.invalid(None, e.to_string()))?;
     if let Some(v) = node_in_no_set(&gtsp) {
         return Err(ctx.invalid(
             Some(ml),
@@ -264,7 +264,7 @@ fn read_glns_matrix<'t>(
             format!("the matrix has {} weights; N = {n} needs {want}", data.len()),
         ));
     }
-    CostMatrix::new(n, data).map_err(|e| ctx.invalid(None, e))
+    CostMatrix::new(n, data).map_err(|e| ctx.invalid(None, e.to_string()))
 }
 
 #[cfg(test)]

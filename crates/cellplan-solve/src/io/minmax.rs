@@ -392,7 +392,7 @@ fn parse_vehicle(
             data.push(non_negative(ctx, ln, tok, &format!("a cost of vehicle {i}"))?);
         }
     }
-    let costs = CostMatrix::new(k, data).map_err(|e| ctx.invalid(Some(matrix_line), e))?;
+    let costs = CostMatrix::new(k, data).map_err(|e| ctx.invalid(Some(matrix_line), e.to_string()))?;
 
     let (ln, l) = lines.next(&format!("ALTERNATIVES of vehicle {i}"))?;
     if l != "ALTERNATIVES" {

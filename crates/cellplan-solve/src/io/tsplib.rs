@@ -3,7 +3,7 @@ use std::collections::BTreeMap;
 use std::path::Path;
 
 use super::{Ctx, DENSE_NODES, MAX_DENSE_NODES, SETS, read_text, text_path};
-use crate::error::ReadError;
+use crate::error::{CostMatrixError, ReadError};
 use crate::problem::CostMatrix;
 
 /// A TSPLIB instance: its name, size and full cost matrix (the TSPLIB distance rules applied).
@@ -582,7 +582,7 @@ fn assemble(ctx: Ctx<'_>, header: Header, sections: Sections) -> Result<Document
         };
         coord_matrix(wt, &c)
     }
-    .map_err(|e| ctx.invalid(None, e))?;
+    .map_err(|e| ctx.invalid(None, e.to_string()))?;
     Ok(Document {
         name: header.name,
         dimension: n,
@@ -613,7 +613,8 @@ fn check_type(ctx: Ctx<'_>, ln: usize, value: &str, kind: Kind) -> Result<(), Re
     ))
 }
 
-fn explicit_matrix(n: usize, f: Format, vals: &[f64]) -> Result<CostMatrix, String> {
+/// The symmetric matrix of `n` nodes from EDGE_WEIGHT_SECTION's values in format `f`.
+fn explicit_matrix(n: usize, f: Format, vals: &[f64]) -> Result<CostMatrix, CostMatrixError> {
     let mut m = vec![0.0; n * n];
     let mut it = vals.iter().copied();
     let mut set = |i: usize, j: usize, v: f64| {
@@ -649,7 +650,8 @@ fn geo_rad(x: f64) -> f64 {
     PI * (deg + 5.0 * min / 3.0) / 180.0
 }
 
-fn coord_matrix(wt: WeightType, c: &[(f64, f64)]) -> Result<CostMatrix, String> {
+/// The matrix of TSPLIB distances of type `wt` between the coordinates `c`.
+fn coord_matrix(wt: WeightType, c: &[(f64, f64)]) -> Result<CostMatrix, CostMatrixError> {
     let n = c.len();
     let geo: Vec<(f64, f64)> = if wt == WeightType::Geo {
         c.iter().map(|&(x, y)| (geo_rad(x), geo_rad(y))).collect()

@@ -12,6 +12,8 @@ use std::time::Duration;
 
 use crate::problem::CostMatrix;
 
+pub use crate::error::{MinMaxError, RoutesError, VehicleError};
+
 mod construct;
 mod generate;
 mod ils;
@@ -43,7 +45,7 @@ impl Vehicle {
         depot: usize,
         cap: usize,
         alternatives: Vec<Vec<usize>>,
-    ) -> Result<Self, String> {
+    ) -> Result<Self, VehicleError> {
         let v = Vehicle {
             costs,
             depot,
@@ -54,22 +56,33 @@ impl Vehicle {
         Ok(v)
     }
 
-    fn validate(&self) -> Result<(), String> {
+    fn validate(&self) -> Result<(), VehicleError> {
         let n = self.costs.n();
         if self.depot >= n {
-            return Err(format!("depot {} is out of range ({n} nodes)", self.depot));
+            return Err(VehicleError::DepotOutOfRange {
+                depot: self.depot,
+                nodes: n,
+            });
         }
         let mut owner: Vec<Option<usize>> = vec![None; n];
         for (t, alts) in self.alternatives.iter().enumerate() {
             for &a in alts {
                 if a >= n {
-                    return Err(format!("task {t} names node {a}, out of range ({n} nodes)"));
+                    return Err(VehicleError::NodeOutOfRange {
+                        task: t,
+                        node: a,
+                        nodes: n,
+                    });
                 }
                 if a == self.depot {
-                    return Err(format!("task {t} names the depot {a} as an alternative"));
+                    return Err(VehicleError::DepotAsAlternative { task: t, depot: a });
                 }
                 if let Some(o) = owner[a] {
-                    return Err(format!("node {a} serves task {o} and again task {t}"));
+                    return Err(VehicleError::SharedNode {
+                        node: a,
+                        first: o,
+                        second: t,
+                    });
                 }
                 owner[a] = Some(t);
             }
@@ -101,7 +114,7 @@ impl MinMaxProblem {
         tasks: usize,
         service: Vec<f64>,
         balance_limit: Option<f64>,
-    ) -> Result<Self, String> {
+    ) -> Result<Self, MinMaxError> {
         let p = MinMaxProblem {
             vehicles,
             tasks,
@@ -113,43 +126,49 @@ impl MinMaxProblem {
     }
 
     /// The checks of [`MinMaxProblem::new`], for a problem built field by field.
-    pub fn validate(&self) -> Result<(), String> {
+    pub fn validate(&self) -> Result<(), MinMaxError> {
         if self.service.len() != self.tasks {
-            return Err(format!(
-                "{} service times for {} tasks",
-                self.service.len(),
-                self.tasks
-            ));
+            return Err(MinMaxError::ServiceCount {
+                given: self.service.len(),
+                tasks: self.tasks,
+            });
         }
         if let Some(t) = self.service.iter().position(|s| !s.is_finite() || *s < 0.0) {
-            return Err(format!("service time of task {t} is {}", self.service[t]));
+            return Err(MinMaxError::ServiceValue {
+                task: t,
+                value: self.service[t],
+            });
         }
         if let Some(g) = self.balance_limit
             && (!g.is_finite() || g < 0.0)
         {
-            return Err(format!("balance limit {g} must be finite and non-negative"));
+            return Err(MinMaxError::BalanceLimit { value: g });
         }
         for (i, v) in self.vehicles.iter().enumerate() {
             if v.alternatives.len() != self.tasks {
-                return Err(format!(
-                    "vehicle {i} has {} alternative lists for {} tasks",
-                    v.alternatives.len(),
-                    self.tasks
-                ));
+                return Err(MinMaxError::AlternativeLists {
+                    vehicle: i,
+                    lists: v.alternatives.len(),
+                    tasks: self.tasks,
+                });
             }
-            v.validate().map_err(|e| format!("vehicle {i}: {e}"))?;
+            v.validate()
+                .map_err(|error| MinMaxError::Vehicle { vehicle: i, error })?;
         }
         if let Some(t) = (0..self.tasks).find(|&t| self.capable(t).is_empty()) {
-            return Err(format!("no vehicle can do task {t}"));
+            return Err(MinMaxError::Undoable { task: t });
         }
         let cap: usize = self.vehicles.iter().map(|v| v.cap).sum();
         if cap < self.tasks {
-            return Err(format!("total cap {cap} is below the {} tasks", self.tasks));
+            return Err(MinMaxError::TotalCap {
+                cap,
+                tasks: self.tasks,
+            });
         }
         let caps: Vec<usize> = self.vehicles.iter().map(|v| v.cap).collect();
         assign_within_caps(self.tasks, &caps, |v, t| self.can_do(v, t))
             .map(|_| ())
-            .map_err(|t| format!("the caps admit no assignment of every task (stuck at task {t})"))
+            .map_err(|task| MinMaxError::NoAssignment { task })
     }
 
     /// Whether vehicle `v` can do task `t`.
@@ -219,41 +238,46 @@ impl Routes {
 
     /// Ok if there is one tour per vehicle, every task is done exactly once by a vehicle that
     /// can do it at one of its nodes for it, and no vehicle exceeds its cap.
-    pub fn check(&self, p: &MinMaxProblem) -> Result<(), String> {
+    pub fn check(&self, p: &MinMaxProblem) -> Result<(), RoutesError> {
         if self.tours.len() != p.vehicles.len() {
-            return Err(format!(
-                "{} tours for {} vehicles",
-                self.tours.len(),
-                p.vehicles.len()
-            ));
+            return Err(RoutesError::TourCount {
+                tours: self.tours.len(),
+                vehicles: p.vehicles.len(),
+            });
         }
         let mut done: Vec<Option<usize>> = vec![None; p.tasks];
         for (v, tour) in self.tours.iter().enumerate() {
             let veh = &p.vehicles[v];
             if tour.len() > veh.cap {
-                return Err(format!(
-                    "vehicle {v} has {} tasks, over its cap {}",
-                    tour.len(),
-                    veh.cap
-                ));
+                return Err(RoutesError::OverCap {
+                    vehicle: v,
+                    tasks: tour.len(),
+                    cap: veh.cap,
+                });
             }
             for &(t, node) in tour {
                 if t >= p.tasks {
-                    return Err(format!("vehicle {v} visits task {t}, out of range"));
+                    return Err(RoutesError::TaskOutOfRange { vehicle: v, task: t });
                 }
                 if !veh.alternatives[t].contains(&node) {
-                    return Err(format!(
-                        "vehicle {v} does task {t} at node {node}, not one of its alternatives"
-                    ));
+                    return Err(RoutesError::NotAlternative {
+                        vehicle: v,
+                        task: t,
+                        node,
+                    });
                 }
                 if let Some(w) = done[t] {
-                    return Err(format!("task {t} is done by vehicle {w} and again by {v}"));
+                    return Err(RoutesError::DoneTwice {
+                        task: t,
+                        first: w,
+                        second: v,
+                    });
                 }
                 done[t] = Some(v);
             }
         }
         if let Some(t) = done.iter().position(Option::is_none) {
-            return Err(format!("task {t} is not done"));
+            return Err(RoutesError::NotDone { task: t });
         }
         Ok(())
     }
