@@ -1,11 +1,13 @@
 //! `cellplan plan`: the main job.
 use crate::{Failure, load_options, spinner};
+use cellplan_core::CandidateTable;
 use cellplan_core::coord::{CoordSettings, Coordination};
 use cellplan_core::document as output;
 use cellplan_core::pipeline::{self, PipelineError, Step};
 use cellplan_core::plan::{Allocation, CoverMethod, MoveModel, PlanSettings, Stage};
-use cellplan_model::InputError;
 use cellplan_model::io::{check_writable, write_all_atomic};
+use cellplan_model::{Cell, InputError};
+use cellplan_verify::VerifySettings;
 use clap::Args;
 use serde::Serialize;
 use std::path::PathBuf;
@@ -168,14 +170,20 @@ pub fn run(args: &PlanArgs) -> Result<(), Failure> {
             })
         }
     };
-    let run = pipeline::run(&cell, &settings, &coord_settings, load_s, &progress).map_err(|e| match e {
-        PipelineError::Input(e) => Failure::Input(e),
-        PipelineError::Plan(e) if e.is_input() => Failure::Input(Box::new(
-            InputError::new(&cell.path, e.to_string())
-                .hint("see `task_cap` and `balance_limit` in the [planning] table of the cell file"),
-        )),
-        PipelineError::Plan(e) => Failure::Other(e.to_string()),
-    })?;
+    let verifier = |cell: &Cell, table: &CandidateTable, plan: &output::Plan| {
+        let report = cellplan_verify::verify_with(cell, Some(table), plan, &VerifySettings::default());
+        (report.ok, report)
+    };
+    let run = pipeline::run(&cell, &settings, &coord_settings, load_s, &progress, &verifier).map_err(
+        |e| match e {
+            PipelineError::Input(e) => Failure::Input(e),
+            PipelineError::Plan(e) if e.is_input() => Failure::Input(Box::new(
+                InputError::new(&cell.path, e.to_string())
+                    .hint("see `task_cap` and `balance_limit` in the [planning] table of the cell file"),
+            )),
+            PipelineError::Plan(e) => Failure::Other(e.to_string()),
+        },
+    )?;
     let (mut doc, report) = (run.plan, run.report);
     if !report.ok && !args.no_verify {
         pb.finish_and_clear();

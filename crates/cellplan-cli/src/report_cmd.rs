@@ -2,13 +2,13 @@
 use crate::Failure;
 use cellplan_core::Plan;
 use cellplan_core::document::{self, DocumentError};
-use cellplan_core::verify::{self, VerifySettings};
 use cellplan_model::{
     Cell, InputError, LoadOptions,
     io::{write_all_atomic, write_atomic},
 };
 use cellplan_report::html::{PlanReport, plan_html};
 use cellplan_report::scene::{MESH_BUDGET, Scene};
+use cellplan_verify::{self as verify, VerifySettings};
 use clap::Args;
 use std::path::{Path, PathBuf};
 use std::time::Instant;

@@ -1,7 +1,7 @@
 //! `cellplan verify`: the independent check of a plan.
 use crate::Failure;
-use cellplan_core::verify::{VerifySettings, Violation, verify};
 use cellplan_model::LoadOptions;
+use cellplan_verify::{VerifySettings, Violation, verify};
 use clap::Args;
 use std::path::PathBuf;
 
@@ -36,7 +36,7 @@ pub fn run(args: &VerifyArgs) -> Result<(), Failure> {
         time_step: args.time_step,
         ..VerifySettings::default()
     };
-    if let Some(why) = cellplan_core::verify::too_large(&plan, &settings) {
+    if let Some(why) = cellplan_verify::too_large(&plan, &settings) {
         return Err(Failure::Input(Box::new(
             cellplan_model::InputError::new(&args.plan, format!("the plan is too large to check: {why}"))
                 .hint("give a larger --time-step, or check a plan `cellplan plan` wrote"),

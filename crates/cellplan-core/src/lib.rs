@@ -2,7 +2,7 @@
 //! [`candidates`] (every task × robot: the feasible configurations, or why there are none);
 //! [`plan`] allocates, sequences, plans collision-free legs ([`motion`]) and times them;
 //! [`coord`] puts every robot on one clock and resolves robot–robot conflicts; [`document`] is
-//! the Plan document and [`verify`] its independent check; [`pipeline`] runs the stages as
+//! the Plan document (its independent check is the `cellplan-verify` crate); [`pipeline`] runs the stages as
 //! `cellplan plan` does and owns the choice of "ours" once. No process is named here: what
 //! differs between processes comes through [`cellplan_model::Process`].
 #![warn(missing_docs)]
@@ -14,7 +14,6 @@ pub mod document;
 pub mod motion;
 pub mod pipeline;
 pub mod plan;
-pub mod verify;
 
 pub use candidates::{Candidate, CandidateTable};
 pub use document::Plan;

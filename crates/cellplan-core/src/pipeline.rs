@@ -8,7 +8,6 @@ use crate::check::{cap_error, idle_robot_error};
 use crate::coord::{CoordSettings, Coordinated, Coordination, coordinate_outcome, cycle_and_delta};
 use crate::document::{self, Plan};
 use crate::plan::{self, Allocation, Outcome, PlanError, PlanSettings, Stage};
-use crate::verify::{self, VerifySettings};
 use cellplan_model::{Cell, InputError};
 use std::time::Instant;
 
@@ -42,24 +41,29 @@ pub enum PipelineError {
 
 /// What a run made.
 #[derive(Debug)]
-pub struct Run {
+pub struct Run<R> {
     /// The candidate table.
     pub table: CandidateTable,
-    /// The plan document (`verified` set from `report`).
+    /// The plan document (`verified` set from the verifier's verdict).
     pub plan: Plan,
     /// The verifier's report on it.
-    pub report: verify::Report,
+    pub report: R,
 }
 
+/// The independent check a run ends with (`cellplan_verify` provides it; the core does not
+/// depend on its verifier): the verdict and the report.
+pub type Verifier<'a, R> = &'a dyn Fn(&Cell, &CandidateTable, &Plan) -> (bool, R);
+
 /// Runs the whole pipeline on a loaded cell: `load_s` is what loading took (for the
-/// document's compute times).
-pub fn run(
+/// document's compute times); `verify` checks the document at the end.
+pub fn run<R>(
     cell: &Cell,
     settings: &PlanSettings,
     coord: &CoordSettings,
     load_s: f64,
     progress: &(dyn Fn(Step) + Sync),
-) -> Result<Run, PipelineError> {
+    verify: Verifier<'_, R>,
+) -> Result<Run<R>, PipelineError> {
     if !cell.process.relations().is_empty() {
         // Precedence and pairing are part of the interface for the processes to come; no
         // allocation or sequencing honours them yet, so a plan that ignored them would be wrong.
@@ -92,9 +96,9 @@ pub fn run(
     );
     progress(Step::Verification);
     let lap = Instant::now();
-    let report = verify::verify_with(cell, Some(&table), &plan, &VerifySettings::default());
+    let (ok, report) = verify(cell, &table, &plan);
     plan.compute_s.verification = lap.elapsed().as_secs_f64();
-    plan.verified = report.ok;
+    plan.verified = ok;
     Ok(Run { table, plan, report })
 }
 

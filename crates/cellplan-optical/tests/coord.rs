@@ -5,10 +5,10 @@
 //! rejected, naming the conflict; injected faults must be caught.
 use cellplan_core::coord::{self, Coordination};
 use cellplan_core::document as output;
-use cellplan_core::verify::{VerifySettings, ViolationKind, verify};
 use cellplan_model::LoadOptions;
 use cellplan_optical::load;
 use cellplan_optical::testing::{crossing_cell, document, fixture};
+use cellplan_verify::{VerifySettings, ViolationKind, verify};
 
 #[test]
 fn the_uncoordinated_plan_has_a_conflict_and_the_verifier_names_it() {

@@ -11,9 +11,9 @@ use super::playback::{Doing, intervals, probe_track};
 use super::scene::{Scene, SceneRobot, robot_colour};
 use base64::Engine;
 use cellplan_core::document::{ConflictOut, Plan, RobotPlan};
-use cellplan_core::verify;
 use cellplan_geom::{DVec3, Pose};
 use cellplan_model::Cell;
+use cellplan_verify as verify;
 use maud::{DOCTYPE, Markup, PreEscaped, html};
 use serde_json::{Value, json};
 

@@ -2,8 +2,8 @@
 //! example with the robots' paths crossing, from `cellplan_optical::testing`): the HTML page,
 //! the drawn scene, the glTF and the CSV files.
 use cellplan_core::coord::Coordination;
-use cellplan_core::verify::{VerifySettings, verify};
 use cellplan_optical::testing::{document, fixture};
+use cellplan_verify::{VerifySettings, verify};
 
 /// Reads `count` × `width` little-endian floats of accessor `a` from the GLB's binary chunk.
 fn floats(a: &gltf::Accessor, blob: &[u8], width: usize) -> Vec<f32> {

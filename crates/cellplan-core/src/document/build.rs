@@ -58,7 +58,7 @@ pub fn build(
 }
 
 /// `cycle / lower_bound`, 1 when the bound is 0.
-pub(crate) fn ratio(cycle: f64, lower_bound: f64) -> f64 {
+pub fn ratio(cycle: f64, lower_bound: f64) -> f64 {
     if lower_bound > 0.0 {
         cycle / lower_bound
     } else {
@@ -213,7 +213,7 @@ fn unmeasured(cell: &Cell, table: &CandidateTable) -> Vec<UnmeasuredTask> {
 }
 
 /// The code of the furthest rejection of task `t` over the robots.
-pub(crate) fn unmeasured_reason(table: &CandidateTable, t: usize) -> &'static str {
+pub fn unmeasured_reason(table: &CandidateTable, t: usize) -> &'static str {
     table.table[t]
         .iter()
         .filter_map(|reach| reach.reason())

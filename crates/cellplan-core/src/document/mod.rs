@@ -1,6 +1,6 @@
 //! The Plan document (`docs/plan-format.md`, schema `docs/plan.schema.json`, generated from
 //! these types): versioned JSON, SI units (m, rad, s), written atomically. Its key names are
-//! stable. Every number it states about the plan is recomputed by [`crate::verify`]; `stats`
+//! stable. Every number it states about the plan is recomputed by the `cellplan-verify` crate; `stats`
 //! and `compute_s` describe the search that found it and are not claims about the plan.
 //!
 //! A document read from a file is checked by [`validate`] (sizes, magnitudes, orders) before
@@ -9,7 +9,7 @@ mod build;
 mod validate;
 
 pub use build::{build, process_settings};
-pub(crate) use build::{ratio, unmeasured_reason};
+pub use build::{ratio, unmeasured_reason};
 pub use validate::{DocumentError, MAX_PLAN_BYTES, matches_cell, read, validate};
 
 use crate::coord::{Coordination, WaitReason};

@@ -14,7 +14,7 @@
 //! - [`record`]: the settings the cell fixes, the cycle time, Δt, the lower bound (recomputed
 //!   from the candidates), the coordination record and the candidate count.
 //!
-//! Before any of that the document is [`validate`](crate::document::validate)d, and a plan too
+//! Before any of that the document is [`validate`](cellplan_core::document::validate)d, and a plan too
 //! large to check at the requested resolution is refused ([`workload`]).
 mod paths;
 mod record;
@@ -22,8 +22,8 @@ mod robots;
 mod tasks;
 mod timing;
 
-use crate::candidates::{self, CandidateTable};
-use crate::document::{Plan, RobotPlan, validate};
+use cellplan_core::candidates::{self, CandidateTable};
+use cellplan_core::document::{Plan, RobotPlan, validate};
 use cellplan_model::Cell;
 use cellplan_model::robot::Robot;
 use serde::Serialize;

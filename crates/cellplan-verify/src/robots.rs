@@ -2,7 +2,7 @@
 //! reported once per robot pair and time interval.
 use super::timing::position;
 use super::{VerifySettings, Violation, ViolationKind};
-use crate::document::RobotPlan;
+use cellplan_core::document::RobotPlan;
 use cellplan_model::Cell;
 use cellplan_model::robot::{Robot, Scratch};
 use std::collections::BTreeMap;

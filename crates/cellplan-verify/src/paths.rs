@@ -2,8 +2,8 @@
 //! joint step against the static scene and the robot itself; and the trajectory walked
 //! forward along them, so that the motion checked is the motion timed.
 use super::{VerifySettings, Violation, ViolationKind};
-use crate::document::{LegOut, RobotPlan};
-use crate::plan::Stop;
+use cellplan_core::document::{LegOut, RobotPlan};
+use cellplan_core::plan::Stop;
 use cellplan_geom::BodyContact;
 use cellplan_model::Cell;
 use cellplan_model::robot::{Robot, Scratch};

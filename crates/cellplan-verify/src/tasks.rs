@@ -1,8 +1,8 @@
 //! Every task done exactly once, by a robot that can do it, at a pose the process accepts and
 //! with the figures the process gives; the unmeasured list exactly the tasks nobody can do.
 use super::{Violation, ViolationKind};
-use crate::candidates::CandidateTable;
-use crate::document::{Plan, RobotPlan, Visit};
+use cellplan_core::candidates::CandidateTable;
+use cellplan_core::document::{Plan, RobotPlan, Visit};
 use cellplan_geom::DVec3;
 use cellplan_model::Cell;
 use cellplan_model::robot::{Robot, Scratch};
@@ -214,7 +214,7 @@ fn check_counts(cell: &Cell, table: &CandidateTable, plan: &Plan, count: &[usize
             _ => {}
         }
         if let Some(&reason) = listed.get(name) {
-            let expected = crate::document::unmeasured_reason(table, t);
+            let expected = cellplan_core::document::unmeasured_reason(table, t);
             if doable {
                 out.push(task_violation(
                     ViolationKind::Unmeasured,

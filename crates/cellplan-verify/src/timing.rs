@@ -5,7 +5,7 @@
 //! the robot's totals recomputed from all that.
 use super::paths::{dist, name};
 use super::{VerifySettings, Violation, ViolationKind};
-use crate::document::{Plan, RobotPlan, Sample};
+use cellplan_core::document::{Plan, RobotPlan, Sample};
 use cellplan_model::Cell;
 use cellplan_model::robot::Robot;
 

@@ -3,10 +3,10 @@
 //! coordination record (strategy, wait and pose counts, priority, the tracks before
 //! coordination and the conflicts met on them).
 use super::{Violation, ViolationKind};
-use crate::candidates::CandidateTable;
-use crate::document::{self, ActivityOut, ConflictOut, Plan, ProbeTrack, RobotPlan};
-use crate::plan::allocate;
-use crate::plan::graph::RobotGraph;
+use cellplan_core::candidates::CandidateTable;
+use cellplan_core::document::{self, ActivityOut, ConflictOut, Plan, ProbeTrack, RobotPlan};
+use cellplan_core::plan::allocate;
+use cellplan_core::plan::graph::RobotGraph;
 use cellplan_geom::DVec3;
 use cellplan_model::Cell;
 use cellplan_model::robot::Robot;
@@ -138,7 +138,7 @@ fn coordination(plan: &Plan, robots: &[(&Robot, &RobotPlan)], out: &mut Vec<Viol
             }
         }
     }
-    if c.strategy != crate::coord::Coordination::None && !c.conflicts_after.is_empty() {
+    if c.strategy != cellplan_core::coord::Coordination::None && !c.conflicts_after.is_empty() {
         totals(format!(
             "{} conflicts left, but the strategy resolves conflicts",
             c.conflicts_after.len()
