@@ -83,7 +83,7 @@ fn load_cell(plan_path: &Path, plan: &Plan, cell: &Option<PathBuf>) -> Result<Ce
         }
     };
     let cell = crate::load_cell(&path, &LoadOptions::default())?;
-    document::matches_cell(plan, &cell).map_err(|e| mismatch(plan_path)(e.to_string()))?;
+    document::matches_cell(plan, &cell).map_err(mismatch(plan_path))?;
     if cell.name != plan.cell {
         eprintln!(
             "note: the plan was made for cell `{}`, {} is cell `{}`",
@@ -95,10 +95,10 @@ fn load_cell(plan_path: &Path, plan: &Plan, cell: &Option<PathBuf>) -> Result<Ce
     Ok(cell)
 }
 
-fn mismatch(plan_path: &Path) -> impl Fn(String) -> Failure + '_ {
+fn mismatch<E: std::fmt::Display>(plan_path: &Path) -> impl Fn(E) -> Failure + '_ {
     move |m| {
         Failure::Input(Box::new(
-            InputError::new(plan_path, m).hint("give the cell file the plan was made for"),
+            InputError::new(plan_path, m.to_string()).hint("give the cell file the plan was made for"),
         ))
     }
 }

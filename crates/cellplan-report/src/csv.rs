@@ -10,7 +10,7 @@ use cellplan_core::document::{Plan, RobotPlan};
 use std::fmt::Write;
 
 /// The files to write: `(file name, contents)`, two per robot.
-pub fn files(plan: &Plan, scene: &Scene) -> Result<Vec<(String, String)>, String> {
+pub fn files(plan: &Plan, scene: &Scene) -> Result<Vec<(String, String)>, crate::scene::Mismatch> {
     let order = scene.match_plan(plan)?;
     let mut out = Vec::new();
     for (rp, &k) in plan.robots.iter().zip(&order) {

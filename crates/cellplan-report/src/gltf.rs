@@ -85,7 +85,7 @@ fn node(name: &str, pose: &Pose) -> Value {
 ///
 /// The steps: the static objects, each robot (its node chain with geometry and joint
 /// animation, and its probe path), the MPs as lines, then the root and the container.
-pub fn glb(plan: &Plan, cell: &Cell, scene: &Scene) -> Result<Vec<u8>, String> {
+pub fn glb(plan: &Plan, cell: &Cell, scene: &Scene) -> Result<Vec<u8>, crate::scene::Mismatch> {
     let order = scene.match_plan(plan)?;
     let mut b = Builder::new(scene);
     b.statics();

@@ -75,15 +75,6 @@ pub fn long_axis(cell: &Cell) -> usize {
     if extent(1) > extent(0) { 1 } else { 0 }
 }
 
-/// A serde enum's wire name (`"balanced"`, `"pose-perturbation"`).
-fn json_word<T: serde::Serialize>(v: &T) -> String {
-    match serde_json::to_value(v) {
-        Ok(Value::String(s)) => s,
-        Ok(other) => other.to_string(),
-        Err(_) => String::new(),
-    }
-}
-
 /// `<head>` of every page: the title and the report's style sheet.
 fn head(title: &str) -> Markup {
     html! {
@@ -169,7 +160,7 @@ fn shown_conflicts(plan: &Plan) -> &[ConflictOut] {
 ///
 /// Fails (with a sentence) when the plan does not fit the cell: a robot missing, or other
 /// joints.
-pub fn plan_html(rep: &PlanReport) -> Result<String, String> {
+pub fn plan_html(rep: &PlanReport) -> Result<String, crate::scene::Mismatch> {
     let (plan, cell, scene) = (rep.plan, rep.cell, rep.scene);
     let order = scene.match_plan(plan)?;
     let axis = long_axis(cell);
@@ -230,8 +221,8 @@ fn heading(rep: &PlanReport, title: &str) -> Markup {
             @if let Some(file) = rep.plan_file {
                 ", plan " code { (file) }
             }
-            " — " (json_word(&plan.settings.allocation)) " allocation, "
-            (json_word(&plan.settings.coordination)) " coordination, seed "
+            " — " (plan.settings.allocation) " allocation, "
+            (plan.settings.coordination) " coordination, seed "
             (plan.settings.seed) "."
         }
     }
@@ -289,10 +280,7 @@ fn time_position_section(plan: &Plan, tracks: &ChartTracks, axis: usize, t_end: 
     let (after_title, after_marks) = if c.conflicts_after.is_empty() {
         let title = format!(
             "After coordination ({}): {} wait(s), {} pose(s) changed, cycle {:.2} s",
-            json_word(&c.strategy),
-            c.waits,
-            c.poses_changed,
-            plan.cycle_time_s
+            c.strategy, c.waits, c.poses_changed, plan.cycle_time_s
         );
         (title, Marks::Resolution(plan))
     } else {
@@ -448,7 +436,7 @@ fn coordination_section(plan: &Plan) -> Markup {
         section id="coordination" {
             h2 { "Coordination" }
             p {
-                "Strategy " b { (json_word(&c.strategy)) }
+                "Strategy " b { (c.strategy) }
                 @if !c.priority.is_empty() { ", priority " (c.priority.join(" > ")) }
                 "; " (c.conflicts_before.len()) " conflict(s) in the programs before coordination, "
                 (plan.stats.conflicts_resolved) " resolution(s), " (format_args!("{:.1}", plan.compute_s.coordination))

@@ -108,6 +108,27 @@ pub fn robot_colour(r: usize) -> [f32; 3] {
     [byte(1), byte(3), byte(5)]
 }
 
+/// Why a plan cannot be drawn in a cell's scene.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum Mismatch {
+    /// A robot of the plan the cell does not have.
+    #[error("the plan's robot {robot} is not in the cell")]
+    NoRobot {
+        /// Its name.
+        robot: String,
+    },
+    /// A robot with another joint count.
+    #[error("robot {robot} has {cell} joints in the cell, the plan gives {plan}")]
+    Joints {
+        /// Its name.
+        robot: String,
+        /// Joints in the cell.
+        cell: usize,
+        /// Joints in the plan.
+        plan: usize,
+    },
+}
+
 impl Scene {
     /// The scene of `cell`, meshes decimated to `budget` triangles each.
     pub fn new(cell: &Cell, budget: usize) -> Scene {
@@ -206,7 +227,7 @@ impl Scene {
 
     /// The scene's robots matched to a plan's, in the plan's order: an error names the first
     /// robot that does not fit (missing from the cell, or a different number of joints).
-    pub fn match_plan(&self, plan: &Plan) -> Result<Vec<usize>, String> {
+    pub fn match_plan(&self, plan: &Plan) -> Result<Vec<usize>, Mismatch> {
         plan.robots
             .iter()
             .map(|rp| {
@@ -214,14 +235,16 @@ impl Scene {
                     .robots
                     .iter()
                     .position(|r| r.name == rp.name)
-                    .ok_or_else(|| format!("the plan's robot {} is not in the cell", rp.name))?;
+                    .ok_or_else(|| Mismatch::NoRobot {
+                        robot: rp.name.clone(),
+                    })?;
                 let dof = self.robots[k].model.chain.dof();
                 if rp.joints.len() != dof || rp.trajectory.iter().any(|s| s.q.len() != dof) {
-                    return Err(format!(
-                        "robot {} has {dof} joints in the cell, the plan gives {}",
-                        rp.name,
-                        rp.joints.len()
-                    ));
+                    return Err(Mismatch::Joints {
+                        robot: rp.name.clone(),
+                        cell: dof,
+                        plan: rp.joints.len(),
+                    });
                 }
                 Ok(k)
             })

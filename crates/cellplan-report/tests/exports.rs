@@ -119,7 +119,11 @@ fn the_report_shows_the_plan_its_conflicts_and_its_waits() {
         plan_file: None,
     })
     .unwrap_err();
-    assert!(err.contains("R9"), "{err}");
+    assert_eq!(
+        err,
+        cellplan_report::scene::Mismatch::NoRobot { robot: "R9".into() },
+        "{err}"
+    );
 }
 
 /// Robots of one model share their meshes; a small budget decimates every drawn mesh.
