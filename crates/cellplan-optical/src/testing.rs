@@ -19,11 +19,14 @@ pub fn repo_root() -> PathBuf {
         .unwrap()
 }
 
-/// The temporary folder `cellplan-{name}-{pid}` of this process, created.
+/// A fresh temporary folder `cellplan-{name}-XXXXXX`, created and kept (fixtures live as long
+/// as the test process).
 pub fn scratch_dir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("cellplan-{name}-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+    tempfile::Builder::new()
+        .prefix(&format!("cellplan-{name}-"))
+        .tempdir()
+        .unwrap()
+        .keep()
 }
 
 /// The bundled two-robot example with only its first `tasks` MPs, named `name` and its

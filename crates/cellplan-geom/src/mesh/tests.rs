@@ -1,5 +1,4 @@
 use super::*;
-use std::sync::atomic::{AtomicUsize, Ordering};
 
 /// A flat square grid of `n` × `n` cells, two triangles each, on z = 0.
 fn grid(n: u32) -> Mesh {
@@ -41,13 +40,15 @@ fn decimation_meets_the_budget_and_keeps_the_shape() {
     assert_eq!(m.decimated(20_000), m);
 }
 
-/// Writes `bytes` to a fresh file named `*.{ext}` in the temp dir.
+/// Writes `bytes` to a fresh file named `*.{ext}` in the temp dir (kept: the caller removes it).
 fn temp_file(ext: &str, bytes: &[u8]) -> PathBuf {
-    static N: AtomicUsize = AtomicUsize::new(0);
-    let n = N.fetch_add(1, Ordering::Relaxed);
-    let path = std::env::temp_dir().join(format!("cellplan-geom-test-{}-{n}.{ext}", std::process::id()));
-    std::fs::write(&path, bytes).unwrap();
-    path
+    let file = tempfile::Builder::new()
+        .prefix("cellplan-geom-test-")
+        .suffix(&format!(".{ext}"))
+        .tempfile()
+        .unwrap();
+    std::fs::write(file.path(), bytes).unwrap();
+    file.into_temp_path().keep().unwrap()
 }
 
 fn load_temp(ext: &str, bytes: &[u8]) -> Result<Mesh, MeshError> {

@@ -584,13 +584,11 @@ EOF
             e.to_string().starts_with("<text>: not a valid min-max problem"),
             "{e}"
         );
-        let dir = std::env::temp_dir().join(format!("cellplan-minmax-io-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        let f = dir.join("bad.minmax");
+        let dir = tempfile::tempdir().unwrap();
+        let f = dir.path().join("bad.minmax");
         std::fs::write(&f, &text).unwrap();
         let e = read_minmax(&f).unwrap_err();
         assert_eq!(e.path(), f.as_path());
         assert!(e.to_string().contains("bad.minmax"), "{e}");
-        let _ = std::fs::remove_dir_all(&dir);
     }
 }
