@@ -78,6 +78,9 @@ def make_tf(xyz, rot):
     return t
 
 
+_I3 = np.eye(3)
+
+
 def axis_angle_batch(axis, angles):
     """(N,3,3) rotations about a unit axis (Rodrigues)."""
     a = np.asarray(axis, dtype=float)
@@ -172,6 +175,10 @@ class Robot:
                 order.append(j)
                 stack.append(j["child"])
         self.joints = order
+        for j in order:
+            x, y, z = j["axis"]
+            j["K"] = np.array([[0, -z, y], [z, 0, -x], [-y, x, 0]])
+            j["K2"] = j["K"] @ j["K"]
         self.parent_joint = {j["child"]: j for j in order}
         movable = [j["name"] for j in order if j["type"] in ("revolute", "continuous", "prismatic")]
         self.active = list(active_joints) if active_joints is not None else movable
@@ -295,8 +302,10 @@ class Robot:
         for j in self.joints:
             t = frames[j["parent"]] @ j["origin"]
             if j["type"] in ("revolute", "continuous"):
+                a = qs[:, self.index[j["name"]]]
                 m = np.zeros((n, 4, 4))
-                m[:, :3, :3] = axis_angle_batch(j["axis"], qs[:, self.index[j["name"]]])
+                # Rodrigues: I + sin(a) K + (1 - cos(a)) K^2, K the axis' cross-product matrix
+                m[:, :3, :3] = _I3 + np.sin(a)[:, None, None] * j["K"] + (1 - np.cos(a))[:, None, None] * j["K2"]
                 m[:, 3, 3] = 1.0
                 t = t @ m
             frames[j["child"]] = t
@@ -397,6 +406,13 @@ class CollisionModel:
         self.obs_center = np.array([t[:3, 3] for t in self.obs_tf]).reshape(-1, 3)
         self.obs_radius = np.array([obstacle_radius(o) for o in obstacles])
         self.obs_rot = np.array([t[:3, :3] for t in self.obs_tf]).reshape(-1, 3, 3)
+        self.links = list(robot.collision_links)
+        self.link_c = np.array([robot.sphere[l][0] for l in self.links])
+        self.link_r = np.array([robot.sphere[l][1] for l in self.links])
+        index = {l: i for i, l in enumerate(self.links)}
+        self.pair_a = np.array([index[a] for a, _ in robot.moving_pairs], dtype=int)
+        self.pair_b = np.array([index[b] for _, b in robot.moving_pairs], dtype=int)
+        self.pair_r = self.link_r[self.pair_a] + self.link_r[self.pair_b]
         self.obs_half = np.array([obstacle_half_box(o) for o in obstacles]).reshape(-1, 3)
         self.req = fcl.CollisionRequest()
         self.req_contacts = fcl.CollisionRequest(num_max_contacts=1000, enable_contact=True)
@@ -445,25 +461,22 @@ class CollisionModel:
             obj.setTransform(self.fcl.Transform(t[:3, :3], t[:3, 3]))
 
     def candidates(self, frames):
-        """Broad phase for a batch: per link, a boolean (N, n_obstacles) array of the obstacles
-        whose bounding box the link's bounding sphere reaches; per self pair, a boolean (N,) array
-        of overlapping link spheres. Conservative: FCL decides every candidate."""
-        env, selfc, centers = {}, {}, {}
-        for l in self.robot.collision_links:
-            c, r = self.robot.sphere[l]
-            f = frames[l]
-            w = f[:, :3, :3] @ c + f[:, :3, 3]
-            centers[l] = (w, r)
-            if len(self.obstacles):
-                # distance from the link's sphere centre to each obstacle's bounding box
-                p = np.einsum("nkj,kji->nki", w[:, None, :] - self.obs_center[None], self.obs_rot)
-                gap = np.maximum(np.abs(p) - self.obs_half[None], 0.0)
-                env[l] = np.linalg.norm(gap, axis=2) <= r + 1e-9
-            else:
-                env[l] = np.zeros((len(w), 0), dtype=bool)
-        for a, b in self.robot.moving_pairs:
-            (wa, ra), (wb, rb) = centers[a], centers[b]
-            selfc[(a, b)] = np.linalg.norm(wa - wb, axis=1) <= ra + rb + 1e-9
+        """Broad phase for a batch, all links at once: env (N, links, obstacles) is True where the
+        link's bounding sphere reaches the obstacle's bounding box; selfc (N, moving pairs) where
+        the two links' spheres overlap. Conservative: FCL decides every candidate."""
+        f = np.stack([frames[l] for l in self.links], axis=1)  # (N, L, 4, 4)
+        w = np.einsum("nlij,lj->nli", f[:, :, :3, :3], self.link_c) + f[:, :, :3, 3]
+        if len(self.obstacles):
+            p = np.einsum("nlkj,kji->nlki", w[:, :, None, :] - self.obs_center[None, None], self.obs_rot)
+            gap = np.maximum(np.abs(p) - self.obs_half[None, None], 0.0)
+            env = np.sqrt((gap * gap).sum(axis=3)) <= self.link_r[None, :, None] + 1e-9
+        else:
+            env = np.zeros((len(w), len(self.links), 0), dtype=bool)
+        if len(self.pair_a):
+            d = w[:, self.pair_a] - w[:, self.pair_b]
+            selfc = np.sqrt((d * d).sum(axis=2)) <= self.pair_r[None] + 1e-9
+        else:
+            selfc = np.zeros((len(w), 0), dtype=bool)
         return env, selfc
 
     def collides_env(self, link, k):
@@ -522,11 +535,8 @@ class CollisionModel:
         out = [list(self.rigid_contacts) for _ in range(len(qs))]
         if stop_at_first and self.rigid_contacts:
             return out
-        rows = np.zeros(len(qs), dtype=bool)
-        for l in env:
-            rows |= env[l].any(axis=1)
-        for p in selfc:
-            rows |= selfc[p]
+        rows = env.any(axis=(1, 2)) | selfc.any(axis=1)
+        pairs = self.robot.moving_pairs
         for i in np.nonzero(rows)[0]:
             placed = set()
 
@@ -535,22 +545,27 @@ class CollisionModel:
                     self._place(l, frames[l][i])
                     placed.add(l)
 
-            for l in self.robot.collision_links:
-                for k in np.nonzero(env[l][i])[0]:
-                    place(l)
-                    if self.collides_env(l, k):
-                        if with_depth:
-                            fd, vd = self.env_depth(l, k, frames[l][i])
-                        else:
-                            fd, vd = None, None
-                        out[i].append(("env", l, self.obstacles[k].get("name", str(k)), fd, vd))
-            for (a, b), m in selfc.items():
-                if m[i]:
+            for li, k in zip(*np.nonzero(env[i])):
+                l = self.links[li]
+                place(l)
+                if self.collides_env(l, k):
+                    if with_depth:
+                        fd, vd = self.env_depth(l, k, frames[l][i])
+                    else:
+                        fd, vd = None, None
+                    out[i].append(("env", l, self.obstacles[k].get("name", str(k)), fd, vd))
+                    if stop_at_first:
+                        break
+            if not (stop_at_first and out[i]):
+                for pi in np.nonzero(selfc[i])[0]:
+                    a, b = pairs[pi]
                     place(a)
                     place(b)
                     if self.collides_self(a, b):
                         d = self.self_depth(a, b) if with_depth else None
                         out[i].append(("self", a, b, d, None))
+                        if stop_at_first:
+                            break
             if stop_at_first and out[i]:
                 break
         return out
