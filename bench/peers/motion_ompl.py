@@ -17,7 +17,7 @@ SimpleSetup.solve() (plus simplifySolution() with --simplify), with the validity
 Python; validity_checks counts the checker's calls.
 
 Usage: motion_ompl.py SCENE_JSON... [--planner RRTConnect] [--time-limit S] [--resolution R]
-                      [--simplify] [--first N] [--json]
+                      [--simplify] [--first N] [--seed S] [--json]
 """
 import argparse
 import json
@@ -53,12 +53,15 @@ def main():
     ap.add_argument("--resolution", type=float, default=1 / 32, help="motion check step, rad")
     ap.add_argument("--simplify", action="store_true", help="also run simplifySolution()")
     ap.add_argument("--first", type=int, default=None, help="only the first N problems per file")
+    ap.add_argument("--seed", type=int, default=None, help="OMPL's global RNG seed (default: random)")
     ap.add_argument("--json", action="store_true")
     a = ap.parse_args()
     from ompl import base as ob
     from ompl import geometric as og
     from ompl import util as ou
 
+    if a.seed is not None:
+        ou.RNG.setSeed(a.seed)
     if hasattr(ou, "setLogLevel") and hasattr(ou, "LogLevel"):
         ou.setLogLevel(ou.LogLevel.LOG_WARN)
     name = f"ompl-{a.planner}" + ("+simplify" if a.simplify else "")

@@ -6,7 +6,7 @@
 # Only the UR5 robot module is compiled (VAMP_ROBOT_MODULES=ur5) to save build time.
 #
 #   apt-get install -y libeigen3-dev pdqsort-dev
-#   bash bench/peers/vamp_offline/build.sh          # ~10 min on 2 cores
+#   bash bench/peers/vamp_offline/build.sh          # ~3 min on 2 cores (UR5 module only)
 set -euo pipefail
 HERE=$(cd "$(dirname "$0")" && pwd)
 VENV=${VENV:-$HERE/../.venv}
