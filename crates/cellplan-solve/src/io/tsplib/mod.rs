@@ -3,8 +3,11 @@ use std::collections::BTreeMap;
 use std::path::Path;
 
 use super::{Ctx, DENSE_NODES, MAX_DENSE_NODES, SETS, read_text, text_path};
-use crate::error::{CostMatrixError, ReadError};
+use crate::error::ReadError;
 use crate::problem::CostMatrix;
+
+mod metric;
+use metric::{Format, WeightType, coord_matrix, explicit_matrix};
 
 /// A TSPLIB instance: its name, size and full cost matrix (the TSPLIB distance rules applied).
 #[derive(Clone, Debug, PartialEq)]
@@ -99,24 +102,6 @@ pub(crate) struct Document {
     pub gtsp_sets: Option<(usize, usize)>,
     /// GTSP_SET_SECTION's sets, with the line of the section keyword.
     pub sets: Option<(usize, Vec<RawSet>)>,
-}
-
-#[derive(Clone, Copy, PartialEq, Eq, Debug)]
-enum WeightType {
-    Euc2d,
-    Ceil2d,
-    Att,
-    Geo,
-    Explicit,
-}
-
-#[derive(Clone, Copy, PartialEq, Eq, Debug)]
-enum Format {
-    Full,
-    UpperRow,
-    LowerRow,
-    UpperDiagRow,
-    LowerDiagRow,
 }
 
 const WEIGHT_TYPES: &str = "EUC_2D, CEIL_2D, ATT, GEO or EXPLICIT";
@@ -613,190 +598,5 @@ fn check_type(ctx: Ctx<'_>, ln: usize, value: &str, kind: Kind) -> Result<(), Re
     ))
 }
 
-/// The symmetric matrix of `n` nodes from EDGE_WEIGHT_SECTION's values in format `f`.
-fn explicit_matrix(n: usize, f: Format, vals: &[f64]) -> Result<CostMatrix, CostMatrixError> {
-    let mut m = vec![0.0; n * n];
-    let mut it = vals.iter().copied();
-    let mut set = |i: usize, j: usize, v: f64| {
-        m[i * n + j] = v;
-        m[j * n + i] = v;
-    };
-    match f {
-        Format::Full => {
-            return CostMatrix::new(n, vals.to_vec());
-        }
-        Format::UpperRow => (0..n).for_each(|i| (i + 1..n).for_each(|j| set(i, j, it.next().unwrap_or(0.0)))),
-        Format::LowerRow => (0..n).for_each(|i| (0..i).for_each(|j| set(i, j, it.next().unwrap_or(0.0)))),
-        Format::UpperDiagRow => (0..n).for_each(|i| (i..n).for_each(|j| set(i, j, it.next().unwrap_or(0.0)))),
-        Format::LowerDiagRow => {
-            (0..n).for_each(|i| (0..=i).for_each(|j| set(i, j, it.next().unwrap_or(0.0))))
-        }
-    }
-    CostMatrix::new(n, m)
-}
-
-/// TSPLIB's `nint`: `(int)(x + 0.5)`.
-fn nint(x: f64) -> f64 {
-    (x + 0.5).floor()
-}
-
-/// Latitude or longitude in radians from TSPLIB's DDD.MM notation.
-fn geo_rad(x: f64) -> f64 {
-    // TSPLIB95 fixes PI to 3.141592; the published optima depend on it.
-    #[allow(clippy::approx_constant)]
-    const PI: f64 = 3.141592;
-    let deg = x.trunc();
-    let min = x - deg;
-    PI * (deg + 5.0 * min / 3.0) / 180.0
-}
-
-/// The matrix of TSPLIB distances of type `wt` between the coordinates `c`.
-fn coord_matrix(wt: WeightType, c: &[(f64, f64)]) -> Result<CostMatrix, CostMatrixError> {
-    let n = c.len();
-    let geo: Vec<(f64, f64)> = if wt == WeightType::Geo {
-        c.iter().map(|&(x, y)| (geo_rad(x), geo_rad(y))).collect()
-    } else {
-        Vec::new()
-    };
-    let mut m = vec![0.0; n * n];
-    for i in 0..n {
-        for j in i + 1..n {
-            let (dx, dy) = (c[i].0 - c[j].0, c[i].1 - c[j].1);
-            let d = match wt {
-                WeightType::Euc2d => nint((dx * dx + dy * dy).sqrt()),
-                WeightType::Ceil2d => (dx * dx + dy * dy).sqrt().ceil(),
-                WeightType::Att => {
-                    let r = ((dx * dx + dy * dy) / 10.0).sqrt();
-                    let t = nint(r);
-                    if t < r { t + 1.0 } else { t }
-                }
-                WeightType::Geo => {
-                    const RRR: f64 = 6378.388;
-                    let ((lat_i, lon_i), (lat_j, lon_j)) = (geo[i], geo[j]);
-                    let q1 = (lon_i - lon_j).cos();
-                    let q2 = (lat_i - lat_j).cos();
-                    let q3 = (lat_i + lat_j).cos();
-                    let a = (0.5 * ((1.0 + q1) * q2 - (1.0 - q1) * q3)).clamp(-1.0, 1.0);
-                    (RRR * a.acos() + 1.0).trunc()
-                }
-                WeightType::Explicit => 0.0,
-            };
-            m[i * n + j] = d;
-            m[j * n + i] = d;
-        }
-    }
-    CostMatrix::new(n, m)
-}
-
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    const SMALL: &str = "NAME : small\nTYPE : TSP\nDIMENSION : 3\nEDGE_WEIGHT_TYPE : EUC_2D\n\
-        NODE_COORD_SECTION\n1 0 0\n2 3 4\n3 0 1.4\nEOF\n";
-
-    #[test]
-    fn euc_2d_rounds() {
-        let t = parse_tsplib(SMALL).unwrap();
-        assert_eq!(t.name, "small");
-        assert_eq!(t.costs.get(0, 1), 5.0);
-        assert_eq!(t.costs.get(0, 2), 1.0);
-        assert_eq!(t.costs.get(1, 1), 0.0);
-    }
-
-    #[test]
-    fn explicit_formats_agree() {
-        let full = "0 1 2\n1 0 3\n2 3 0";
-        let forms = [
-            ("FULL_MATRIX", full),
-            ("UPPER_ROW", "1 2 3"),
-            ("LOWER_ROW", "1 2 3"),
-            ("UPPER_DIAG_ROW", "0 1 2 0 3 0"),
-            ("LOWER_DIAG_ROW", "0 1 0 2 3 0"),
-        ];
-        for (f, body) in forms {
-            let text = format!(
-                "TYPE: TSP\nDIMENSION: 3\nEDGE_WEIGHT_TYPE: EXPLICIT\nEDGE_WEIGHT_FORMAT: {f}\nEDGE_WEIGHT_SECTION\n{body}\nEOF\n"
-            );
-            let t = parse_tsplib(&text).unwrap_or_else(|e| panic!("{f}: {e}"));
-            assert_eq!(t.costs.get(0, 1), 1.0, "{f}");
-            assert_eq!(t.costs.get(2, 0), 2.0, "{f}");
-            assert_eq!(t.costs.get(1, 2), 3.0, "{f}");
-        }
-    }
-
-    #[test]
-    fn att_and_ceil_rules() {
-        let t = parse_tsplib(
-            "TYPE: TSP\nDIMENSION: 2\nEDGE_WEIGHT_TYPE: ATT\nNODE_COORD_SECTION\n1 0 0\n2 10 0\n",
-        )
-        .unwrap();
-        // r = sqrt(100/10) = 3.162..., nint = 3 < r, so 4.
-        assert_eq!(t.costs.get(0, 1), 4.0);
-        let t = parse_tsplib(
-            "TYPE: TSP\nDIMENSION: 2\nEDGE_WEIGHT_TYPE: CEIL_2D\nNODE_COORD_SECTION\n1 0 0\n2 1 1\n",
-        )
-        .unwrap();
-        assert_eq!(t.costs.get(0, 1), 2.0);
-    }
-
-    #[test]
-    fn optima_file_format() {
-        let m = parse_optima("a280 : 2579\ndsj1000 : 18660188 (CEIL_2D)\n\n").unwrap();
-        assert_eq!(m["a280"], 2579.0);
-        assert_eq!(m["dsj1000"], 18660188.0);
-        let e = parse_optima("a280 2579\n").unwrap_err();
-        assert_eq!(e.line(), Some(1));
-    }
-
-    #[test]
-    fn errors_name_line_and_expectation() {
-        let e = parse_tsplib(&SMALL.replace("EUC_2D", "EUC_3D")).unwrap_err();
-        assert!(matches!(e, ReadError::Unsupported { line: Some(4), .. }), "{e}");
-        assert!(
-            e.to_string().contains("EUC_3D") && e.to_string().contains("EUC_2D"),
-            "{e}"
-        );
-
-        let e = parse_tsplib(&SMALL.replace("DIMENSION : 3\n", "")).unwrap_err();
-        assert!(e.to_string().contains("DIMENSION"), "{e}");
-        assert!(matches!(e, ReadError::Syntax { line: Some(4), .. }), "{e}");
-
-        let e = parse_tsplib(&SMALL.replace("2 3 4", "2 3 x4")).unwrap_err();
-        assert!(matches!(e, ReadError::Syntax { line: Some(7), .. }), "{e}");
-        assert!(
-            e.to_string().contains("`x4`") && e.to_string().contains("y coordinate"),
-            "{e}"
-        );
-
-        let e = parse_tsplib(&SMALL.replace("3 0 1.4\n", "")).unwrap_err();
-        assert!(matches!(e, ReadError::Syntax { line: Some(8), .. }), "{e}");
-        assert!(e.to_string().contains("2 of 3"), "{e}");
-
-        let e = parse_tsplib(&SMALL.replace("3 0 1.4\nEOF\n", "")).unwrap_err();
-        assert!(matches!(e, ReadError::Syntax { line: None, .. }), "{e}");
-
-        let e = parse_tsplib(&SMALL.replace("TYPE : TSP", "TYPE : ATSP")).unwrap_err();
-        assert!(matches!(e, ReadError::Unsupported { line: Some(2), .. }), "{e}");
-
-        let e = parse_tsplib(&SMALL.replace("NAME", "NAMX")).unwrap_err();
-        assert!(e.to_string().contains("unknown keyword"), "{e}");
-
-        let e = parse_tsplib(&SMALL.replace("3 0 1.4", "4 0 1.4")).unwrap_err();
-        assert!(matches!(e, ReadError::Invalid { line: Some(8), .. }), "{e}");
-    }
-
-    #[test]
-    fn garbage_does_not_panic() {
-        for text in [
-            "",
-            "EOF",
-            ":",
-            "DIMENSION: -3",
-            "DIMENSION: 2\nEDGE_WEIGHT_SECTION\n1",
-            "\u{0}\u{1}",
-        ] {
-            assert!(parse_tsplib(text).is_err(), "{text:?}");
-        }
-    }
-}
+mod tests;
