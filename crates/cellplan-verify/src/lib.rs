@@ -257,7 +257,7 @@ pub fn verify_with(
     let robots = pair_robots(cell, plan, &mut out);
     tasks::check(cell, table, plan, &robots, &mut out);
     let checked = paths::check(cell, &robots, settings, &mut out);
-    let times = timing::check(cell, plan, &robots, settings, &mut out);
+    let times = timing::check(plan, &robots, settings, &mut out);
     if settings.robot_robot {
         robots::check(cell, &robots, &times, settings, &mut out);
     }

@@ -6,7 +6,6 @@
 use super::paths::{dist, name};
 use super::{VerifySettings, Violation, ViolationKind};
 use cellplan_core::document::{Plan, RobotPlan, Sample};
-use cellplan_model::Cell;
 use cellplan_model::robot::Robot;
 
 /// Times are compared to this (s).
@@ -14,13 +13,11 @@ const TIME_TOL: f64 = 1e-6;
 
 /// The timing checks; returns each robot's recomputed time (trajectory duration).
 pub(super) fn check(
-    cell: &Cell,
     plan: &Plan,
     robots: &[(&Robot, &RobotPlan)],
     settings: &VerifySettings,
     out: &mut Vec<Violation>,
 ) -> Vec<f64> {
-    let _ = cell;
     let mut times = Vec::with_capacity(robots.len());
     for (robot, rp) in robots {
         let mut push = |kind, t: Option<f64>, detail: String| {

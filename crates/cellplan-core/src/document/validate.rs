@@ -71,23 +71,25 @@ pub fn read(path: &Path) -> Result<Plan, DocumentError> {
         LimitedReadError::Io(e) => DocumentError::Read(e),
         LimitedReadError::TooLarge { size } => DocumentError::TooLarge { size },
     })?;
-    // The layout and version first, so that an old document gets a clear answer.
+    match serde_json::from_slice::<Plan>(&bytes) {
+        Ok(plan) => validate(&plan).map(|()| plan),
+        // Not this layout: an old document gets the version answer, anything else the parser's.
+        Err(source) => Err(other_version(&bytes).unwrap_or(DocumentError::Json { source })),
+    }
+}
+
+/// The version error, when the bytes are a document of another format or version.
+fn other_version(bytes: &[u8]) -> Option<DocumentError> {
     #[derive(serde::Deserialize)]
     struct Header {
         format: Option<String>,
         version: Option<u32>,
     }
-    if let Ok(h) = serde_json::from_slice::<Header>(&bytes)
-        && (h.format.as_deref() != Some(FORMAT) || h.version != Some(VERSION))
-    {
-        return Err(DocumentError::Version {
-            format: h.format.unwrap_or_default(),
-            version: h.version.unwrap_or(0),
-        });
-    }
-    let plan: Plan = serde_json::from_slice(&bytes).map_err(|source| DocumentError::Json { source })?;
-    validate(&plan)?;
-    Ok(plan)
+    let h = serde_json::from_slice::<Header>(bytes).ok()?;
+    (h.format.as_deref() != Some(FORMAT) || h.version != Some(VERSION)).then(|| DocumentError::Version {
+        format: h.format.unwrap_or_default(),
+        version: h.version.unwrap_or(0),
+    })
 }
 
 fn invalid(at: impl Into<String>, what: impl Into<String>) -> DocumentError {
