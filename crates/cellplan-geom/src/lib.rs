@@ -7,6 +7,7 @@
 //!   that name the file and line.
 //! - [`read`]: reading input files with a size limit (meshes, URDFs, cell files).
 //! - [`shape`]: [`ShapeSpec`], the shapes a cell file can state (box, cylinder, sphere, mesh).
+//! - [`spheres`]: conservative sphere covers of bodies, the world's broad phase.
 //! - [`world`]: [`CollisionWorld`], the static scene plus articulated body groups (robots),
 //!   with contact, distance and ray queries.
 #![warn(missing_docs)]
@@ -16,6 +17,7 @@ mod hull;
 pub mod mesh;
 pub mod read;
 pub mod shape;
+pub mod spheres;
 pub mod world;
 
 pub use error::MeshError;
@@ -23,4 +25,5 @@ pub use glam::{DMat3, DQuat, DVec3};
 pub use mesh::{Mesh, load_mesh};
 pub use parry3d_f64::math::Pose;
 pub use shape::ShapeSpec;
+pub use spheres::Sphere;
 pub use world::{BodyContact, CollisionWorld, GroupBody, GroupId, RayHit, StaticId};

@@ -25,6 +25,7 @@
 //! static object, or with its pair partner), and as at distance 0; rays ignore it.
 use crate::hull::FastHull;
 use crate::shape::{body_shape, shape_as_mesh, static_shape};
+use crate::spheres::Cover;
 use crate::{DVec3, Mesh, Pose, ShapeSpec};
 use parry3d_f64::bounding_volume::Aabb;
 use parry3d_f64::partitioning::TraversalAction;
@@ -103,6 +104,8 @@ struct BodyConvex {
     local_aabb: Aabb,
     /// Hill-climbing support for large hulls.
     fast: Option<FastHull>,
+    /// Spheres containing the shape (body frame), for lower bounds on distances.
+    cover: Cover,
 }
 
 impl BodyConvex {
@@ -111,6 +114,7 @@ impl BodyConvex {
         let fast = shape.as_convex_polyhedron().and_then(FastHull::new);
         Some(BodyConvex {
             local_aabb: shape.compute_aabb(&local),
+            cover: Cover::of(&*shape, &local),
             shape,
             local,
             fast,
@@ -1045,6 +1049,8 @@ where
         GJKResult::NoIntersection(_) | GJKResult::Proximity(_) => None,
     }
 }
+
+mod bounds;
 
 #[cfg(test)]
 mod tests;

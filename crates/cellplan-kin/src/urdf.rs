@@ -20,8 +20,13 @@ pub struct RobotModel {
     /// Chain from the URDF root link to the tip link.
     pub chain: Chain,
     /// Collision shapes per chain link (same index as `chain.links`), in the link frame, metres.
-    /// Links rigidly attached off the chain have their shapes merged into their chain parent.
+    /// Links rigidly attached off the chain have their shapes listed with their chain parent's
+    /// (placed in its frame); [`RobotModel::collision_links`] says which URDF link each came from.
     pub collision: Vec<Vec<(ShapeSpec, Pose)>>,
+    /// Beside [`RobotModel::collision`], shape by shape: the name of the URDF link the shape
+    /// belongs to (the chain link itself, or a link rigidly attached off the chain, such as a
+    /// gripper finger). SRDF collision rules name these links.
+    pub collision_links: Vec<Vec<String>>,
 }
 
 /// Loads a URDF. `packages` maps a ROS package name to its folder (for `package://name/...`);
@@ -114,12 +119,13 @@ impl Loader<'_> {
         let path_links = self.chain_path(&robot, &tree, tip)?;
         let (chain, chain_pos) = self.chain(&doc, &robot, &tree, &path_links)?;
         let attach = self.attachments(&robot, &tree, &chain_pos)?;
-        let collision = self.collision(&doc, &robot, &attach, chain.links.len())?;
+        let (collision, collision_links) = self.collision(&doc, &robot, &attach, chain.links.len())?;
         Ok(RobotModel {
             name: robot.name.clone(),
             path: self.path.to_path_buf(),
             chain,
             collision,
+            collision_links,
         })
     }
 
@@ -448,15 +454,18 @@ impl Loader<'_> {
     }
 
     /// The collision shapes of every link, placed in the frame of the chain link it hangs
-    /// from (`chain_links` of them). Meshes named twice are loaded once.
+    /// from (`chain_links` of them), and beside them the URDF link each came from. Meshes named
+    /// twice are loaded once.
+    #[allow(clippy::type_complexity)]
     fn collision(
         &self,
         doc: &xml::Document,
         robot: &urdf_rs::Robot,
         attach: &[Option<Attachment>],
         chain_links: usize,
-    ) -> Result<Vec<Vec<(ShapeSpec, Pose)>>, KinError> {
+    ) -> Result<(Vec<Vec<(ShapeSpec, Pose)>>, Vec<Vec<String>>), KinError> {
         let mut collision: Vec<Vec<(ShapeSpec, Pose)>> = vec![Vec::new(); chain_links];
+        let mut names: Vec<Vec<String>> = vec![Vec::new(); chain_links];
         let mut meshes: HashMap<PathBuf, Arc<Mesh>> = HashMap::new();
         let mesh_lines = mesh_lines(doc);
         for (l, link) in robot.links.iter().enumerate() {
@@ -465,10 +474,11 @@ impl Loader<'_> {
                 let pose = at.pose * origin_pose(&c.origin);
                 for (shape, local) in self.shapes(&link.name, &c.geometry, &mut meshes, &mesh_lines)? {
                     collision[at.chain_link].push((shape, pose * local));
+                    names[at.chain_link].push(link.name.clone());
                 }
             }
         }
-        Ok(collision)
+        Ok((collision, names))
     }
 
     /// The shapes of one `<collision>` geometry in the collision frame.
