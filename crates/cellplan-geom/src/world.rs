@@ -614,11 +614,11 @@ impl CollisionWorld {
         dir: DVec3,
         max_distance: f64,
     ) -> Option<(usize, f64)> {
-        self.cast_ray_group_except(g, poses, origin, dir, max_distance, None)
+        self.cast_ray_group_except(g, poses, origin, dir, max_distance, &[])
     }
 
-    /// [`CollisionWorld::cast_ray_group`] ignoring body `except` (for rays that start on it,
-    /// such as the beams of a probe, which must not hide the bodies behind it).
+    /// [`CollisionWorld::cast_ray_group`] ignoring the bodies `except` (for rays that start on
+    /// them, such as the beams of a probe, which must not hide the bodies behind it).
     pub fn cast_ray_group_except(
         &self,
         g: GroupId,
@@ -626,13 +626,13 @@ impl CollisionWorld {
         origin: DVec3,
         dir: DVec3,
         max_distance: f64,
-        except: Option<usize>,
+        except: &[usize],
     ) -> Option<(usize, f64)> {
         let (ray, max) = make_ray(origin, dir, max_distance)?;
         let group = self.group(g);
         let mut best: Option<(usize, f64)> = None;
         for (i, (body, pose)) in group.bodies.iter().zip(poses).enumerate() {
-            if except == Some(i) {
+            if except.contains(&i) {
                 continue;
             }
             let Placement::At(p) = place(body, pose) else {

@@ -63,8 +63,13 @@ pub struct Robot {
     pub max_acceleration: Vec<f64>,
     /// The robot's body group in the cell's collision world.
     pub group: GroupId,
-    /// What each body of the group is attached to.
+    /// What each body of the group is attached to. A link or the tool may carry several bodies:
+    /// one per collision shape (each its own convex body, never merged with the others).
     pub bodies: Vec<BodyFrame>,
+    /// For each body, the chain link it hangs on (the tip link for the tool's bodies).
+    pub body_links: Vec<usize>,
+    /// For each body, its shape and pose in the frame of what it is attached to.
+    pub body_shapes: Vec<(ShapeSpec, Pose)>,
     /// Body pairs checked for self-collision (the rest are adjacent, never or always in contact).
     pub self_pairs: Vec<(usize, usize)>,
     /// Upper bound on the distance from the base origin to the TCP (m): the sum of the
@@ -144,6 +149,19 @@ impl Robot {
     /// Whether every joint is within its limits.
     pub fn within_limits(&self, q: &[f64]) -> bool {
         q.len() == self.dof() && self.model.chain.within_limits(q, 1e-9)
+    }
+
+    /// The robot as the motion core sees it: chain, base, body group and self pairs in `world`
+    /// (the cell's collision world).
+    pub fn arm<'a>(&'a self, world: &'a CollisionWorld) -> cellplan_motion::arm::Arm<'a> {
+        cellplan_motion::arm::Arm {
+            world,
+            chain: &self.model.chain,
+            base: self.base,
+            group: self.group,
+            body_links: &self.body_links,
+            self_pairs: &self.self_pairs,
+        }
     }
 
     /// Joint names.

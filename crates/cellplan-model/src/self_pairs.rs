@@ -15,7 +15,7 @@ use std::path::{Path, PathBuf};
 /// A pair closer than this in any sample is kept ("never in contact" must mean never near).
 const NEAR: f64 = 0.02;
 /// Bumped when the sampling rule changes, so old cache files are not reused.
-const RULE_VERSION: u64 = 3;
+const RULE_VERSION: u64 = 4;
 
 /// Outcome of sampling one robot.
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
@@ -24,36 +24,43 @@ pub struct SelfPairs {
     pub pairs: Vec<(usize, usize)>,
 }
 
-/// Every body pair `(i, j)`, `i < j`, that is not adjacent in the chain: the pairs that can be
-/// checked for self-collision at all.
+/// Every body pair `(i, j)`, `i < j`, that can be checked for self-collision at all: not on
+/// the same frame (the shapes of one link, or of the tool, move together) and not adjacent in
+/// the chain.
 pub fn non_adjacent_pairs(robot: &Robot) -> Vec<(usize, usize)> {
     let n = robot.bodies.len();
     let adjacent = adjacent(robot);
     (0..n)
         .flat_map(|i| (i + 1..n).map(move |j| (i, j)))
-        .filter(|p| !adjacent.contains(p))
+        .filter(|&(i, j)| robot.bodies[i] != robot.bodies[j] && !adjacent.contains(&(i, j)))
         .collect()
 }
 
-/// Bodies adjacent in the chain: `a` is the nearest body up the chain from `b` (links without
-/// geometry are skipped over).
+/// Bodies adjacent in the chain: `a` is on the nearest frame up the chain from `b`'s that
+/// carries bodies (links without geometry are skipped over; the tool's frame is the tip).
 fn adjacent(robot: &Robot) -> Vec<(usize, usize)> {
     let chain = &robot.model.chain;
     let tip = chain.links.len() - 1;
-    let body_of_link = |l: usize| robot.bodies.iter().position(|b| *b == BodyFrame::Link(l));
+    let bodies_of_link = |l: usize| {
+        robot
+            .bodies
+            .iter()
+            .enumerate()
+            .filter(move |(_, b)| **b == BodyFrame::Link(l))
+            .map(|(i, _)| i)
+    };
     let mut pairs = Vec::new();
     for (bi, b) in robot.bodies.iter().enumerate() {
-        // The link this body hangs from, then walk towards the root.
+        // The link this body's frame hangs from, then walk towards the root.
         let mut l = match *b {
             BodyFrame::Link(0) => continue,
             BodyFrame::Link(l) => l - 1,
             BodyFrame::Tool => tip,
         };
         loop {
-            if let Some(a) = body_of_link(l) {
-                if a != bi {
-                    pairs.push((a.min(bi), a.max(bi)));
-                }
+            let above: Vec<usize> = bodies_of_link(l).collect();
+            if !above.is_empty() {
+                pairs.extend(above.into_iter().map(|a| (a.min(bi), a.max(bi))));
                 break;
             }
             if l == 0 {
@@ -62,6 +69,8 @@ fn adjacent(robot: &Robot) -> Vec<(usize, usize)> {
             l -= 1;
         }
     }
+    pairs.sort_unstable();
+    pairs.dedup();
     pairs
 }
 
@@ -270,18 +279,29 @@ mod tests {
             .map(|i| cell.world.body_name(robot.group, i))
             .collect();
         assert_eq!(names.first(), Some(&"base_link"));
-        assert_eq!(names.last(), Some(&"tool:probe"));
-        for i in 0..names.len() - 1 {
-            assert!(
-                !robot.self_pairs.contains(&(i, i + 1)),
-                "adjacent {} / {} checked",
-                names[i],
-                names[i + 1]
-            );
+        // The probe's two shapes are two bodies, never merged into one hull.
+        let probe: Vec<usize> = (0..names.len())
+            .filter(|&i| names[i].starts_with("tool:probe"))
+            .collect();
+        assert_eq!(probe.len(), 2, "{names:?}");
+        assert!(probe.iter().all(|&i| robot.bodies[i] == BodyFrame::Tool));
+        let last_link = probe[0] - 1;
+        for (i, j) in (0..names.len()).flat_map(|i| (i + 1..names.len()).map(move |j| (i, j))) {
+            let same_frame = robot.bodies[i] == robot.bodies[j];
+            let chain_neighbours = j == i + 1 && j < probe[0];
+            let tool_on_tip = i == last_link && probe.contains(&j);
+            if same_frame || chain_neighbours || tool_on_tip {
+                assert!(
+                    !robot.self_pairs.contains(&(i, j)),
+                    "adjacent {} / {} checked",
+                    names[i],
+                    names[j]
+                );
+            }
         }
         // The probe can swing down onto the robot's own base: that pair must be checked.
         assert!(
-            robot.self_pairs.contains(&(0, names.len() - 1)),
+            probe.iter().any(|&p| robot.self_pairs.contains(&(0, p))),
             "{:?}",
             robot.self_pairs
         );

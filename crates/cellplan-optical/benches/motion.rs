@@ -3,7 +3,7 @@
 //! straight leg from home to a measuring candidate, and an RRT-Connect leg (with shortcutting)
 //! between two candidates whose straight segment is blocked.
 use cellplan_core::candidates::generate;
-use cellplan_core::motion::{RobotValidity, joint_space, plan_leg};
+use cellplan_core::motion::{joint_space, plan_leg, robot_validity};
 use cellplan_model::{LoadOptions, TaskId};
 use cellplan_motion::plan::{PlanSettings, Planner, StateValidity, Straight, check_segment};
 use cellplan_optical::load;
@@ -18,7 +18,7 @@ fn motion_benches(c: &mut Criterion) {
     let robot = &cell.robots[0];
     let margin = cell.planning.clearance;
     let space = joint_space(&cell, robot);
-    let validity = RobotValidity::new(&cell, robot, margin);
+    let validity = robot_validity(&cell, robot, margin);
     let settings = PlanSettings::default();
     let candidates: Vec<Vec<f64>> = (0..cell.tasks.len())
         .filter_map(|t| table.get(TaskId(t), robot.id).candidates.first())

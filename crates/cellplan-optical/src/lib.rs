@@ -280,10 +280,12 @@ impl Process for OpticalProcess {
     ) -> Result<(), ProcessReason> {
         // The beams start on the probe, so the probe itself is left out: only the arm can
         // block them.
-        let tool = robot.bodies.iter().position(|b| *b == BodyFrame::Tool);
+        let tool: Vec<usize> = (0..robot.bodies.len())
+            .filter(|&i| robot.bodies[i] == BodyFrame::Tool)
+            .collect();
         for (from, dir, len) in self.beams(task, tcp) {
             if world
-                .cast_ray_group_except(robot.group, bodies, from, dir, len, tool)
+                .cast_ray_group_except(robot.group, bodies, from, dir, len, &tool)
                 .is_some()
             {
                 return Err(Rejection::BeamOccluded.reason());

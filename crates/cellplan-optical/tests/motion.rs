@@ -2,7 +2,7 @@
 //! legs from home to measuring candidates and back, and a blocked leg solved by RRT-Connect —
 //! every path re-checked densely (1 mm Cartesian steps) with `Robot::contact_at`.
 use cellplan_core::candidates::generate;
-use cellplan_core::motion::{RobotValidity, joint_space, plan_leg};
+use cellplan_core::motion::{RobotValidity, joint_space, plan_leg, robot_validity};
 use cellplan_model::robot::Scratch;
 use cellplan_model::{Cell, LoadOptions, Robot, TaskId};
 use cellplan_motion::plan::{PlanError, PlanSettings, Planner, StateValidity, Straight};
@@ -120,7 +120,7 @@ fn clearance_agrees_with_contact_checks() {
     let f = fixture();
     let cell = &f.cell;
     let robot = &cell.robots[0];
-    let v = RobotValidity::new(cell, robot, margin(cell));
+    let v = robot_validity(cell, robot, margin(cell));
     let mut rng = ChaCha8Rng::seed_from_u64(11);
     let mut scratch = Scratch::default();
     let (mut valid, mut invalid) = (0, 0);
@@ -158,7 +158,7 @@ fn home_to_candidates_and_back() {
     let s = PlanSettings::default();
     let mut legs = 0;
     for (robot, candidates) in cell.robots.iter().zip(&f.candidates) {
-        let v = RobotValidity::new(cell, robot, margin(cell));
+        let v = robot_validity(cell, robot, margin(cell));
         for goal in candidates
             .iter()
             .filter(|q| v.clearance(q) > s.min_clearance)
@@ -192,7 +192,7 @@ fn blocked_leg_is_solved_by_rrt_connect() {
         .zip(&f.candidates)
         .find_map(|(robot, candidates)| {
             let space = joint_space(cell, robot);
-            let v = RobotValidity::new(cell, robot, margin(cell));
+            let v = robot_validity(cell, robot, margin(cell));
             candidates
                 .iter()
                 .filter(|q| v.clearance(q) > s.min_clearance)
@@ -232,7 +232,7 @@ fn accepted_segments_pass_the_dense_recheck() {
     let (mut accepted, mut refused) = (0, 0);
     for robot in &cell.robots {
         let space = joint_space(cell, robot);
-        let v = RobotValidity::new(cell, robot, margin(cell));
+        let v = robot_validity(cell, robot, margin(cell));
         // From home or a candidate to a random valid configuration.
         let mut starts = vec![robot.home.clone()];
         starts.extend(f.candidates[robot.id.0].iter().take(4).cloned());
@@ -273,7 +273,7 @@ fn capped_segment_step_agrees_with_the_default() {
     let mut rng = ChaCha8Rng::seed_from_u64(11);
     let mut checked = 0;
     for robot in &f.cell.robots {
-        let v = RobotValidity::new(&f.cell, robot, margin(&f.cell));
+        let v = robot_validity(&f.cell, robot, margin(&f.cell));
         let plain = Plain(&v);
         let mut qs = f.candidates[robot.id.0].clone();
         qs.extend((0..40).map(|_| random_q(robot, &mut rng)));

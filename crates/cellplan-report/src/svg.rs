@@ -3,7 +3,7 @@
 use crate::escape;
 use cellplan_core::CandidateTable;
 use cellplan_geom::{DVec3, Mesh, Pose};
-use cellplan_model::robot::{BodyFrame, Scratch};
+use cellplan_model::robot::Scratch;
 use cellplan_model::{Cell, TaskId};
 use std::fmt::Write;
 
@@ -164,15 +164,9 @@ fn scene(cell: &Cell) -> Vec<Item> {
         let mut scratch = Scratch::default();
         r.body_poses(&r.home, &mut scratch);
         let mut meshes = Vec::new();
-        for (b, pose) in r.bodies.iter().zip(&scratch.bodies) {
-            let shapes = match *b {
-                BodyFrame::Link(i) => &r.model.collision[i],
-                BodyFrame::Tool => &r.tool.shapes,
-            };
-            for (s, local) in shapes {
-                let world: Pose = *pose * *local;
-                meshes.push(s.to_mesh().transformed(&world));
-            }
+        for ((s, local), pose) in r.body_shapes.iter().zip(&scratch.bodies) {
+            let world: Pose = *pose * *local;
+            meshes.push(s.to_mesh().transformed(&world));
         }
         items.push(Item {
             label: r.name.clone(),

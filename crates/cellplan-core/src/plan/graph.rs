@@ -1,7 +1,6 @@
 //! Per-robot graphs: the robot's home and every candidate of every task it can do, with the
 //! lower-bound move times between them (paper 000 eq. 3 with the move model of the settings).
 use crate::candidates::CandidateTable;
-use crate::motion::RobotValidity;
 use cellplan_model::Cell;
 use cellplan_model::robot::Robot;
 use cellplan_model::tasks::TaskId;
@@ -137,7 +136,7 @@ impl RobotGraph {
         per_task: usize,
         roomy: f64,
     ) -> Self {
-        let validity = RobotValidity::new(cell, robot, cell.planning.clearance);
+        let validity = crate::motion::robot_validity(cell, robot, cell.planning.clearance);
         // Some self pairs are close by construction (a tool beside its wrist): what is roomy
         // for them is what they have at home, if less.
         let self_roomy = roomy.min(validity.scene_and_self_clearance(&robot.home).1);

@@ -327,7 +327,7 @@ fn polish_leg(
     settings: &PlanSettings,
 ) -> Leg {
     let space = crate::motion::joint_space(cell, robot);
-    let validity = crate::motion::RobotValidity::new(cell, robot, cell.planning.clearance);
+    let validity = crate::motion::robot_validity(cell, robot, cell.planning.clearance);
     let motion = MotionSettings {
         seed: leg_seed(settings.seed, robot.id.0, k.0, k.1) ^ 1,
         shortcut_iterations: settings.final_shortcut_iterations,

@@ -244,29 +244,56 @@ fn robots(
     Ok((robots, source))
 }
 
-/// Adds each robot to `world` as a group: its links that have collision shapes, then its tool.
+/// Adds each robot to `world` as a group: one body per collision shape (so that no hull spans
+/// parts that are apart, such as a gripper's fingers), the links' shapes in chain order, then
+/// the tool's. A body is named after the URDF link its shape belongs to (or `tool:NAME`), with
+/// `#k` when that link has several shapes.
 fn add_robot_bodies(world: &mut CollisionWorld, robots: &mut [Robot]) {
     for robot in robots {
+        let tip = robot.model.chain.links.len().saturating_sub(1);
         let mut bodies = Vec::new();
         let mut frames = Vec::new();
+        let mut links = Vec::new();
+        let mut shapes_of = Vec::new();
+        let mut push = |name: String, shape: &(ShapeSpec, Pose), frame: BodyFrame, link: usize| {
+            bodies.push(GroupBody {
+                name,
+                shapes: vec![shape.clone()],
+            });
+            frames.push(frame);
+            links.push(link);
+            shapes_of.push(shape.clone());
+        };
         for (i, shapes) in robot.model.collision.iter().enumerate() {
-            if !shapes.is_empty() {
-                bodies.push(GroupBody {
-                    name: robot.model.chain.links[i].name.clone(),
-                    shapes: shapes.clone(),
-                });
-                frames.push(BodyFrame::Link(i));
+            let names = robot.model.collision_links.get(i);
+            for (k, shape) in shapes.iter().enumerate() {
+                let source = names
+                    .and_then(|n| n.get(k))
+                    .cloned()
+                    .unwrap_or_else(|| robot.model.chain.links[i].name.clone());
+                let siblings = names.map_or(0, |n| n.iter().filter(|m| **m == source).count());
+                let nth = names.map_or(0, |n| n[..k].iter().filter(|m| **m == source).count());
+                let name = if siblings > 1 {
+                    format!("{source}#{nth}")
+                } else {
+                    source
+                };
+                push(name, shape, BodyFrame::Link(i), i);
             }
         }
-        if !robot.tool.shapes.is_empty() {
-            bodies.push(GroupBody {
-                name: format!("tool:{}", robot.tool.name),
-                shapes: robot.tool.shapes.clone(),
-            });
-            frames.push(BodyFrame::Tool);
+        let several = robot.tool.shapes.len() > 1;
+        for (k, shape) in robot.tool.shapes.iter().enumerate() {
+            let name = if several {
+                format!("tool:{}#{k}", robot.tool.name)
+            } else {
+                format!("tool:{}", robot.tool.name)
+            };
+            push(name, shape, BodyFrame::Tool, tip);
         }
         robot.group = world.add_group(&robot.name, bodies);
         robot.bodies = frames;
+        robot.body_links = links;
+        robot.body_shapes = shapes_of;
     }
 }
 

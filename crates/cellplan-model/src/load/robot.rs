@@ -89,6 +89,8 @@ pub(super) fn robot(
         max_acceleration,
         group: cellplan_geom::GroupId(u32::MAX),
         bodies: Vec::new(),
+        body_links: Vec::new(),
+        body_shapes: Vec::new(),
         self_pairs: Vec::new(),
         reach,
     })

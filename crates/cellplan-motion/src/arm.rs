@@ -1,0 +1,421 @@
+//! A serial arm in a collision world: its joint space and its validity checker, the bridge
+//! between geometry ([`cellplan_geom::CollisionWorld`]), kinematics ([`cellplan_kin::Chain`])
+//! and the generic planners of [`crate::plan`].
+//!
+//! - [`Arm`]: the chain, where its root stands, its body group in the world and the chain link
+//!   each body hangs on, and the self pairs to check.
+//! - [`joint_radii`] and [`joint_space`]: limits, metric weights `1/v_max` (a time-like
+//!   metric) and per-joint Cartesian radii that bound how far any body point moves.
+//! - [`ArmValidity`]: the clearance of a configuration — joint limits, distance of the moving
+//!   bodies to the static scene and to parked groups (minus the margin), distance of the
+//!   checked self pairs — split by the joints that can reduce each part, with the sphere-cover
+//!   broad phase of the world in front of every exact distance.
+//!
+//! # The broad phase
+//!
+//! A segment check asks each part only whether its clearance reaches `step · bound` (see
+//! [`StateValidity::segment_step`]). The world's sphere covers give a lower bound on every
+//! distance for a few point queries ([`CollisionWorld::body_static_bound`],
+//! [`CollisionWorld::pair_bound`]); when the bound already reaches what is asked, that answer
+//! is proven and the exact (GJK) distance is skipped. Only parts whose bound falls short pay
+//! for the exact query, which then decides. Bounds never exceed exact distances, so the
+//! guarantee of the segment check is unchanged.
+use crate::plan::{Clearance, JointSpace, StateValidity, narrow_step};
+use cellplan_geom::{CollisionWorld, GroupId, Pose};
+use cellplan_kin::{Chain, JointKind};
+use std::cell::RefCell;
+use std::ops::Range;
+
+/// Clearances are capped at this (m) by default: larger values only lengthen the steps of a
+/// segment check a little, and the cap lets the distance queries skip everything further.
+pub const DEFAULT_CLEARANCE_CAP: f64 = 0.25;
+
+/// Taken off every measured distance (m), for the tolerance of the GJK distance.
+const DISTANCE_SLACK: f64 = 1e-6;
+
+/// A serial arm placed in a collision world.
+#[derive(Clone, Copy)]
+pub struct Arm<'a> {
+    /// The world holding the arm's body group and the static scene.
+    pub world: &'a CollisionWorld,
+    /// The kinematic chain (root to tip).
+    pub chain: &'a Chain,
+    /// Pose of the chain's root link in the world.
+    pub base: Pose,
+    /// The arm's body group in `world`.
+    pub group: GroupId,
+    /// For each body of the group, the chain link it hangs on (index into `chain.links`).
+    pub body_links: &'a [usize],
+    /// Body pairs `(i, j)` checked for self-collision.
+    pub self_pairs: &'a [(usize, usize)],
+}
+
+impl std::fmt::Debug for Arm<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Arm")
+            .field("group", &self.group)
+            .field("bodies", &self.body_links.len())
+            .field("self_pairs", &self.self_pairs.len())
+            .finish_non_exhaustive()
+    }
+}
+
+thread_local! {
+    static LINKS: RefCell<(Vec<Pose>, Vec<Pose>)> = const { RefCell::new((Vec::new(), Vec::new())) };
+    static CLEARANCES: RefCell<Vec<Clearance>> = const { RefCell::new(Vec::new()) };
+}
+
+impl Arm<'_> {
+    /// World poses of the arm's bodies at `q` into `out` (cleared first); `links` is scratch.
+    pub fn body_poses(&self, q: &[f64], links: &mut Vec<Pose>, out: &mut Vec<Pose>) {
+        links.resize(self.chain.links.len(), Pose::IDENTITY);
+        self.chain.fk_all(q, links);
+        out.clear();
+        out.extend(
+            self.body_links
+                .iter()
+                .map(|&l| self.base * links.get(l).copied().unwrap_or(Pose::IDENTITY)),
+        );
+    }
+
+    /// For each chain link `k`, the number of joints up to and including it: the joints that
+    /// move link `k` are `0..joints_to[k]` (joints are numbered root to tip).
+    fn joints_to(&self) -> Vec<usize> {
+        self.chain
+            .links
+            .iter()
+            .scan(0, |n, l| {
+                if let Some(j) = l.joint {
+                    *n = (*n).max(j + 1);
+                }
+                Some(*n)
+            })
+            .collect()
+    }
+}
+
+/// For each joint, an upper bound (m) on the distance from its axis of any point of any body it
+/// moves, valid in every configuration (1 for a prismatic joint).
+///
+/// Why it bounds motion: joint `j`'s axis passes through the origin `o_j` of the link it moves.
+/// A point `p` of a body on link `k` downstream of `j` is `p = o_j + Σ_m R_m·t_m +
+/// Σ_prismatic R·axis·q + R_k·p_local`, where `t_m` are the fixed origin offsets of the links
+/// after `j` up to `k` and `R` rotations, so `|p − o_j| ≤ Σ_m |t_m| + Σ_prismatic
+/// max(|lower|, |upper|) + |p_local|`, and `|p_local|` is at most `|c| + r` over the spheres
+/// `(c, r)` of the body's cover (they contain the body). Along a straight joint-space segment
+/// the velocity of `p` is `Σ_j q̇_j·(axis_j × (p − o_j))` (revolute) plus `q̇_j·axis_j`
+/// (prismatic), of norm at most `Σ_j r_j·|q̇_j|`; integrating, `p` moves at most
+/// `Σ_j r_j·|b_j − a_j|`. The root is fixed in the world, so the bound holds in world
+/// coordinates. A joint that moves no body gets 0.
+pub fn joint_radii(arm: &Arm) -> Vec<f64> {
+    let chain = arm.chain;
+    let bodies: Vec<(usize, f64)> = arm
+        .body_links
+        .iter()
+        .enumerate()
+        .filter_map(|(i, &link)| {
+            let cover = arm.world.body_cover(arm.group, i);
+            let norm = cover
+                .iter()
+                .map(|s| s.centre.length() + s.radius)
+                .fold(None, |m: Option<f64>, v| Some(m.map_or(v, |m| m.max(v))))?;
+            Some((link, norm))
+        })
+        .collect();
+    let offset: Vec<f64> = chain
+        .links
+        .iter()
+        .map(|l| {
+            let travel = l.joint.and_then(|j| chain.joints.get(j)).map_or(0.0, |j| {
+                if j.kind == JointKind::Prismatic {
+                    j.lower.abs().max(j.upper.abs())
+                } else {
+                    0.0
+                }
+            });
+            l.origin.translation.length() + travel
+        })
+        .collect();
+    (0..chain.dof())
+        .map(|j| {
+            if chain.joints[j].kind == JointKind::Prismatic {
+                return 1.0;
+            }
+            let Some(lj) = chain.joint_link(j) else {
+                return 0.0;
+            };
+            bodies
+                .iter()
+                .filter(|&&(k, _)| k >= lj)
+                .map(|&(k, norm)| offset[lj + 1..=k].iter().sum::<f64>() + norm)
+                .fold(0.0, f64::max)
+        })
+        .collect()
+}
+
+/// The arm's joint space: the chain's limits, [`joint_radii`], and metric weights `1/v` from
+/// `max_velocity` (1 where a velocity is missing, zero or not finite).
+pub fn joint_space(arm: &Arm, max_velocity: &[f64]) -> JointSpace {
+    let chain = arm.chain;
+    let lower = chain.joints.iter().map(|j| j.lower).collect();
+    let upper = chain.joints.iter().map(|j| j.upper).collect();
+    let weights = (0..chain.dof())
+        .map(|j| match max_velocity.get(j) {
+            Some(&v) if v.is_finite() && v > 0.0 => 1.0 / v,
+            _ => 1.0,
+        })
+        .collect();
+    JointSpace::new(lower, upper, joint_radii(arm)).with_weights(weights)
+}
+
+/// The clearance of an arm's configurations (see the module documentation).
+///
+/// [`StateValidity::clearances`] splits it by the joints that can reduce each part: the
+/// distance of a body on link `k` to the scene (minus the margin) by joints `0..=k`, the
+/// distance of a self pair by the joints between its two links. Every distance is capped at
+/// [`ArmValidity::cap`].
+#[derive(Clone, Debug)]
+pub struct ArmValidity<'a> {
+    /// The arm.
+    pub arm: Arm<'a>,
+    /// Required distance (m) from the static scene and the parked groups.
+    pub margin: f64,
+    /// Clearances are capped at this (m).
+    pub cap: f64,
+    /// Whether the sphere-cover bounds are asked before exact distances (on by default; off
+    /// only to measure what the broad phase saves).
+    pub broad_phase: bool,
+    /// Bodies checked against the scene (those moved by some joint), with their joints.
+    moving: Vec<(usize, Range<usize>)>,
+    /// Checked self pairs with the joints between them.
+    pairs: Vec<(usize, usize, Range<usize>)>,
+    /// Other groups standing still (obstacles like the scene), with their body poses.
+    parked: Vec<(GroupId, Vec<Pose>)>,
+}
+
+impl<'a> ArmValidity<'a> {
+    /// With the default cap [`DEFAULT_CLEARANCE_CAP`], keeping `margin` from the scene and from
+    /// the `parked` groups. Bodies on links before the first joint never move and are not
+    /// checked against the scene (a robot's base stands on its floor).
+    pub fn new(arm: Arm<'a>, margin: f64, parked: Vec<(GroupId, Vec<Pose>)>) -> Self {
+        let joints_to = arm.joints_to();
+        let tip = arm.chain.links.len().saturating_sub(1);
+        let moved_by = |i: usize| {
+            let l = arm.body_links.get(i).copied().unwrap_or(tip).min(tip);
+            joints_to.get(l).copied().unwrap_or(0)
+        };
+        let moving = (0..arm.body_links.len())
+            .map(|i| (i, 0..moved_by(i)))
+            .filter(|(_, r)| !r.is_empty())
+            .collect();
+        let pairs = arm
+            .self_pairs
+            .iter()
+            .map(|&(i, j)| {
+                let (a, b) = (moved_by(i), moved_by(j));
+                (i, j, a.min(b)..a.max(b))
+            })
+            .collect();
+        ArmValidity {
+            arm,
+            margin,
+            cap: DEFAULT_CLEARANCE_CAP,
+            broad_phase: true,
+            moving,
+            pairs,
+            parked,
+        }
+    }
+
+    /// Distance of body `i` (posed in `bodies`) to the scene and the parked groups, capped.
+    fn body_scene_distance(&self, i: usize, bodies: &[Pose], cap: f64) -> f64 {
+        let world = self.arm.world;
+        let g = self.arm.group;
+        let mut d = world.body_static_distance(g, i, bodies, cap);
+        for (other, poses) in &self.parked {
+            if d <= 0.0 {
+                break;
+            }
+            d = world.body_group_distance(g, i, bodies, *other, poses, d);
+        }
+        d
+    }
+
+    /// The sphere-cover lower bound of [`Self::body_scene_distance`].
+    fn body_scene_bound(&self, i: usize, bodies: &[Pose], cap: f64) -> f64 {
+        let world = self.arm.world;
+        let g = self.arm.group;
+        let mut d = world.body_static_bound(g, i, bodies, cap);
+        for (other, poses) in &self.parked {
+            if d <= 0.0 {
+                break;
+            }
+            d = world.body_group_bound(g, i, bodies, *other, poses, d);
+        }
+        d
+    }
+
+    /// Whether `q` is valid: within the joint limits, every moving body farther than the
+    /// margin from the scene and the parked groups, every checked self pair apart. Broad phase
+    /// first, the exact test only for the parts it does not clear.
+    pub fn is_valid(&self, q: &[f64]) -> bool {
+        if !self.arm.chain.within_limits(q, 1e-9) {
+            return false;
+        }
+        LINKS.with_borrow_mut(|(links, bodies)| {
+            self.arm.body_poses(q, links, bodies);
+            let world = self.arm.world;
+            let g = self.arm.group;
+            let margin = self.margin.max(0.0);
+            // Strictly farther than the margin, as the clearance (> 0) requires.
+            let need = margin + DISTANCE_SLACK;
+            let tiny = 1e-9;
+            let scene_ok = self.moving.iter().all(|(i, _)| {
+                (self.broad_phase && self.body_scene_bound(*i, bodies, need + tiny) >= need + tiny)
+                    || self.body_scene_distance(*i, bodies, need + tiny) > need
+            });
+            scene_ok
+                && self.pairs.iter().all(|&(i, j, _)| {
+                    (self.broad_phase
+                        && world.pair_bound(g, i, j, bodies, DISTANCE_SLACK + tiny) > DISTANCE_SLACK)
+                        || world.pair_distance(g, i, j, bodies, DISTANCE_SLACK + tiny) > DISTANCE_SLACK
+                })
+        })
+    }
+
+    /// The clearance of `q` from the scene (minus the margin) and the smallest distance between
+    /// its checked self pairs, each capped at [`Self::cap`] (the parts of
+    /// [`StateValidity::clearances`], split); both negative infinity outside the joint limits.
+    pub fn scene_and_self_clearance(&self, q: &[f64]) -> (f64, f64) {
+        if !self.arm.chain.within_limits(q, 1e-9) {
+            return (f64::NEG_INFINITY, f64::NEG_INFINITY);
+        }
+        CLEARANCES.with_borrow_mut(|out| {
+            self.clearances(q, out);
+            // `clearances` lists the moving bodies first, then the pairs.
+            let (scene, pairs) = out.split_at(self.moving.len().min(out.len()));
+            let min = |parts: &[Clearance]| parts.iter().map(|c| c.distance).fold(self.cap, f64::min);
+            (min(scene), min(pairs))
+        })
+    }
+
+    /// The distance of one part, asked only as far as it matters: `wanted` is the clearance
+    /// that would not shorten the step (the step so far times the part's bound, or the floor
+    /// when the part cannot move), at most [`Self::cap`]. The sphere-cover bound answers when it
+    /// reaches `wanted`; else the exact query, capped there, decides. Returns the part's
+    /// clearance (capped at `wanted`).
+    #[allow(clippy::too_many_arguments)]
+    fn capped_part(
+        &self,
+        bound_query: impl FnOnce(f64) -> f64,
+        exact_query: impl FnOnce(f64) -> f64,
+        offset: f64,
+        bound: f64,
+        step: f64,
+        floor: f64,
+    ) -> f64 {
+        let wanted = if bound > 0.0 {
+            (step * bound).min(self.cap).max(floor)
+        } else {
+            floor
+        };
+        let cap = wanted + offset + DISTANCE_SLACK;
+        if self.broad_phase && bound_query(cap) >= cap {
+            return wanted;
+        }
+        let d = exact_query(cap);
+        // At the cap, the answer is `wanted` itself (subtracting back could round below it).
+        if d >= cap {
+            wanted
+        } else {
+            d - offset - DISTANCE_SLACK
+        }
+    }
+}
+
+impl StateValidity for ArmValidity<'_> {
+    fn clearance(&self, q: &[f64]) -> f64 {
+        CLEARANCES.with_borrow_mut(|out| {
+            self.clearances(q, out);
+            out.iter().map(|c| c.distance).fold(f64::INFINITY, f64::min)
+        })
+    }
+
+    fn clearances(&self, q: &[f64], out: &mut Vec<Clearance>) {
+        out.clear();
+        if !self.arm.chain.within_limits(q, 1e-9) {
+            out.push(Clearance {
+                distance: f64::NEG_INFINITY,
+                joints: 0..usize::MAX,
+            });
+            return;
+        }
+        LINKS.with_borrow_mut(|(links, bodies)| {
+            self.arm.body_poses(q, links, bodies);
+            let world = self.arm.world;
+            let g = self.arm.group;
+            let margin = self.margin.max(0.0);
+            for (i, joints) in &self.moving {
+                let d = self.body_scene_distance(*i, bodies, self.cap + margin);
+                out.push(Clearance {
+                    distance: d - margin - DISTANCE_SLACK,
+                    joints: joints.clone(),
+                });
+            }
+            for (i, j, joints) in &self.pairs {
+                let d = world.pair_distance(g, *i, *j, bodies, self.cap);
+                out.push(Clearance {
+                    distance: d - DISTANCE_SLACK,
+                    joints: joints.clone(),
+                });
+            }
+        });
+    }
+
+    /// As the default, with every part asked only as far as it matters (see `capped_part`):
+    /// bodies from the tip inwards (the tool is the usual tightest part, and its step then caps
+    /// the others' queries), then the self pairs.
+    fn segment_step(
+        &self,
+        q: &[f64],
+        bound: &dyn Fn(&Range<usize>) -> f64,
+        floor: f64,
+        limit: f64,
+    ) -> Option<f64> {
+        if !self.arm.chain.within_limits(q, 1e-9) {
+            return None;
+        }
+        LINKS.with_borrow_mut(|(links, bodies)| {
+            self.arm.body_poses(q, links, bodies);
+            let world = self.arm.world;
+            let g = self.arm.group;
+            let margin = self.margin.max(0.0);
+            let mut step = limit;
+            for (i, joints) in self.moving.iter().rev() {
+                let b = bound(joints);
+                let part = self.capped_part(
+                    |cap| self.body_scene_bound(*i, bodies, cap),
+                    |cap| self.body_scene_distance(*i, bodies, cap),
+                    margin,
+                    b,
+                    step,
+                    floor,
+                );
+                step = narrow_step(step, part, b, floor)?;
+            }
+            for (i, j, joints) in &self.pairs {
+                let b = bound(joints);
+                let part = self.capped_part(
+                    |cap| world.pair_bound(g, *i, *j, bodies, cap),
+                    |cap| world.pair_distance(g, *i, *j, bodies, cap),
+                    0.0,
+                    b,
+                    step,
+                    floor,
+                );
+                step = narrow_step(step, part, b, floor)?;
+            }
+            Some(step)
+        })
+    }
+}
