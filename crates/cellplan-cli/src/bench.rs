@@ -21,6 +21,9 @@ pub enum Kind {
     Setcover,
     /// cellplan min-max multi-vehicle routing with alternatives (docs/minmax-format.md).
     Minmax,
+    /// Motion planning problems without a cell (docs/motion-problems.md), every path
+    /// re-checked exactly.
+    Motion,
 }
 
 /// Solver method.
@@ -46,16 +49,37 @@ pub enum Method {
 pub struct BenchArgs {
     /// Problem kind.
     #[arg(value_enum)]
-    kind: Kind,
+    pub kind: Kind,
     /// Instance files.
     #[arg(required_unless_present = "generate")]
-    files: Vec<PathBuf>,
-    /// Time limit per run, in seconds.
+    pub files: Vec<PathBuf>,
+    /// Time limit per run, in seconds (motion: a wall-clock safety net per query; the work
+    /// budget binds first).
     #[arg(long, default_value_t = 1.0)]
-    time_limit: f64,
+    pub time_limit: f64,
     /// Runs per instance (seeds 0, 1, ...).
     #[arg(long, default_value_t = 1)]
-    runs: u64,
+    pub runs: u64,
+    /// Motion: the planner (leg, rrt-connect, straight).
+    #[arg(long, default_value = "leg")]
+    pub planner: String,
+    /// Motion: only the first N problems of each file.
+    #[arg(long, value_name = "N")]
+    pub first: Option<usize>,
+    /// Motion: re-check the paths of a peer's run file (bench/peers/motion_*.py) instead of
+    /// planning.
+    #[arg(long, value_name = "RUN_JSON")]
+    pub recheck: Option<PathBuf>,
+    /// Motion: time N single validity checks per problem (random configurations, with and
+    /// without the broad phase) instead of planning.
+    #[arg(long, value_name = "N")]
+    pub checks: Option<usize>,
+    /// Motion: largest point motion between two samples of the exact re-check, in mm.
+    #[arg(long, default_value_t = 1.0)]
+    pub exact_step_mm: f64,
+    /// Motion: keep the paths in the JSON rows.
+    #[arg(long)]
+    pub with_paths: bool,
     /// Method (default: ils for tsp/gtsp/minmax, exact for setcover; minmax also takes
     /// algorithm1 and proximity).
     #[arg(long, value_enum)]
@@ -173,7 +197,7 @@ pub fn run(args: &BenchArgs) -> Result<Vec<Row>, BenchError> {
         return run_minmax(args, limit);
     }
     let method = args.method.unwrap_or(match args.kind {
-        Kind::Tsp | Kind::Gtsp | Kind::Minmax => Method::Ils,
+        Kind::Tsp | Kind::Gtsp | Kind::Minmax | Kind::Motion => Method::Ils,
         Kind::Setcover => Method::Exact,
     });
     if matches!(method, Method::Algorithm1 | Method::Proximity) {
@@ -194,7 +218,11 @@ pub fn run(args: &BenchArgs) -> Result<Vec<Row>, BenchError> {
             Kind::Tsp => Instance::Route(Gtsp::tsp(read_tsplib(file).map_err(BenchError::Input)?.costs)),
             Kind::Gtsp => Instance::Route(read_gtsplib(file).map_err(BenchError::Input)?.gtsp),
             Kind::Setcover => Instance::Cover(read_orlib_setcover(file).map_err(BenchError::Input)?),
-            Kind::Minmax => unreachable!("min-max is benchmarked by run_minmax"),
+            Kind::Minmax | Kind::Motion => {
+                return Err(BenchError::Usage(
+                    "min-max and motion are benchmarked by their own runners".into(),
+                ));
+            }
         };
         let mut costs = Vec::new();
         let mut proven = false;

@@ -5,6 +5,7 @@
 //! 4 `verify` found the plan violates something (each violation is printed);
 //! 1 anything else.
 mod bench;
+mod bench_motion;
 mod compare_cmd;
 mod plan_cmd;
 mod report_cmd;
@@ -319,6 +320,9 @@ fn run_gen_tasks(args: &GenTasksArgs) -> Result<(), Failure> {
 }
 
 fn run_bench(args: &bench::BenchArgs) -> Result<(), Failure> {
+    if args.kind == bench::Kind::Motion {
+        return run_bench_motion(args);
+    }
     let failure = |e| match e {
         bench::BenchError::Input(e) => Failure::Input(Box::new(
             InputError::at_line(e.path(), e.line(), e.detail()).hint(
@@ -343,6 +347,77 @@ fn run_bench(args: &bench::BenchArgs) -> Result<(), Failure> {
         print!("{}", bench::render(&rows));
     }
     Ok(())
+}
+
+/// `cellplan bench motion`: plan (or re-check a peer's run, or time single checks) and print.
+fn run_bench_motion(args: &bench::BenchArgs) -> Result<(), Failure> {
+    let problem_failure = |e: cellplan_motion::problem::ProblemError| {
+        let hint = e.hint().to_string();
+        let (path, line) = match &e {
+            cellplan_motion::problem::ProblemError::Json { path, line, .. } => (path.clone(), Some(*line)),
+            cellplan_motion::problem::ProblemError::Io { path, .. }
+            | cellplan_motion::problem::ProblemError::Invalid { path, .. } => (path.clone(), None),
+            cellplan_motion::problem::ProblemError::Robot(_) => (PathBuf::from("robot"), None),
+        };
+        let err = match line {
+            Some(l) => InputError::at_line(&path, Some(l), e.to_string()),
+            None => InputError::new(&path, e.to_string()),
+        };
+        Failure::Input(Box::new(err.hint(hint)))
+    };
+    if !bench_motion::PLANNERS.contains(&args.planner.as_str()) {
+        return Err(Failure::Usage(format!(
+            "unknown planner `{}` (known: {})",
+            args.planner,
+            bench_motion::PLANNERS.join(", ")
+        )));
+    }
+    if !(args.time_limit > 0.0 && args.time_limit.is_finite()) || !(args.exact_step_mm > 0.0) {
+        return Err(Failure::Usage("--time-limit and --exact-step-mm must be positive".into()));
+    }
+    let print = |value: &dyn erased::Show| -> Result<(), Failure> {
+        println!("{}", value.show().map_err(Failure::Other)?);
+        Ok(())
+    };
+    if let Some(n) = args.checks {
+        let rows = bench_motion::time_checks(&args.files, n, args.first).map_err(problem_failure)?;
+        return print(&rows);
+    }
+    let step = args.exact_step_mm * 1e-3;
+    let mut rows = match &args.recheck {
+        Some(run) => bench_motion::recheck(&args.files, run, step).map_err(Failure::Other)?,
+        None => bench_motion::run(&bench_motion::Request {
+            files: &args.files,
+            planner: &args.planner,
+            time_limit: args.time_limit,
+            runs: args.runs,
+            first: args.first,
+            exact_step: step,
+        })
+        .map_err(problem_failure)?,
+    };
+    if !args.with_paths {
+        rows.iter_mut().for_each(|r| r.path = None);
+    }
+    if args.json {
+        print(&rows)
+    } else {
+        print!("{}", bench_motion::render(&rows));
+        Ok(())
+    }
+}
+
+/// JSON printing of whatever the bench produced.
+mod erased {
+    /// A value printed as pretty JSON.
+    pub trait Show {
+        fn show(&self) -> Result<String, String>;
+    }
+    impl<T: serde::Serialize> Show for T {
+        fn show(&self) -> Result<String, String> {
+            serde_json::to_string_pretty(self).map_err(|e| e.to_string())
+        }
+    }
 }
 
 fn main() -> ExitCode {

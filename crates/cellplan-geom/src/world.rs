@@ -195,6 +195,12 @@ impl CollisionWorld {
         id
     }
 
+    /// Removes every static object (their ids become invalid); the groups stay. For a scene whose
+    /// obstacles change between queries while the robots stay.
+    pub fn clear_statics(&mut self) {
+        self.statics.clear();
+    }
+
     /// Name of a static object.
     pub fn static_name(&self, id: StaticId) -> &str {
         &self.statics[id.0 as usize].name

@@ -3,6 +3,7 @@
 //! damped-least-squares solver for the rest.
 //!
 //! - [`urdf`]: [`load_urdf`] reads a URDF (resolving `package://` URIs) into a [`RobotModel`].
+//! - [`srdf`]: the `disable_collisions` rules of an SRDF.
 //! - [`chain`]: the serial [`Chain`], its [`Joint`]s and forward kinematics.
 //! - [`opw`]: [`OpwParameters`] and the closed-form solution with all eight branches.
 //! - [`ik`]: the [`IkSolver`] trait, [`OpwIk`] (OPW on a URDF chain), [`DlsIk`] (numeric),
@@ -15,6 +16,7 @@ pub mod chain;
 pub mod error;
 pub mod ik;
 pub mod opw;
+pub mod srdf;
 pub mod urdf;
 
 pub use chain::{Chain, ChainLink, Joint, JointKind, pose_error};

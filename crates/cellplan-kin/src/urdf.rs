@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 mod validate;
-mod xml;
+pub(crate) mod xml;
 
 /// A robot read from a URDF: its serial chain and the collision geometry of each chain link.
 #[derive(Clone, Debug)]

@@ -14,8 +14,12 @@
 //! - [`record`]: the settings the cell fixes, the cycle time, Δt, the lower bound (recomputed
 //!   from the candidates), the coordination record and the candidate count.
 //!
+//! Apart from plans of cells, [`motion`] re-checks bare joint paths (the motion benchmark's)
+//! exactly, on the robot's collision meshes as given.
+//!
 //! Before any of that the document is [`validate`](cellplan_core::document::validate)d, and a plan too
 //! large to check at the requested resolution is refused ([`workload`]).
+pub mod motion;
 mod paths;
 mod record;
 mod robots;

@@ -1,0 +1,359 @@
+//! `cellplan bench motion SCENE...`: the motion core on planning problems without a cell
+//! (docs/motion-problems.md), OMPL's benchmark shape: a request (planner, time limit, runs,
+//! seeds), one row per problem and run — solved, time, path length, validity checks — and an
+//! exact re-check of every path on the robot's collision meshes as given
+//! ([`cellplan_verify::motion`]). `--recheck RUN.json` re-checks a peer's paths instead
+//! (bench/peers/motion_*.py write them), and `--checks N` times single validity checks.
+use cellplan_motion::arm::{self, ArmValidity};
+use cellplan_motion::plan::{self, JointSpace, PlanError, PlanSettings, Planner, RrtConnect, Straight};
+use cellplan_motion::problem::{ArmSetup, Problem, ProblemError, ProblemSet, read_problems};
+use cellplan_verify::motion::{ExactCheck, ExactObstacle, ExactRobot};
+use rand::{RngExt, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
+
+/// The planners `--planner` takes.
+pub const PLANNERS: &[&str] = &["leg", "rrt-connect", "straight"];
+
+/// What the motion benchmark is asked.
+pub struct Request<'a> {
+    /// Problem files.
+    pub files: &'a [PathBuf],
+    /// Planner name.
+    pub planner: &'a str,
+    /// Wall-clock safety net per query (s); the work budget is the planner's sample limit.
+    pub time_limit: f64,
+    /// Runs per problem (seeds 0, 1, …).
+    pub runs: u64,
+    /// Only the first problems of each file.
+    pub first: Option<usize>,
+    /// Largest point motion between two samples of the exact re-check (m).
+    pub exact_step: f64,
+}
+
+/// One problem × run.
+#[derive(Serialize, Deserialize, Clone, Debug)]
+pub struct Row {
+    /// Problem name.
+    pub problem: String,
+    /// Planner name.
+    pub planner: String,
+    /// Seed of the run.
+    pub seed: u64,
+    /// Whether a path was found.
+    pub solved: bool,
+    /// Why not, or `solved`.
+    pub status: String,
+    /// Wall time of the query (s).
+    pub time_s: f64,
+    /// Path length: Euclidean in joint space (rad), as OMPL and VAMP state it.
+    pub path_length: Option<f64>,
+    /// Waypoints of the path.
+    pub waypoints: usize,
+    /// Validity checks (clearance evaluations) made.
+    pub validity_checks: usize,
+    /// The exact re-check passed (`false` when there is no path).
+    pub exact_valid: bool,
+    /// Configurations the exact re-check tested.
+    pub exact_samples: usize,
+    /// The exact re-check's first contact.
+    pub exact_contact: Option<String>,
+    /// The path, in the file's joint order.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub path: Option<Vec<Vec<f64>>>,
+}
+
+/// A peer's row as bench/peers/motion_*.py write them.
+#[derive(Deserialize)]
+struct PeerRow {
+    problem: String,
+    planner: String,
+    solved: bool,
+    #[serde(default)]
+    time_s: f64,
+    #[serde(default)]
+    path_length: Option<f64>,
+    #[serde(default)]
+    validity_checks: Option<usize>,
+    #[serde(default)]
+    path: Option<Vec<Vec<f64>>>,
+}
+
+fn euclidean_length(path: &[Vec<f64>]) -> f64 {
+    path.windows(2)
+        .map(|w| w[0].iter().zip(&w[1]).map(|(a, b)| (a - b) * (a - b)).sum::<f64>().sqrt())
+        .sum()
+}
+
+fn exact_of(setup: &ArmSetup, problem: &Problem, path_file_order: &[Vec<f64>], step: f64) -> ExactCheck {
+    let robot = ExactRobot::new(&setup.model, setup.base, &setup.self_pairs);
+    let obstacles: Vec<ExactObstacle> = problem
+        .obstacles
+        .iter()
+        .filter_map(|o| ExactObstacle::new(&o.name, &o.shape, o.pose))
+        .collect();
+    let chain_path: Vec<Vec<f64>> = path_file_order.iter().map(|q| setup.to_chain(q)).collect();
+    robot.check_path(&chain_path, &obstacles, problem.margin, step)
+}
+
+/// Plans one problem with the named planner; `(path in chain order, status, checks)`.
+fn solve(
+    planner: &str,
+    space: &JointSpace,
+    validity: &ArmValidity,
+    start: &[f64],
+    goals: &[Vec<f64>],
+    settings: &PlanSettings,
+) -> (Option<Vec<Vec<f64>>>, String, usize) {
+    let mut checks = 0;
+    let mut last = String::from("no goal");
+    // One goal after another until one is reached (the MBM problems have one each).
+    for goal in goals {
+        let result = match planner {
+            "straight" => Straight.plan(space, validity, start, goal, settings),
+            "rrt-connect" => RrtConnect.plan(space, validity, start, goal, settings),
+            _ => plan::plan_leg(space, validity, start, goal, settings),
+        };
+        match result {
+            Ok(p) => return (Some(p.waypoints), "solved".into(), checks + p.validity_calls),
+            Err(e) => {
+                checks += match &e {
+                    PlanError::NoPath { validity_calls, .. } => *validity_calls,
+                    _ => 2,
+                };
+                last = match e {
+                    PlanError::StartInvalid { .. } => "invalid-start".into(),
+                    PlanError::GoalInvalid { .. } => "invalid-goal".into(),
+                    PlanError::NoPath { .. } => "no-path".into(),
+                };
+                if last == "invalid-start" {
+                    break;
+                }
+            }
+        }
+    }
+    (None, last, checks)
+}
+
+/// Loads a file and its robot.
+pub fn load(file: &Path) -> Result<(ProblemSet, ArmSetup), ProblemError> {
+    let set = read_problems(file)?;
+    let setup = ArmSetup::load(&set)?;
+    Ok((set, setup))
+}
+
+/// Runs the request: every problem of every file, `runs` times, sequentially (so that times are
+/// single-core times), then the exact re-checks in parallel.
+pub fn run(req: &Request) -> Result<Vec<Row>, ProblemError> {
+    let mut rows = Vec::new();
+    for file in req.files {
+        let (set, mut setup) = load(file)?;
+        let problems = &set.problems[..req.first.unwrap_or(usize::MAX).min(set.problems.len())];
+        let velocities: Vec<f64> = setup.model.chain.joints.iter().map(|j| j.max_velocity).collect();
+        let mut file_rows = Vec::new();
+        for problem in problems {
+            setup.set_obstacles(&problem.obstacles);
+            let validity = setup.validity(problem.margin);
+            let space = arm::joint_space(&setup.arm(), &velocities);
+            let start = setup.to_chain(&problem.start);
+            let goals: Vec<Vec<f64>> = problem.goals.iter().map(|g| setup.to_chain(g)).collect();
+            for seed in 0..req.runs {
+                let settings = PlanSettings {
+                    seed,
+                    time_limit: Duration::from_secs_f64(req.time_limit),
+                    ..PlanSettings::default()
+                };
+                let began = Instant::now();
+                let (path, mut status, checks) = solve(req.planner, &space, &validity, &start, &goals, &settings);
+                let time_s = began.elapsed().as_secs_f64();
+                if path.is_none() && status == "no-path" && time_s >= req.time_limit {
+                    status = "timeout".into();
+                }
+                let file_path = path.map(|p| p.iter().map(|q| setup.to_file(q)).collect::<Vec<_>>());
+                file_rows.push(Row {
+                    problem: problem.name.clone(),
+                    planner: req.planner.to_string(),
+                    seed,
+                    solved: file_path.is_some(),
+                    status,
+                    time_s,
+                    path_length: file_path.as_deref().map(euclidean_length),
+                    waypoints: file_path.as_ref().map_or(0, Vec::len),
+                    validity_checks: checks,
+                    exact_valid: false,
+                    exact_samples: 0,
+                    exact_contact: None,
+                    path: file_path,
+                });
+            }
+        }
+        recheck_rows(&set, &mut setup, &mut file_rows, req.exact_step);
+        rows.extend(file_rows);
+    }
+    Ok(rows)
+}
+
+/// Fills the exact re-check of every row with a path (rows name their problems).
+fn recheck_rows(set: &ProblemSet, setup: &mut ArmSetup, rows: &mut [Row], step: f64) {
+    let setup = &*setup;
+    rows.par_iter_mut().for_each(|row| {
+        let (Some(problem), Some(path)) = (
+            set.problems.iter().find(|p| p.name == row.problem),
+            row.path.as_ref(),
+        ) else {
+            return;
+        };
+        let check = exact_of(setup, problem, path, step);
+        row.exact_valid = check.valid;
+        row.exact_samples = check.samples;
+        row.exact_contact = check.contact.map(|(seg, t, what)| format!("segment {seg} at {t:.4}: {what}"));
+    });
+}
+
+/// Re-checks a peer's run file (`[{problem, planner, solved, time_s, path_length,
+/// validity_checks, path}]`) against the problems of `files`.
+pub fn recheck(files: &[PathBuf], run_file: &Path, step: f64) -> Result<Vec<Row>, String> {
+    let text = std::fs::read_to_string(run_file).map_err(|e| format!("cannot read {}: {e}", run_file.display()))?;
+    let peers: Vec<PeerRow> =
+        serde_json::from_str(&text).map_err(|e| format!("{}:{}:{}: {e}", run_file.display(), e.line(), e.column()))?;
+    let mut rows = Vec::new();
+    for file in files {
+        let (set, mut setup) = load(file).map_err(|e| e.to_string())?;
+        let mut file_rows: Vec<Row> = peers
+            .iter()
+            .filter(|p| set.problems.iter().any(|q| q.name == p.problem))
+            .map(|p| Row {
+                problem: p.problem.clone(),
+                planner: p.planner.clone(),
+                seed: 0,
+                solved: p.solved && p.path.is_some(),
+                status: if p.solved { "solved".into() } else { "unsolved".into() },
+                time_s: p.time_s,
+                path_length: p.path_length,
+                waypoints: p.path.as_ref().map_or(0, Vec::len),
+                validity_checks: p.validity_checks.unwrap_or(0),
+                exact_valid: false,
+                exact_samples: 0,
+                exact_contact: None,
+                path: p.path.clone(),
+            })
+            .collect();
+        recheck_rows(&set, &mut setup, &mut file_rows, step);
+        rows.extend(file_rows);
+    }
+    Ok(rows)
+}
+
+/// The timing of single validity checks in one file's scenes.
+#[derive(Serialize, Debug)]
+pub struct CheckRow {
+    /// Scene (file) name.
+    pub scene: String,
+    /// Configurations timed (random, within the limits, over the file's problems).
+    pub configurations: usize,
+    /// Share of them valid.
+    pub valid_share: f64,
+    /// Median time of one check with the sphere-cover broad phase (µs).
+    pub median_us: f64,
+    /// Median time of one check with exact distances only (µs).
+    pub median_exact_only_us: f64,
+    /// Checks where the two answers differ (must be 0).
+    pub disagreements: usize,
+}
+
+fn median(mut v: Vec<f64>) -> f64 {
+    if v.is_empty() {
+        return f64::NAN;
+    }
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
+}
+
+/// Times `per_problem` random valid-or-not configurations per problem, each checked with and
+/// without the broad phase (single thread).
+pub fn time_checks(files: &[PathBuf], per_problem: usize, first: Option<usize>) -> Result<Vec<CheckRow>, ProblemError> {
+    let mut out = Vec::new();
+    for file in files {
+        let (set, mut setup) = load(file)?;
+        let problems = &set.problems[..first.unwrap_or(usize::MAX).min(set.problems.len())];
+        let mut rng = ChaCha8Rng::seed_from_u64(1);
+        let (mut with, mut without) = (Vec::new(), Vec::new());
+        let (mut valid, mut disagree) = (0, 0);
+        for problem in problems {
+            setup.set_obstacles(&problem.obstacles);
+            let fast = setup.validity(problem.margin);
+            let mut exact = setup.validity(problem.margin);
+            exact.broad_phase = false;
+            let chain = &setup.model.chain;
+            let configs: Vec<Vec<f64>> = (0..per_problem)
+                .map(|_| {
+                    chain
+                        .joints
+                        .iter()
+                        .map(|j| rng.random_range(j.lower..=j.upper))
+                        .collect()
+                })
+                .collect();
+            for q in &configs {
+                // Each timed alone, a batch of 8 for the clock's resolution.
+                let t = Instant::now();
+                let mut a = false;
+                for _ in 0..8 {
+                    a = std::hint::black_box(fast.is_valid(std::hint::black_box(q)));
+                }
+                with.push(t.elapsed().as_secs_f64() * 1e6 / 8.0);
+                let t = Instant::now();
+                let mut b = false;
+                for _ in 0..8 {
+                    b = std::hint::black_box(exact.is_valid(std::hint::black_box(q)));
+                }
+                without.push(t.elapsed().as_secs_f64() * 1e6 / 8.0);
+                valid += usize::from(a);
+                disagree += usize::from(a != b);
+            }
+        }
+        let n = with.len();
+        out.push(CheckRow {
+            scene: set.scene.clone(),
+            configurations: n,
+            valid_share: valid as f64 / n.max(1) as f64,
+            median_us: median(with),
+            median_exact_only_us: median(without),
+            disagreements: disagree,
+        });
+    }
+    Ok(out)
+}
+
+/// A plain-text table of rows, per scene: solved, median time, exact failures.
+pub fn render(rows: &[Row]) -> String {
+    let mut scenes: Vec<String> = rows
+        .iter()
+        .map(|r| r.problem.split('/').next().unwrap_or("").to_string())
+        .collect();
+    scenes.dedup();
+    let mut out = format!(
+        "{:<20} {:>8} {:>8} {:>12} {:>10} {:>14}\n",
+        "scene", "queries", "solved", "median_ms", "checks", "exact_invalid"
+    );
+    for scene in scenes {
+        let of: Vec<&Row> = rows.iter().filter(|r| r.problem.starts_with(&format!("{scene}/"))).collect();
+        let solved: Vec<&&Row> = of.iter().filter(|r| r.solved).collect();
+        let ms = median(solved.iter().map(|r| r.time_s * 1e3).collect());
+        let checks = median(solved.iter().map(|r| r.validity_checks as f64).collect());
+        let bad = solved.iter().filter(|r| !r.exact_valid).count();
+        out += &format!(
+            "{:<20} {:>8} {:>8} {:>12.3} {:>10.0} {:>14}\n",
+            scene,
+            of.len(),
+            solved.len(),
+            ms,
+            checks,
+            bad
+        );
+    }
+    out
+}

@@ -1,0 +1,513 @@
+//! A planning problem without a cell: a robot (URDF, optional SRDF, where its root stands),
+//! obstacles, a start, one or more goals and a margin — the motion-problem format of
+//! `docs/motion-problems.md` (one JSON file per scene, many problems in it) — and the arm set up
+//! in a collision world to solve them ([`ArmSetup`]).
+//!
+//! The robot is built as the cell loader builds one: one convex body per collision shape of
+//! every link (links rigidly attached off the chain, such as a gripper's fingers, keep their own
+//! bodies), the SRDF's `disable_collisions` pairs left out of the self checks (without an SRDF:
+//! every pair of bodies on different links that are not parent and child).
+use crate::arm::{Arm, ArmValidity};
+use cellplan_geom::read::{LimitedReadError, read_limited, show_bytes, utf8_text};
+use cellplan_geom::{CollisionWorld, DQuat, DVec3, GroupBody, GroupId, Pose, ShapeSpec};
+use cellplan_kin::{KinError, RobotModel, load_urdf, srdf};
+use serde::Deserialize;
+use std::collections::{BTreeMap, BTreeSet};
+use std::path::{Path, PathBuf};
+
+/// The format name a problem file states.
+pub const FORMAT: &str = "cellplan-motion-problems";
+/// The version read.
+pub const VERSION: u32 = 1;
+/// Largest problem file read (256 MiB).
+pub const MAX_FILE_BYTES: u64 = 256 << 20;
+/// Most problems in one file.
+pub const MAX_PROBLEMS: usize = 100_000;
+/// Most obstacles in one problem.
+pub const MAX_OBSTACLES: usize = 100_000;
+/// Most goals in one problem.
+pub const MAX_GOALS: usize = 10_000;
+/// Largest length accepted (m): positions, sizes, margins.
+pub const MAX_LENGTH_M: f64 = 1e4;
+
+/// Why a problem file cannot be used.
+#[derive(Debug, thiserror::Error)]
+pub enum ProblemError {
+    /// The file cannot be read.
+    #[error("cannot read {}: {source}", path.display())]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// The cause.
+        source: std::io::Error,
+    },
+    /// The file is not valid JSON of this format.
+    #[error("{}:{line}:{column}: {message}", path.display())]
+    Json {
+        /// The file.
+        path: PathBuf,
+        /// 1-based line.
+        line: usize,
+        /// 1-based column.
+        column: usize,
+        /// What is wrong.
+        message: String,
+    },
+    /// The content is refused.
+    #[error("{}: {message}", path.display())]
+    Invalid {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong (naming the problem and member).
+        message: String,
+        /// What to do about it.
+        hint: String,
+    },
+    /// The robot's URDF or SRDF cannot be used.
+    #[error(transparent)]
+    Robot(#[from] KinError),
+}
+
+impl ProblemError {
+    /// What to do about it.
+    pub fn hint(&self) -> &str {
+        match self {
+            ProblemError::Io { .. } => "check the path",
+            ProblemError::Json { .. } => "see docs/motion-problems.md for the format",
+            ProblemError::Invalid { hint, .. } => hint,
+            ProblemError::Robot(KinError::Urdf { hint, .. }) => hint,
+            ProblemError::Robot(_) => "check the robot's files",
+        }
+    }
+}
+
+/// A pose as written: position and unit quaternion (x, y, z, w).
+#[derive(Deserialize)]
+struct PoseDoc {
+    xyz: [f64; 3],
+    #[serde(default)]
+    quat_xyzw: Option<[f64; 4]>,
+    #[serde(default)]
+    rpy: Option<[f64; 3]>,
+}
+
+#[derive(Deserialize)]
+struct RobotDoc {
+    urdf: String,
+    #[serde(default)]
+    srdf: Option<String>,
+    #[serde(default)]
+    base: Option<PoseDoc>,
+}
+
+#[derive(Deserialize)]
+struct ObstacleDoc {
+    #[serde(default)]
+    name: String,
+    shape: String,
+    #[serde(default)]
+    half_extents: Option<[f64; 3]>,
+    #[serde(default)]
+    radius: Option<f64>,
+    #[serde(default)]
+    length: Option<f64>,
+    pose: PoseDoc,
+}
+
+#[derive(Deserialize)]
+struct ProblemDoc {
+    name: String,
+    start: Vec<f64>,
+    goals: Vec<Vec<f64>>,
+    #[serde(default)]
+    margin: f64,
+    #[serde(default)]
+    obstacles: Vec<ObstacleDoc>,
+}
+
+#[derive(Deserialize)]
+struct FileDoc {
+    format: String,
+    version: u32,
+    #[serde(default)]
+    scene: String,
+    #[serde(default)]
+    source: String,
+    robot: RobotDoc,
+    joints: Vec<String>,
+    problems: Vec<ProblemDoc>,
+}
+
+/// The robot of a problem file.
+#[derive(Clone, Debug)]
+pub struct RobotRef {
+    /// The URDF (resolved against the problem file's folder).
+    pub urdf: PathBuf,
+    /// The SRDF, if given.
+    pub srdf: Option<PathBuf>,
+    /// Where the URDF's root link stands in the world.
+    pub base: Pose,
+}
+
+/// An obstacle: a solid primitive at a world pose.
+#[derive(Clone, Debug)]
+pub struct Obstacle {
+    /// Name (informative).
+    pub name: String,
+    /// Its shape (a cylinder's axis is its local z).
+    pub shape: ShapeSpec,
+    /// Pose of the shape's centre in the world.
+    pub pose: Pose,
+}
+
+/// One query.
+#[derive(Clone, Debug)]
+pub struct Problem {
+    /// Name (`scene/NNNN` in the MBM files).
+    pub name: String,
+    /// Start configuration, in the file's joint order.
+    pub start: Vec<f64>,
+    /// Goal configurations (a path may end at any), in the file's joint order.
+    pub goals: Vec<Vec<f64>>,
+    /// Clearance the path must keep from obstacles (m).
+    pub margin: f64,
+    /// The obstacles.
+    pub obstacles: Vec<Obstacle>,
+}
+
+/// A problem file.
+#[derive(Clone, Debug)]
+pub struct ProblemSet {
+    /// The file.
+    pub path: PathBuf,
+    /// Scene name.
+    pub scene: String,
+    /// Where the problems come from.
+    pub source: String,
+    /// The robot.
+    pub robot: RobotRef,
+    /// The joints a configuration lists, in order.
+    pub joints: Vec<String>,
+    /// The problems.
+    pub problems: Vec<Problem>,
+}
+
+/// The pose of a written pose: `quat_xyzw` (normalised; its norm must be within 1 ± 0.01), or
+/// `rpy` as in URDF, or the identity rotation.
+fn pose_of(doc: &PoseDoc, what: &str) -> Result<Pose, String> {
+    let t = DVec3::from_array(doc.xyz);
+    if !t.is_finite() || t.abs().max_element() > MAX_LENGTH_M {
+        return Err(format!("{what}: position {:?} is not finite or beyond {MAX_LENGTH_M} m", doc.xyz));
+    }
+    let rot = match (doc.quat_xyzw, doc.rpy) {
+        (Some(q), _) => {
+            let q = DQuat::from_xyzw(q[0], q[1], q[2], q[3]);
+            let n = q.length();
+            if !n.is_finite() || (n - 1.0).abs() > 0.01 {
+                return Err(format!("{what}: quat_xyzw has norm {n}, not a unit quaternion"));
+            }
+            q / n
+        }
+        (None, Some([r, p, y])) => {
+            if ![r, p, y].iter().all(|v| v.is_finite()) {
+                return Err(format!("{what}: rpy is not finite"));
+            }
+            (DQuat::from_rotation_z(y) * DQuat::from_rotation_y(p) * DQuat::from_rotation_x(r)).normalize()
+        }
+        (None, None) => DQuat::IDENTITY,
+    };
+    Ok(Pose::from_parts(t, rot))
+}
+
+/// A length that must be finite, positive (or zero when `zero_ok`) and within bounds.
+fn length(v: f64, what: &str, zero_ok: bool) -> Result<f64, String> {
+    if !v.is_finite() || v < 0.0 || (!zero_ok && v == 0.0) || v > MAX_LENGTH_M {
+        return Err(format!("{what} = {v} is not a length in (0, {MAX_LENGTH_M}] m"));
+    }
+    Ok(v)
+}
+
+fn obstacle(doc: &ObstacleDoc, what: &str) -> Result<Obstacle, String> {
+    let pose = pose_of(&doc.pose, what)?;
+    let need = |v: Option<f64>, key: &str| v.ok_or_else(|| format!("{what}: a {} needs `{key}`", doc.shape));
+    let shape = match doc.shape.as_str() {
+        "box" => {
+            let h = doc
+                .half_extents
+                .ok_or_else(|| format!("{what}: a box needs `half_extents`"))?;
+            for (k, v) in h.iter().enumerate() {
+                length(*v, &format!("{what}: half_extents[{k}]"), true)?;
+            }
+            ShapeSpec::Box {
+                half_extents: DVec3::from_array(h),
+            }
+        }
+        "cylinder" => ShapeSpec::Cylinder {
+            radius: length(need(doc.radius, "radius")?, &format!("{what}: radius"), false)?,
+            half_height: length(need(doc.length, "length")?, &format!("{what}: length"), false)? / 2.0,
+        },
+        "sphere" => ShapeSpec::Sphere {
+            radius: length(need(doc.radius, "radius")?, &format!("{what}: radius"), false)?,
+        },
+        other => return Err(format!("{what}: unknown shape \"{other}\" (box, cylinder or sphere)")),
+    };
+    Ok(Obstacle {
+        name: doc.name.clone(),
+        shape,
+        pose,
+    })
+}
+
+fn configuration(q: &[f64], n: usize, what: &str) -> Result<Vec<f64>, String> {
+    if q.len() != n {
+        return Err(format!("{what} has {} values for {n} joints", q.len()));
+    }
+    if let Some(v) = q.iter().find(|v| !v.is_finite() || v.abs() > 1e3) {
+        return Err(format!("{what} holds {v}, not a joint value"));
+    }
+    Ok(q.to_vec())
+}
+
+/// Reads a problem file (see the module documentation): refuses, naming the file, line or
+/// problem, another format or version, files over [`MAX_FILE_BYTES`], more than
+/// [`MAX_PROBLEMS`] problems, [`MAX_OBSTACLES`] obstacles or [`MAX_GOALS`] goals per problem,
+/// configurations of the wrong length or with non-finite values, unknown shapes, non-unit
+/// quaternions and absurd lengths. Members it does not know are ignored.
+pub fn read_problems(path: &Path) -> Result<ProblemSet, ProblemError> {
+    let invalid = |message: String, hint: &str| ProblemError::Invalid {
+        path: path.to_path_buf(),
+        message,
+        hint: hint.to_string(),
+    };
+    let bytes = read_limited(path, MAX_FILE_BYTES).map_err(|e| match e {
+        LimitedReadError::Io(source) => ProblemError::Io {
+            path: path.to_path_buf(),
+            source,
+        },
+        LimitedReadError::TooLarge { size } => invalid(
+            format!("the file is {size}, larger than the {} a problem file may have", show_bytes(MAX_FILE_BYTES)),
+            "split the problems over several files",
+        ),
+    })?;
+    let text = utf8_text(bytes).map_err(|e| ProblemError::Json {
+        path: path.to_path_buf(),
+        line: e.line,
+        column: 1,
+        message: format!("byte {} is not UTF-8 text", e.offset),
+    })?;
+    let doc: FileDoc = serde_json::from_str(&text).map_err(|e| ProblemError::Json {
+        path: path.to_path_buf(),
+        line: e.line(),
+        column: e.column(),
+        message: e.to_string(),
+    })?;
+    let hint = "see docs/motion-problems.md for the format";
+    if doc.format != FORMAT || doc.version != VERSION {
+        return Err(invalid(
+            format!("format \"{}\" version {}, not \"{FORMAT}\" version {VERSION}", doc.format, doc.version),
+            hint,
+        ));
+    }
+    if doc.problems.len() > MAX_PROBLEMS {
+        return Err(invalid(
+            format!("{} problems, more than the {MAX_PROBLEMS} a file may hold", doc.problems.len()),
+            "split the problems over several files",
+        ));
+    }
+    let n = doc.joints.len();
+    if n == 0 {
+        return Err(invalid("`joints` is empty".into(), hint));
+    }
+    let dir = path.parent().unwrap_or(Path::new(""));
+    let base = match &doc.robot.base {
+        Some(b) => pose_of(b, "robot.base").map_err(|m| invalid(m, hint))?,
+        None => Pose::IDENTITY,
+    };
+    let robot = RobotRef {
+        urdf: dir.join(&doc.robot.urdf),
+        srdf: doc.robot.srdf.as_ref().map(|s| dir.join(s)),
+        base,
+    };
+    let mut problems = Vec::with_capacity(doc.problems.len());
+    for (k, p) in doc.problems.iter().enumerate() {
+        let what = format!("problem {} (\"{}\")", k + 1, p.name);
+        let check = || -> Result<Problem, String> {
+            if p.goals.is_empty() || p.goals.len() > MAX_GOALS {
+                return Err(format!("{what} has {} goals (1 to {MAX_GOALS})", p.goals.len()));
+            }
+            if p.obstacles.len() > MAX_OBSTACLES {
+                return Err(format!("{what} has {} obstacles (at most {MAX_OBSTACLES})", p.obstacles.len()));
+            }
+            let start = configuration(&p.start, n, &format!("{what}: start"))?;
+            let goals = p
+                .goals
+                .iter()
+                .enumerate()
+                .map(|(g, q)| configuration(q, n, &format!("{what}: goal {}", g + 1)))
+                .collect::<Result<Vec<_>, _>>()?;
+            let margin = length(p.margin, &format!("{what}: margin"), true)?;
+            let obstacles = p
+                .obstacles
+                .iter()
+                .enumerate()
+                .map(|(o, d)| obstacle(d, &format!("{what}: obstacle {} (\"{}\")", o + 1, d.name)))
+                .collect::<Result<Vec<_>, _>>()?;
+            Ok(Problem {
+                name: p.name.clone(),
+                start,
+                goals,
+                margin,
+                obstacles,
+            })
+        };
+        problems.push(check().map_err(|m| invalid(m, hint))?);
+    }
+    Ok(ProblemSet {
+        path: path.to_path_buf(),
+        scene: doc.scene,
+        source: doc.source,
+        robot,
+        joints: doc.joints,
+        problems,
+    })
+}
+
+/// A robot of a problem file set up in a collision world (see the module documentation); the
+/// obstacles are swapped per problem with [`ArmSetup::set_obstacles`].
+pub struct ArmSetup {
+    /// The URDF model.
+    pub model: RobotModel,
+    /// The world: the arm's group and the current obstacles.
+    pub world: CollisionWorld,
+    /// The arm's group.
+    pub group: GroupId,
+    /// The chain link each body hangs on.
+    pub body_links: Vec<usize>,
+    /// The URDF link each body's shape belongs to.
+    pub body_sources: Vec<String>,
+    /// The body pairs checked for self-collision.
+    pub self_pairs: Vec<(usize, usize)>,
+    /// Where the root stands.
+    pub base: Pose,
+    /// For each chain joint, its index in the file's joint list.
+    order: Vec<usize>,
+}
+
+impl ArmSetup {
+    /// Loads the robot of `set`: the URDF (whose movable joints must be exactly the file's
+    /// `joints`), one body per collision shape, the SRDF's rules.
+    pub fn load(set: &ProblemSet) -> Result<ArmSetup, ProblemError> {
+        let model = load_urdf(&set.robot.urdf, &BTreeMap::new(), None)?;
+        let chain = &model.chain;
+        let order = chain
+            .joints
+            .iter()
+            .map(|j| set.joints.iter().position(|n| *n == j.name))
+            .collect::<Option<Vec<usize>>>()
+            .filter(|o| o.len() == set.joints.len())
+            .ok_or_else(|| ProblemError::Invalid {
+                path: set.path.clone(),
+                message: format!(
+                    "`joints` lists {:?}, but the chain from {} to {} moves {:?}",
+                    set.joints,
+                    chain.root_name(),
+                    chain.tip_name(),
+                    chain.joints.iter().map(|j| j.name.as_str()).collect::<Vec<_>>()
+                ),
+                hint: "list every movable joint of the chain, once".into(),
+            })?;
+        let mut bodies = Vec::new();
+        let mut body_links = Vec::new();
+        let mut body_sources = Vec::new();
+        for (l, shapes) in model.collision.iter().enumerate() {
+            for (k, shape) in shapes.iter().enumerate() {
+                let source = model.collision_links[l][k].clone();
+                bodies.push(GroupBody {
+                    name: format!("{source}#{k}"),
+                    shapes: vec![shape.clone()],
+                });
+                body_links.push(l);
+                body_sources.push(source);
+            }
+        }
+        let mut world = CollisionWorld::new();
+        let group = world.add_group(&model.name, bodies);
+        let disabled: BTreeSet<(String, String)> = match &set.robot.srdf {
+            Some(p) => srdf::read_disabled_pairs(p)?
+                .into_iter()
+                .flat_map(|d| [(d.link1.clone(), d.link2.clone()), (d.link2, d.link1)])
+                .collect(),
+            None => BTreeSet::new(),
+        };
+        let n = body_links.len();
+        let mut self_pairs = Vec::new();
+        for i in 0..n {
+            for j in i + 1..n {
+                let (si, sj) = (&body_sources[i], &body_sources[j]);
+                if si == sj || disabled.contains(&(si.clone(), sj.clone())) {
+                    continue;
+                }
+                if set.robot.srdf.is_none() {
+                    // No rules: links that never move relative to each other, and parent and
+                    // child, are left out.
+                    let (a, b) = (body_links[i].min(body_links[j]), body_links[i].max(body_links[j]));
+                    if b - a <= 1 {
+                        continue;
+                    }
+                }
+                self_pairs.push((i, j));
+            }
+        }
+        Ok(ArmSetup {
+            base: set.robot.base,
+            model,
+            world,
+            group,
+            body_links,
+            body_sources,
+            self_pairs,
+            order,
+        })
+    }
+
+    /// Replaces the obstacles of the world.
+    pub fn set_obstacles(&mut self, obstacles: &[Obstacle]) {
+        self.world.clear_statics();
+        for o in obstacles {
+            self.world.add_static(&o.name, &o.shape, o.pose);
+        }
+    }
+
+    /// A configuration in the file's joint order, in the chain's order.
+    pub fn to_chain(&self, q: &[f64]) -> Vec<f64> {
+        self.order.iter().map(|&k| q.get(k).copied().unwrap_or(f64::NAN)).collect()
+    }
+
+    /// A configuration in the chain's order, in the file's joint order.
+    pub fn to_file(&self, q: &[f64]) -> Vec<f64> {
+        let mut out = vec![f64::NAN; self.order.len()];
+        for (c, &k) in self.order.iter().enumerate() {
+            if let (Some(slot), Some(&v)) = (out.get_mut(k), q.get(c)) {
+                *slot = v;
+            }
+        }
+        out
+    }
+
+    /// The arm as the motion core sees it.
+    pub fn arm(&self) -> Arm<'_> {
+        Arm {
+            world: &self.world,
+            chain: &self.model.chain,
+            base: self.base,
+            group: self.group,
+            body_links: &self.body_links,
+            self_pairs: &self.self_pairs,
+        }
+    }
+
+    /// The validity checker keeping `margin` from the obstacles.
+    pub fn validity(&self, margin: f64) -> ArmValidity<'_> {
+        ArmValidity::new(self.arm(), margin, Vec::new())
+    }
+}
