@@ -1,8 +1,40 @@
 //! Collision-free joint-space path planning, arranged as OMPL arranges it: a state space
 //! ([`JointSpace`]), a validity checker ([`StateValidity`]), a motion validator
-//! ([`check_segment`]) and planners behind one interface ([`Planner`]: [`Straight`],
-//! [`RrtConnect`]), plus path post-processing ([`shortcut`]) and the usual recipe for one leg
-//! ([`plan_leg`]: the straight segment if clear, else RRT-Connect, shortcut and smoothed).
+//! ([`check_segment`]), a query ([`Problem`]: one start, one or more goals), a stop condition
+//! ([`Termination`]: a work budget and an optional wall clock), and planners behind one
+//! interface ([`MotionPlanner`]) that answer with a [`PlanResult`] (a [`Status`], the path,
+//! the goal reached, the [`Work`] spent), plus path post-processing ([`shortcut`]).
+//!
+//! # Choosing a planner
+//!
+//! Planners are built by name from a static registry ([`planners`], [`planner`]) with one
+//! parameter struct ([`PlannerParams`]):
+//!
+//! | name          | planner          | what it does |
+//! |---------------|------------------|--------------|
+//! | `straight`    | [`Straight`]     | the direct segment only; [`Status::Infeasible`] when blocked |
+//! | `rrt-connect` | [`RrtConnect`]   | bidirectional trees, the goal tree rooted at every valid goal |
+//! | `rrt-star`    | [`RrtStar`]      | anytime: spends the budget shortening the best path |
+//! | `prm`         | [`Prm`]          | lazy PRM over a [`Roadmap`] reused across queries in one scene |
+//! | `leg`         | [`Leg`]          | the direct segment if clear, else RRT-Connect, then post-processing |
+//!
+//! ```
+//! use cellplan_motion::plan::{JointSpace, PlannerParams, Problem, Status, Termination, planner};
+//! let space = JointSpace::new(vec![0.0; 2], vec![10.0; 2], vec![1.0; 2]);
+//! // A disc of radius 2 at (5, 5): clearance is the distance to its surface.
+//! let validity = |q: &[f64]| ((q[0] - 5.0).powi(2) + (q[1] - 5.0).powi(2)).sqrt() - 2.0;
+//! let goals = [vec![9.0, 5.0], vec![9.0, 9.0]];
+//! let problem = Problem::new(&space, &validity, &[1.0, 5.0], &goals);
+//! let mut leg = (planner("leg").unwrap().build)(&PlannerParams { seed: 7, ..Default::default() });
+//! let result = leg.solve(&problem, &Termination::samples(5_000));
+//! assert_eq!(result.status, Status::Solved);
+//! assert!(result.goal.is_some());
+//! ```
+//!
+//! Runs are reproducible: the same seed and work budget give the same path on any machine;
+//! the wall clock is a safety net whose binding the result reports ([`Work::clock_bound`]).
+//! The older two-configuration interface ([`Planner`], [`plan_leg`], [`PlanSettings`],
+//! [`PlanError`]) is kept for existing callers and runs on the same planners.
 //!
 //! # Why no contact is missed between samples
 //!
@@ -22,13 +54,23 @@
 use std::time::Duration;
 use thiserror::Error;
 
+mod prm;
+mod problem;
+mod registry;
 mod rrt_connect;
+mod rrt_star;
 mod simplify;
 mod space;
 mod straight;
 mod validity;
 
+pub use prm::{Prm, Roadmap};
+use problem::solve_with;
+pub use problem::{PlanResult, Problem, Status, Termination, Work};
+pub use registry::{Entry, Leg, MotionPlanner, PlannerParams, UnknownPlanner, planner, planners};
 pub use rrt_connect::RrtConnect;
+pub use rrt_star::RrtStar;
+use simplify::shortcut_with;
 pub use simplify::{path_length, shortcut};
 pub use space::JointSpace;
 pub use straight::Straight;
@@ -112,8 +154,9 @@ pub enum PlanError {
     },
 }
 
-/// A path planner between two configurations (OMPL's `Planner`): implementations are
-/// interchangeable behind this trait, for benchmarks.
+/// The older two-configuration interface, with [`PlanSettings`] and [`PlanError`]: kept for
+/// existing callers ([`Straight`], [`RrtConnect`]); new code uses [`MotionPlanner`] from the
+/// registry ([`planner`]), which takes goal sets and reports a [`Status`].
 pub trait Planner {
     /// Short name, for reports.
     fn name(&self) -> &str;
@@ -128,35 +171,9 @@ pub trait Planner {
     ) -> Result<PlannedPath, PlanError>;
 }
 
-/// Checks both ends (two clearance calls).
-fn check_ends(
-    space: &JointSpace,
-    validity: &dyn StateValidity,
-    start: &[f64],
-    goal: &[f64],
-    settings: &PlanSettings,
-) -> Result<(), PlanError> {
-    let floor = settings.min_clearance.max(1e-9);
-    let measure = |q: &[f64]| {
-        if space.contains(q) {
-            validity.clearance(q)
-        } else {
-            f64::NEG_INFINITY
-        }
-    };
-    let cs = measure(start);
-    if cs.is_nan() || cs < floor {
-        return Err(PlanError::StartInvalid { clearance: cs });
-    }
-    let cg = measure(goal);
-    if cg.is_nan() || cg < floor {
-        return Err(PlanError::GoalInvalid { clearance: cg });
-    }
-    Ok(())
-}
-
 /// One leg: the straight segment if it is clear, else [`RrtConnect`] followed by
-/// [`shortcut`]. The counts in the result add up every stage.
+/// [`shortcut`] (the [`Leg`] planner with the parameters and limits of `settings`). The counts
+/// in the result add up every stage.
 pub fn plan_leg(
     space: &JointSpace,
     validity: &dyn StateValidity,
@@ -164,27 +181,68 @@ pub fn plan_leg(
     goal: &[f64],
     settings: &PlanSettings,
 ) -> Result<PlannedPath, PlanError> {
-    let straight_calls = match Straight.plan(space, validity, start, goal, settings) {
-        Ok(path) => return Ok(path),
-        Err(PlanError::NoPath { validity_calls, .. }) => validity_calls,
-        Err(e) => return Err(e),
+    let goals = [goal.to_vec()];
+    let problem = Problem::new(space, validity, start, &goals).with_min_clearance(settings.min_clearance);
+    let mut leg = Leg {
+        params: settings.params(),
     };
-    let mut path = match RrtConnect.plan(space, validity, start, goal, settings) {
-        Ok(p) => p,
-        Err(PlanError::NoPath {
-            samples,
-            validity_calls,
-        }) => {
-            return Err(PlanError::NoPath {
-                samples,
-                validity_calls: validity_calls + straight_calls,
-            });
+    leg.solve(&problem, &settings.termination()).into_planned()
+}
+
+impl PlanSettings {
+    /// The planner parameters of these settings (seed, range, shortcut iterations;
+    /// post-processing on).
+    pub fn params(&self) -> PlannerParams {
+        PlannerParams {
+            seed: self.seed,
+            range: self.range,
+            simplify: true,
+            shortcut_iterations: self.shortcut_iterations,
+            ..PlannerParams::default()
         }
-        Err(e) => return Err(e),
-    };
-    path.validity_calls += straight_calls;
-    path.validity_calls += shortcut(space, validity, &mut path.waypoints, settings);
-    Ok(path)
+    }
+
+    /// The stop condition of these settings: `max_samples`, no limit on validity calls, the
+    /// time limit.
+    pub fn termination(&self) -> Termination {
+        Termination {
+            max_samples: self.max_samples,
+            max_validity_calls: usize::MAX,
+            time_limit: Some(self.time_limit),
+        }
+    }
+}
+
+impl PlanResult {
+    /// The result in the older form: a [`PlannedPath`] when solved, else the [`PlanError`]
+    /// (an approximate path counts as no path; for several goals all invalid, the largest
+    /// goal clearance).
+    pub fn into_planned(self) -> Result<PlannedPath, PlanError> {
+        match self.status {
+            Status::Solved => Ok(PlannedPath {
+                waypoints: self.waypoints,
+                straight: self.straight,
+                samples: self.work.samples,
+                validity_calls: self.work.validity_calls,
+            }),
+            Status::InvalidStart => Err(PlanError::StartInvalid {
+                clearance: self.start_clearance,
+            }),
+            Status::InvalidGoal => Err(PlanError::GoalInvalid {
+                clearance: self
+                    .goal_clearances
+                    .iter()
+                    .copied()
+                    .fold(f64::NEG_INFINITY, |a, b| if b > a { b } else { a }),
+            }),
+            Status::Approximate | Status::Timeout | Status::BudgetExhausted | Status::Infeasible => {
+                Err(PlanError::NoPath {
+                    samples: self.work.samples,
+                    validity_calls: self.work.validity_calls,
+                })
+            }
+        }
+    }
 }
 
 #[cfg(test)]

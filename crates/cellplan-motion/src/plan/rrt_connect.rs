@@ -1,39 +1,45 @@
 //! RRT-Connect.
+use super::problem::{Found, Run, range_of};
 use super::{
-    JointSpace, PlanError, PlanSettings, PlannedPath, Planner, StateValidity, check_ends, segment_valid,
+    JointSpace, MotionPlanner, PlanError, PlanResult, PlanSettings, PlannedPath, Planner, PlannerParams,
+    Problem, StateValidity, Termination, solve_with,
 };
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
-use std::time::Instant;
 
-/// RRT-Connect (Kuffner & LaValle 2000): two trees, rooted at the start and the goal, grown in
-/// turn towards random samples; after each extension the other tree greedily connects to the
-/// new node. Every edge passes [`check_segment`]. Deterministic for a seed (ChaCha8).
-#[derive(Clone, Copy, Debug, Default)]
-pub struct RrtConnect;
+/// RRT-Connect (Kuffner & LaValle 2000): two trees, one rooted at the start, the other at
+/// every valid goal (a forest), grown in turn towards random samples; after each extension
+/// the other tree greedily connects to the new node. The path ends at the goal whose root the
+/// connection reached. Every edge passes [`super::check_segment`]. Deterministic for a seed
+/// (ChaCha8); uses [`PlannerParams::seed`], [`PlannerParams::range`] and the post-processing
+/// settings.
+#[derive(Clone, Debug, Default)]
+pub struct RrtConnect {
+    /// Its parameters (for [`MotionPlanner::solve`]; [`Planner::plan`] takes them from its
+    /// settings).
+    pub params: PlannerParams,
+}
 
 struct Tree {
     nodes: Vec<Vec<f64>>,
     parent: Vec<usize>,
+    /// For each node, the index of its root's query end (0 for the start, else the goal's).
+    origin: Vec<usize>,
 }
 
 impl Tree {
-    fn new(root: &[f64]) -> Self {
-        Tree {
-            nodes: vec![root.to_vec()],
-            parent: vec![usize::MAX],
+    fn new(roots: impl IntoIterator<Item = (Vec<f64>, usize)>) -> Self {
+        let mut tree = Tree {
+            nodes: Vec::new(),
+            parent: Vec::new(),
+            origin: Vec::new(),
+        };
+        for (q, origin) in roots {
+            tree.nodes.push(q);
+            tree.parent.push(usize::MAX);
+            tree.origin.push(origin);
         }
-    }
-
-    fn nearest(&self, space: &JointSpace, q: &[f64]) -> usize {
-        let mut best = (0, f64::INFINITY);
-        for (i, n) in self.nodes.iter().enumerate() {
-            let d = space.distance(n, q);
-            if d < best.1 {
-                best = (i, d);
-            }
-        }
-        best.0
+        tree
     }
 
     /// Root-to-node path.
@@ -54,61 +60,105 @@ enum Extend {
     Reached(usize),
 }
 
-struct Search<'a> {
-    space: &'a JointSpace,
-    validity: &'a dyn StateValidity,
-    range: f64,
-    min_clearance: f64,
-    calls: usize,
+/// One RRT extension of `tree` from node `from` towards `target`.
+fn extend_from(run: &mut Run, range: f64, tree: &mut Tree, from: usize, target: &[f64]) -> Extend {
+    let near = &tree.nodes[from];
+    let d = run.space.distance(near, target);
+    let (q_new, reached) = if d <= range {
+        (target.to_vec(), true)
+    } else {
+        let mut q = Vec::new();
+        run.space.interpolate(near, target, range / d, &mut q);
+        (q, false)
+    };
+    if !run.segment(near, &q_new) {
+        return Extend::Trapped;
+    }
+    tree.nodes.push(q_new);
+    tree.parent.push(from);
+    tree.origin.push(tree.origin[from]);
+    let i = tree.nodes.len() - 1;
+    if reached {
+        Extend::Reached(i)
+    } else {
+        Extend::Advanced(i)
+    }
 }
 
-impl Search<'_> {
-    /// One RRT extension of `tree` from node `from` towards `target`.
-    fn extend_from(&mut self, tree: &mut Tree, from: usize, target: &[f64]) -> Extend {
-        let near = &tree.nodes[from];
-        let d = self.space.distance(near, target);
-        let (q_new, reached) = if d <= self.range {
-            (target.to_vec(), true)
+/// Extends `tree` towards `target` until it is reached, the tree is trapped or the run must
+/// stop.
+fn connect(run: &mut Run, range: f64, tree: &mut Tree, target: &[f64]) -> Option<usize> {
+    let mut from = run.space.nearest(&tree.nodes, target);
+    loop {
+        match extend_from(run, range, tree, from, target) {
+            Extend::Trapped => return None,
+            Extend::Reached(i) => return Some(i),
+            Extend::Advanced(i) => from = i,
+        }
+        if run.must_stop().is_some() {
+            return None;
+        }
+    }
+}
+
+/// The search of [`RrtConnect`], shared with [`super::Leg`].
+pub(crate) fn search(
+    run: &mut Run,
+    params: &PlannerParams,
+    start: &[f64],
+    goals: &[Vec<f64>],
+    valid: &[usize],
+) -> Found {
+    let range = range_of(run.space, params);
+    let mut rng = ChaCha8Rng::seed_from_u64(params.seed);
+    // trees[0] grows from the start, trees[1] from the goals; `a` is the one extended.
+    let mut trees = [
+        Tree::new([(start.to_vec(), 0)]),
+        Tree::new(valid.iter().map(|&g| (goals[g].clone(), g))),
+    ];
+    let mut a = 0;
+    let mut q_rand = Vec::with_capacity(run.space.dim());
+    loop {
+        if let Err(why) = run.sample(&mut rng, &mut q_rand) {
+            return Found::none(why);
+        }
+        let (x, y) = trees.split_at_mut(1);
+        let (ta, tb) = if a == 0 {
+            (&mut x[0], &mut y[0])
         } else {
-            let mut q = Vec::new();
-            self.space.interpolate(near, target, self.range / d, &mut q);
-            (q, false)
+            (&mut y[0], &mut x[0])
         };
-        if !segment_valid(
-            self.space,
-            self.validity,
-            near,
-            &q_new,
-            self.min_clearance,
-            &mut self.calls,
-        ) {
-            return Extend::Trapped;
-        }
-        tree.nodes.push(q_new);
-        tree.parent.push(from);
-        let i = tree.nodes.len() - 1;
-        if reached {
-            Extend::Reached(i)
-        } else {
-            Extend::Advanced(i)
-        }
-    }
-
-    fn extend(&mut self, tree: &mut Tree, target: &[f64]) -> Extend {
-        let from = tree.nearest(self.space, target);
-        self.extend_from(tree, from, target)
-    }
-
-    /// Extends `tree` towards `target` until it is reached or the tree is trapped.
-    fn connect(&mut self, tree: &mut Tree, target: &[f64]) -> Option<usize> {
-        let mut from = tree.nearest(self.space, target);
-        loop {
-            match self.extend_from(tree, from, target) {
-                Extend::Trapped => return None,
-                Extend::Reached(i) => return Some(i),
-                Extend::Advanced(i) => from = i,
+        let from = run.space.nearest(&ta.nodes, &q_rand);
+        let new = match extend_from(run, range, ta, from, &q_rand) {
+            Extend::Trapped => None,
+            Extend::Advanced(i) | Extend::Reached(i) => Some(i),
+        };
+        if let Some(i) = new {
+            let target = ta.nodes[i].clone();
+            if let Some(j) = connect(run, range, tb, &target) {
+                let (si, gi) = if a == 0 { (i, j) } else { (j, i) };
+                let mut waypoints = trees[0].path_to(si);
+                let mut back = trees[1].path_to(gi);
+                back.reverse();
+                // The meeting node is in both halves.
+                back.remove(0);
+                waypoints.extend(back);
+                return Found::path(waypoints, trees[1].origin[gi]);
             }
         }
+        a = 1 - a;
+    }
+}
+
+impl MotionPlanner for RrtConnect {
+    fn name(&self) -> &'static str {
+        "rrt-connect"
+    }
+
+    fn solve(&mut self, problem: &Problem, stop: &Termination) -> PlanResult {
+        solve_with(problem, stop, &self.params, |run, valid| {
+            search(run, &self.params, problem.start, problem.goals, valid)
+        })
     }
 }
 
@@ -117,6 +167,7 @@ impl Planner for RrtConnect {
         "rrt-connect"
     }
 
+    /// The raw RRT-Connect path (no post-processing), with the parameters of `settings`.
     fn plan(
         &self,
         space: &JointSpace,
@@ -125,63 +176,15 @@ impl Planner for RrtConnect {
         goal: &[f64],
         settings: &PlanSettings,
     ) -> Result<PlannedPath, PlanError> {
-        let began = Instant::now();
-        check_ends(space, validity, start, goal, settings)?;
-        let range = if settings.range > 0.0 {
-            settings.range
-        } else {
-            (0.2 * space.extent()).max(1e-6)
+        let goals = [goal.to_vec()];
+        let problem = Problem::new(space, validity, start, &goals).with_min_clearance(settings.min_clearance);
+        let params = PlannerParams {
+            simplify: false,
+            ..settings.params()
         };
-        let mut search = Search {
-            space,
-            validity,
-            range,
-            min_clearance: settings.min_clearance,
-            calls: 2,
-        };
-        let mut rng = ChaCha8Rng::seed_from_u64(settings.seed);
-        // trees[0] grows from the start, trees[1] from the goal; `a` is the one extended.
-        let mut trees = [Tree::new(start), Tree::new(goal)];
-        let mut a = 0;
-        let mut samples = 0;
-        let mut q_rand = Vec::with_capacity(space.dim());
-        while samples < settings.max_samples && began.elapsed() < settings.time_limit {
-            space.sample(&mut rng, &mut q_rand);
-            samples += 1;
-            let (ta, tb) = if a == 0 {
-                let (x, y) = trees.split_at_mut(1);
-                (&mut x[0], &mut y[0])
-            } else {
-                let (x, y) = trees.split_at_mut(1);
-                (&mut y[0], &mut x[0])
-            };
-            let new = match search.extend(ta, &q_rand) {
-                Extend::Trapped => None,
-                Extend::Advanced(i) | Extend::Reached(i) => Some(i),
-            };
-            if let Some(i) = new {
-                let target = ta.nodes[i].clone();
-                if let Some(j) = search.connect(tb, &target) {
-                    let (si, gi) = if a == 0 { (i, j) } else { (j, i) };
-                    let mut waypoints = trees[0].path_to(si);
-                    let mut back = trees[1].path_to(gi);
-                    back.reverse();
-                    // The meeting node is in both halves.
-                    back.remove(0);
-                    waypoints.extend(back);
-                    return Ok(PlannedPath {
-                        waypoints,
-                        straight: false,
-                        samples,
-                        validity_calls: search.calls,
-                    });
-                }
-            }
-            a = 1 - a;
-        }
-        Err(PlanError::NoPath {
-            samples,
-            validity_calls: search.calls,
+        solve_with(&problem, &settings.termination(), &params, |run, valid| {
+            search(run, &params, start, &goals, valid)
         })
+        .into_planned()
     }
 }

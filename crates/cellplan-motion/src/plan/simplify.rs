@@ -13,18 +13,38 @@ pub fn path_length(space: &JointSpace, waypoints: &[Vec<f64>]) -> f64 {
 /// different segments (partial shortcuts, deterministic for `settings.seed`), then removes
 /// redundant waypoints (each waypoint whose neighbours see each other). A change is kept only
 /// when the new segment passes [`check_segment`] and the path gets shorter, so the path never
-/// lengthens (the metric is a norm) and stays valid.
+/// lengthens (the metric is a norm) and stays valid. The planners of the registry apply the
+/// same post-processing when [`super::PlannerParams::simplify`] is set.
 pub fn shortcut(
     space: &JointSpace,
     validity: &dyn StateValidity,
     waypoints: &mut Vec<Vec<f64>>,
     settings: &PlanSettings,
 ) -> usize {
+    shortcut_with(
+        space,
+        validity,
+        waypoints,
+        settings.seed,
+        settings.shortcut_iterations,
+        settings.min_clearance,
+    )
+}
+
+/// [`shortcut`] with its settings spelled out.
+pub(crate) fn shortcut_with(
+    space: &JointSpace,
+    validity: &dyn StateValidity,
+    waypoints: &mut Vec<Vec<f64>>,
+    seed: u64,
+    iterations: usize,
+    min_clearance: f64,
+) -> usize {
     let mut calls = 0;
     waypoints.dedup_by(|b, a| space.distance(a, b) == 0.0);
-    let mut rng = ChaCha8Rng::seed_from_u64(settings.seed ^ 0x5348_4f52_5443_5554);
+    let mut rng = ChaCha8Rng::seed_from_u64(seed ^ 0x5348_4f52_5443_5554);
     let (mut p1, mut p2) = (Vec::new(), Vec::new());
-    for _ in 0..settings.shortcut_iterations {
+    for _ in 0..iterations {
         let segments = waypoints.len().saturating_sub(1);
         if segments < 2 {
             break;
@@ -44,7 +64,7 @@ pub fn shortcut(
         if space.distance(&p1, &p2) >= old - 1e-9 {
             continue;
         }
-        let check = check_segment(space, validity, &p1, &p2, settings.min_clearance);
+        let check = check_segment(space, validity, &p1, &p2, min_clearance);
         calls += check.calls;
         if check.valid {
             // waypoints[..=i], p1, p2, waypoints[j+1..]
@@ -56,7 +76,7 @@ pub fn shortcut(
             waypoints.dedup_by(|b, a| space.distance(a, b) <= 1e-12);
         }
     }
-    calls += remove_redundant(space, validity, waypoints, settings.min_clearance);
+    calls += remove_redundant(space, validity, waypoints, min_clearance);
     calls
 }
 

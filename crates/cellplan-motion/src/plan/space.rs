@@ -84,6 +84,18 @@ impl JointSpace {
         self.distance(&self.lower, &self.upper)
     }
 
+    /// Index of the node of `nodes` nearest to `q` (the first on ties; 0 when empty).
+    pub(crate) fn nearest(&self, nodes: &[Vec<f64>], q: &[f64]) -> usize {
+        let mut best = (0, f64::INFINITY);
+        for (i, n) in nodes.iter().enumerate() {
+            let d = self.distance(n, q);
+            if d < best.1 {
+                best = (i, d);
+            }
+        }
+        best.0
+    }
+
     pub(crate) fn sample(&self, rng: &mut ChaCha8Rng, out: &mut Vec<f64>) {
         out.clear();
         out.extend(
