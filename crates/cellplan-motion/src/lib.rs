@@ -1,7 +1,14 @@
-//! Joint-space motion with no robot or geometry types in its API: the time a move needs under
-//! per-joint velocity and acceleration limits, collision-free path planning behind one
-//! interface (a state space, a validity checker, a planner — as OMPL arranges them), and time
-//! parameterisation of a path under the limits.
+//! Joint-space motion with no robot or geometry types in its API:
+//!
+//! - [`timing`]: the time a move needs under per-joint velocity and acceleration limits, and
+//!   time parameterisation of a path under those limits.
+//! - [`plan`]: collision-free path planning as OMPL arranges it — a state space
+//!   ([`plan::JointSpace`]), a validity checker giving a clearance ([`plan::StateValidity`]),
+//!   a conservative segment check that misses no contact ([`plan::check_segment`]), and
+//!   planners behind one interface ([`plan::MotionPlanner`]) chosen by name from a registry
+//!   ([`plan::planner`]: `straight`, `rrt-connect`, `rrt-star`, `prm`, `leg`), each answering a
+//!   query with one start and one or more goals ([`plan::Problem`]) within a work budget
+//!   ([`plan::Termination`]) with a [`plan::Status`], the path and the work spent.
 #![warn(missing_docs)]
 
 pub mod plan;

@@ -158,7 +158,8 @@ pub struct PlanResult {
     pub status: Status,
     /// The path (straight segments between waypoints, each passing
     /// [`super::check_segment`]), from the start to the goal [`PlanResult::goal`]; empty
-    /// unless the status is [`Status::Solved`] or [`Status::Approximate`].
+    /// unless the status is [`Status::Solved`] or [`Status::Approximate`] (an approximate
+    /// path ends short of the goal and may be the start alone).
     pub waypoints: Vec<Vec<f64>>,
     /// Index in [`Problem::goals`] of the goal reached (or approached, when approximate).
     pub goal: Option<usize>,
