@@ -60,9 +60,12 @@ pub struct BenchArgs {
     /// Runs per instance (seeds 0, 1, ...).
     #[arg(long, default_value_t = 1)]
     pub runs: u64,
-    /// Motion: the planner (leg, rrt-connect, straight).
+    /// Motion: the planner, by its registry name (straight, rrt-connect, rrt-star, prm, leg).
     #[arg(long, default_value = "leg")]
     pub planner: String,
+    /// Motion: the work budget per query, in random samples.
+    #[arg(long, default_value_t = 20_000)]
+    pub max_samples: usize,
     /// Motion: only the first N problems of each file.
     #[arg(long, value_name = "N")]
     pub first: Option<usize>,
@@ -77,6 +80,10 @@ pub struct BenchArgs {
     /// Motion: largest point motion between two samples of the exact re-check, in mm.
     #[arg(long, default_value_t = 1.0)]
     pub exact_step_mm: f64,
+    /// Motion: skip the exact re-check (`exact_valid` is then false everywhere; for timing the
+    /// planner alone).
+    #[arg(long)]
+    pub no_exact: bool,
     /// Motion: keep the paths in the JSON rows.
     #[arg(long)]
     pub with_paths: bool,

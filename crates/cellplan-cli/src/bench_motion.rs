@@ -4,8 +4,8 @@
 //! exact re-check of every path on the robot's collision meshes as given
 //! ([`cellplan_verify::motion`]). `--recheck RUN.json` re-checks a peer's paths instead
 //! (bench/peers/motion_*.py write them), and `--checks N` times single validity checks.
-use cellplan_motion::arm::{self, ArmValidity};
-use cellplan_motion::plan::{self, JointSpace, PlanError, PlanSettings, Planner, RrtConnect, Straight};
+use cellplan_motion::arm;
+use cellplan_motion::plan::{self, PlannerParams, Status, Termination};
 use cellplan_motion::problem::{ArmSetup, Problem, ProblemError, ProblemSet, read_problems};
 use cellplan_verify::motion::{ExactCheck, ExactObstacle, ExactRobot};
 use rand::{RngExt, SeedableRng};
@@ -15,23 +15,22 @@ use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
-/// The planners `--planner` takes.
-pub const PLANNERS: &[&str] = &["leg", "rrt-connect", "straight"];
-
 /// What the motion benchmark is asked.
 pub struct Request<'a> {
     /// Problem files.
     pub files: &'a [PathBuf],
     /// Planner name.
     pub planner: &'a str,
-    /// Wall-clock safety net per query (s); the work budget is the planner's sample limit.
+    /// Wall-clock safety net per query (s); the work budget binds first.
     pub time_limit: f64,
+    /// Work budget per query: random samples.
+    pub max_samples: usize,
     /// Runs per problem (seeds 0, 1, …).
     pub runs: u64,
     /// Only the first problems of each file.
     pub first: Option<usize>,
-    /// Largest point motion between two samples of the exact re-check (m).
-    pub exact_step: f64,
+    /// Largest point motion between two samples of the exact re-check (m); `None`: no re-check.
+    pub exact_step: Option<f64>,
 }
 
 /// One problem × run.
@@ -55,6 +54,9 @@ pub struct Row {
     pub waypoints: usize,
     /// Validity checks (clearance evaluations) made.
     pub validity_checks: usize,
+    /// Of those, the checks of the path's simplification.
+    #[serde(default)]
+    pub simplify_checks: usize,
     /// The exact re-check passed (`false` when there is no path).
     pub exact_valid: bool,
     /// Configurations the exact re-check tested.
@@ -73,7 +75,7 @@ struct PeerRow {
     planner: String,
     solved: bool,
     #[serde(default)]
-    time_s: f64,
+    time_s: Option<f64>,
     #[serde(default)]
     path_length: Option<f64>,
     #[serde(default)]
@@ -84,7 +86,13 @@ struct PeerRow {
 
 fn euclidean_length(path: &[Vec<f64>]) -> f64 {
     path.windows(2)
-        .map(|w| w[0].iter().zip(&w[1]).map(|(a, b)| (a - b) * (a - b)).sum::<f64>().sqrt())
+        .map(|w| {
+            w[0].iter()
+                .zip(&w[1])
+                .map(|(a, b)| (a - b) * (a - b))
+                .sum::<f64>()
+                .sqrt()
+        })
         .sum()
 }
 
@@ -99,43 +107,17 @@ fn exact_of(setup: &ArmSetup, problem: &Problem, path_file_order: &[Vec<f64>], s
     robot.check_path(&chain_path, &obstacles, problem.margin, step)
 }
 
-/// Plans one problem with the named planner; `(path in chain order, status, checks)`.
-fn solve(
-    planner: &str,
-    space: &JointSpace,
-    validity: &ArmValidity,
-    start: &[f64],
-    goals: &[Vec<f64>],
-    settings: &PlanSettings,
-) -> (Option<Vec<Vec<f64>>>, String, usize) {
-    let mut checks = 0;
-    let mut last = String::from("no goal");
-    // One goal after another until one is reached (the MBM problems have one each).
-    for goal in goals {
-        let result = match planner {
-            "straight" => Straight.plan(space, validity, start, goal, settings),
-            "rrt-connect" => RrtConnect.plan(space, validity, start, goal, settings),
-            _ => plan::plan_leg(space, validity, start, goal, settings),
-        };
-        match result {
-            Ok(p) => return (Some(p.waypoints), "solved".into(), checks + p.validity_calls),
-            Err(e) => {
-                checks += match &e {
-                    PlanError::NoPath { validity_calls, .. } => *validity_calls,
-                    _ => 2,
-                };
-                last = match e {
-                    PlanError::StartInvalid { .. } => "invalid-start".into(),
-                    PlanError::GoalInvalid { .. } => "invalid-goal".into(),
-                    PlanError::NoPath { .. } => "no-path".into(),
-                };
-                if last == "invalid-start" {
-                    break;
-                }
-            }
-        }
+/// The status as a kebab-case word.
+fn status_name(status: Status) -> &'static str {
+    match status {
+        Status::Solved => "solved",
+        Status::Approximate => "approximate",
+        Status::Timeout => "timeout",
+        Status::BudgetExhausted => "budget-exhausted",
+        Status::InvalidStart => "invalid-start",
+        Status::InvalidGoal => "invalid-goal",
+        Status::Infeasible => "infeasible",
     }
-    (None, last, checks)
 }
 
 /// Loads a file and its robot.
@@ -160,29 +142,39 @@ pub fn run(req: &Request) -> Result<Vec<Row>, ProblemError> {
             let space = arm::joint_space(&setup.arm(), &velocities);
             let start = setup.to_chain(&problem.start);
             let goals: Vec<Vec<f64>> = problem.goals.iter().map(|g| setup.to_chain(g)).collect();
+            let entry = plan::planner(req.planner).map_err(|e| ProblemError::Invalid {
+                path: file.clone(),
+                message: e.to_string(),
+                hint: "name a planner of the registry".into(),
+            })?;
             for seed in 0..req.runs {
-                let settings = PlanSettings {
+                let params = PlannerParams {
                     seed,
-                    time_limit: Duration::from_secs_f64(req.time_limit),
-                    ..PlanSettings::default()
+                    ..PlannerParams::default()
                 };
+                let stop = Termination::samples(req.max_samples)
+                    .with_time_limit(Duration::from_secs_f64(req.time_limit));
+                let query = plan::Problem::new(&space, &validity, &start, &goals);
                 let began = Instant::now();
-                let (path, mut status, checks) = solve(req.planner, &space, &validity, &start, &goals, &settings);
+                let result = (entry.build)(&params).solve(&query, &stop);
                 let time_s = began.elapsed().as_secs_f64();
-                if path.is_none() && status == "no-path" && time_s >= req.time_limit {
-                    status = "timeout".into();
-                }
+                let status = status_name(result.status).to_string();
+                let checks = result.work.validity_calls;
+                let simplify_checks = result.work.simplify_calls;
+                let path = result.status.is_solved().then_some(result.waypoints);
                 let file_path = path.map(|p| p.iter().map(|q| setup.to_file(q)).collect::<Vec<_>>());
+                let solved = file_path.is_some();
                 file_rows.push(Row {
                     problem: problem.name.clone(),
                     planner: req.planner.to_string(),
                     seed,
-                    solved: file_path.is_some(),
+                    solved,
                     status,
                     time_s,
                     path_length: file_path.as_deref().map(euclidean_length),
                     waypoints: file_path.as_ref().map_or(0, Vec::len),
                     validity_checks: checks,
+                    simplify_checks,
                     exact_valid: false,
                     exact_samples: 0,
                     exact_contact: None,
@@ -190,7 +182,9 @@ pub fn run(req: &Request) -> Result<Vec<Row>, ProblemError> {
                 });
             }
         }
-        recheck_rows(&set, &mut setup, &mut file_rows, req.exact_step);
+        if let Some(step) = req.exact_step {
+            recheck_rows(&set, &mut setup, &mut file_rows, step);
+        }
         rows.extend(file_rows);
     }
     Ok(rows)
@@ -209,16 +203,19 @@ fn recheck_rows(set: &ProblemSet, setup: &mut ArmSetup, rows: &mut [Row], step: 
         let check = exact_of(setup, problem, path, step);
         row.exact_valid = check.valid;
         row.exact_samples = check.samples;
-        row.exact_contact = check.contact.map(|(seg, t, what)| format!("segment {seg} at {t:.4}: {what}"));
+        row.exact_contact = check
+            .contact
+            .map(|(seg, t, what)| format!("segment {seg} at {t:.4}: {what}"));
     });
 }
 
 /// Re-checks a peer's run file (`[{problem, planner, solved, time_s, path_length,
 /// validity_checks, path}]`) against the problems of `files`.
 pub fn recheck(files: &[PathBuf], run_file: &Path, step: f64) -> Result<Vec<Row>, String> {
-    let text = std::fs::read_to_string(run_file).map_err(|e| format!("cannot read {}: {e}", run_file.display()))?;
-    let peers: Vec<PeerRow> =
-        serde_json::from_str(&text).map_err(|e| format!("{}:{}:{}: {e}", run_file.display(), e.line(), e.column()))?;
+    let text =
+        std::fs::read_to_string(run_file).map_err(|e| format!("cannot read {}: {e}", run_file.display()))?;
+    let peers: Vec<PeerRow> = serde_json::from_str(&text)
+        .map_err(|e| format!("{}:{}:{}: {e}", run_file.display(), e.line(), e.column()))?;
     let mut rows = Vec::new();
     for file in files {
         let (set, mut setup) = load(file).map_err(|e| e.to_string())?;
@@ -230,11 +227,16 @@ pub fn recheck(files: &[PathBuf], run_file: &Path, step: f64) -> Result<Vec<Row>
                 planner: p.planner.clone(),
                 seed: 0,
                 solved: p.solved && p.path.is_some(),
-                status: if p.solved { "solved".into() } else { "unsolved".into() },
-                time_s: p.time_s,
+                status: if p.solved {
+                    "solved".into()
+                } else {
+                    "unsolved".into()
+                },
+                time_s: p.time_s.unwrap_or(f64::NAN),
                 path_length: p.path_length,
                 waypoints: p.path.as_ref().map_or(0, Vec::len),
                 validity_checks: p.validity_checks.unwrap_or(0),
+                simplify_checks: 0,
                 exact_valid: false,
                 exact_samples: 0,
                 exact_contact: None,
@@ -274,7 +276,11 @@ fn median(mut v: Vec<f64>) -> f64 {
 
 /// Times `per_problem` random valid-or-not configurations per problem, each checked with and
 /// without the broad phase (single thread).
-pub fn time_checks(files: &[PathBuf], per_problem: usize, first: Option<usize>) -> Result<Vec<CheckRow>, ProblemError> {
+pub fn time_checks(
+    files: &[PathBuf],
+    per_problem: usize,
+    first: Option<usize>,
+) -> Result<Vec<CheckRow>, ProblemError> {
     let mut out = Vec::new();
     for file in files {
         let (set, mut setup) = load(file)?;
@@ -340,7 +346,10 @@ pub fn render(rows: &[Row]) -> String {
         "scene", "queries", "solved", "median_ms", "checks", "exact_invalid"
     );
     for scene in scenes {
-        let of: Vec<&Row> = rows.iter().filter(|r| r.problem.starts_with(&format!("{scene}/"))).collect();
+        let of: Vec<&Row> = rows
+            .iter()
+            .filter(|r| r.problem.starts_with(&format!("{scene}/")))
+            .collect();
         let solved: Vec<&&Row> = of.iter().filter(|r| r.solved).collect();
         let ms = median(solved.iter().map(|r| r.time_s * 1e3).collect());
         let checks = median(solved.iter().map(|r| r.validity_checks as f64).collect());

@@ -365,15 +365,14 @@ fn run_bench_motion(args: &bench::BenchArgs) -> Result<(), Failure> {
         };
         Failure::Input(Box::new(err.hint(hint)))
     };
-    if !bench_motion::PLANNERS.contains(&args.planner.as_str()) {
-        return Err(Failure::Usage(format!(
-            "unknown planner `{}` (known: {})",
-            args.planner,
-            bench_motion::PLANNERS.join(", ")
-        )));
+    if let Err(e) = cellplan_motion::plan::planner(&args.planner) {
+        return Err(Failure::Usage(e.to_string()));
     }
-    if !(args.time_limit > 0.0 && args.time_limit.is_finite()) || !(args.exact_step_mm > 0.0) {
-        return Err(Failure::Usage("--time-limit and --exact-step-mm must be positive".into()));
+    let positive = |v: f64| v.is_finite() && v > 0.0;
+    if !positive(args.time_limit) || !positive(args.exact_step_mm) {
+        return Err(Failure::Usage(
+            "--time-limit and --exact-step-mm must be positive".into(),
+        ));
     }
     let print = |value: &dyn erased::Show| -> Result<(), Failure> {
         println!("{}", value.show().map_err(Failure::Other)?);
@@ -390,9 +389,10 @@ fn run_bench_motion(args: &bench::BenchArgs) -> Result<(), Failure> {
             files: &args.files,
             planner: &args.planner,
             time_limit: args.time_limit,
+            max_samples: args.max_samples,
             runs: args.runs,
             first: args.first,
-            exact_step: step,
+            exact_step: (!args.no_exact).then_some(step),
         })
         .map_err(problem_failure)?,
     };

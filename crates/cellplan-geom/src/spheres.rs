@@ -95,10 +95,10 @@ fn enclosing(spheres: &[Sphere]) -> Option<Sphere> {
 
 /// Number of slabs for a body `length` long and `width` wide.
 fn slab_count(length: f64, width: f64) -> usize {
-    if !(length > 0.0) || !length.is_finite() {
+    if length.is_nan() || length <= 0.0 || !length.is_finite() {
         return 1;
     }
-    if !(width > 0.0) {
+    if width.is_nan() || width <= 0.0 {
         return MAX_SLABS;
     }
     ((length / width).ceil() as usize).clamp(1, MAX_SLABS)

@@ -35,14 +35,20 @@ pub fn read_disabled_pairs(path: &Path) -> Result<Vec<DisabledPair>, KinError> {
         },
         LimitedReadError::TooLarge { size } => refuse(
             None,
-            format!("the file is {size}, larger than the {} an SRDF may have", show_bytes(MAX_SRDF_BYTES)),
+            format!(
+                "the file is {size}, larger than the {} an SRDF may have",
+                show_bytes(MAX_SRDF_BYTES)
+            ),
             "check that the path names an SRDF",
         ),
     })?;
     let text = utf8_text(bytes).map_err(|e| {
         refuse(
             Some(e.line),
-            format!("byte {} (0x{:02x}) is not UTF-8 text: this is not an SRDF file", e.offset, e.byte),
+            format!(
+                "byte {} (0x{:02x}) is not UTF-8 text: this is not an SRDF file",
+                e.offset, e.byte
+            ),
             "check that the path names an SRDF, and save it as UTF-8",
         )
     })?;
@@ -60,7 +66,10 @@ pub(crate) fn parse_disabled_pairs(text: &str) -> Result<Vec<DisabledPair>, (usi
     let doc = xml::parse(text).map_err(|(line, msg)| (line, format!("not well-formed XML: {msg}")))?;
     let root = doc.root();
     if root.name != "robot" {
-        return Err((root.line, format!("the root element is <{}>, not <robot>", root.name)));
+        return Err((
+            root.line,
+            format!("the root element is <{}>, not <robot>", root.name),
+        ));
     }
     doc.children(root)
         .filter(|e| e.name == "disable_collisions")
@@ -93,7 +102,12 @@ mod tests {
         assert_eq!(pairs[0].reason, "Adjacent");
         let missing = "<robot name=\"r\">\n<disable_collisions link1=\"a\"/>\n</robot>";
         assert_eq!(parse_disabled_pairs(missing).unwrap_err().0, 2);
-        assert!(parse_disabled_pairs("<srdf/>").unwrap_err().1.contains("not <robot>"));
+        assert!(
+            parse_disabled_pairs("<srdf/>")
+                .unwrap_err()
+                .1
+                .contains("not <robot>")
+        );
         assert!(parse_disabled_pairs("<robot><x></robot>").is_err());
     }
 }

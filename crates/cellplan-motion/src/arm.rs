@@ -208,12 +208,21 @@ impl<'a> ArmValidity<'a> {
             .map(|i| (i, 0..moved_by(i)))
             .filter(|(_, r)| !r.is_empty())
             .collect();
+        // Pairs that no joint moves relative to each other keep one distance: measured once
+        // (at the middle of the limits) and dropped when apart; kept when touching, which
+        // makes every configuration invalid, as it is.
+        let mut links = Vec::new();
+        let mut poses = Vec::new();
+        arm.body_poses(&arm.chain.mid_configuration(), &mut links, &mut poses);
         let pairs = arm
             .self_pairs
             .iter()
             .map(|&(i, j)| {
                 let (a, b) = (moved_by(i), moved_by(j));
                 (i, j, a.min(b)..a.max(b))
+            })
+            .filter(|(i, j, r)| {
+                !r.is_empty() || arm.world.pair_distance(arm.group, *i, *j, &poses, 1.0) <= DISTANCE_SLACK
             })
             .collect();
         ArmValidity {

@@ -197,7 +197,10 @@ pub struct ProblemSet {
 fn pose_of(doc: &PoseDoc, what: &str) -> Result<Pose, String> {
     let t = DVec3::from_array(doc.xyz);
     if !t.is_finite() || t.abs().max_element() > MAX_LENGTH_M {
-        return Err(format!("{what}: position {:?} is not finite or beyond {MAX_LENGTH_M} m", doc.xyz));
+        return Err(format!(
+            "{what}: position {:?} is not finite or beyond {MAX_LENGTH_M} m",
+            doc.xyz
+        ));
     }
     let rot = match (doc.quat_xyzw, doc.rpy) {
         (Some(q), _) => {
@@ -249,7 +252,11 @@ fn obstacle(doc: &ObstacleDoc, what: &str) -> Result<Obstacle, String> {
         "sphere" => ShapeSpec::Sphere {
             radius: length(need(doc.radius, "radius")?, &format!("{what}: radius"), false)?,
         },
-        other => return Err(format!("{what}: unknown shape \"{other}\" (box, cylinder or sphere)")),
+        other => {
+            return Err(format!(
+                "{what}: unknown shape \"{other}\" (box, cylinder or sphere)"
+            ));
+        }
     };
     Ok(Obstacle {
         name: doc.name.clone(),
@@ -285,7 +292,10 @@ pub fn read_problems(path: &Path) -> Result<ProblemSet, ProblemError> {
             source,
         },
         LimitedReadError::TooLarge { size } => invalid(
-            format!("the file is {size}, larger than the {} a problem file may have", show_bytes(MAX_FILE_BYTES)),
+            format!(
+                "the file is {size}, larger than the {} a problem file may have",
+                show_bytes(MAX_FILE_BYTES)
+            ),
             "split the problems over several files",
         ),
     })?;
@@ -304,13 +314,19 @@ pub fn read_problems(path: &Path) -> Result<ProblemSet, ProblemError> {
     let hint = "see docs/motion-problems.md for the format";
     if doc.format != FORMAT || doc.version != VERSION {
         return Err(invalid(
-            format!("format \"{}\" version {}, not \"{FORMAT}\" version {VERSION}", doc.format, doc.version),
+            format!(
+                "format \"{}\" version {}, not \"{FORMAT}\" version {VERSION}",
+                doc.format, doc.version
+            ),
             hint,
         ));
     }
     if doc.problems.len() > MAX_PROBLEMS {
         return Err(invalid(
-            format!("{} problems, more than the {MAX_PROBLEMS} a file may hold", doc.problems.len()),
+            format!(
+                "{} problems, more than the {MAX_PROBLEMS} a file may hold",
+                doc.problems.len()
+            ),
             "split the problems over several files",
         ));
     }
@@ -336,7 +352,10 @@ pub fn read_problems(path: &Path) -> Result<ProblemSet, ProblemError> {
                 return Err(format!("{what} has {} goals (1 to {MAX_GOALS})", p.goals.len()));
             }
             if p.obstacles.len() > MAX_OBSTACLES {
-                return Err(format!("{what} has {} obstacles (at most {MAX_OBSTACLES})", p.obstacles.len()));
+                return Err(format!(
+                    "{what} has {} obstacles (at most {MAX_OBSTACLES})",
+                    p.obstacles.len()
+                ));
             }
             let start = configuration(&p.start, n, &format!("{what}: start"))?;
             let goals = p
@@ -480,7 +499,10 @@ impl ArmSetup {
 
     /// A configuration in the file's joint order, in the chain's order.
     pub fn to_chain(&self, q: &[f64]) -> Vec<f64> {
-        self.order.iter().map(|&k| q.get(k).copied().unwrap_or(f64::NAN)).collect()
+        self.order
+            .iter()
+            .map(|&k| q.get(k).copied().unwrap_or(f64::NAN))
+            .collect()
     }
 
     /// A configuration in the chain's order, in the file's joint order.

@@ -4,16 +4,25 @@
 //! densely along every segment and tested with parry's exact queries against the obstacles and
 //! against each other (the checked self pairs).
 //!
-//! Density: between two consecutive samples no vertex of any shape moves more than `max_step`
+//! Density: between two consecutive samples no point of any shape moves more than `max_step`
 //! (m). The bound is this module's own: joint `j` moves a point at most `R_j·|Δq_j|`, `R_j` the
 //! sum of the link offsets from joint `j` to the shape's link plus the shape's farthest point
-//! from its link's origin. A triangle mesh is a surface: an obstacle that slips wholly inside a
-//! link's mesh between two samples would be missed, which a step far below the obstacles' size
-//! (1 mm against centimetres) rules out.
+//! from its link's origin. A pair measured far apart at one sample is not tested again until it
+//! could have closed the distance (the distance over the motion per sample), which saves the
+//! exact mesh–mesh queries without weakening the check; the distance of a mesh's convex hull,
+//! which contains it, serves as that lower bound whenever the hull is clear (GJK instead of a
+//! triangle search). A triangle mesh is a surface: an
+//! obstacle that slips wholly inside a link's mesh between two samples would be missed, which a
+//! step far below the obstacles' size (1 mm against centimetres) rules out.
 use cellplan_geom::{DQuat, Pose, ShapeSpec};
 use cellplan_kin::{Chain, JointKind, RobotModel};
+use parry3d_f64::bounding_volume::Aabb;
 use parry3d_f64::query;
 use parry3d_f64::shape::{Ball, Cuboid, Cylinder, SharedShape, TriMesh};
+
+/// Joint values may pass their limits by this much (rad or m): paths written in single
+/// precision (VAMP's) end a few 1e-7 beyond a goal that lies on a limit.
+pub const LIMIT_TOLERANCE: f64 = 1e-5;
 
 /// One shape of the robot, as given.
 struct Part {
@@ -24,6 +33,11 @@ struct Part {
     local: Pose,
     /// Farthest point of the shape from the link origin (m).
     reach: f64,
+    /// Bounds of `shape` in its own frame.
+    aabb: Aabb,
+    /// For a mesh, its convex hull (same frame): it contains the mesh, so its distance is a
+    /// lower bound on the mesh's, found by GJK where the mesh needs a triangle search.
+    hull: Option<SharedShape>,
 }
 
 /// The robot for exact checks: its chain, base and collision shapes as given, and the shape
@@ -35,6 +49,8 @@ pub struct ExactRobot<'a> {
     pairs: Vec<(usize, usize)>,
     /// Per joint, the bound `R_j` (see the module documentation).
     radii: Vec<f64>,
+    /// Per part, the joints that move it (`0..n`).
+    part_joints: Vec<usize>,
 }
 
 /// A parry shape for a shape spec, with its pose in the spec's frame, and the farthest distance
@@ -52,7 +68,11 @@ fn exact_shape(spec: &ShapeSpec) -> Option<(SharedShape, Pose, f64)> {
             Pose::from_rotation(DQuat::from_rotation_x(std::f64::consts::FRAC_PI_2)),
             (radius * radius + half_height * half_height).sqrt(),
         )),
-        ShapeSpec::Sphere { radius } => Some((SharedShape::new(Ball::new(radius.abs())), Pose::IDENTITY, radius.abs())),
+        ShapeSpec::Sphere { radius } => Some((
+            SharedShape::new(Ball::new(radius.abs())),
+            Pose::IDENTITY,
+            radius.abs(),
+        )),
         ShapeSpec::Mesh(m) => {
             let reach = m.vertices.iter().map(|v| v.length()).fold(0.0, f64::max);
             let tris: Vec<[u32; 3]> = m
@@ -76,8 +96,14 @@ impl<'a> ExactRobot<'a> {
         for (link, shapes) in model.collision.iter().enumerate() {
             for (spec, pose) in shapes {
                 if let Some((shape, local, r)) = exact_shape(spec) {
+                    let hull = match spec {
+                        ShapeSpec::Mesh(m) => SharedShape::convex_hull(&m.vertices),
+                        _ => None,
+                    };
                     parts.push(Part {
                         link,
+                        aabb: shape.compute_local_aabb(),
+                        hull,
                         shape,
                         local: *pose * local,
                         reach: pose.translation.length() + r,
@@ -113,9 +139,22 @@ impl<'a> ExactRobot<'a> {
                     .fold(0.0, f64::max)
             })
             .collect();
+        let mut moved = 0;
+        let joints_to: Vec<usize> = chain
+            .links
+            .iter()
+            .map(|l| {
+                if let Some(j) = l.joint {
+                    moved = moved.max(j + 1);
+                }
+                moved
+            })
+            .collect();
+        let part_joints = parts.iter().map(|p| joints_to[p.link]).collect();
         ExactRobot {
             chain,
             base,
+            part_joints,
             parts,
             pairs: pairs.to_vec(),
             radii,
@@ -145,50 +184,152 @@ pub struct ExactObstacle {
     pub name: String,
     shape: SharedShape,
     pose: Pose,
+    /// World bounds.
+    aabb: Aabb,
 }
 
 impl ExactObstacle {
     /// The obstacle `spec` at `pose`; `None` for a degenerate shape.
     pub fn new(name: &str, spec: &ShapeSpec, pose: Pose) -> Option<Self> {
         let (shape, local, _) = exact_shape(spec)?;
+        let pose = pose * local;
         Some(ExactObstacle {
             name: name.to_string(),
+            aabb: shape.compute_aabb(&pose),
             shape,
-            pose: pose * local,
+            pose,
         })
+    }
+}
+
+/// Distance between two boxes (0 when they overlap): a lower bound on the distance of anything
+/// inside them.
+fn box_gap(a: &Aabb, b: &Aabb) -> f64 {
+    (a.mins - b.maxs)
+        .max(b.mins - a.maxs)
+        .max(cellplan_geom::DVec3::ZERO)
+        .length()
+}
+
+/// For each tested pair (part–obstacle, then self pair), how much closer it may come before it
+/// must be tested again (m): until then it is provably apart (see [`ExactRobot::contact_at`]).
+struct Schedule {
+    slack: Vec<f64>,
+    /// Per pair, the joints that move its two members relative to each other.
+    joints: Vec<std::ops::Range<usize>>,
+}
+
+impl Schedule {
+    /// Takes one sample's motion off every slack: `prefix[j]` is the sum over joints `< j` of
+    /// `R_j·|Δq_j|` per sample.
+    fn advance(&mut self, prefix: &[f64]) {
+        for (slack, r) in self.slack.iter_mut().zip(&self.joints) {
+            *slack -= prefix[r.end] - prefix[r.start];
+        }
     }
 }
 
 impl ExactRobot<'_> {
     /// The first contact at `q` (`None` when clear): a part within `margin` of an obstacle, or a
-    /// checked pair touching. `poses` is scratch.
-    fn contact_at(&self, q: &[f64], obstacles: &[ExactObstacle], margin: f64, links: &mut [Pose]) -> Option<String> {
+    /// checked pair touching. `links` is scratch.
+    ///
+    /// A pair found `d` beyond what is allowed (exact parry distance, or the gap of the two
+    /// bounding boxes, which is smaller) cannot touch before the joints that move its members
+    /// relative to each other have moved them `d`: the schedule holds that slack, which
+    /// [`Schedule::advance`] spends sample by sample, and the pair is tested again only when it
+    /// is spent. Two members of one link never move relative to each other: tested once.
+    fn contact_at(
+        &self,
+        q: &[f64],
+        obstacles: &[ExactObstacle],
+        margin: f64,
+        schedule: &mut Schedule,
+        links: &mut [Pose],
+    ) -> Option<String> {
         self.chain.fk_all(q, links);
-        let world: Vec<Pose> = self.parts.iter().map(|p| self.base * links[p.link] * p.local).collect();
-        for (p, pose) in self.parts.iter().zip(&world) {
-            for o in obstacles {
-                let hit = if margin > 0.0 {
-                    query::distance(pose, &*p.shape, &o.pose, &*o.shape).map(|d| d.distance <= margin)
-                } else {
-                    query::intersection_test(pose, &*p.shape, &o.pose, &*o.shape).map(|r| r.intersecting)
-                };
-                // A pair parry cannot test counts as a contact: the check must not pass blind.
-                if hit.unwrap_or(true) {
-                    return Some(format!("link {} with obstacle {}", self.chain.links[p.link].name, o.name));
+        let world: Vec<Pose> = self
+            .parts
+            .iter()
+            .map(|p| self.base * links[p.link] * p.local)
+            .collect();
+        let boxes: Vec<Aabb> = self
+            .parts
+            .iter()
+            .zip(&world)
+            .map(|(p, pose)| p.aabb.transform_by(pose))
+            .collect();
+        let n_obs = obstacles.len();
+        for (pi, (p, pose)) in self.parts.iter().zip(&world).enumerate() {
+            for (oi, o) in obstacles.iter().enumerate() {
+                let slot = pi * n_obs + oi;
+                if schedule.slack[slot] > 0.0 {
+                    continue;
                 }
+                let gap = box_gap(&boxes[pi], &o.aabb) - margin;
+                let d = if gap > 0.0 {
+                    gap
+                } else {
+                    let hull = p
+                        .hull
+                        .as_ref()
+                        .and_then(|h| query::distance(pose, &**h, &o.pose, &*o.shape).ok());
+                    match hull.map(|d| d.distance - margin) {
+                        Some(lower) if lower > 0.0 => lower,
+                        _ => match query::distance(pose, &*p.shape, &o.pose, &*o.shape) {
+                            Ok(d) => d.distance - margin,
+                            // A pair parry cannot measure counts as a contact: no blind pass.
+                            Err(_) => -1.0,
+                        },
+                    }
+                };
+                if d <= 0.0 {
+                    return Some(format!(
+                        "link {} with obstacle {}",
+                        self.chain.links[p.link].name, o.name
+                    ));
+                }
+                schedule.slack[slot] = d;
             }
         }
-        for &(i, j) in &self.pairs {
+        let base = self.parts.len() * n_obs;
+        for (s, &(i, j)) in self.pairs.iter().enumerate() {
             let (Some(a), Some(b)) = (self.parts.get(i), self.parts.get(j)) else {
                 continue;
             };
-            let hit = query::intersection_test(&world[i], &*a.shape, &world[j], &*b.shape).map(|r| r.intersecting);
-            if hit.unwrap_or(true) {
+            let slot = base + s;
+            if schedule.slack[slot] > 0.0 {
+                continue;
+            }
+            let gap = box_gap(&boxes[i], &boxes[j]);
+            let d = if gap > 0.0 {
+                gap
+            } else {
+                let (ha, hb) = (
+                    a.hull.as_ref().unwrap_or(&a.shape),
+                    b.hull.as_ref().unwrap_or(&b.shape),
+                );
+                match query::distance(&world[i], &**ha, &world[j], &**hb)
+                    .ok()
+                    .map(|d| d.distance)
+                {
+                    Some(lower) if lower > 0.0 => lower,
+                    _ => match query::distance(&world[i], &*a.shape, &world[j], &*b.shape) {
+                        Ok(d) => d.distance,
+                        Err(_) => -1.0,
+                    },
+                }
+            };
+            if d <= 0.0 {
                 return Some(format!(
                     "link {} with link {} (parts {i}, {j})",
                     self.chain.links[a.link].name, self.chain.links[b.link].name
                 ));
             }
+            schedule.slack[slot] = if schedule.joints[slot].is_empty() {
+                f64::INFINITY
+            } else {
+                d
+            };
         }
         None
     }
@@ -219,17 +360,41 @@ impl ExactRobot<'_> {
             };
         }
         let mut q = vec![0.0; self.chain.dof()];
+        let mut joints: Vec<std::ops::Range<usize>> = Vec::new();
+        for &m in &self.part_joints {
+            joints.extend(std::iter::repeat_n(0..m, obstacles.len()));
+        }
+        for &(i, j) in &self.pairs {
+            let (a, b) = (
+                self.part_joints.get(i).copied().unwrap_or(0),
+                self.part_joints.get(j).copied().unwrap_or(0),
+            );
+            joints.push(a.min(b)..a.max(b));
+        }
+        let mut schedule = Schedule {
+            slack: vec![0.0; joints.len()],
+            joints,
+        };
+        let mut prefix = vec![0.0; self.chain.dof() + 1];
         for seg in 0..waypoints.len().max(2) - 1 {
             let a = &waypoints[seg];
             let b = waypoints.get(seg + 1).unwrap_or(a);
             if a.len() != q.len() || b.len() != q.len() {
                 return fail(samples, seg, 0.0, "wrong number of joint values".into());
             }
-            let bound: f64 = a.iter().zip(b).zip(&self.radii).map(|((x, y), r)| r * (x - y).abs()).sum();
+            let bound: f64 = a
+                .iter()
+                .zip(b)
+                .zip(&self.radii)
+                .map(|((x, y), r)| r * (x - y).abs())
+                .sum();
             if !bound.is_finite() {
                 return fail(samples, seg, 0.0, "non-finite joint values".into());
             }
             let n = ((bound / step).ceil() as usize).max(1);
+            for (j, ((x, y), r)) in a.iter().zip(b).zip(&self.radii).enumerate() {
+                prefix[j + 1] = prefix[j] + r * (x - y).abs() / n as f64;
+            }
             // The first waypoint once; then every sample after the segment's start.
             let first = if seg == 0 { 0 } else { 1 };
             for k in first..=n {
@@ -237,11 +402,15 @@ impl ExactRobot<'_> {
                 for (v, (x, y)) in q.iter_mut().zip(a.iter().zip(b)) {
                     *v = x + t * (y - x);
                 }
-                samples += 1;
-                if !self.chain.within_limits(&q, 1e-9) {
-                    return fail(samples, seg, t, "outside the joint limits".into());
+                if !self.chain.within_limits(&q, LIMIT_TOLERANCE) {
+                    return fail(samples + 1, seg, t, "outside the joint limits".into());
                 }
-                if let Some(what) = self.contact_at(&q, obstacles, margin, &mut links) {
+                if k > 0 {
+                    schedule.advance(&prefix);
+                }
+                let hit = self.contact_at(&q, obstacles, margin, &mut schedule, &mut links);
+                samples += 1;
+                if let Some(what) = hit {
                     return fail(samples, seg, t, what);
                 }
             }

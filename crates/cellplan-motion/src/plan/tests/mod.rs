@@ -98,7 +98,7 @@ fn around_the_wall() {
         Err(PlanError::NoPath { samples: 0, .. })
     ));
     for seed in 0..10 {
-        let raw = RrtConnect
+        let raw = RrtConnect::default()
             .plan(&space, &v, &start, &goal, &settings(seed))
             .unwrap();
         assert!(!raw.straight && raw.samples > 0);
@@ -121,7 +121,7 @@ fn invalid_ends_are_refused() {
     let space = square(2, 10.0);
     let v = wall();
     let s = settings(0);
-    for planner in [&Straight as &dyn Planner, &RrtConnect] {
+    for planner in [&Straight as &dyn Planner, &RrtConnect::default()] {
         assert!(matches!(
             planner.plan(&space, &v, &[5.0, 2.0], &[9.0, 1.0], &s),
             Err(PlanError::StartInvalid { clearance }) if clearance < 0.0
@@ -185,7 +185,7 @@ fn enclosed_goal_gives_no_path() {
         ..settings(3)
     };
     assert!(matches!(
-        RrtConnect.plan(&space, &v, &[1.0, 1.0], &[8.0, 8.0], &s),
+        RrtConnect::default().plan(&space, &v, &[1.0, 1.0], &[8.0, 8.0], &s),
         Err(PlanError::NoPath { samples: 0, .. })
     ));
 }
@@ -251,7 +251,7 @@ fn shortcut_never_lengthens_and_stays_valid() {
     let space = square(2, 10.0);
     let v = wall();
     for seed in 0..20 {
-        let raw = RrtConnect
+        let raw = RrtConnect::default()
             .plan(&space, &v, &[1.0, 1.0], &[9.0, 1.0], &settings(seed))
             .unwrap();
         let before = path_length(&space, &raw.waypoints);
@@ -350,3 +350,5 @@ fn structured_clearances_step_by_the_joints_that_matter() {
     let floor = check_segment(&space, &TightWrist, &[0.0, 1.0], &[1.0, 1.0], 0.02);
     assert!(!floor.valid);
 }
+
+mod planners;

@@ -1,0 +1,249 @@
+//! Collision-free joint-space path planning, arranged as OMPL arranges it: a state space
+//! ([`JointSpace`]), a validity checker ([`StateValidity`]), a motion validator
+//! ([`check_segment`]), a query ([`Problem`]: one start, one or more goals), a stop condition
+//! ([`Termination`]: a work budget and an optional wall clock), and planners behind one
+//! interface ([`MotionPlanner`]) that answer with a [`PlanResult`] (a [`Status`], the path,
+//! the goal reached, the [`Work`] spent), plus path post-processing ([`shortcut`]).
+//!
+//! # Choosing a planner
+//!
+//! Planners are built by name from a static registry ([`planners`], [`planner`]) with one
+//! parameter struct ([`PlannerParams`]):
+//!
+//! | name          | planner          | what it does |
+//! |---------------|------------------|--------------|
+//! | `straight`    | [`Straight`]     | the direct segment only; [`Status::Infeasible`] when blocked |
+//! | `rrt-connect` | [`RrtConnect`]   | bidirectional trees, the goal tree rooted at every valid goal |
+//! | `rrt-star`    | [`RrtStar`]      | anytime: spends the budget shortening the best path |
+//! | `prm`         | [`Prm`]          | lazy PRM over a [`Roadmap`] reused across queries in one scene |
+//! | `leg`         | [`Leg`]          | the direct segment if clear, else RRT-Connect, then post-processing |
+//!
+//! ```
+//! use cellplan_motion::plan::{JointSpace, PlannerParams, Problem, Status, Termination, planner};
+//! let space = JointSpace::new(vec![0.0; 2], vec![10.0; 2], vec![1.0; 2]);
+//! // A disc of radius 2 at (5, 5): clearance is the distance to its surface.
+//! let validity = |q: &[f64]| ((q[0] - 5.0).powi(2) + (q[1] - 5.0).powi(2)).sqrt() - 2.0;
+//! let goals = [vec![9.0, 5.0], vec![9.0, 9.0]];
+//! let problem = Problem::new(&space, &validity, &[1.0, 5.0], &goals);
+//! let mut leg = (planner("leg").unwrap().build)(&PlannerParams { seed: 7, ..Default::default() });
+//! let result = leg.solve(&problem, &Termination::samples(5_000));
+//! assert_eq!(result.status, Status::Solved);
+//! assert!(result.goal.is_some());
+//! ```
+//!
+//! Runs are reproducible: the same seed and work budget give the same path on any machine;
+//! the wall clock is a safety net whose binding the result reports ([`Work::clock_bound`]).
+//! The older two-configuration interface ([`Planner`], [`plan_leg`], [`PlanSettings`],
+//! [`PlanError`]) is kept for existing callers and runs on the same planners.
+//!
+//! # Why no contact is missed between samples
+//!
+//! A [`StateValidity`] returns a *clearance* `c(q)`: a lower bound on how far every point of
+//! every moving body may move (in Cartesian space) before the state can become invalid (for a
+//! robot: distance to obstacles minus the margin, self distances halved because both bodies
+//! move). A [`JointSpace`] carries per-joint radii such that along a straight joint-space
+//! segment from `a` to `b` no point moves more than `Σ_j radii[j]·|a_j − b_j|`. So around a
+//! sample at parameter `s` of a segment whose whole bound is `L`, every parameter `s'` with
+//! `|s' − s|·L < c(q(s))` is valid: [`check_segment`] covers the segment with such intervals,
+//! placing each new sample where its interval should about touch the covered part, until no
+//! gap is left. Samples therefore crowd near obstacles and spread in free space; a clearance below
+//! [`PlanSettings::min_clearance`] counts as a contact (so the check always ends). A checker
+//! may split its clearance by the joints that can reduce each part
+//! ([`StateValidity::clearances`]): the step is then the smallest `c_k / L_k`, `L_k` summing
+//! only over the joints of part `k`.
+use std::time::Duration;
+use thiserror::Error;
+
+mod prm;
+mod problem;
+mod registry;
+mod rrt_connect;
+mod rrt_star;
+mod simplify;
+mod space;
+mod straight;
+mod validity;
+
+pub use prm::{Prm, Roadmap};
+use problem::solve_with;
+pub use problem::{PlanResult, Problem, Status, Termination, Work};
+pub use registry::{Entry, Leg, MotionPlanner, PlannerParams, UnknownPlanner, planner, planners};
+pub use rrt_connect::RrtConnect;
+pub use rrt_star::RrtStar;
+use simplify::shortcut_with;
+pub use simplify::{path_length, shortcut};
+pub use space::JointSpace;
+pub use straight::Straight;
+use validity::segment_valid;
+pub use validity::{Clearance, SegmentCheck, StateValidity, check_segment, narrow_step};
+
+/// Limits and knobs of a planning query.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PlanSettings {
+    /// Seed of the planner's random numbers (same seed, same path, unless the time limit
+    /// stops the search first).
+    pub seed: u64,
+    /// Wall-clock limit of the search.
+    pub time_limit: Duration,
+    /// Most random samples a sampling planner draws.
+    pub max_samples: usize,
+    /// Longest tree edge, in the space's metric; 0 or less: a fifth of the space's
+    /// [`JointSpace::extent`] (OMPL's default).
+    pub range: f64,
+    /// Clearances below this (m) count as contact, so that checks end.
+    pub min_clearance: f64,
+    /// Random shortcut attempts after a sampling planner.
+    pub shortcut_iterations: usize,
+}
+
+impl Default for PlanSettings {
+    fn default() -> Self {
+        PlanSettings {
+            seed: 0,
+            time_limit: Duration::from_secs(5),
+            max_samples: 20_000,
+            range: 0.0,
+            min_clearance: 1e-4,
+            shortcut_iterations: 100,
+        }
+    }
+}
+
+/// A collision-free joint-space path: straight segments between waypoints.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PlannedPath {
+    /// From the start to the goal, inclusive.
+    pub waypoints: Vec<Vec<f64>>,
+    /// Whether it is the direct segment (two waypoints, no search).
+    pub straight: bool,
+    /// Random samples drawn.
+    pub samples: usize,
+    /// Calls of [`StateValidity::clearance`] made (checks, search and post-processing).
+    pub validity_calls: usize,
+}
+
+impl PlannedPath {
+    /// Length in the space's metric.
+    pub fn length(&self, space: &JointSpace) -> f64 {
+        path_length(space, &self.waypoints)
+    }
+}
+
+/// Why no path.
+#[derive(Clone, Debug, PartialEq, Error)]
+pub enum PlanError {
+    /// The start is outside the space or invalid.
+    #[error("the start configuration is invalid (clearance {clearance} m)")]
+    StartInvalid {
+        /// Its clearance (negative infinity outside the joint limits).
+        clearance: f64,
+    },
+    /// The goal is outside the space or invalid.
+    #[error("the goal configuration is invalid (clearance {clearance} m)")]
+    GoalInvalid {
+        /// Its clearance (negative infinity outside the joint limits).
+        clearance: f64,
+    },
+    /// The planner gave up.
+    #[error("no path found within the limits ({samples} samples, {validity_calls} validity calls)")]
+    NoPath {
+        /// Random samples drawn.
+        samples: usize,
+        /// Validity calls made.
+        validity_calls: usize,
+    },
+}
+
+/// The older two-configuration interface, with [`PlanSettings`] and [`PlanError`]: kept for
+/// existing callers ([`Straight`], [`RrtConnect`]); new code uses [`MotionPlanner`] from the
+/// registry ([`planner`]), which takes goal sets and reports a [`Status`].
+pub trait Planner {
+    /// Short name, for reports.
+    fn name(&self) -> &str;
+    /// A path from `start` to `goal` whose every segment passes [`check_segment`].
+    fn plan(
+        &self,
+        space: &JointSpace,
+        validity: &dyn StateValidity,
+        start: &[f64],
+        goal: &[f64],
+        settings: &PlanSettings,
+    ) -> Result<PlannedPath, PlanError>;
+}
+
+/// One leg: the straight segment if it is clear, else [`RrtConnect`] followed by
+/// [`shortcut`] (the [`Leg`] planner with the parameters and limits of `settings`). The counts
+/// in the result add up every stage.
+pub fn plan_leg(
+    space: &JointSpace,
+    validity: &dyn StateValidity,
+    start: &[f64],
+    goal: &[f64],
+    settings: &PlanSettings,
+) -> Result<PlannedPath, PlanError> {
+    let goals = [goal.to_vec()];
+    let problem = Problem::new(space, validity, start, &goals).with_min_clearance(settings.min_clearance);
+    let mut leg = Leg {
+        params: settings.params(),
+    };
+    leg.solve(&problem, &settings.termination()).into_planned()
+}
+
+impl PlanSettings {
+    /// The planner parameters of these settings (seed, range, shortcut iterations;
+    /// post-processing on).
+    pub fn params(&self) -> PlannerParams {
+        PlannerParams {
+            seed: self.seed,
+            range: self.range,
+            simplify: true,
+            shortcut_iterations: self.shortcut_iterations,
+            ..PlannerParams::default()
+        }
+    }
+
+    /// The stop condition of these settings: `max_samples`, no limit on validity calls, the
+    /// time limit.
+    pub fn termination(&self) -> Termination {
+        Termination {
+            max_samples: self.max_samples,
+            max_validity_calls: usize::MAX,
+            time_limit: Some(self.time_limit),
+        }
+    }
+}
+
+impl PlanResult {
+    /// The result in the older form: a [`PlannedPath`] when solved, else the [`PlanError`]
+    /// (an approximate path counts as no path; for several goals all invalid, the largest
+    /// goal clearance).
+    pub fn into_planned(self) -> Result<PlannedPath, PlanError> {
+        match self.status {
+            Status::Solved => Ok(PlannedPath {
+                waypoints: self.waypoints,
+                straight: self.straight,
+                samples: self.work.samples,
+                validity_calls: self.work.validity_calls,
+            }),
+            Status::InvalidStart => Err(PlanError::StartInvalid {
+                clearance: self.start_clearance,
+            }),
+            Status::InvalidGoal => Err(PlanError::GoalInvalid {
+                clearance: self
+                    .goal_clearances
+                    .iter()
+                    .copied()
+                    .fold(f64::NEG_INFINITY, |a, b| if b > a { b } else { a }),
+            }),
+            Status::Approximate | Status::Timeout | Status::BudgetExhausted | Status::Infeasible => {
+                Err(PlanError::NoPath {
+                    samples: self.work.samples,
+                    validity_calls: self.work.validity_calls,
+                })
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,190 @@
+//! RRT-Connect.
+use super::problem::{Found, Run, range_of};
+use super::{
+    JointSpace, MotionPlanner, PlanError, PlanResult, PlanSettings, PlannedPath, Planner, PlannerParams,
+    Problem, StateValidity, Termination, solve_with,
+};
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+
+/// RRT-Connect (Kuffner & LaValle 2000): two trees, one rooted at the start, the other at
+/// every valid goal (a forest), grown in turn towards random samples; after each extension
+/// the other tree greedily connects to the new node. The path ends at the goal whose root the
+/// connection reached. Every edge passes [`super::check_segment`]. Deterministic for a seed
+/// (ChaCha8); uses [`PlannerParams::seed`], [`PlannerParams::range`] and the post-processing
+/// settings.
+#[derive(Clone, Debug, Default)]
+pub struct RrtConnect {
+    /// Its parameters (for [`MotionPlanner::solve`]; [`Planner::plan`] takes them from its
+    /// settings).
+    pub params: PlannerParams,
+}
+
+struct Tree {
+    nodes: Vec<Vec<f64>>,
+    parent: Vec<usize>,
+    /// For each node, the index of its root's query end (0 for the start, else the goal's).
+    origin: Vec<usize>,
+}
+
+impl Tree {
+    fn new(roots: impl IntoIterator<Item = (Vec<f64>, usize)>) -> Self {
+        let mut tree = Tree {
+            nodes: Vec::new(),
+            parent: Vec::new(),
+            origin: Vec::new(),
+        };
+        for (q, origin) in roots {
+            tree.nodes.push(q);
+            tree.parent.push(usize::MAX);
+            tree.origin.push(origin);
+        }
+        tree
+    }
+
+    /// Root-to-node path.
+    fn path_to(&self, mut i: usize) -> Vec<Vec<f64>> {
+        let mut out = Vec::new();
+        while i != usize::MAX {
+            out.push(self.nodes[i].clone());
+            i = self.parent[i];
+        }
+        out.reverse();
+        out
+    }
+}
+
+enum Extend {
+    Trapped,
+    Advanced(usize),
+    Reached(usize),
+}
+
+/// One RRT extension of `tree` from node `from` towards `target`.
+fn extend_from(run: &mut Run, range: f64, tree: &mut Tree, from: usize, target: &[f64]) -> Extend {
+    let near = &tree.nodes[from];
+    let d = run.space.distance(near, target);
+    let (q_new, reached) = if d <= range {
+        (target.to_vec(), true)
+    } else {
+        let mut q = Vec::new();
+        run.space.interpolate(near, target, range / d, &mut q);
+        (q, false)
+    };
+    if !run.segment(near, &q_new) {
+        return Extend::Trapped;
+    }
+    tree.nodes.push(q_new);
+    tree.parent.push(from);
+    tree.origin.push(tree.origin[from]);
+    let i = tree.nodes.len() - 1;
+    if reached {
+        Extend::Reached(i)
+    } else {
+        Extend::Advanced(i)
+    }
+}
+
+/// Extends `tree` towards `target` until it is reached, the tree is trapped or the run must
+/// stop.
+fn connect(run: &mut Run, range: f64, tree: &mut Tree, target: &[f64]) -> Option<usize> {
+    let mut from = run.space.nearest(&tree.nodes, target);
+    loop {
+        match extend_from(run, range, tree, from, target) {
+            Extend::Trapped => return None,
+            Extend::Reached(i) => return Some(i),
+            Extend::Advanced(i) => from = i,
+        }
+        if run.must_stop().is_some() {
+            return None;
+        }
+    }
+}
+
+/// The search of [`RrtConnect`], shared with [`super::Leg`].
+pub(crate) fn search(
+    run: &mut Run,
+    params: &PlannerParams,
+    start: &[f64],
+    goals: &[Vec<f64>],
+    valid: &[usize],
+) -> Found {
+    let range = range_of(run.space, params);
+    let mut rng = ChaCha8Rng::seed_from_u64(params.seed);
+    // trees[0] grows from the start, trees[1] from the goals; `a` is the one extended.
+    let mut trees = [
+        Tree::new([(start.to_vec(), 0)]),
+        Tree::new(valid.iter().map(|&g| (goals[g].clone(), g))),
+    ];
+    let mut a = 0;
+    let mut q_rand = Vec::with_capacity(run.space.dim());
+    loop {
+        if let Err(why) = run.sample(&mut rng, &mut q_rand) {
+            return Found::none(why);
+        }
+        let (x, y) = trees.split_at_mut(1);
+        let (ta, tb) = if a == 0 {
+            (&mut x[0], &mut y[0])
+        } else {
+            (&mut y[0], &mut x[0])
+        };
+        let from = run.space.nearest(&ta.nodes, &q_rand);
+        let new = match extend_from(run, range, ta, from, &q_rand) {
+            Extend::Trapped => None,
+            Extend::Advanced(i) | Extend::Reached(i) => Some(i),
+        };
+        if let Some(i) = new {
+            let target = ta.nodes[i].clone();
+            if let Some(j) = connect(run, range, tb, &target) {
+                let (si, gi) = if a == 0 { (i, j) } else { (j, i) };
+                let mut waypoints = trees[0].path_to(si);
+                let mut back = trees[1].path_to(gi);
+                back.reverse();
+                // The meeting node is in both halves.
+                back.remove(0);
+                waypoints.extend(back);
+                return Found::path(waypoints, trees[1].origin[gi]);
+            }
+        }
+        a = 1 - a;
+    }
+}
+
+impl MotionPlanner for RrtConnect {
+    fn name(&self) -> &'static str {
+        "rrt-connect"
+    }
+
+    fn solve(&mut self, problem: &Problem, stop: &Termination) -> PlanResult {
+        solve_with(problem, stop, &self.params, |run, valid| {
+            search(run, &self.params, problem.start, problem.goals, valid)
+        })
+    }
+}
+
+impl Planner for RrtConnect {
+    fn name(&self) -> &str {
+        "rrt-connect"
+    }
+
+    /// The raw RRT-Connect path (no post-processing), with the parameters of `settings`.
+    fn plan(
+        &self,
+        space: &JointSpace,
+        validity: &dyn StateValidity,
+        start: &[f64],
+        goal: &[f64],
+        settings: &PlanSettings,
+    ) -> Result<PlannedPath, PlanError> {
+        let goals = [goal.to_vec()];
+        let problem = Problem::new(space, validity, start, &goals).with_min_clearance(settings.min_clearance);
+        let params = PlannerParams {
+            simplify: false,
+            ..settings.params()
+        };
+        solve_with(&problem, &settings.termination(), &params, |run, valid| {
+            search(run, &params, start, &goals, valid)
+        })
+        .into_planned()
+    }
+}

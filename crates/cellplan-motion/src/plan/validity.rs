@@ -1,0 +1,189 @@
+//! Validity as a clearance, and the conservative segment check built on it (see the
+//! [module documentation](super) for the proof).
+use super::JointSpace;
+use std::ops::Range;
+
+/// Steps are shortened by this factor so that a step never reaches the clearance exactly.
+const STEP_SAFETY: f64 = 0.999;
+
+/// One clearance with the joints whose motion can reduce it (see
+/// [`StateValidity::clearances`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Clearance {
+    /// How far (m) the points involved may move relative to each other; `<= 0`: invalid.
+    pub distance: f64,
+    /// The joints (indices, clipped to the space) whose motion can reduce it: along a segment
+    /// the points involved move relative to each other by at most
+    /// `Σ_{j in joints} radii[j]·|Δq_j|`.
+    pub joints: Range<usize>,
+}
+
+/// Whether a configuration is valid, as a clearance.
+pub trait StateValidity: Sync {
+    /// A lower bound on how far (m) every point of every moving body may move from its place
+    /// at `q` before the state can become invalid: the distance to every obstacle (static
+    /// scene and checked self pairs) minus the required margin. `<= 0` (or NaN) means invalid.
+    /// Implementations may cap the value (return `min(d, cap)`) for speed: a smaller value is
+    /// always safe.
+    fn clearance(&self, q: &[f64]) -> f64;
+
+    /// The same, finer: several clearances into `out` (cleared first), each with the range of
+    /// joints that can reduce it — on a serial chain, a body on link `k` is moved only by
+    /// joints up to `k`, and two bodies of the chain move relative to each other only by the
+    /// joints between them. The segment check steps by the smallest `distance / bound over
+    /// joints`, which allows long steps when the only tight clearance is one that few joints
+    /// change (a tool near the wrist it hangs on). The smallest distance must not exceed
+    /// [`StateValidity::clearance`]. Default: that one clearance, over every joint.
+    fn clearances(&self, q: &[f64], out: &mut Vec<Clearance>) {
+        out.clear();
+        out.push(Clearance {
+            distance: self.clearance(q),
+            joints: 0..usize::MAX,
+        });
+    }
+
+    /// The radius, in segment parameter, of the piece of a segment around `q` proven valid:
+    /// `min_k distance_k / bound(joints_k)` over [`StateValidity::clearances`], at most
+    /// `limit`; `None` when some distance is below `floor` (or NaN). `bound(joints)` is the
+    /// Cartesian displacement bound of those joints over the whole segment (0 when they do not
+    /// move). The segment check calls this; an implementation may override it to skip work
+    /// the answer does not need — a distance query capped at `step · bound` (the step found so
+    /// far) answers as well as an exact one. The result must not exceed the default's.
+    fn segment_step(
+        &self,
+        q: &[f64],
+        bound: &dyn Fn(&Range<usize>) -> f64,
+        floor: f64,
+        limit: f64,
+    ) -> Option<f64> {
+        // One buffer per thread, taken out while in use (so a nested call gets its own).
+        thread_local! {
+            static BUF: std::cell::Cell<Vec<Clearance>> = const { std::cell::Cell::new(Vec::new()) };
+        }
+        let mut buf = BUF.take();
+        self.clearances(q, &mut buf);
+        let step = buf.iter().try_fold(limit, |step, c| {
+            narrow_step(step, c.distance, bound(&c.joints), floor)
+        });
+        BUF.set(buf);
+        step
+    }
+}
+
+/// One part's say in [`StateValidity::segment_step`]: `None` when its clearance `distance` is
+/// below `floor` (or NaN), else `step` shortened to `distance / bound` if that is shorter
+/// (a part whose joints do not move, `bound` 0, only has to be valid).
+pub fn narrow_step(step: f64, distance: f64, bound: f64, floor: f64) -> Option<f64> {
+    // NaN fails the comparison and so counts as a contact.
+    if distance.is_nan() || distance < floor {
+        return None;
+    }
+    Some(if bound > 0.0 {
+        step.min(distance / bound)
+    } else {
+        step
+    })
+}
+
+/// A plain function or closure of `q` is a validity checker (its value is the clearance).
+impl<F: Fn(&[f64]) -> f64 + Sync> StateValidity for F {
+    fn clearance(&self, q: &[f64]) -> f64 {
+        self(q)
+    }
+}
+
+/// The outcome of [`check_segment`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct SegmentCheck {
+    /// Whether the whole straight segment is valid.
+    pub valid: bool,
+    /// Calls of [`StateValidity::clearance`] made.
+    pub calls: usize,
+}
+
+/// Conservative check of the straight joint-space segment `a → b`: valid only when every
+/// configuration on it is proven valid (see the module documentation). A clearance below
+/// `min_clearance` (clamped to at least 1e-9) counts as invalid.
+pub fn check_segment(
+    space: &JointSpace,
+    validity: &dyn StateValidity,
+    a: &[f64],
+    b: &[f64],
+    min_clearance: f64,
+) -> SegmentCheck {
+    let mut calls = 0;
+    let valid = segment_valid(space, validity, a, b, min_clearance, &mut calls);
+    SegmentCheck { valid, calls }
+}
+
+/// The check of [`check_segment`]; counts the clearance calls into `calls`.
+///
+/// The segment is covered by parameter intervals proven valid, one around each sample (its
+/// radius from [`StateValidity::segment_step`]). Gaps between covered pieces are kept in a
+/// first-in first-out list; a gap wider than two of its ends' radii is entered one radius
+/// past its left end (where, the radius being 1-Lipschitz in the parameter, the new ball
+/// about touches the covered piece: each sample covers about twice its radius, where a walk
+/// would cover one), a narrower gap is sampled in its middle. The check ends at the first
+/// contact or when no gap is left.
+pub(crate) fn segment_valid(
+    space: &JointSpace,
+    validity: &dyn StateValidity,
+    a: &[f64],
+    b: &[f64],
+    min_clearance: f64,
+    calls: &mut usize,
+) -> bool {
+    let floor = min_clearance.max(1e-9);
+    let n = space.dim().min(a.len()).min(b.len());
+    // Bound of each joint over the whole segment, and prefix sums for the ranges.
+    let mut prefix = Vec::with_capacity(n + 1);
+    prefix.push(0.0);
+    for j in 0..n {
+        let r = space.radii.get(j).copied().unwrap_or(f64::INFINITY);
+        let d = (a[j] - b[j]).abs();
+        let term = if d == 0.0 { 0.0 } else { r * d };
+        prefix.push(prefix[j] + term);
+    }
+    if !prefix[n].is_finite() {
+        return false;
+    }
+    let bound = |joints: &Range<usize>| {
+        let (lo, hi) = (joints.start.min(n), joints.end.min(n));
+        if hi > lo { prefix[hi] - prefix[lo] } else { 0.0 }
+    };
+    let mut measure = |q: &[f64], limit: f64| -> Option<f64> {
+        *calls += 1;
+        validity
+            .segment_step(q, &bound, floor, limit)
+            .map(|r| r * STEP_SAFETY)
+    };
+    let Some(ra) = measure(a, 1.0) else {
+        return false;
+    };
+    let Some(rb) = measure(b, 1.0) else {
+        return false;
+    };
+    // Gaps (left end, its radius, right end, its radius).
+    let mut gaps = std::collections::VecDeque::from([(0.0, ra, 1.0, rb)]);
+    let mut q = Vec::with_capacity(n);
+    while let Some((s0, r0, s1, r1)) = gaps.pop_front() {
+        let (lo, hi) = (s0 + r0, s1 - r1);
+        if lo >= hi {
+            continue;
+        }
+        let guess = r0.min(r1);
+        let s = if hi - lo <= 2.0 * guess {
+            0.5 * (lo + hi)
+        } else {
+            lo + guess
+        };
+        space.interpolate(a, b, s, &mut q);
+        // A radius beyond the farther end of the gap is of no use.
+        let Some(r) = measure(&q, (s - s0).max(s1 - s)) else {
+            return false;
+        };
+        gaps.push_back((s0, r0, s, r));
+        gaps.push_back((s, r, s1, r1));
+    }
+    true
+}

@@ -1,0 +1,181 @@
+//! The motion-problem format and the arm set up from it, on the MBM UR5 files of bench/motion
+//! and on broken files.
+use cellplan_motion::arm;
+use cellplan_motion::plan::{self, PlannerParams, Termination, check_segment};
+use cellplan_motion::problem::{ArmSetup, ProblemError, read_problems};
+use std::path::{Path, PathBuf};
+
+fn mbm(scene: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("../../bench/motion/mbm-ur5/{scene}.json"))
+}
+
+#[test]
+fn reads_the_mbm_files_and_sets_up_the_ur5() {
+    let set = read_problems(&mbm("box")).unwrap();
+    assert_eq!(set.problems.len(), 100);
+    assert_eq!(set.joints.len(), 6);
+    let setup = ArmSetup::load(&set).unwrap();
+    // One body per collision shape: the arm's links, the F/T sensor and the gripper's parts.
+    assert!(setup.body_links.len() >= 17, "{}", setup.body_links.len());
+    assert!(
+        setup
+            .body_sources
+            .iter()
+            .any(|s| s == "robotiq_85_left_finger_tip_link")
+    );
+    // The SRDF's rules leave out adjacent and never-touching pairs; the rest are checked.
+    let named = |a: &str, b: &str| {
+        setup.self_pairs.iter().any(|&(i, j)| {
+            let (x, y) = (&setup.body_sources[i], &setup.body_sources[j]);
+            (x == a && y == b) || (x == b && y == a)
+        })
+    };
+    assert!(!named("forearm_link", "wrist_1_link"), "adjacent pair checked");
+    assert!(named("base_link", "robotiq_85_left_finger_tip_link"));
+    // The file's joint order maps to the chain's and back.
+    let q = &set.problems[0].start;
+    assert_eq!(&setup.to_file(&setup.to_chain(q)), q);
+}
+
+#[test]
+fn starts_and_goals_of_the_mbm_problems_are_valid_with_fitted_bodies() {
+    // With one hull per link (the gripper a solid block) most grasp goals were "in collision";
+    // with one body per shape the starts and goals of the first problems are free.
+    let set = read_problems(&mbm("table_pick")).unwrap();
+    let mut setup = ArmSetup::load(&set).unwrap();
+    let mut valid = 0;
+    for p in &set.problems[..10] {
+        setup.set_obstacles(&p.obstacles);
+        let v = setup.validity(p.margin);
+        valid += usize::from(v.is_valid(&setup.to_chain(&p.start)));
+        valid += usize::from(v.is_valid(&setup.to_chain(&p.goals[0])));
+    }
+    assert!(valid >= 18, "{valid} of 20 starts and goals valid");
+}
+
+#[test]
+fn the_broad_phase_changes_no_answer() {
+    use cellplan_motion::plan::StateValidity;
+    let set = read_problems(&mbm("bookshelf_small")).unwrap();
+    let mut setup = ArmSetup::load(&set).unwrap();
+    let p = &set.problems[3];
+    setup.set_obstacles(&p.obstacles);
+    let fast = setup.validity(0.0);
+    let mut exact = setup.validity(0.0);
+    exact.broad_phase = false;
+    let space = arm::joint_space(&setup.arm(), &[]);
+    let start = setup.to_chain(&p.start);
+    let goal = setup.to_chain(&p.goals[0]);
+    let mut q = Vec::new();
+    let (mut valid, mut steps) = (0, 0);
+    for k in 0..=200 {
+        space.interpolate(&start, &goal, k as f64 / 200.0, &mut q);
+        let a = fast.is_valid(&q);
+        assert_eq!(a, exact.is_valid(&q), "at {k}");
+        assert_eq!(
+            a,
+            fast.clearance(&q) > 0.0,
+            "is_valid and clearance disagree at {k}"
+        );
+        valid += usize::from(a);
+        let bound = |_: &std::ops::Range<usize>| 1.0;
+        let s1 = fast.segment_step(&q, &bound, 1e-4, 1.0);
+        let s2 = exact.segment_step(&q, &bound, 1e-4, 1.0);
+        assert_eq!(s1.is_some(), s2.is_some(), "at {k}");
+        if let (Some(s1), Some(s2)) = (s1, s2) {
+            // The broad phase answers only what it proves: never a longer step.
+            assert!(s1 <= s2 + 1e-12, "{s1} > {s2} at {k}");
+            steps += 1;
+        }
+    }
+    assert!(valid > 0 && steps > 0);
+}
+
+#[test]
+fn every_registered_planner_solves_an_mbm_problem_with_checked_segments() {
+    let set = read_problems(&mbm("box")).unwrap();
+    let mut setup = ArmSetup::load(&set).unwrap();
+    let p = &set.problems[0];
+    setup.set_obstacles(&p.obstacles);
+    let v = setup.validity(p.margin);
+    let space = arm::joint_space(&setup.arm(), &[]);
+    let start = setup.to_chain(&p.start);
+    let goals: Vec<Vec<f64>> = p.goals.iter().map(|g| setup.to_chain(g)).collect();
+    for name in ["leg", "rrt-connect"] {
+        let entry = plan::planner(name).unwrap();
+        let query = plan::Problem::new(&space, &v, &start, &goals);
+        let result = (entry.build)(&PlannerParams::default()).solve(&query, &Termination::samples(5_000));
+        assert!(result.status.is_solved(), "{name}: {:?}", result.status);
+        for w in result.waypoints.windows(2) {
+            assert!(check_segment(&space, &v, &w[0], &w[1], 1e-4).valid, "{name}");
+        }
+    }
+}
+
+fn write(dir: &Path, text: &str) -> PathBuf {
+    let f = dir.join("p.json");
+    std::fs::write(&f, text).unwrap();
+    f
+}
+
+#[test]
+fn broken_files_are_refused_with_the_place() {
+    let tmp = tempfile::tempdir().unwrap();
+    let head = r#"{"format": "cellplan-motion-problems", "version": 1,
+ "robot": {"urdf": "r.urdf"}, "joints": ["a", "b"],
+ "problems": ["#;
+    let cases: &[(&str, &str)] = &[
+        ("{\"format\": 1", "1:"),
+        (
+            r#"{"format": "other", "version": 1, "robot": {"urdf": "r"}, "joints": ["a"], "problems": []}"#,
+            "not \"cellplan-motion-problems\"",
+        ),
+        (
+            &format!("{head}{{\"name\": \"p\", \"start\": [0, 0, 0], \"goals\": [[0, 0]]}}]}}"),
+            "start has 3 values for 2 joints",
+        ),
+        (
+            &format!("{head}{{\"name\": \"p\", \"start\": [0, 0], \"goals\": []}}]}}"),
+            "0 goals",
+        ),
+        (
+            &format!("{head}{{\"name\": \"p\", \"start\": [0, 0], \"goals\": [[0, 1e9]]}}]}}"),
+            "not a joint value",
+        ),
+        (
+            &format!(
+                "{head}{{\"name\": \"p\", \"start\": [0, 0], \"goals\": [[0, 0]], \"obstacles\": [{{\"shape\": \"cone\", \"pose\": {{\"xyz\": [0,0,0]}}}}]}}]}}"
+            ),
+            "unknown shape \"cone\"",
+        ),
+        (
+            &format!(
+                "{head}{{\"name\": \"p\", \"start\": [0, 0], \"goals\": [[0, 0]], \"obstacles\": [{{\"shape\": \"sphere\", \"radius\": -1, \"pose\": {{\"xyz\": [0,0,0]}}}}]}}]}}"
+            ),
+            "radius = -1",
+        ),
+        (
+            &format!(
+                "{head}{{\"name\": \"p\", \"start\": [0, 0], \"goals\": [[0, 0]], \"obstacles\": [{{\"shape\": \"box\", \"half_extents\": [1,1,1], \"pose\": {{\"xyz\": [0,0,0], \"quat_xyzw\": [0,0,0,2]}}}}]}}]}}"
+            ),
+            "not a unit quaternion",
+        ),
+    ];
+    for (text, expect) in cases {
+        let f = write(tmp.path(), text);
+        let e = read_problems(&f).unwrap_err();
+        let msg = e.to_string();
+        assert!(msg.contains("p.json"), "{msg}");
+        assert!(msg.contains(expect), "{msg} lacks {expect}");
+        assert!(!e.hint().is_empty());
+    }
+    let missing = read_problems(&tmp.path().join("none.json")).unwrap_err();
+    assert!(matches!(missing, ProblemError::Io { .. }));
+    // A robot whose URDF is missing is refused when the arm is set up.
+    let f = write(
+        tmp.path(),
+        &format!("{head}{{\"name\": \"p\", \"start\": [0, 0], \"goals\": [[0, 0]]}}]}}"),
+    );
+    let set = read_problems(&f).unwrap();
+    assert!(matches!(ArmSetup::load(&set), Err(ProblemError::Robot(_))));
+}
