@@ -97,7 +97,7 @@ fn euclidean_length(path: &[Vec<f64>]) -> f64 {
 }
 
 fn exact_of(setup: &ArmSetup, problem: &Problem, path_file_order: &[Vec<f64>], step: f64) -> ExactCheck {
-    let robot = ExactRobot::new(&setup.model, setup.base, &setup.self_pairs);
+    let robot = ExactRobot::new(&setup.model, setup.base, &setup.link_pairs());
     let obstacles: Vec<ExactObstacle> = problem
         .obstacles
         .iter()

@@ -5,6 +5,7 @@
 //!
 //! - [`mesh`]: [`Mesh`] and its loaders, [`load_mesh`] (binary/ASCII STL, OBJ), with errors
 //!   that name the file and line.
+//! - [`pieces`]: convex pieces of concave meshes (V-HACD), for collision bodies that fit.
 //! - [`read`]: reading input files with a size limit (meshes, URDFs, cell files).
 //! - [`shape`]: [`ShapeSpec`], the shapes a cell file can state (box, cylinder, sphere, mesh).
 //! - [`spheres`]: conservative sphere covers of bodies, the world's broad phase.
@@ -15,6 +16,7 @@
 pub mod error;
 mod hull;
 pub mod mesh;
+pub mod pieces;
 pub mod read;
 pub mod shape;
 pub mod spheres;

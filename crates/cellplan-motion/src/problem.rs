@@ -5,11 +5,21 @@
 //!
 //! The robot is built as the cell loader builds one: one convex body per collision shape of
 //! every link (links rigidly attached off the chain, such as a gripper's fingers, keep their own
-//! bodies), the SRDF's `disable_collisions` pairs left out of the self checks (without an SRDF:
+//! bodies; a markedly concave mesh is cut into convex pieces, [`cellplan_geom::pieces`]), the
+//! SRDF's `disable_collisions` pairs left out of the self checks (without an SRDF:
 //! every pair of bodies on different links that are not parent and child).
 use crate::arm::{Arm, ArmValidity};
+use cellplan_geom::pieces::convex_pieces;
 use cellplan_geom::read::{LimitedReadError, read_limited, show_bytes, utf8_text};
-use cellplan_geom::{CollisionWorld, DQuat, DVec3, GroupBody, GroupId, Pose, ShapeSpec};
+use cellplan_geom::{CollisionWorld, DQuat, DVec3, GroupBody, GroupId, Mesh, Pose, ShapeSpec};
+use std::sync::Arc;
+
+/// A convex piece (its points) as a mesh shape (its hull's triangles).
+fn piece_mesh(points: Vec<DVec3>) -> Option<ShapeSpec> {
+    let hull = parry3d_f64::shape::ConvexPolyhedron::from_convex_hull(&points)?;
+    let (vertices, triangles) = hull.to_trimesh();
+    Some(ShapeSpec::Mesh(Arc::new(Mesh { vertices, triangles })))
+}
 use cellplan_kin::{KinError, RobotModel, load_urdf, srdf};
 use serde::Deserialize;
 use std::collections::{BTreeMap, BTreeSet};
@@ -439,14 +449,28 @@ impl ArmSetup {
         let mut body_links = Vec::new();
         let mut body_sources = Vec::new();
         for (l, shapes) in model.collision.iter().enumerate() {
-            for (k, shape) in shapes.iter().enumerate() {
+            for (k, (shape, pose)) in shapes.iter().enumerate() {
                 let source = model.collision_links[l][k].clone();
-                bodies.push(GroupBody {
-                    name: format!("{source}#{k}"),
-                    shapes: vec![shape.clone()],
-                });
-                body_links.push(l);
-                body_sources.push(source);
+                // A markedly concave mesh becomes its convex pieces, each a body.
+                let pieces: Vec<ShapeSpec> = match shape {
+                    ShapeSpec::Mesh(m) => convex_pieces(m).map_or_else(Vec::new, |pieces| {
+                        pieces.into_iter().filter_map(piece_mesh).collect()
+                    }),
+                    _ => Vec::new(),
+                };
+                let parts = if pieces.is_empty() {
+                    vec![shape.clone()]
+                } else {
+                    pieces
+                };
+                for (p, part) in parts.into_iter().enumerate() {
+                    bodies.push(GroupBody {
+                        name: format!("{source}#{k}.{p}"),
+                        shapes: vec![(part, *pose)],
+                    });
+                    body_links.push(l);
+                    body_sources.push(source.clone());
+                }
             }
         }
         let mut world = CollisionWorld::new();
@@ -526,6 +550,18 @@ impl ArmSetup {
             body_links: &self.body_links,
             self_pairs: &self.self_pairs,
         }
+    }
+
+    /// The checked self pairs by URDF link names (each once).
+    pub fn link_pairs(&self) -> Vec<(String, String)> {
+        let mut out: Vec<(String, String)> = self
+            .self_pairs
+            .iter()
+            .map(|&(i, j)| (self.body_sources[i].clone(), self.body_sources[j].clone()))
+            .collect();
+        out.sort();
+        out.dedup();
+        out
     }
 
     /// The validity checker keeping `margin` from the obstacles.

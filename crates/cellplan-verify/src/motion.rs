@@ -88,14 +88,15 @@ fn exact_shape(spec: &ShapeSpec) -> Option<(SharedShape, Pose, f64)> {
 }
 
 impl<'a> ExactRobot<'a> {
-    /// The robot of `model` standing at `base`, one part per collision shape in the order of
-    /// `model.collision` (link by link, shape by shape — the order the problem loader gives its
-    /// bodies), checking the part pairs `pairs`.
-    pub fn new(model: &'a RobotModel, base: Pose, pairs: &[(usize, usize)]) -> Self {
+    /// The robot of `model` standing at `base`, one part per collision shape, checking every
+    /// part of URDF link `a` against every part of link `b` for each `(a, b)` in `link_pairs`.
+    pub fn new(model: &'a RobotModel, base: Pose, link_pairs: &[(String, String)]) -> Self {
         let mut parts = Vec::new();
+        let mut sources: Vec<&str> = Vec::new();
         for (link, shapes) in model.collision.iter().enumerate() {
-            for (spec, pose) in shapes {
+            for (k, (spec, pose)) in shapes.iter().enumerate() {
                 if let Some((shape, local, r)) = exact_shape(spec) {
+                    sources.push(model.collision_links[link].get(k).map_or("", String::as_str));
                     let hull = match spec {
                         ShapeSpec::Mesh(m) => SharedShape::convex_hull(&m.vertices),
                         _ => None,
@@ -151,12 +152,24 @@ impl<'a> ExactRobot<'a> {
             })
             .collect();
         let part_joints = parts.iter().map(|p| joints_to[p.link]).collect();
+        let mut pairs = Vec::new();
+        for i in 0..parts.len() {
+            for j in i + 1..parts.len() {
+                let (a, b) = (sources[i], sources[j]);
+                if link_pairs
+                    .iter()
+                    .any(|(x, y)| (x == a && y == b) || (x == b && y == a))
+                {
+                    pairs.push((i, j));
+                }
+            }
+        }
         ExactRobot {
             chain,
             base,
             part_joints,
             parts,
-            pairs: pairs.to_vec(),
+            pairs,
             radii,
         }
     }

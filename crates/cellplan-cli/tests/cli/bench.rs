@@ -199,12 +199,25 @@ fn bench_motion_plans_and_rechecks_exactly() {
         &["bench", "motion", scene, "--first", "2", "--json", "--with-paths"],
         &dir,
     );
-    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let rows: Value = serde_json::from_slice(&out.stdout).unwrap();
     let rows = rows.as_array().unwrap();
     assert_eq!(rows.len(), 2);
     for row in rows {
-        for key in ["problem", "planner", "solved", "time_s", "path_length", "validity_checks", "exact_valid"] {
+        for key in [
+            "problem",
+            "planner",
+            "solved",
+            "time_s",
+            "path_length",
+            "validity_checks",
+            "exact_valid",
+        ] {
             assert!(!row[key].is_null(), "{key} missing in {row}");
         }
         assert_eq!(row["planner"], "leg");
@@ -222,27 +235,65 @@ fn bench_motion_plans_and_rechecks_exactly() {
     ]);
     let run = dir.join("peer.json");
     std::fs::write(&run, serde_json::to_string(&peer).unwrap()).unwrap();
-    let out = cellplan(&["bench", "motion", scene, "--recheck", run.to_str().unwrap(), "--json"], &dir);
-    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+    let out = cellplan(
+        &[
+            "bench",
+            "motion",
+            scene,
+            "--recheck",
+            run.to_str().unwrap(),
+            "--json",
+        ],
+        &dir,
+    );
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let checked: Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(checked[0]["exact_valid"], true);
-    assert_eq!(checked[1]["exact_valid"], true, "standing still at a valid start is valid");
+    assert_eq!(
+        checked[1]["exact_valid"], true,
+        "standing still at a valid start is valid"
+    );
     // The elbow folded shut (3.1 rad) folds the wrist onto the upper arm: a self-collision.
     let mut folded = rows[0]["path"][0].clone();
     folded[2] = serde_json::json!(3.1);
     let cut = serde_json::json!([{"problem": rows[0]["problem"], "planner": "peer", "solved": true,
                                   "path": [rows[0]["path"][0], folded]}]);
     std::fs::write(&run, serde_json::to_string(&cut).unwrap()).unwrap();
-    let out = cellplan(&["bench", "motion", scene, "--recheck", run.to_str().unwrap(), "--json"], &dir);
+    let out = cellplan(
+        &[
+            "bench",
+            "motion",
+            scene,
+            "--recheck",
+            run.to_str().unwrap(),
+            "--json",
+        ],
+        &dir,
+    );
     let checked: Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(checked[0]["exact_valid"], false, "{checked}");
-    assert!(checked[0]["exact_contact"].as_str().unwrap().contains("with link"), "{checked}");
+    assert!(
+        checked[0]["exact_contact"]
+            .as_str()
+            .unwrap()
+            .contains("with link"),
+        "{checked}"
+    );
     // Refusals: an unknown planner (usage), a broken file (exit 2, file and line).
     let out = cellplan(&["bench", "motion", scene, "--planner", "rrt-sharp"], &dir);
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("rrt-connect"));
     let bad = dir.join("bad.json");
-    std::fs::write(&bad, "{\"format\": \"cellplan-motion-problems\",\n \"version\": 1,\n \"robot\": [}").unwrap();
+    std::fs::write(
+        &bad,
+        "{\"format\": \"cellplan-motion-problems\",\n \"version\": 1,\n \"robot\": [}",
+    )
+    .unwrap();
     let out = cellplan(&["bench", "motion", bad.to_str().unwrap()], &dir);
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "{stderr}");
