@@ -5,8 +5,10 @@
 //!
 //! The robot is built as the cell loader builds one: one convex body per collision shape of
 //! every link (links rigidly attached off the chain, such as a gripper's fingers, keep their own
-//! bodies; a markedly concave mesh is cut into convex pieces, [`cellplan_geom::pieces`]), the
-//! SRDF's `disable_collisions` pairs left out of the self checks (without an SRDF:
+//! bodies; a markedly concave mesh of a link that a joint moves is cut into convex pieces,
+//! [`cellplan_geom::pieces`] — the hulls of such links are what touch their neighbours across
+//! the joint, while every piece multiplies the pairs to check, so rigid attachments such as
+//! gripper fingers keep one hull per mesh), the SRDF's `disable_collisions` pairs left out of the self checks (without an SRDF:
 //! every pair of bodies on different links that are not parent and child).
 use crate::arm::{Arm, ArmValidity};
 use cellplan_geom::pieces::convex_pieces;
@@ -451,9 +453,11 @@ impl ArmSetup {
         for (l, shapes) in model.collision.iter().enumerate() {
             for (k, (shape, pose)) in shapes.iter().enumerate() {
                 let source = model.collision_links[l][k].clone();
-                // A markedly concave mesh becomes its convex pieces, each a body.
+                // A markedly concave mesh of a link a joint moves becomes its convex pieces,
+                // each a body (see the module documentation for why only those).
+                let jointed = model.chain.links[l].joint.is_some() && model.chain.links[l].name == source;
                 let pieces: Vec<ShapeSpec> = match shape {
-                    ShapeSpec::Mesh(m) => convex_pieces(m).map_or_else(Vec::new, |pieces| {
+                    ShapeSpec::Mesh(m) if jointed => convex_pieces(m).map_or_else(Vec::new, |pieces| {
                         pieces.into_iter().filter_map(piece_mesh).collect()
                     }),
                     _ => Vec::new(),
