@@ -1,5 +1,8 @@
+use super::narrow::AxisCache;
 use super::*;
 use crate::{DQuat, load_mesh};
+use parry3d_f64::query;
+use parry3d_f64::shape::Triangle;
 use proptest::prelude::*;
 use std::f64::consts::{FRAC_PI_2, FRAC_PI_4};
 use std::sync::Arc;

@@ -1,0 +1,306 @@
+//! The exact narrow phase of the world: GJK decisions and distances between convex shapes, and
+//! between a triangle mesh and a convex shape (a BVH walk with cached separating axes).
+use super::{Placed, StaticObject, aabb_distance, box_overlap, loosened, overlap};
+use crate::{DVec3, Pose};
+use parry3d_f64::bounding_volume::Aabb;
+use parry3d_f64::partitioning::TraversalAction;
+use parry3d_f64::query;
+use parry3d_f64::query::gjk::{self, CsoPoint, GJKResult, VoronoiSimplex};
+use parry3d_f64::shape::{Shape, SupportMap, TriMesh, Triangle};
+use std::cell::{Cell, RefCell};
+
+/// The AABB, in the frame where it stands at `pose`, of a convex shape (six support queries).
+pub(super) fn support_aabb(support: &dyn SupportMap, pose: &Pose) -> Aabb {
+    let mut mins = DVec3::ZERO;
+    let mut maxs = DVec3::ZERO;
+    for (i, axis) in [DVec3::X, DVec3::Y, DVec3::Z].into_iter().enumerate() {
+        maxs[i] = support.support_point(pose, axis)[i];
+        mins[i] = support.support_point(pose, -axis)[i];
+    }
+    Aabb::new(mins, maxs)
+}
+
+/// Whether a static object and a placed body are closer than `margin` (`margin ≥ 0`).
+///
+/// Convex pairs run GJK without exact distance: it stops as soon as it proves the distance
+/// above or below the margin. A triangle mesh is handled by [`mesh_within`].
+pub(super) fn static_within(s: &StaticObject, shape: &dyn Shape, b: &Placed, margin: f64) -> bool {
+    let pos12 = s.pose.inv_mul(&b.pose);
+    if let Some(c) = shape.as_support_map() {
+        convex_within(&pos12, c, b.support, margin)
+    } else if let Some(mesh) = shape.as_trimesh() {
+        mesh_within(&pos12, mesh, b.support, margin)
+    } else {
+        // Never built by this crate; kept for safety. An unsupported pair counts as touching.
+        !matches!(
+            query::closest_points(&s.pose, shape, &b.pose, b.shape, margin),
+            Ok(query::ClosestPoints::Disjoint)
+        )
+    }
+}
+
+/// GJK decision "distance ≤ margin" for two convex shapes; `pos12` places `g2` in `g1`'s frame.
+#[inline]
+pub(super) fn convex_within<G1, G2>(pos12: &Pose, g1: &G1, g2: &G2, margin: f64) -> bool
+where
+    G1: ?Sized + SupportMap,
+    G2: ?Sized + SupportMap,
+{
+    !matches!(
+        convex_gjk(pos12, g1, g2, margin, false, None),
+        GJKResult::NoIntersection(_)
+    )
+}
+
+/// A GJK run; `init` seeds the search direction, pointing from `g1` towards `g2`.
+#[inline]
+pub(super) fn convex_gjk<G1, G2>(
+    pos12: &Pose,
+    g1: &G1,
+    g2: &G2,
+    max_dist: f64,
+    exact: bool,
+    init: Option<DVec3>,
+) -> GJKResult
+where
+    G1: ?Sized + SupportMap,
+    G2: ?Sized + SupportMap,
+{
+    // GJK's CSO is g1 − g2, so its first direction points from g2 towards g1.
+    let dir = init
+        .map(|d| -d)
+        .or_else(|| (-pos12.translation).try_normalize())
+        .unwrap_or(DVec3::X);
+    let mut simplex = VoronoiSimplex::new();
+    simplex.reset(CsoPoint::from_shapes(pos12, g1, g2, dir));
+    gjk::closest_points(pos12, g1, g2, max_dist, exact, &mut simplex)
+}
+
+/// Whether a triangle mesh (frame 1) and a convex shape (at `pos12` in the mesh's frame) are
+/// closer than `margin`.
+///
+/// Walks the mesh's BVH, pruning nodes and triangles that lie outside the convex shape's box
+/// (loosened by the margin) or beyond an axis that already separated a triangle, then tries
+/// the triangle's plane as a separating axis, and runs GJK on the rest, stopping at the first
+/// triangle within the margin. Each separating axis found (plane or GJK) is cached: along a
+/// panel, one axis usually disposes of the neighbouring triangles and whole BVH nodes.
+pub(super) fn mesh_within(pos12: &Pose, mesh: &TriMesh, convex: &dyn SupportMap, margin: f64) -> bool {
+    let query = loosened(&support_aabb(convex, pos12), margin);
+    if !overlap(&query, &mesh.local_aabb()) {
+        return false;
+    }
+    let mut cache = AxisCache::default();
+    let centre = query.center();
+    let mut hit = false;
+    mesh.bvh().traverse(|node| {
+        let (lo, hi) = (node.mins(), node.maxs());
+        if !box_overlap(&query, lo, hi) || cache.separates_box(lo, hi) {
+            return TraversalAction::Prune;
+        }
+        let Some(i) = node.leaf_data() else {
+            return TraversalAction::Continue;
+        };
+        let t = mesh.triangle(i);
+        if cache.separates(&t) {
+            return TraversalAction::Continue;
+        }
+        // The triangle's plane often separates (a link above a panel), for one support query.
+        if let Some(n) = (t.b - t.a).cross(t.c - t.a).try_normalize() {
+            let n = if n.dot(centre - t.a) < 0.0 { -n } else { n };
+            let lowest = n.dot(convex.support_point(pos12, -n));
+            if lowest - margin > n.dot(t.a) {
+                cache.push(n, lowest - margin);
+                return TraversalAction::Continue;
+            }
+        }
+        match convex_gjk(pos12, &t, convex, margin, false, cache.last_dir()) {
+            GJKResult::NoIntersection(dir) => {
+                // The convex shape lies beyond the triangle along `dir`: remember by how much.
+                let lowest = dir.dot(convex.support_point(pos12, -dir));
+                cache.push(dir, lowest - margin);
+                TraversalAction::Continue
+            }
+            _ => {
+                hit = true;
+                TraversalAction::EarlyExit
+            }
+        }
+    });
+    hit
+}
+
+/// The last few axes that separated a triangle from the convex shape, each with the shape's
+/// lowest projection on it minus the margin. Neighbouring triangles (and whole BVH nodes) are
+/// usually separated by the same axis: testing it costs a dot product or three instead of a
+/// GJK run.
+#[derive(Default)]
+pub(super) struct AxisCache {
+    axes: [(DVec3, f64); 4],
+    len: usize,
+    next: usize,
+}
+
+/// The highest projection of a triangle on `d`.
+#[inline]
+pub(super) fn triangle_top(d: DVec3, t: &Triangle) -> f64 {
+    d.dot(t.a).max(d.dot(t.b)).max(d.dot(t.c))
+}
+
+/// The highest projection on `d` of the box with centre `c` and half extents `e`.
+#[inline]
+pub(super) fn box_top(d: DVec3, c: DVec3, e: DVec3) -> f64 {
+    d.dot(c) + d.abs().dot(e)
+}
+
+impl AxisCache {
+    #[inline]
+    fn separates(&self, t: &Triangle) -> bool {
+        self.axes[..self.len]
+            .iter()
+            .any(|&(d, limit)| triangle_top(d, t) < limit)
+    }
+
+    #[inline]
+    fn separates_box(&self, mins: DVec3, maxs: DVec3) -> bool {
+        let (c, e) = ((mins + maxs) * 0.5, (maxs - mins) * 0.5);
+        self.axes[..self.len]
+            .iter()
+            .any(|&(d, limit)| box_top(d, c, e) < limit)
+    }
+
+    /// The largest gap `limit − max(axis · vertex)` over the cached axes (−∞ when empty): with
+    /// limits that are the convex shape's lowest projections, a lower bound on the distance
+    /// from the triangle to the shape.
+    #[inline]
+    pub(super) fn triangle_gap(&self, t: &Triangle) -> f64 {
+        self.axes[..self.len]
+            .iter()
+            .map(|&(d, limit)| limit - triangle_top(d, t))
+            .fold(f64::NEG_INFINITY, f64::max)
+    }
+
+    /// [`AxisCache::triangle_gap`] for everything inside the box `mins..maxs`.
+    #[inline]
+    pub(super) fn box_gap(&self, mins: DVec3, maxs: DVec3) -> f64 {
+        let (c, e) = ((mins + maxs) * 0.5, (maxs - mins) * 0.5);
+        self.axes[..self.len]
+            .iter()
+            .map(|&(d, limit)| limit - box_top(d, c, e))
+            .fold(f64::NEG_INFINITY, f64::max)
+    }
+
+    pub(super) fn push(&mut self, dir: DVec3, limit: f64) {
+        self.axes[self.next] = (dir, limit);
+        self.next = (self.next + 1) % self.axes.len();
+        self.len = (self.len + 1).min(self.axes.len());
+    }
+
+    fn last_dir(&self) -> Option<DVec3> {
+        (self.len > 0).then(|| self.axes[(self.next + self.axes.len() - 1) % self.axes.len()].0)
+    }
+}
+
+/// Exact distance between a static object and a placed body (0 when they overlap), if it is
+/// below `best`; `None` otherwise.
+pub(super) fn static_distance(s: &StaticObject, shape: &dyn Shape, b: &Placed, best: f64) -> Option<f64> {
+    let pos12 = s.pose.inv_mul(&b.pose);
+    if let Some(c) = shape.as_support_map() {
+        convex_distance(&pos12, c, b.support, best)
+    } else if let Some(mesh) = shape.as_trimesh() {
+        mesh_distance(&pos12, mesh, b.support, best)
+    } else {
+        let d = query::distance(&s.pose, shape, &b.pose, b.shape).map_or(0.0, |d| d.distance);
+        (d < best).then_some(d.max(0.0))
+    }
+}
+
+/// Exact distance between a triangle mesh (frame 1) and a convex shape (at `pos12` in the
+/// mesh's frame), 0 when they touch, if below `best`; `None` otherwise.
+///
+/// The BVH is searched nearest box first. Every axis that separated a triangle from the
+/// convex shape (the GJK witness direction, or the direction that proved a triangle beyond
+/// `best`) is cached with the shape's lowest projection on it: the gap along such an axis is
+/// a lower bound on the distance of any other triangle or BVH node, usually a tight one for
+/// the neighbours of the nearest triangle, so most of them are dismissed without GJK.
+pub(super) fn mesh_distance(pos12: &Pose, mesh: &TriMesh, convex: &dyn SupportMap, best: f64) -> Option<f64> {
+    let query = support_aabb(convex, pos12);
+    let cache = RefCell::new(AxisCache::default());
+    let convex = Recording {
+        inner: convex,
+        last: Cell::new((DVec3::ZERO, DVec3::ZERO)),
+    };
+    // Caches `dir` (pointing from the triangle towards the shape) with the shape's lowest
+    // projection on it; GJK's last support query was usually that very one.
+    let remember = |dir: DVec3| {
+        let (asked, point) = convex.last.get();
+        let point = if asked == -dir {
+            point
+        } else {
+            convex.support_point(pos12, -dir)
+        };
+        cache.borrow_mut().push(dir, dir.dot(point));
+    };
+    mesh.bvh()
+        .find_best(
+            best,
+            |node, _| {
+                let (lo, hi) = (node.mins(), node.maxs());
+                aabb_distance(&query, &Aabb::new(lo, hi)).max(cache.borrow().box_gap(lo, hi))
+            },
+            |i, best| {
+                let t = mesh.triangle(i);
+                if cache.borrow().triangle_gap(&t) >= best {
+                    return None;
+                }
+                match convex_gjk(pos12, &t, &convex, best, true, None) {
+                    GJKResult::ClosestPoints(p1, p2, _) => {
+                        let d = (p2 - p1).length();
+                        if d > 0.0 {
+                            remember((p2 - p1) / d);
+                        }
+                        (d < best).then_some(d)
+                    }
+                    GJKResult::Intersection => Some(0.0),
+                    GJKResult::NoIntersection(dir) => {
+                        remember(dir);
+                        None
+                    }
+                    GJKResult::Proximity(_) => None,
+                }
+            },
+        )
+        .map(|(_, d)| d)
+}
+
+/// A support map that remembers its last world-frame query `(direction, support point)`.
+struct Recording<'a> {
+    inner: &'a dyn SupportMap,
+    last: Cell<(DVec3, DVec3)>,
+}
+
+impl SupportMap for Recording<'_> {
+    #[inline]
+    fn local_support_point(&self, dir: DVec3) -> DVec3 {
+        self.inner.local_support_point(dir)
+    }
+
+    #[inline]
+    fn support_point(&self, transform: &Pose, dir: DVec3) -> DVec3 {
+        let p = self.inner.support_point(transform, dir);
+        self.last.set((dir, p));
+        p
+    }
+}
+
+/// Exact distance between two convex shapes (0 when they overlap) if below `max`.
+pub(super) fn convex_distance<G1, G2>(pos12: &Pose, g1: &G1, g2: &G2, max: f64) -> Option<f64>
+where
+    G1: ?Sized + SupportMap,
+    G2: ?Sized + SupportMap,
+{
+    match convex_gjk(pos12, g1, g2, max, true, None) {
+        GJKResult::ClosestPoints(p1, p2, _) => Some((p1 - p2).length()).filter(|&d| d < max),
+        GJKResult::Intersection => Some(0.0),
+        GJKResult::NoIntersection(_) | GJKResult::Proximity(_) => None,
+    }
+}
