@@ -6,8 +6,8 @@
 //! (bench/peers/motion_*.py write them), and `--checks N` times single validity checks.
 use cellplan_motion::arm;
 use cellplan_motion::plan::{self, PlannerParams, Status, Termination};
-use cellplan_motion::problem::{ArmSetup, Problem, ProblemError, ProblemSet, read_problems};
-use cellplan_verify::motion::{ExactCheck, ExactObstacle, ExactRobot};
+use cellplan_motion::problem::{ArmSetup, ProblemError, ProblemSet, read_problems};
+use cellplan_verify::motion::{ExactObstacle, ExactRobot};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
@@ -96,17 +96,6 @@ fn euclidean_length(path: &[Vec<f64>]) -> f64 {
         .sum()
 }
 
-fn exact_of(setup: &ArmSetup, problem: &Problem, path_file_order: &[Vec<f64>], step: f64) -> ExactCheck {
-    let robot = ExactRobot::new(&setup.model, setup.base, &setup.link_pairs());
-    let obstacles: Vec<ExactObstacle> = problem
-        .obstacles
-        .iter()
-        .filter_map(|o| ExactObstacle::new(&o.name, &o.shape, o.pose))
-        .collect();
-    let chain_path: Vec<Vec<f64>> = path_file_order.iter().map(|q| setup.to_chain(q)).collect();
-    robot.check_path(&chain_path, &obstacles, problem.margin, step)
-}
-
 /// The status as a kebab-case word.
 fn status_name(status: Status) -> &'static str {
     match status {
@@ -183,7 +172,7 @@ pub fn run(req: &Request) -> Result<Vec<Row>, ProblemError> {
             }
         }
         if let Some(step) = req.exact_step {
-            recheck_rows(&set, &mut setup, &mut file_rows, step);
+            recheck_rows(&set, &setup, &mut file_rows, step);
         }
         rows.extend(file_rows);
     }
@@ -191,8 +180,9 @@ pub fn run(req: &Request) -> Result<Vec<Row>, ProblemError> {
 }
 
 /// Fills the exact re-check of every row with a path (rows name their problems).
-fn recheck_rows(set: &ProblemSet, setup: &mut ArmSetup, rows: &mut [Row], step: f64) {
-    let setup = &*setup;
+fn recheck_rows(set: &ProblemSet, setup: &ArmSetup, rows: &mut [Row], step: f64) {
+    // One exact robot (its meshes and their hulls) for every row.
+    let robot = ExactRobot::new(&setup.model, setup.base, &setup.link_pairs());
     rows.par_iter_mut().for_each(|row| {
         let (Some(problem), Some(path)) = (
             set.problems.iter().find(|p| p.name == row.problem),
@@ -200,7 +190,13 @@ fn recheck_rows(set: &ProblemSet, setup: &mut ArmSetup, rows: &mut [Row], step: 
         ) else {
             return;
         };
-        let check = exact_of(setup, problem, path, step);
+        let obstacles: Vec<ExactObstacle> = problem
+            .obstacles
+            .iter()
+            .filter_map(|o| ExactObstacle::new(&o.name, &o.shape, o.pose))
+            .collect();
+        let chain_path: Vec<Vec<f64>> = path.iter().map(|q| setup.to_chain(q)).collect();
+        let check = robot.check_path(&chain_path, &obstacles, problem.margin, step);
         row.exact_valid = check.valid;
         row.exact_samples = check.samples;
         row.exact_contact = check
@@ -218,7 +214,7 @@ pub fn recheck(files: &[PathBuf], run_file: &Path, step: f64) -> Result<Vec<Row>
         .map_err(|e| format!("{}:{}:{}: {e}", run_file.display(), e.line(), e.column()))?;
     let mut rows = Vec::new();
     for file in files {
-        let (set, mut setup) = load(file).map_err(|e| e.to_string())?;
+        let (set, setup) = load(file).map_err(|e| e.to_string())?;
         let mut file_rows: Vec<Row> = peers
             .iter()
             .filter(|p| set.problems.iter().any(|q| q.name == p.problem))
@@ -243,7 +239,7 @@ pub fn recheck(files: &[PathBuf], run_file: &Path, step: f64) -> Result<Vec<Row>
                 path: p.path.clone(),
             })
             .collect();
-        recheck_rows(&set, &mut setup, &mut file_rows, step);
+        recheck_rows(&set, &setup, &mut file_rows, step);
         rows.extend(file_rows);
     }
     Ok(rows)

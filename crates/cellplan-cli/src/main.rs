@@ -374,13 +374,9 @@ fn run_bench_motion(args: &bench::BenchArgs) -> Result<(), Failure> {
             "--time-limit and --exact-step-mm must be positive".into(),
         ));
     }
-    let print = |value: &dyn erased::Show| -> Result<(), Failure> {
-        println!("{}", value.show().map_err(Failure::Other)?);
-        Ok(())
-    };
     if let Some(n) = args.checks {
         let rows = bench_motion::time_checks(&args.files, n, args.first).map_err(problem_failure)?;
-        return print(&rows);
+        return print_json(&rows);
     }
     let step = args.exact_step_mm * 1e-3;
     let mut rows = match &args.recheck {
@@ -400,24 +396,20 @@ fn run_bench_motion(args: &bench::BenchArgs) -> Result<(), Failure> {
         rows.iter_mut().for_each(|r| r.path = None);
     }
     if args.json {
-        print(&rows)
+        print_json(&rows)
     } else {
         print!("{}", bench_motion::render(&rows));
         Ok(())
     }
 }
 
-/// JSON printing of whatever the bench produced.
-mod erased {
-    /// A value printed as pretty JSON.
-    pub trait Show {
-        fn show(&self) -> Result<String, String>;
-    }
-    impl<T: serde::Serialize> Show for T {
-        fn show(&self) -> Result<String, String> {
-            serde_json::to_string_pretty(self).map_err(|e| e.to_string())
-        }
-    }
+/// Prints `value` as pretty JSON.
+fn print_json<T: serde::Serialize>(value: &T) -> Result<(), Failure> {
+    println!(
+        "{}",
+        serde_json::to_string_pretty(value).map_err(|e| Failure::Other(e.to_string()))?
+    );
+    Ok(())
 }
 
 fn main() -> ExitCode {
