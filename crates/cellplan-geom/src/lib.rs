@@ -28,4 +28,6 @@ pub use mesh::{Mesh, load_mesh};
 pub use parry3d_f64::math::Pose;
 pub use shape::ShapeSpec;
 pub use spheres::Sphere;
-pub use world::{BodyContact, CollisionWorld, GroupBody, GroupId, RayHit, StaticId};
+pub use world::{
+    BodyContact, BroadPhase, CollisionWorld, GroupBody, GroupId, PlacedCovers, RayHit, StaticId,
+};

@@ -536,6 +536,77 @@ impl CollisionWorld {
         best
     }
 
+    /// Distance from body `i` of `g` (at `poses[i]`) to static object `object` alone, capped at
+    /// `cap` (as [`CollisionWorld::body_static_distance`] measures each object). The cap for an
+    /// object without geometry, a missing pose or a body without shapes; 0 at a non-finite pose.
+    pub fn body_object_distance(&self, g: GroupId, i: usize, poses: &[Pose], object: usize, cap: f64) -> f64 {
+        self.body_object_distance_hinted(g, i, poses, object, cap, DVec3::ZERO)
+    }
+
+    /// [`CollisionWorld::body_object_distance`] with a guess of the separating direction:
+    /// `towards`, in the world, from the body towards the object (zero for none). Any
+    /// direction gives a lower bound (the gap between the supports), which answers when it
+    /// reaches the cap; else it seeds GJK. Meshes keep their own axis cache and ignore it.
+    pub fn body_object_distance_hinted(
+        &self,
+        g: GroupId,
+        i: usize,
+        poses: &[Pose],
+        object: usize,
+        cap: f64,
+        towards: DVec3,
+    ) -> f64 {
+        let best = sanitize_margin(cap);
+        let (Some(body), Some(pose), Some(s)) = (
+            self.group(g).bodies.get(i),
+            poses.get(i),
+            self.statics.get(object),
+        ) else {
+            return best;
+        };
+        let Some(shape) = s.shape.as_deref() else {
+            return best;
+        };
+        match place(body, pose) {
+            Placement::Empty => best,
+            Placement::Invalid => 0.0,
+            Placement::At(p) => {
+                if aabb_distance(&p.aabb, &s.aabb) >= best {
+                    return best;
+                }
+                static_distance_hinted(s, shape, &p, best, towards).map_or(best, |d| d.min(best))
+            }
+        }
+    }
+
+    /// Distance from body `i` of `g` (at `poses[i]`) to body `j` of group `other` standing at
+    /// `pose`, capped at `cap` (as [`CollisionWorld::body_group_distance`] measures each body).
+    #[allow(clippy::too_many_arguments)]
+    pub fn body_body_distance(
+        &self,
+        g: GroupId,
+        i: usize,
+        poses: &[Pose],
+        other: GroupId,
+        j: usize,
+        pose: &Pose,
+        cap: f64,
+    ) -> f64 {
+        let best = sanitize_margin(cap);
+        let (Some(a), Some(pa), Some(b)) = (
+            self.group(g).bodies.get(i),
+            poses.get(i),
+            self.group(other).bodies.get(j),
+        ) else {
+            return best;
+        };
+        match (place(a, pa), place(b, pose)) {
+            (Placement::Empty, _) | (_, Placement::Empty) => best,
+            (Placement::Invalid, _) | (_, Placement::Invalid) => 0.0,
+            (Placement::At(a), Placement::At(b)) => placed_distance(&a, &b, best),
+        }
+    }
+
     /// Smallest distance between the checked self pairs of `g` (see
     /// [`CollisionWorld::set_self_pairs`]), capped at `cap`: `min(true distance, cap)`, 0 when
     /// a pair touches or a pose is not finite. `cap` (at least 0) when no pair is checked.
@@ -556,6 +627,22 @@ impl CollisionWorld {
     /// at `cap`: `min(true distance, cap)`, 0 when they touch or a pose is not finite. The cap
     /// (at least 0) when `i == j`, a body has no shapes or a pose is missing.
     pub fn pair_distance(&self, g: GroupId, i: usize, j: usize, poses: &[Pose], cap: f64) -> f64 {
+        self.pair_distance_hinted(g, i, j, poses, cap, DVec3::ZERO)
+    }
+
+    /// [`CollisionWorld::pair_distance`] with a guess of the separating direction: `towards`,
+    /// in the world, from body `i` towards body `j` (zero for none; see
+    /// [`CollisionWorld::body_object_distance_hinted`]).
+    #[allow(clippy::too_many_arguments)]
+    pub fn pair_distance_hinted(
+        &self,
+        g: GroupId,
+        i: usize,
+        j: usize,
+        poses: &[Pose],
+        cap: f64,
+        towards: DVec3,
+    ) -> f64 {
         let group = self.group(g);
         let best = sanitize_margin(cap);
         let (Some(ba), Some(bb), Some(pa), Some(pb)) = (
@@ -572,7 +659,13 @@ impl CollisionWorld {
         match (place(ba, pa), place(bb, pb)) {
             (Placement::Empty, _) | (_, Placement::Empty) => best,
             (Placement::Invalid, _) | (_, Placement::Invalid) => 0.0,
-            (Placement::At(a), Placement::At(b)) => placed_distance(&a, &b, best),
+            (Placement::At(a), Placement::At(b)) => {
+                if aabb_distance(&a.aabb, &b.aabb) >= best {
+                    return best;
+                }
+                let seed = a.pose.rotation.inverse() * towards;
+                hinted_distance(&a.pose.inv_mul(&b.pose), a.support, b.support, best, seed)
+            }
         }
     }
 
@@ -741,7 +834,7 @@ fn placed_distance(a: &Placed, b: &Placed, best: f64) -> f64 {
     if aabb_distance(&a.aabb, &b.aabb) >= best {
         return best;
     }
-    convex_distance(&a.pose.inv_mul(&b.pose), a.support, b.support, best).unwrap_or(best)
+    hinted_distance(&a.pose.inv_mul(&b.pose), a.support, b.support, best, DVec3::ZERO)
 }
 
 fn aabb_distance(a: &Aabb, b: &Aabb) -> f64 {
@@ -758,9 +851,12 @@ fn make_ray(origin: DVec3, dir: DVec3, max_distance: f64) -> Option<(Ray, f64)> 
 }
 
 mod bounds;
+mod broad;
 mod narrow;
 
-use narrow::{convex_distance, convex_within, static_distance, static_within};
+pub use broad::{BroadPhase, PlacedCovers};
+
+use narrow::{convex_within, hinted_distance, static_distance, static_distance_hinted, static_within};
 
 #[cfg(test)]
 mod tests;

@@ -21,7 +21,7 @@
 //! for the exact query, which then decides. Bounds never exceed exact distances, so the
 //! guarantee of the segment check is unchanged.
 use crate::plan::{Clearance, JointSpace, StateValidity, narrow_step};
-use cellplan_geom::{CollisionWorld, GroupId, Pose};
+use cellplan_geom::{BroadPhase, CollisionWorld, GroupId, PlacedCovers, Pose};
 use cellplan_kin::{Chain, JointKind};
 use std::cell::RefCell;
 use std::ops::Range;
@@ -30,8 +30,21 @@ use std::ops::Range;
 /// segment check a little, and the cap lets the distance queries skip everything further.
 pub const DEFAULT_CLEARANCE_CAP: f64 = 0.25;
 
-/// Taken off every measured distance (m), for the tolerance of the GJK distance.
+/// Taken off every measured distance (m), for rounding (the world's distances are certified
+/// lower bounds: the gap of the supports along GJK's witness direction).
 const DISTANCE_SLACK: f64 = 1e-6;
+
+/// The part of a measured distance `d` that is trusted: `d` less the slack.
+#[inline]
+fn trusted(d: f64) -> f64 {
+    d - DISTANCE_SLACK
+}
+
+/// The measured distance whose trusted part is `t` (the inverse of [`trusted`]).
+#[inline]
+fn measured_for(t: f64) -> f64 {
+    t + DISTANCE_SLACK
+}
 
 /// A serial arm placed in a collision world.
 #[derive(Clone, Copy)]
@@ -63,6 +76,7 @@ impl std::fmt::Debug for Arm<'_> {
 thread_local! {
     static LINKS: RefCell<(Vec<Pose>, Vec<Pose>)> = const { RefCell::new((Vec::new(), Vec::new())) };
     static CLEARANCES: RefCell<Vec<Clearance>> = const { RefCell::new(Vec::new()) };
+    static COVERS: RefCell<PlacedCovers> = RefCell::new(PlacedCovers::default());
 }
 
 impl Arm<'_> {
@@ -191,6 +205,8 @@ pub struct ArmValidity<'a> {
     pairs: Vec<(usize, usize, Range<usize>)>,
     /// Other groups standing still (obstacles like the scene), with their body poses.
     parked: Vec<(GroupId, Vec<Pose>)>,
+    /// The arm's covers against the scene and the parked groups.
+    broad: BroadPhase,
 }
 
 impl<'a> ArmValidity<'a> {
@@ -226,6 +242,7 @@ impl<'a> ArmValidity<'a> {
             })
             .collect();
         ArmValidity {
+            broad: BroadPhase::new(arm.world, arm.group, &parked),
             arm,
             margin,
             cap: DEFAULT_CLEARANCE_CAP,
@@ -250,20 +267,6 @@ impl<'a> ArmValidity<'a> {
         d
     }
 
-    /// The sphere-cover lower bound of [`Self::body_scene_distance`].
-    fn body_scene_bound(&self, i: usize, bodies: &[Pose], cap: f64) -> f64 {
-        let world = self.arm.world;
-        let g = self.arm.group;
-        let mut d = world.body_static_bound(g, i, bodies, cap);
-        for (other, poses) in &self.parked {
-            if d <= 0.0 {
-                break;
-            }
-            d = world.body_group_bound(g, i, bodies, *other, poses, d);
-        }
-        d
-    }
-
     /// Whether `q` is valid: within the joint limits, every moving body farther than the
     /// margin from the scene and the parked groups, every checked self pair apart. Broad phase
     /// first, the exact test only for the parts it does not clear.
@@ -275,20 +278,29 @@ impl<'a> ArmValidity<'a> {
             self.arm.body_poses(q, links, bodies);
             let world = self.arm.world;
             let g = self.arm.group;
-            let margin = self.margin.max(0.0);
             // Strictly farther than the margin, as the clearance (> 0) requires.
-            let need = margin + DISTANCE_SLACK;
+            let need = measured_for(self.margin.max(0.0));
             let tiny = 1e-9;
-            let scene_ok = self.moving.iter().all(|(i, _)| {
-                (self.broad_phase && self.body_scene_bound(*i, bodies, need + tiny) >= need + tiny)
-                    || self.body_scene_distance(*i, bodies, need + tiny) > need
-            });
-            scene_ok
-                && self.pairs.iter().all(|&(i, j, _)| {
-                    (self.broad_phase
-                        && world.pair_bound(g, i, j, bodies, DISTANCE_SLACK + tiny) > DISTANCE_SLACK)
-                        || world.pair_distance(g, i, j, bodies, DISTANCE_SLACK + tiny) > DISTANCE_SLACK
-                })
+            if !self.broad_phase {
+                return self
+                    .moving
+                    .iter()
+                    .all(|(i, _)| self.body_scene_distance(*i, bodies, need + tiny) > need)
+                    && self.pairs.iter().all(|&(i, j, _)| {
+                        world.pair_distance(g, i, j, bodies, measured_for(0.0) + tiny) > measured_for(0.0)
+                    });
+            }
+            COVERS.with_borrow_mut(|placed| {
+                let broad = &self.broad;
+                broad.place(bodies, placed);
+                self.moving
+                    .iter()
+                    .all(|(i, _)| broad.scene_distance(world, *i, bodies, placed, need + tiny) > need)
+                    && self.pairs.iter().all(|&(i, j, _)| {
+                        broad.pair_distance(world, i, j, bodies, placed, measured_for(0.0) + tiny)
+                            > measured_for(0.0)
+                    })
+            })
         })
     }
 
@@ -310,14 +322,12 @@ impl<'a> ArmValidity<'a> {
 
     /// The distance of one part, asked only as far as it matters: `wanted` is the clearance
     /// that would not shorten the step (the step so far times the part's bound, or the floor
-    /// when the part cannot move), at most [`Self::cap`]. The sphere-cover bound answers when it
-    /// reaches `wanted`; else the exact query, capped there, decides. Returns the part's
-    /// clearance (capped at `wanted`).
-    #[allow(clippy::too_many_arguments)]
+    /// when the part cannot move), at most [`Self::cap`]; `query(cap)` is the part's distance
+    /// capped at `cap` (the broad phase inside it skips every exact query whose bound reaches
+    /// the cap). Returns the part's clearance (capped at `wanted`).
     fn capped_part(
         &self,
-        bound_query: impl FnOnce(f64) -> f64,
-        exact_query: impl FnOnce(f64) -> f64,
+        query: impl FnOnce(f64) -> f64,
         offset: f64,
         bound: f64,
         step: f64,
@@ -328,21 +338,18 @@ impl<'a> ArmValidity<'a> {
         } else {
             floor
         };
-        let cap = wanted + offset + DISTANCE_SLACK;
-        if self.broad_phase && bound_query(cap) >= cap {
-            return wanted;
-        }
-        let d = exact_query(cap);
+        let cap = measured_for(wanted + offset);
+        let d = query(cap);
         // At the cap, the answer is `wanted` itself (subtracting back could round below it).
-        if d >= cap {
-            wanted
-        } else {
-            d - offset - DISTANCE_SLACK
-        }
+        if d >= cap { wanted } else { trusted(d) - offset }
     }
 }
 
 impl StateValidity for ArmValidity<'_> {
+    fn is_valid(&self, q: &[f64]) -> bool {
+        ArmValidity::is_valid(self, q)
+    }
+
     fn clearance(&self, q: &[f64]) -> f64 {
         CLEARANCES.with_borrow_mut(|out| {
             self.clearances(q, out);
@@ -361,23 +368,38 @@ impl StateValidity for ArmValidity<'_> {
         }
         LINKS.with_borrow_mut(|(links, bodies)| {
             self.arm.body_poses(q, links, bodies);
-            let world = self.arm.world;
-            let g = self.arm.group;
-            let margin = self.margin.max(0.0);
-            for (i, joints) in &self.moving {
-                let d = self.body_scene_distance(*i, bodies, self.cap + margin);
-                out.push(Clearance {
-                    distance: d - margin - DISTANCE_SLACK,
-                    joints: joints.clone(),
-                });
-            }
-            for (i, j, joints) in &self.pairs {
-                let d = world.pair_distance(g, *i, *j, bodies, self.cap);
-                out.push(Clearance {
-                    distance: d - DISTANCE_SLACK,
-                    joints: joints.clone(),
-                });
-            }
+            COVERS.with_borrow_mut(|placed| {
+                let world = self.arm.world;
+                let g = self.arm.group;
+                let margin = self.margin.max(0.0);
+                let broad = &self.broad;
+                if self.broad_phase {
+                    broad.place(bodies, placed);
+                }
+                for (i, joints) in &self.moving {
+                    let cap = self.cap + margin;
+                    let d = if self.broad_phase {
+                        broad.scene_distance(world, *i, bodies, placed, cap)
+                    } else {
+                        self.body_scene_distance(*i, bodies, cap)
+                    };
+                    out.push(Clearance {
+                        distance: trusted(d) - margin,
+                        joints: joints.clone(),
+                    });
+                }
+                for (i, j, joints) in &self.pairs {
+                    let d = if self.broad_phase {
+                        broad.pair_distance(world, *i, *j, bodies, placed, self.cap)
+                    } else {
+                        world.pair_distance(g, *i, *j, bodies, self.cap)
+                    };
+                    out.push(Clearance {
+                        distance: trusted(d),
+                        joints: joints.clone(),
+                    });
+                }
+            });
         });
     }
 
@@ -396,35 +418,51 @@ impl StateValidity for ArmValidity<'_> {
         }
         LINKS.with_borrow_mut(|(links, bodies)| {
             self.arm.body_poses(q, links, bodies);
-            let world = self.arm.world;
-            let g = self.arm.group;
-            let margin = self.margin.max(0.0);
-            let mut step = limit;
-            for (i, joints) in self.moving.iter().rev() {
-                let b = bound(joints);
-                let part = self.capped_part(
-                    |cap| self.body_scene_bound(*i, bodies, cap),
-                    |cap| self.body_scene_distance(*i, bodies, cap),
-                    margin,
-                    b,
-                    step,
-                    floor,
-                );
-                step = narrow_step(step, part, b, floor)?;
-            }
-            for (i, j, joints) in &self.pairs {
-                let b = bound(joints);
-                let part = self.capped_part(
-                    |cap| world.pair_bound(g, *i, *j, bodies, cap),
-                    |cap| world.pair_distance(g, *i, *j, bodies, cap),
-                    0.0,
-                    b,
-                    step,
-                    floor,
-                );
-                step = narrow_step(step, part, b, floor)?;
-            }
-            Some(step)
+            COVERS.with_borrow_mut(|placed| {
+                let world = self.arm.world;
+                let g = self.arm.group;
+                let margin = self.margin.max(0.0);
+                let broad = &self.broad;
+                if self.broad_phase {
+                    broad.place(bodies, placed);
+                }
+                let mut step = limit;
+                for (i, joints) in self.moving.iter().rev() {
+                    let b = bound(joints);
+                    let part = self.capped_part(
+                        |cap| {
+                            if self.broad_phase {
+                                broad.scene_distance(world, *i, bodies, placed, cap)
+                            } else {
+                                self.body_scene_distance(*i, bodies, cap)
+                            }
+                        },
+                        margin,
+                        b,
+                        step,
+                        floor,
+                    );
+                    step = narrow_step(step, part, b, floor)?;
+                }
+                for (i, j, joints) in &self.pairs {
+                    let b = bound(joints);
+                    let part = self.capped_part(
+                        |cap| {
+                            if self.broad_phase {
+                                broad.pair_distance(world, *i, *j, bodies, placed, cap)
+                            } else {
+                                world.pair_distance(g, *i, *j, bodies, cap)
+                            }
+                        },
+                        0.0,
+                        b,
+                        step,
+                        floor,
+                    );
+                    step = narrow_step(step, part, b, floor)?;
+                }
+                Some(step)
+            })
         })
     }
 }

@@ -83,8 +83,9 @@ fn the_broad_phase_changes_no_answer() {
         let s2 = exact.segment_step(&q, &bound, 1e-4, 1.0);
         assert_eq!(s1.is_some(), s2.is_some(), "at {k}");
         if let (Some(s1), Some(s2)) = (s1, s2) {
-            // The broad phase answers only what it proves: never a longer step.
-            assert!(s1 <= s2 + 1e-12, "{s1} > {s2} at {k}");
+            // The broad phase answers only what it proves: never a longer step (up to GJK's
+            // own tolerance, which a remembered direction changes; DISTANCE_SLACK covers it).
+            assert!(s1 <= s2 + 1e-9, "{s1} > {s2} at {k}");
             steps += 1;
         }
     }

@@ -54,9 +54,9 @@ pub fn example_copy(folder: &str, name: &str, tasks: usize, edit: impl FnOnce(St
 /// Writes the crossing cell to a temporary folder of this process and returns the path of its
 /// `cell.toml`.
 pub fn crossing_cell() -> PathBuf {
-    example_copy("coord-test", "crossing-2r", 8, |text| {
-        let text = text.replace("xyz = [3100, 1100, 0]", "xyz = [3100, -100, 0]");
-        assert!(text.contains("[3100, -100, 0]"), "the second robot is moved");
+    example_copy("coord-test", "crossing-2r", 12, |text| {
+        let text = text.replace("xyz = [3100, 1100, 0]", "xyz = [3100, -200, 0]");
+        assert!(text.contains("[3100, -200, 0]"), "the second robot is moved");
         text
     })
 }

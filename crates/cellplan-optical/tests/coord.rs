@@ -1,5 +1,5 @@
 //! Coordination on a two-robot cell built so that the robots' paths cross: the bundled
-//! two-robot example with the second robot moved to 1 m from the first, and its first 8 MPs
+//! two-robot example with the second robot moved to 0.9 m from the first, and its first 12 MPs
 //! (`cellplan_optical::testing`, shared with the report's tests).
 //! Every strategy must give a plan the verifier accepts; the uncoordinated plan must be
 //! rejected, naming the conflict; injected faults must be caught.
@@ -110,7 +110,7 @@ fn the_verifier_catches_injected_faults() {
     let moved_path = crossing_cell().with_file_name("moved.toml");
     let text = std::fs::read_to_string(crossing_cell())
         .unwrap()
-        .replace("xyz = [3100, -100, 0]", "xyz = [3100, -150, 0]");
+        .replace("xyz = [3100, -200, 0]", "xyz = [3100, -250, 0]");
     std::fs::write(&moved_path, text).unwrap();
     let moved = load(&moved_path, &LoadOptions::default()).unwrap();
     let k: Vec<ViolationKind> = verify(&moved, &good, &settings)

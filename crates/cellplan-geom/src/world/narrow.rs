@@ -203,9 +203,24 @@ impl AxisCache {
 /// Exact distance between a static object and a placed body (0 when they overlap), if it is
 /// below `best`; `None` otherwise.
 pub(super) fn static_distance(s: &StaticObject, shape: &dyn Shape, b: &Placed, best: f64) -> Option<f64> {
+    static_distance_hinted(s, shape, b, best, DVec3::ZERO)
+}
+
+/// [`static_distance`] with a guess of the separating direction for convex objects:
+/// `towards`, in the world, from the body towards the object (zero for none; see
+/// [`hinted_distance`]).
+pub(super) fn static_distance_hinted(
+    s: &StaticObject,
+    shape: &dyn Shape,
+    b: &Placed,
+    best: f64,
+    towards: DVec3,
+) -> Option<f64> {
     let pos12 = s.pose.inv_mul(&b.pose);
     if let Some(c) = shape.as_support_map() {
-        convex_distance(&pos12, c, b.support, best)
+        // From the object (shape 1) towards the body, in the object's frame.
+        let seed = s.pose.rotation.inverse() * -towards;
+        Some(hinted_distance(&pos12, c, b.support, best, seed)).filter(|&d| d < best)
     } else if let Some(mesh) = shape.as_trimesh() {
         mesh_distance(&pos12, mesh, b.support, best)
     } else {
@@ -255,9 +270,14 @@ pub(super) fn mesh_distance(pos12: &Pose, mesh: &TriMesh, convex: &dyn SupportMa
                 match convex_gjk(pos12, &t, &convex, best, true, None) {
                     GJKResult::ClosestPoints(p1, p2, _) => {
                         let d = (p2 - p1).length();
-                        if d > 0.0 {
-                            remember((p2 - p1) / d);
+                        if d <= 0.0 {
+                            return Some(0.0);
                         }
+                        let n = (p2 - p1) / d;
+                        // Certified from below, as in `hinted_distance`.
+                        let gap = n.dot(convex.support_point(pos12, -n)) - n.dot(t.local_support_point(n));
+                        remember(n);
+                        let d = gap.clamp(0.0, d);
                         (d < best).then_some(d)
                     }
                     GJKResult::Intersection => Some(0.0),
@@ -292,15 +312,39 @@ impl SupportMap for Recording<'_> {
     }
 }
 
-/// Exact distance between two convex shapes (0 when they overlap) if below `max`.
-pub(super) fn convex_distance<G1, G2>(pos12: &Pose, g1: &G1, g2: &G2, max: f64) -> Option<f64>
+/// Exact distance between two convex shapes capped at `best` (0 when they overlap), certified
+/// from below (never above the true distance; see the witness gap below), with a guess of the
+/// separating direction: `seed` (in `g1`'s frame, from `g1` towards `g2`; zero for none) is
+/// tried first — the gap between the two shapes' supports along any direction is a lower
+/// bound on their distance, so a gap that reaches `best` answers without GJK — then seeds GJK.
+/// The answer is a function of the shapes, their placement, `best` and `seed` alone.
+pub(super) fn hinted_distance<G1, G2>(pos12: &Pose, g1: &G1, g2: &G2, best: f64, seed: DVec3) -> f64
 where
     G1: ?Sized + SupportMap,
     G2: ?Sized + SupportMap,
 {
-    match convex_gjk(pos12, g1, g2, max, true, None) {
-        GJKResult::ClosestPoints(p1, p2, _) => Some((p1 - p2).length()).filter(|&d| d < max),
-        GJKResult::Intersection => Some(0.0),
-        GJKResult::NoIntersection(_) | GJKResult::Proximity(_) => None,
+    let seed = seed.try_normalize().unwrap_or(DVec3::ZERO);
+    if seed != DVec3::ZERO {
+        let gap = seed.dot(g2.support_point(pos12, -seed)) - seed.dot(g1.local_support_point(seed));
+        if gap >= best {
+            return best;
+        }
+    }
+    match convex_gjk(pos12, g1, g2, best, true, (seed != DVec3::ZERO).then_some(seed)) {
+        GJKResult::ClosestPoints(p1, p2, _) => {
+            let v = p2 - p1;
+            let d = v.length();
+            if d <= 0.0 {
+                return 0.0;
+            }
+            let n = v / d;
+            // GJK's distance is that of two witness points: at or above the true distance,
+            // by its tolerance (or more, where it stalls). The gap of the supports along the
+            // witness direction is below it: the certified answer.
+            let gap = n.dot(g2.support_point(pos12, -n)) - n.dot(g1.local_support_point(n));
+            gap.clamp(0.0, d).min(best)
+        }
+        GJKResult::Intersection => 0.0,
+        GJKResult::NoIntersection(_) | GJKResult::Proximity(_) => best,
     }
 }

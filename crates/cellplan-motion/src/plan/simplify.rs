@@ -42,6 +42,7 @@ pub(crate) fn shortcut_with(
 ) -> usize {
     let mut calls = 0;
     waypoints.dedup_by(|b, a| space.distance(a, b) == 0.0);
+    calls += remove_redundant(space, validity, waypoints, min_clearance);
     let mut rng = ChaCha8Rng::seed_from_u64(seed ^ 0x5348_4f52_5443_5554);
     let (mut p1, mut p2) = (Vec::new(), Vec::new());
     for _ in 0..iterations {

@@ -6,6 +6,13 @@ use std::ops::Range;
 /// Steps are shortened by this factor so that a step never reaches the clearance exactly.
 const STEP_SAFETY: f64 = 0.999;
 
+/// A segment whose points move at most this far (m, the bound of the joint radii) gets one
+/// probe per this much, at most [`MAX_PROBES`].
+const PROBE_SPACING: f64 = 0.02;
+
+/// Most probes of one segment before it is covered.
+const MAX_PROBES: usize = 15;
+
 /// One clearance with the joints whose motion can reduce it (see
 /// [`StateValidity::clearances`]).
 #[derive(Clone, Debug, PartialEq)]
@@ -40,6 +47,14 @@ pub trait StateValidity: Sync {
             distance: self.clearance(q),
             joints: 0..usize::MAX,
         });
+    }
+
+    /// Whether `q` is valid (its clearance is positive): a yes-or-no test, which an
+    /// implementation may answer faster than [`StateValidity::clearance`] measures. The segment
+    /// check probes a few points with it first, to reject a segment with a contact before
+    /// covering it. Default: `clearance(q) > 0`.
+    fn is_valid(&self, q: &[f64]) -> bool {
+        self.clearance(q) > 0.0
     }
 
     /// The radius, in segment parameter, of the piece of a segment around `q` proven valid:
@@ -97,8 +112,10 @@ impl<F: Fn(&[f64]) -> f64 + Sync> StateValidity for F {
 pub struct SegmentCheck {
     /// Whether the whole straight segment is valid.
     pub valid: bool,
-    /// Calls of [`StateValidity::clearance`] made.
+    /// Validity calls made: [`StateValidity::segment_step`] and the probes.
     pub calls: usize,
+    /// Of those, the yes-or-no probes ([`StateValidity::is_valid`]).
+    pub probes: usize,
 }
 
 /// Conservative check of the straight joint-space segment `a → b`: valid only when every
@@ -111,9 +128,13 @@ pub fn check_segment(
     b: &[f64],
     min_clearance: f64,
 ) -> SegmentCheck {
-    let mut calls = 0;
-    let valid = segment_valid(space, validity, a, b, min_clearance, &mut calls);
-    SegmentCheck { valid, calls }
+    let (mut calls, mut probes) = (0, 0);
+    let valid = segment_valid_counted(space, validity, a, b, min_clearance, &mut calls, &mut probes);
+    SegmentCheck {
+        valid,
+        calls: calls + probes,
+        probes,
+    }
 }
 
 /// The check of [`check_segment`]; counts the clearance calls into `calls`.
@@ -133,6 +154,22 @@ pub(crate) fn segment_valid(
     min_clearance: f64,
     calls: &mut usize,
 ) -> bool {
+    let mut probes = 0;
+    let valid = segment_valid_counted(space, validity, a, b, min_clearance, calls, &mut probes);
+    *calls += probes;
+    valid
+}
+
+/// [`segment_valid`] counting the steps into `calls` and the probes into `probes`.
+fn segment_valid_counted(
+    space: &JointSpace,
+    validity: &dyn StateValidity,
+    a: &[f64],
+    b: &[f64],
+    min_clearance: f64,
+    calls: &mut usize,
+    probes_made: &mut usize,
+) -> bool {
     let floor = min_clearance.max(1e-9);
     let n = space.dim().min(a.len()).min(b.len());
     // Bound of each joint over the whole segment, and prefix sums for the ranges.
@@ -151,6 +188,29 @@ pub(crate) fn segment_valid(
         let (lo, hi) = (joints.start.min(n), joints.end.min(n));
         if hi > lo { prefix[hi] - prefix[lo] } else { 0.0 }
     };
+    // Probes: a contact inside the segment is found in a few yes-or-no tests, in bisection
+    // order, rather than by covering the segment up to it (steps shrink geometrically towards
+    // a contact). Only an invalid point rejects, so the answer is unchanged.
+    let probes = ((prefix[n] / PROBE_SPACING) as usize).min(MAX_PROBES);
+    if probes > 0 {
+        let mut q = Vec::with_capacity(n);
+        let mut level = 2usize;
+        let mut done = 0;
+        'probe: while done < probes {
+            for k in (1..level).step_by(2) {
+                space.interpolate(a, b, k as f64 / level as f64, &mut q);
+                *probes_made += 1;
+                if !validity.is_valid(&q) {
+                    return false;
+                }
+                done += 1;
+                if done == probes {
+                    break 'probe;
+                }
+            }
+            level *= 2;
+        }
+    }
     let mut measure = |q: &[f64], limit: f64| -> Option<f64> {
         *calls += 1;
         validity
@@ -166,13 +226,16 @@ pub(crate) fn segment_valid(
     // Gaps (left end, its radius, right end, its radius).
     let mut gaps = std::collections::VecDeque::from([(0.0, ra, 1.0, rb)]);
     let mut q = Vec::with_capacity(n);
+    // The first sample goes to the middle, the point farthest from both (valid) ends, where
+    // a contact is likeliest.
+    let mut first = true;
     while let Some((s0, r0, s1, r1)) = gaps.pop_front() {
         let (lo, hi) = (s0 + r0, s1 - r1);
         if lo >= hi {
             continue;
         }
         let guess = r0.min(r1);
-        let s = if hi - lo <= 2.0 * guess {
+        let s = if std::mem::take(&mut first) || hi - lo <= 2.0 * guess {
             0.5 * (lo + hi)
         } else {
             lo + guess

@@ -1,0 +1,589 @@
+//! The broad phase of one body group against everything that stands still, precomputed:
+//! [`BroadPhase`] (the whole group placed at once, then each body against each object).
+//!
+//! [`CollisionWorld::body_static_bound`] and its kin answer one body at a time and look up
+//! shapes, covers and poses on every call. A motion planner asks the same group thousands of
+//! times per query, so [`BroadPhase`] does the lookups once:
+//!
+//! - each body's cover (see [`crate::spheres`]) is kept in one flat array, and
+//!   [`BroadPhase::place`] puts every cover in the world at once (one rotation matrix per
+//!   body);
+//! - each object — a static object, or a body of another group parked at a fixed pose — gets
+//!   its world box and, for boxes, cylinders and balls, its inverse pose, so that a sphere's
+//!   distance to it is a few lines of arithmetic (meshes and other shapes fall back to a point
+//!   projection);
+//! - [`BroadPhase::scene_distance`] then goes object by object: the body's outer sphere against
+//!   the object's box, the cover against the object, and the exact (GJK) distance **for that
+//!   object only** when the cover's bound falls short of what is asked. The answer is the
+//!   exact capped distance, as [`CollisionWorld::body_static_distance`] and
+//!   [`CollisionWorld::body_group_distance`] would give it together, at a fraction of the work
+//!   when most objects are far.
+//!
+//! Bounds never exceed exact distances (the covers contain the bodies), so skipping an exact
+//! query whose bound already reaches the cap changes no answer.
+use super::{CollisionWorld, GroupId, sanitize_margin};
+use crate::spheres::Sphere;
+use crate::{DMat3, DVec3, Pose};
+use std::ops::Range;
+
+/// Distance from `p` to a box, 0 inside.
+#[inline]
+fn point_box_distance(p: DVec3, mins: DVec3, maxs: DVec3) -> f64 {
+    (mins - p).max(p - maxs).max(DVec3::ZERO).length()
+}
+
+/// What an object is, for a sphere's distance to it.
+#[derive(Clone, Debug)]
+enum Kind {
+    /// A solid box: world-to-local rotation, centre, half extents.
+    Cuboid {
+        to_local: DMat3,
+        centre: DVec3,
+        half: DVec3,
+    },
+    /// A solid cylinder along its local y axis (parry's): world-to-local rotation, centre,
+    /// radius, half height.
+    Cylinder {
+        to_local: DMat3,
+        centre: DVec3,
+        radius: f64,
+        half_height: f64,
+    },
+    /// A solid ball.
+    Ball { centre: DVec3, radius: f64 },
+    /// Any other static object, measured by the world's point projection (meshes: surfaces;
+    /// other convex shapes: solids).
+    Other,
+    /// Body `body` of group `group`, standing at `pose`; its cover in the world is
+    /// `parked[spheres]`.
+    Body {
+        group: GroupId,
+        body: usize,
+        pose: Pose,
+        spheres: Range<usize>,
+    },
+}
+
+/// One object that stands still.
+#[derive(Clone, Debug)]
+struct Object {
+    /// World box (for a parked body: the box of its outer sphere).
+    mins: DVec3,
+    maxs: DVec3,
+    /// The world's index of a static object (unused for a parked body).
+    index: usize,
+    kind: Kind,
+}
+
+/// The world covers of a group's bodies at one set of poses (see [`BroadPhase::place`]).
+#[derive(Clone, Debug, Default)]
+pub struct PlacedCovers {
+    /// Every body's cover in the world; body `i`'s spheres are `spheres[ranges[i]]`.
+    spheres: Vec<Sphere>,
+    /// Each body's outer sphere in the world (`None`: no shape).
+    outer: Vec<Option<Sphere>>,
+    /// Whether each body's pose is finite.
+    finite: Vec<bool>,
+}
+
+/// The broad phase of one group against the static scene and parked groups (see the module
+/// documentation). Built for a world and its current objects: rebuild it when they change.
+#[derive(Clone, Debug)]
+pub struct BroadPhase {
+    group: GroupId,
+    /// Every body's cover in its body frame; body `i`'s are `local[ranges[i]]`.
+    local: Vec<Sphere>,
+    ranges: Vec<Range<usize>>,
+    outer: Vec<Option<Sphere>>,
+    objects: Vec<Object>,
+    /// The covers of the parked bodies, in the world.
+    parked: Vec<Sphere>,
+}
+
+impl BroadPhase {
+    /// The broad phase of group `g` against `world`'s static objects and the `parked` groups
+    /// (each with the poses of its bodies, standing still).
+    pub fn new(world: &CollisionWorld, g: GroupId, parked: &[(GroupId, Vec<Pose>)]) -> BroadPhase {
+        let mut local = Vec::new();
+        let mut ranges = Vec::new();
+        let mut outer = Vec::new();
+        for i in 0..world.body_count(g) {
+            let start = local.len();
+            local.extend_from_slice(world.body_cover(g, i));
+            ranges.push(start..local.len());
+            outer.push(
+                world.group(g).bodies[i]
+                    .convex
+                    .as_ref()
+                    .and_then(|c| c.cover.outer),
+            );
+        }
+        let mut objects = Vec::new();
+        for (index, s) in world.statics.iter().enumerate() {
+            let Some(shape) = s.shape.as_deref() else {
+                continue;
+            };
+            let to_local = DMat3::from_quat(s.pose.rotation.inverse());
+            let centre = s.pose.translation;
+            let kind = if let Some(c) = shape.as_cuboid() {
+                Kind::Cuboid {
+                    to_local,
+                    centre,
+                    half: c.half_extents,
+                }
+            } else if let Some(c) = shape.as_cylinder() {
+                Kind::Cylinder {
+                    to_local,
+                    centre,
+                    radius: c.radius,
+                    half_height: c.half_height,
+                }
+            } else if let Some(b) = shape.as_ball() {
+                Kind::Ball {
+                    centre,
+                    radius: b.radius,
+                }
+            } else {
+                Kind::Other
+            };
+            objects.push(Object {
+                mins: s.aabb.mins,
+                maxs: s.aabb.maxs,
+                index,
+                kind,
+            });
+        }
+        let mut parked_spheres = Vec::new();
+        for (other, poses) in parked {
+            for (j, pose) in poses.iter().enumerate().take(world.body_count(*other)) {
+                let Some(o) = world.group(*other).bodies[j]
+                    .convex
+                    .as_ref()
+                    .and_then(|c| c.cover.outer)
+                else {
+                    continue;
+                };
+                let start = parked_spheres.len();
+                let (mins, maxs) = if pose.is_finite() {
+                    parked_spheres.extend(world.body_cover(*other, j).iter().map(|s| Sphere {
+                        centre: pose.transform_point(s.centre),
+                        radius: s.radius,
+                    }));
+                    let c = pose.transform_point(o.centre);
+                    (c - DVec3::splat(o.radius), c + DVec3::splat(o.radius))
+                } else {
+                    // Never dismissed by its box: the exact query says 0.
+                    (DVec3::splat(f64::NEG_INFINITY), DVec3::splat(f64::INFINITY))
+                };
+                objects.push(Object {
+                    mins,
+                    maxs,
+                    index: usize::MAX,
+                    kind: Kind::Body {
+                        group: *other,
+                        body: j,
+                        pose: *pose,
+                        spheres: start..parked_spheres.len(),
+                    },
+                });
+            }
+        }
+        BroadPhase {
+            group: g,
+            local,
+            ranges,
+            outer,
+            objects,
+            parked: parked_spheres,
+        }
+    }
+
+    /// Number of objects (static objects with geometry, and parked bodies with shapes).
+    pub fn object_count(&self) -> usize {
+        self.objects.len()
+    }
+
+    /// Places every body's cover at `poses` (world frame, one per body of the group) into `out`.
+    pub fn place(&self, poses: &[Pose], out: &mut PlacedCovers) {
+        out.spheres.clear();
+        out.outer.clear();
+        out.finite.clear();
+        for (i, range) in self.ranges.iter().enumerate() {
+            let pose = poses.get(i).copied().unwrap_or(Pose::IDENTITY);
+            let finite = pose.is_finite();
+            out.finite.push(finite);
+            let rot = DMat3::from_quat(pose.rotation);
+            let t = pose.translation;
+            out.spheres
+                .extend(self.local[range.clone()].iter().map(|s| Sphere {
+                    centre: rot * s.centre + t,
+                    radius: s.radius,
+                }));
+            out.outer.push(self.outer[i].map(|s| Sphere {
+                centre: rot * s.centre + t,
+                radius: s.radius,
+            }));
+        }
+    }
+
+    /// Distance from body `i` (placed in `placed`, at `poses`) to every object, capped at
+    /// `cap`: `min(true distance, cap)`, 0 when touching or at a non-finite pose (when there is
+    /// an object), the cap for a body without shapes. Equal to the smaller of
+    /// [`CollisionWorld::body_static_distance`] and [`CollisionWorld::body_group_distance`]
+    /// over the parked groups; the exact query runs only for objects whose bound falls short.
+    pub fn scene_distance(
+        &self,
+        world: &CollisionWorld,
+        i: usize,
+        poses: &[Pose],
+        placed: &PlacedCovers,
+        cap: f64,
+    ) -> f64 {
+        let mut best = sanitize_margin(cap);
+        let Some(Some(outer)) = placed.outer.get(i) else {
+            return best;
+        };
+        if !placed.finite[i] {
+            return if self.objects.is_empty() { best } else { 0.0 };
+        }
+        let spheres = &placed.spheres[self.ranges[i].clone()];
+        for object in &self.objects {
+            if point_box_distance(outer.centre, object.mins, object.maxs) - outer.radius >= best {
+                continue;
+            }
+            let (bound, towards) = self.object_bound(world, object, spheres, best);
+            if bound >= best {
+                continue;
+            }
+            let d = match &object.kind {
+                Kind::Body {
+                    group, body, pose, ..
+                } => world.body_body_distance(self.group, i, poses, *group, *body, pose, best),
+                _ => world.body_object_distance_hinted(self.group, i, poses, object.index, best, towards),
+            };
+            best = best.min(d);
+            if best <= 0.0 {
+                return 0.0;
+            }
+        }
+        best
+    }
+
+    /// A lower bound on the distance from body `i` to every object, capped at `cap` (the cover
+    /// only, never an exact query).
+    pub fn scene_bound(&self, world: &CollisionWorld, i: usize, placed: &PlacedCovers, cap: f64) -> f64 {
+        let mut best = sanitize_margin(cap);
+        let Some(Some(outer)) = placed.outer.get(i) else {
+            return best;
+        };
+        if !placed.finite[i] {
+            return if self.objects.is_empty() { best } else { 0.0 };
+        }
+        let spheres = &placed.spheres[self.ranges[i].clone()];
+        for object in &self.objects {
+            if point_box_distance(outer.centre, object.mins, object.maxs) - outer.radius >= best {
+                continue;
+            }
+            best = best.min(self.object_bound(world, object, spheres, best).0);
+            if best <= 0.0 {
+                return 0.0;
+            }
+        }
+        best
+    }
+
+    /// Distance between bodies `i` and `j` of the group (placed in `placed`, at `poses`),
+    /// capped at `cap`, as [`CollisionWorld::pair_distance`] gives it: the outer spheres, the
+    /// covers, then the exact query only when the covers fall short.
+    pub fn pair_distance(
+        &self,
+        world: &CollisionWorld,
+        i: usize,
+        j: usize,
+        poses: &[Pose],
+        placed: &PlacedCovers,
+        cap: f64,
+    ) -> f64 {
+        let best = sanitize_margin(cap);
+        let (bound, towards) = self.pair_bound_towards(i, j, placed, best);
+        if bound >= best {
+            return best;
+        }
+        world.pair_distance_hinted(self.group, i, j, poses, best, towards)
+    }
+
+    /// A lower bound on the distance between bodies `i` and `j`, capped at `cap` (covers only).
+    pub fn pair_bound(&self, i: usize, j: usize, placed: &PlacedCovers, cap: f64) -> f64 {
+        self.pair_bound_towards(i, j, placed, cap).0
+    }
+
+    /// [`BroadPhase::pair_bound`] with the direction from `i` towards `j` that gives it.
+    fn pair_bound_towards(&self, i: usize, j: usize, placed: &PlacedCovers, cap: f64) -> (f64, DVec3) {
+        let best = sanitize_margin(cap);
+        let (Some(Some(oa)), Some(Some(ob))) = (placed.outer.get(i), placed.outer.get(j)) else {
+            return (best, DVec3::ZERO);
+        };
+        if i == j {
+            return (best, DVec3::ZERO);
+        }
+        if !placed.finite[i] || !placed.finite[j] {
+            return (0.0, DVec3::ZERO);
+        }
+        if (oa.centre - ob.centre).length() - oa.radius - ob.radius >= best {
+            return (best, DVec3::ZERO);
+        }
+        spheres_bound(
+            &placed.spheres[self.ranges[i].clone()],
+            &placed.spheres[self.ranges[j].clone()],
+            best,
+        )
+    }
+
+    /// Lower bound on the distance from `spheres` to `object`, capped at `best`, with the
+    /// direction (world) from the sphere that gives it towards the object (zero when none
+    /// does, or when it is inside): a guess of the separating direction for the exact query.
+    fn object_bound(
+        &self,
+        world: &CollisionWorld,
+        object: &Object,
+        spheres: &[Sphere],
+        best: f64,
+    ) -> (f64, DVec3) {
+        let mut b = best;
+        let mut arg = usize::MAX;
+        let mut towards = DVec3::ZERO;
+        match &object.kind {
+            Kind::Cuboid {
+                to_local,
+                centre,
+                half,
+            } => {
+                for (k, s) in spheres.iter().enumerate() {
+                    let p = *to_local * (s.centre - *centre);
+                    let d = (p.abs() - *half).max(DVec3::ZERO).length() - s.radius;
+                    if d < b {
+                        (b, arg) = (d, k);
+                    }
+                }
+                if let Some(s) = spheres.get(arg) {
+                    let p = *to_local * (s.centre - *centre);
+                    towards = to_local.transpose() * (p.clamp(-*half, *half) - p);
+                }
+            }
+            Kind::Cylinder {
+                to_local,
+                centre,
+                radius,
+                half_height,
+            } => {
+                for (k, s) in spheres.iter().enumerate() {
+                    let p = *to_local * (s.centre - *centre);
+                    let radial = (p.x * p.x + p.z * p.z).sqrt() - radius;
+                    let axial = p.y.abs() - half_height;
+                    let d = radial.max(0.0).hypot(axial.max(0.0)) - s.radius;
+                    if d < b {
+                        (b, arg) = (d, k);
+                    }
+                }
+                if let Some(s) = spheres.get(arg) {
+                    let p = *to_local * (s.centre - *centre);
+                    let r = (p.x * p.x + p.z * p.z).sqrt();
+                    let shrink = if r > *radius { radius / r } else { 1.0 };
+                    let q = DVec3::new(p.x * shrink, p.y.clamp(-half_height, *half_height), p.z * shrink);
+                    towards = to_local.transpose() * (q - p);
+                }
+            }
+            Kind::Ball { centre, radius } => {
+                for (k, s) in spheres.iter().enumerate() {
+                    let d = (s.centre - *centre).length() - radius - s.radius;
+                    if d < b {
+                        (b, arg) = (d, k);
+                    }
+                }
+                if let Some(s) = spheres.get(arg) {
+                    towards = *centre - s.centre;
+                }
+            }
+            Kind::Other => {
+                let st = &world.statics[object.index];
+                let Some(shape) = st.shape.as_deref() else {
+                    return (best, DVec3::ZERO);
+                };
+                let solid = shape.as_trimesh().is_none();
+                for s in spheres {
+                    if point_box_distance(s.centre, object.mins, object.maxs) - s.radius >= b {
+                        continue;
+                    }
+                    let reach = b + s.radius;
+                    if let Some(proj) = shape.project_point_with_max_dist(&st.pose, s.centre, solid, reach) {
+                        let d = if solid && proj.is_inside {
+                            0.0
+                        } else {
+                            (proj.point - s.centre).length()
+                        };
+                        if d - s.radius < b {
+                            b = d - s.radius;
+                            towards = proj.point - s.centre;
+                        }
+                    }
+                    if b <= 0.0 {
+                        return (0.0, towards);
+                    }
+                }
+            }
+            Kind::Body { spheres: range, .. } => {
+                return spheres_bound(spheres, &self.parked[range.clone()], b);
+            }
+        }
+        (b.max(0.0), towards)
+    }
+}
+
+/// Lower bound on the distance between two sphere sets, capped at `best`, with the direction
+/// from the sphere of `a` towards the sphere of `b` that give it (zero when no pair does).
+#[inline]
+fn spheres_bound(a: &[Sphere], b: &[Sphere], best: f64) -> (f64, DVec3) {
+    let mut least = best;
+    let mut arg = (usize::MAX, usize::MAX);
+    for (kb, sb) in b.iter().enumerate() {
+        for (ka, sa) in a.iter().enumerate() {
+            let d = (sb.centre - sa.centre).length() - sa.radius - sb.radius;
+            if d < least {
+                (least, arg) = (d, (ka, kb));
+            }
+        }
+    }
+    let towards = match (a.get(arg.0), b.get(arg.1)) {
+        (Some(sa), Some(sb)) => sb.centre - sa.centre,
+        _ => DVec3::ZERO,
+    };
+    (least.max(0.0), towards)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::BroadPhase;
+    use crate::world::{CollisionWorld, GroupBody};
+    use crate::{DQuat, DVec3, Pose, ShapeSpec};
+    use rand::{RngExt, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
+
+    fn random_pose(rng: &mut ChaCha8Rng, spread: f64) -> Pose {
+        let t = DVec3::new(
+            rng.random_range(-spread..spread),
+            rng.random_range(-spread..spread),
+            rng.random_range(-spread..spread),
+        );
+        let q = DQuat::from_xyzw(
+            rng.random_range(-1.0..1.0),
+            rng.random_range(-1.0..1.0),
+            rng.random_range(-1.0..1.0),
+            rng.random_range(-1.0..1.0),
+        )
+        .normalize();
+        Pose::from_parts(t, q)
+    }
+
+    fn close(a: f64, b: f64) -> bool {
+        (a - b).abs() <= 1e-9 + 1e-3 * b.abs()
+    }
+
+    fn hull_body(name: &str, half: DVec3) -> GroupBody {
+        GroupBody {
+            name: name.into(),
+            shapes: vec![
+                (ShapeSpec::Box { half_extents: half }, Pose::IDENTITY),
+                (
+                    ShapeSpec::Sphere { radius: half.y },
+                    Pose::translation(half.x, 0.0, 0.0),
+                ),
+            ],
+        }
+    }
+
+    /// Over random placements, the broad phase (with its guesses of the separating directions)
+    /// gives the exact distances of the world's own
+    /// queries: to every object kind, to a parked group, between two bodies, under any cap —
+    /// up to GJK's tolerance: a seeded run stops at another point of its convergence, which is
+    /// slow against curved shapes (the ball: a few 1e-4 of the distance). Both answers are
+    /// certified lower bounds (see `hinted_distance`), so neither is ever too large.
+    #[test]
+    fn broad_phase_distances_equal_the_exact_ones() {
+        let mut world = CollisionWorld::new();
+        world.add_static(
+            "box",
+            &ShapeSpec::Box {
+                half_extents: DVec3::new(0.3, 0.2, 0.05),
+            },
+            Pose::from_parts(DVec3::new(0.0, 0.0, 0.0), DQuat::from_rotation_z(0.4)),
+        );
+        world.add_static(
+            "drum",
+            &ShapeSpec::Cylinder {
+                radius: 0.1,
+                half_height: 0.3,
+            },
+            Pose::from_parts(DVec3::new(0.6, 0.0, 0.0), DQuat::from_rotation_x(0.7)),
+        );
+        world.add_static(
+            "ball",
+            &ShapeSpec::Sphere { radius: 0.15 },
+            Pose::translation(-0.5, 0.3, 0.2),
+        );
+        let sheet = crate::Mesh {
+            vertices: vec![
+                DVec3::new(-1.0, -1.0, 0.5),
+                DVec3::new(1.0, -1.0, 0.5),
+                DVec3::new(1.0, 1.0, 0.5),
+                DVec3::new(-1.0, 1.0, 0.7),
+            ],
+            triangles: vec![[0, 1, 2], [0, 2, 3]],
+        };
+        world.add_static(
+            "sheet",
+            &ShapeSpec::Mesh(std::sync::Arc::new(sheet)),
+            Pose::IDENTITY,
+        );
+        let g = world.add_group(
+            "arm",
+            vec![
+                hull_body("a", DVec3::new(0.2, 0.03, 0.04)),
+                hull_body("b", DVec3::new(0.1, 0.05, 0.05)),
+            ],
+        );
+        let other = world.add_group("parked", vec![hull_body("c", DVec3::new(0.15, 0.04, 0.04))]);
+        let parked_poses = vec![Pose::translation(0.2, -0.5, -0.3)];
+        let broad = BroadPhase::new(&world, g, &[(other, parked_poses.clone())]);
+        assert_eq!(broad.object_count(), 5);
+        let mut rng = ChaCha8Rng::seed_from_u64(5);
+        let mut placed = super::PlacedCovers::default();
+        let (mut near, mut touching) = (0, 0);
+        for _ in 0..4000 {
+            let poses = [random_pose(&mut rng, 0.8), random_pose(&mut rng, 0.8)];
+            let cap = if rng.random_bool(0.5) {
+                10.0
+            } else {
+                rng.random_range(0.0..0.2)
+            };
+            broad.place(&poses, &mut placed);
+            for i in 0..2 {
+                let exact = world
+                    .body_static_distance(g, i, &poses, cap)
+                    .min(world.body_group_distance(g, i, &poses, other, &parked_poses, cap));
+                let fast = broad.scene_distance(&world, i, &poses, &placed, cap);
+                assert!(close(fast, exact), "body {i}: {fast} vs {exact} (cap {cap})");
+                let bound = broad.scene_bound(&world, i, &placed, cap);
+                assert!(bound <= exact + 1e-9, "bound {bound} above {exact}");
+                near += usize::from(exact > 0.0 && exact < cap.min(0.05));
+                touching += usize::from(exact == 0.0);
+            }
+            let exact = world.pair_distance(g, 0, 1, &poses, cap);
+            let fast = broad.pair_distance(&world, 0, 1, &poses, &placed, cap);
+            assert!(close(fast, exact), "pair: {fast} vs {exact} (cap {cap})");
+        }
+        assert!(
+            near > 50 && touching > 50,
+            "the test places bodies near and on the objects ({near}, {touching})"
+        );
+    }
+}
