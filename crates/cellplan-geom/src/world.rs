@@ -567,11 +567,12 @@ impl CollisionWorld {
         let Some(shape) = s.shape.as_deref() else {
             return best;
         };
-        match place(body, pose) {
+        let boxed = towards == DVec3::ZERO;
+        match place_with(body, pose, boxed) {
             Placement::Empty => best,
             Placement::Invalid => 0.0,
             Placement::At(p) => {
-                if aabb_distance(&p.aabb, &s.aabb) >= best {
+                if boxed && aabb_distance(&p.aabb, &s.aabb) >= best {
                     return best;
                 }
                 static_distance_hinted(s, shape, &p, best, towards).map_or(best, |d| d.min(best))
@@ -656,11 +657,13 @@ impl CollisionWorld {
         if i == j {
             return best;
         }
-        match (place(ba, pa), place(bb, pb)) {
+        // A caller with a direction has run a broad phase: no box test.
+        let boxed = towards == DVec3::ZERO;
+        match (place_with(ba, pa, boxed), place_with(bb, pb, boxed)) {
             (Placement::Empty, _) | (_, Placement::Empty) => best,
             (Placement::Invalid, _) | (_, Placement::Invalid) => 0.0,
             (Placement::At(a), Placement::At(b)) => {
-                if aabb_distance(&a.aabb, &b.aabb) >= best {
+                if boxed && aabb_distance(&a.aabb, &b.aabb) >= best {
                     return best;
                 }
                 let seed = a.pose.rotation.inverse() * towards;
@@ -768,6 +771,11 @@ enum Placement<'a> {
 }
 
 fn place<'a>(body: &'a Body, pose: &Pose) -> Placement<'a> {
+    place_with(body, pose, true)
+}
+
+/// [`place`], with the world box only when `with_aabb` (else an empty box).
+fn place_with<'a>(body: &'a Body, pose: &Pose, with_aabb: bool) -> Placement<'a> {
     let Some(c) = body.convex.as_ref() else {
         return Placement::Empty;
     };
@@ -778,7 +786,11 @@ fn place<'a>(body: &'a Body, pose: &Pose) -> Placement<'a> {
         shape: &*c.shape,
         support: c.support(),
         // The body-frame box, turned: looser than the shape's own world box, but O(1).
-        aabb: c.local_aabb.transform_by(pose),
+        aabb: if with_aabb {
+            c.local_aabb.transform_by(pose)
+        } else {
+            Aabb::new_invalid()
+        },
         pose: *pose * c.local,
     })
 }
