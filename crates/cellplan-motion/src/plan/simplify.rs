@@ -3,6 +3,13 @@ use super::{JointSpace, PlanSettings, StateValidity, check_segment};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
+/// Shortcutting stops after this many attempts in a row that did not shorten the path (by
+/// [`MIN_GAIN`] at least).
+const MAX_MISSES: usize = 15;
+
+/// A shortcut gaining less than this share of the path's length is a miss.
+const MIN_GAIN: f64 = 0.005;
+
 /// Length of a polyline in the space's metric.
 pub fn path_length(space: &JointSpace, waypoints: &[Vec<f64>]) -> f64 {
     waypoints.windows(2).map(|w| space.distance(&w[0], &w[1])).sum()
@@ -45,7 +52,11 @@ pub(crate) fn shortcut_with(
     calls += remove_redundant(space, validity, waypoints, min_clearance);
     let mut rng = ChaCha8Rng::seed_from_u64(seed ^ 0x5348_4f52_5443_5554);
     let (mut p1, mut p2) = (Vec::new(), Vec::new());
+    let mut misses = 0;
     for _ in 0..iterations {
+        if misses >= MAX_MISSES {
+            break;
+        }
         let segments = waypoints.len().saturating_sub(1);
         if segments < 2 {
             break;
@@ -63,10 +74,19 @@ pub(crate) fn shortcut_with(
             + path_length(space, &waypoints[i + 1..=j])
             + space.distance(&waypoints[j], &p2);
         if space.distance(&p1, &p2) >= old - 1e-9 {
+            misses += 1;
             continue;
         }
         let check = check_segment(space, validity, &p1, &p2, min_clearance);
         calls += check.calls;
+        // A shortcut that gains little counts as a miss too: the path is near its local
+        // optimum, and every further shortcut costs a whole segment check.
+        let gain = old - space.distance(&p1, &p2);
+        misses = if check.valid && gain >= MIN_GAIN * path_length(space, waypoints) {
+            0
+        } else {
+            misses + 1
+        };
         if check.valid {
             // waypoints[..=i], p1, p2, waypoints[j+1..]
             let tail = waypoints.split_off(j + 1);
