@@ -181,26 +181,11 @@ impl CollisionWorld {
 
 #[cfg(test)]
 mod tests {
+    use crate::world::tests::random_pose;
     use crate::world::{CollisionWorld, GroupBody};
-    use crate::{DQuat, DVec3, Pose, ShapeSpec};
-    use rand::{RngExt, SeedableRng};
+    use crate::{DVec3, Pose, ShapeSpec};
+    use rand::SeedableRng;
     use rand_chacha::ChaCha8Rng;
-
-    fn random_pose(rng: &mut ChaCha8Rng, spread: f64) -> Pose {
-        let t = DVec3::new(
-            rng.random_range(-spread..spread),
-            rng.random_range(-spread..spread),
-            rng.random_range(-spread..spread),
-        );
-        let q = DQuat::from_xyzw(
-            rng.random_range(-1.0..1.0),
-            rng.random_range(-1.0..1.0),
-            rng.random_range(-1.0..1.0),
-            rng.random_range(-1.0..1.0),
-        )
-        .normalize();
-        Pose::from_parts(t, q)
-    }
 
     /// Over random placements, every bound is at most the exact distance, and it is tight
     /// enough to be of use: within a few centimetres when the exact distance is small.

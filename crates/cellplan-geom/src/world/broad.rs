@@ -240,13 +240,10 @@ impl BroadPhase {
         cap: f64,
     ) -> f64 {
         let mut best = sanitize_margin(cap);
-        let Some(Some(outer)) = placed.outer.get(i) else {
-            return best;
+        let (outer, spheres) = match self.placed_body(i, placed, best) {
+            Ok(body) => body,
+            Err(answer) => return answer,
         };
-        if !placed.finite[i] {
-            return if self.objects.is_empty() { best } else { 0.0 };
-        }
-        let spheres = &placed.spheres[self.ranges[i].clone()];
         for object in &self.objects {
             if point_box_distance(outer.centre, object.mins, object.maxs) - outer.radius >= best {
                 continue;
@@ -269,17 +266,32 @@ impl BroadPhase {
         best
     }
 
+    /// Body `i`'s outer sphere and cover as placed, or the answer of a distance query capped
+    /// at `best` when there is nothing to measure: `best` for a body without shapes, 0 at a
+    /// non-finite pose (when there is an object).
+    fn placed_body<'p>(
+        &self,
+        i: usize,
+        placed: &'p PlacedCovers,
+        best: f64,
+    ) -> Result<(Sphere, &'p [Sphere]), f64> {
+        let Some(Some(outer)) = placed.outer.get(i) else {
+            return Err(best);
+        };
+        if !placed.finite[i] {
+            return Err(if self.objects.is_empty() { best } else { 0.0 });
+        }
+        Ok((*outer, &placed.spheres[self.ranges[i].clone()]))
+    }
+
     /// A lower bound on the distance from body `i` to every object, capped at `cap` (the cover
     /// only, never an exact query).
     pub fn scene_bound(&self, world: &CollisionWorld, i: usize, placed: &PlacedCovers, cap: f64) -> f64 {
         let mut best = sanitize_margin(cap);
-        let Some(Some(outer)) = placed.outer.get(i) else {
-            return best;
+        let (outer, spheres) = match self.placed_body(i, placed, best) {
+            Ok(body) => body,
+            Err(answer) => return answer,
         };
-        if !placed.finite[i] {
-            return if self.objects.is_empty() { best } else { 0.0 };
-        }
-        let spheres = &placed.spheres[self.ranges[i].clone()];
         for object in &self.objects {
             if point_box_distance(outer.centre, object.mins, object.maxs) - outer.radius >= best {
                 continue;
@@ -463,26 +475,11 @@ fn spheres_bound(a: &[Sphere], b: &[Sphere], best: f64) -> (f64, DVec3) {
 #[cfg(test)]
 mod tests {
     use super::BroadPhase;
+    use crate::world::tests::random_pose;
     use crate::world::{CollisionWorld, GroupBody};
     use crate::{DQuat, DVec3, Pose, ShapeSpec};
     use rand::{RngExt, SeedableRng};
     use rand_chacha::ChaCha8Rng;
-
-    fn random_pose(rng: &mut ChaCha8Rng, spread: f64) -> Pose {
-        let t = DVec3::new(
-            rng.random_range(-spread..spread),
-            rng.random_range(-spread..spread),
-            rng.random_range(-spread..spread),
-        );
-        let q = DQuat::from_xyzw(
-            rng.random_range(-1.0..1.0),
-            rng.random_range(-1.0..1.0),
-            rng.random_range(-1.0..1.0),
-            rng.random_range(-1.0..1.0),
-        )
-        .normalize();
-        Pose::from_parts(t, q)
-    }
 
     fn close(a: f64, b: f64) -> bool {
         (a - b).abs() <= 1e-9 + 1e-3 * b.abs()

@@ -7,6 +7,24 @@ use proptest::prelude::*;
 use std::f64::consts::{FRAC_PI_2, FRAC_PI_4};
 use std::sync::Arc;
 
+/// A random rigid pose within `spread` of the origin (for the bounds' and broad phase's tests).
+pub(super) fn random_pose(rng: &mut rand_chacha::ChaCha8Rng, spread: f64) -> Pose {
+    use rand::RngExt;
+    let t = DVec3::new(
+        rng.random_range(-spread..spread),
+        rng.random_range(-spread..spread),
+        rng.random_range(-spread..spread),
+    );
+    let q = DQuat::from_xyzw(
+        rng.random_range(-1.0..1.0),
+        rng.random_range(-1.0..1.0),
+        rng.random_range(-1.0..1.0),
+        rng.random_range(-1.0..1.0),
+    )
+    .normalize();
+    Pose::from_parts(t, q)
+}
+
 fn cube(h: f64) -> ShapeSpec {
     ShapeSpec::Box {
         half_extents: DVec3::splat(h),
