@@ -56,8 +56,19 @@ pub fn plan_leg(
     plan_leg_with_margin(cell, robot, from, to, cell.planning.clearance, settings)
 }
 
+/// How far (m) a leg the sampler cannot solve backs the tool out along its axis at either end
+/// before sampling again, tried in turn.
+pub const RETRACT_DISTANCES: [f64; 2] = [0.1, 0.25];
+
+/// The step (m) of the tool along its axis in a retract.
+const RETRACT_STEP: f64 = 0.01;
+
 /// One leg keeping `margin` (m) from the static scene: the straight joint segment if it is
-/// clear, else RRT-Connect, shortcut (see [`cellplan_motion::plan::plan_leg`]).
+/// clear, else RRT-Connect, shortcut (see [`cellplan_motion::plan::plan_leg`]). When the
+/// sampler finds no path, the tool backs out along its axis at both ends (a probe at its
+/// stand-off from a surface, deep in an opening, leaves it the way it came) by each of
+/// [`RETRACT_DISTANCES`] in turn, and the sampler plans between the two retracted poses
+/// ([`cellplan_motion::plan::plan_leg_via`]); the first that succeeds is the leg.
 pub fn plan_leg_with_margin(
     cell: &Cell,
     robot: &Robot,
@@ -68,5 +79,45 @@ pub fn plan_leg_with_margin(
 ) -> Result<PlannedPath, PlanError> {
     let space = joint_space(cell, robot);
     let validity = robot_validity(cell, robot, margin);
-    plan::plan_leg(&space, &validity, from, to, settings)
+    let error = match plan::plan_leg(&space, &validity, from, to, settings) {
+        Ok(path) => return Ok(path),
+        Err(e @ PlanError::NoPath { .. }) => e,
+        Err(e) => return Err(e),
+    };
+    let (mut samples, mut calls) = match error {
+        PlanError::NoPath {
+            samples,
+            validity_calls,
+        } => (samples, validity_calls),
+        _ => (0, 0),
+    };
+    let chain = &robot.model.chain;
+    for distance in RETRACT_DISTANCES {
+        let (Some(exit), Some(mut entry)) = (
+            arm::tool_retract(chain, &robot.tool.tcp, from, distance, RETRACT_STEP),
+            arm::tool_retract(chain, &robot.tool.tcp, to, distance, RETRACT_STEP),
+        ) else {
+            continue;
+        };
+        entry.reverse();
+        match plan::plan_leg_via(&space, &validity, &exit, &entry, settings) {
+            Ok(mut path) => {
+                path.samples += samples;
+                path.validity_calls += calls;
+                return Ok(path);
+            }
+            Err(PlanError::NoPath {
+                samples: s,
+                validity_calls: c,
+            }) => {
+                samples += s;
+                calls += c;
+            }
+            Err(_) => {}
+        }
+    }
+    Err(PlanError::NoPath {
+        samples,
+        validity_calls: calls,
+    })
 }

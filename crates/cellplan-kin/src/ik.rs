@@ -313,6 +313,28 @@ impl DlsIk {
         starts
     }
 
+    /// Follows a sequence of nearby tip targets from `start` (chain frame): DLS from the
+    /// previous solution to each target in turn. `None` when a target is not reached, or when
+    /// a joint moves more than `max_joint_step` (rad or m) between two targets — a jump to
+    /// another branch, which would not be the continuous motion the targets describe. The
+    /// configurations returned match `targets`, one each.
+    pub fn follow(&self, start: &[f64], targets: &[Pose], max_joint_step: f64) -> Option<Vec<Vec<f64>>> {
+        let mut poses = vec![Pose::IDENTITY; self.chain.links.len()];
+        let mut q = start.to_vec();
+        let mut out = Vec::with_capacity(targets.len());
+        for target in targets {
+            let before = q.clone();
+            if !self.descend(target, &mut q, &mut poses) {
+                return None;
+            }
+            if before.iter().zip(&q).any(|(a, b)| (a - b).abs() > max_joint_step) {
+                return None;
+            }
+            out.push(q.clone());
+        }
+        Some(out)
+    }
+
     /// Runs DLS from `q` (modified in place); true when it converged within the tolerances.
     fn descend(&self, target: &Pose, q: &mut [f64], poses: &mut [Pose]) -> bool {
         let chain = &self.chain;

@@ -167,6 +167,41 @@ pub fn joint_radii(arm: &Arm) -> Vec<f64> {
         .collect()
 }
 
+/// The configurations that move the tool point `tcp` (a pose in the chain's tip frame) from
+/// where it is at `q` backwards along its own z axis by `distance` (m), its orientation kept:
+/// the retract before a leg, and reversed the approach after it (a probe, a gripper or a gun
+/// leaves and reaches its work along its axis). The line is followed by damped least squares
+/// in steps of at most `step` (m), each from the previous configuration; the first
+/// configuration is `q`. `None` when the line leaves the reachable space or the joint limits,
+/// or when a joint would jump (a change of branch) — a straight line of the tool is then not a
+/// continuous motion of the arm.
+pub fn tool_retract(chain: &Chain, tcp: &Pose, q: &[f64], distance: f64, step: f64) -> Option<Vec<Vec<f64>>> {
+    use cellplan_kin::ik::{DlsIk, DlsParams};
+    if !(distance.is_finite() && step.is_finite() && distance > 0.0 && step > 0.0) {
+        return None;
+    }
+    let steps = (distance / step).ceil().clamp(1.0, 1000.0) as usize;
+    let tip = chain.fk_tip(q);
+    let targets: Vec<Pose> = (1..=steps)
+        .map(|k| {
+            let back = Pose::translation(0.0, 0.0, -distance * k as f64 / steps as f64);
+            tip * *tcp * back * tcp.inverse()
+        })
+        .collect();
+    let ik = DlsIk::new(
+        chain,
+        DlsParams {
+            seeds: 1,
+            ..DlsParams::default()
+        },
+    );
+    // A joint may turn at most about 0.3 rad per step of at most `step`: far more than a
+    // millimetre-scale step needs anywhere but next to a singularity.
+    let mut path = vec![q.to_vec()];
+    path.extend(ik.follow(q, &targets, 0.3)?);
+    path.iter().all(|c| chain.within_limits(c, 1e-9)).then_some(path)
+}
+
 /// The arm's joint space: the chain's limits, [`joint_radii`], and metric weights `1/v` from
 /// `max_velocity` (1 where a velocity is missing, zero or not finite).
 pub fn joint_space(arm: &Arm, max_velocity: &[f64]) -> JointSpace {

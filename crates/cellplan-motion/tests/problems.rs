@@ -180,3 +180,33 @@ fn broken_files_are_refused_with_the_place() {
     let set = read_problems(&f).unwrap();
     assert!(matches!(ArmSetup::load(&set), Err(ProblemError::Robot(_))));
 }
+
+#[test]
+fn the_tool_retracts_along_its_axis() {
+    use cellplan_geom::{DQuat, DVec3, Pose};
+    let set = read_problems(&mbm("table_pick")).unwrap();
+    let setup = ArmSetup::load(&set).unwrap();
+    let chain = &setup.model.chain;
+    // A tool point 0.15 m out along the tip's z axis, turned a little.
+    let tcp = Pose::from_parts(DVec3::new(0.0, 0.0, 0.15), DQuat::from_rotation_x(0.3));
+    let q = setup.to_chain(&set.problems[0].goals[0]);
+    let path = arm::tool_retract(chain, &tcp, &q, 0.1, 0.01).expect("a retract from a grasp");
+    assert_eq!(path.len(), 11);
+    assert_eq!(path[0], q);
+    let at = |c: &[f64]| chain.fk_tip(c) * tcp;
+    let start = at(&q);
+    let axis = start.rotation * DVec3::Z;
+    for (k, c) in path.iter().enumerate() {
+        let p = at(c);
+        // On the line behind the tool point, 1 cm per step, the orientation kept.
+        let expected = start.translation - axis * (0.01 * k as f64);
+        assert!((p.translation - expected).length() < 1e-5, "step {k}");
+        assert!(p.rotation.angle_between(start.rotation) < 1e-5, "step {k}");
+        assert!(chain.within_limits(c, 1e-9));
+    }
+    // Nothing to follow: no retract.
+    assert!(arm::tool_retract(chain, &tcp, &q, 0.0, 0.01).is_none());
+    assert!(arm::tool_retract(chain, &tcp, &q, f64::NAN, 0.01).is_none());
+    // Far beyond the arm's reach: the line cannot be followed.
+    assert!(arm::tool_retract(chain, &tcp, &q, 5.0, 0.01).is_none());
+}

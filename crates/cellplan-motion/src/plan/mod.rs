@@ -189,6 +189,60 @@ pub fn plan_leg(
     leg.solve(&problem, &settings.termination()).into_planned()
 }
 
+/// A leg that leaves its start along `exit` and arrives along `entry` — fixed polylines such as
+/// a retract of the tool along its axis and the matching approach (see
+/// [`crate::arm::tool_retract`]) — with [`plan_leg`] between the end of `exit` and the start
+/// of `entry`. `exit` starts at the leg's start, `entry` ends at its goal; each of their
+/// segments must pass [`check_segment`] or the leg fails ([`PlanError::NoPath`]). The whole
+/// path is then shortened by [`shortcut`] (which keeps it valid), so a retract that is not
+/// needed in full is cut back. Counts add up every stage.
+pub fn plan_leg_via(
+    space: &JointSpace,
+    validity: &dyn StateValidity,
+    exit: &[Vec<f64>],
+    entry: &[Vec<f64>],
+    settings: &PlanSettings,
+) -> Result<PlannedPath, PlanError> {
+    let (Some(from), Some(to)) = (exit.last(), entry.first()) else {
+        return Err(PlanError::NoPath {
+            samples: 0,
+            validity_calls: 0,
+        });
+    };
+    let mut calls = 0;
+    for w in exit.windows(2).chain(entry.windows(2)) {
+        let check = check_segment(space, validity, &w[0], &w[1], settings.min_clearance);
+        calls += check.calls;
+        if !check.valid {
+            return Err(PlanError::NoPath {
+                samples: 0,
+                validity_calls: calls,
+            });
+        }
+    }
+    let middle = plan_leg(space, validity, from, to, settings).map_err(|e| match e {
+        PlanError::NoPath {
+            samples,
+            validity_calls,
+        } => PlanError::NoPath {
+            samples,
+            validity_calls: validity_calls + calls,
+        },
+        other => other,
+    })?;
+    let mut waypoints = exit[..exit.len() - 1].to_vec();
+    waypoints.extend(middle.waypoints);
+    waypoints.extend(entry[1..].iter().cloned());
+    calls += middle.validity_calls;
+    calls += shortcut(space, validity, &mut waypoints, settings);
+    Ok(PlannedPath {
+        waypoints,
+        straight: false,
+        samples: middle.samples,
+        validity_calls: calls,
+    })
+}
+
 impl PlanSettings {
     /// The planner parameters of these settings (seed, range, shortcut iterations;
     /// post-processing on).

@@ -117,6 +117,29 @@ fn around_the_wall() {
 }
 
 #[test]
+fn a_leg_via_fixed_exits_keeps_them_checked_and_its_ends() {
+    let space = square(2, 10.0);
+    let v = wall();
+    // Leave the start straight up, arrive at the goal straight down.
+    let exit = vec![vec![1.0, 1.0], vec![1.0, 2.0], vec![1.0, 3.0]];
+    let entry = vec![vec![9.0, 3.0], vec![9.0, 2.0], vec![9.0, 1.0]];
+    let leg = plan_leg_via(&space, &v, &exit, &entry, &settings(4)).unwrap();
+    assert_eq!(leg.waypoints.first().unwrap(), &exit[0]);
+    assert_eq!(leg.waypoints.last().unwrap(), &entry[2]);
+    assert!(!leg.straight && leg.validity_calls > 0);
+    assert!(brute_force_valid(&v, &leg.waypoints, 1e-3));
+    assert!(leg.waypoints.iter().any(|q| q[1] > 8.3), "over the wall");
+    // An exit through the wall fails the leg before any sampling.
+    let through = vec![vec![1.0, 1.0], vec![9.0, 1.0]];
+    assert!(matches!(
+        plan_leg_via(&space, &v, &through, &entry, &settings(4)),
+        Err(PlanError::NoPath { samples: 0, .. })
+    ));
+    // Empty polylines give no leg.
+    assert!(plan_leg_via(&space, &v, &[], &entry, &settings(4)).is_err());
+}
+
+#[test]
 fn invalid_ends_are_refused() {
     let space = square(2, 10.0);
     let v = wall();
