@@ -1,0 +1,287 @@
+//! Distance queries of the collision world: capped, exact (certified from below) distances
+//! between bodies and the static scene, between bodies of one group and of two groups.
+use super::narrow::{hinted_distance, static_distance, static_distance_hinted};
+use super::{CollisionWorld, GroupId, Placed, Placement, aabb_distance, place, place_with, sanitize_margin};
+use crate::{DVec3, Pose};
+
+impl CollisionWorld {
+    /// Distance from body `i` of `g` (at `poses[i]`) to every body of group `other` (at
+    /// `other_poses`), capped at `cap`: `min(true distance, cap)`, 0 when touching or at a
+    /// non-finite pose. A NaN or negative cap counts as 0; a missing pose or a body without
+    /// shapes gives the cap.
+    pub fn body_group_distance(
+        &self,
+        g: GroupId,
+        i: usize,
+        poses: &[Pose],
+        other: GroupId,
+        other_poses: &[Pose],
+        cap: f64,
+    ) -> f64 {
+        let mut best = sanitize_margin(cap);
+        let (Some(body), Some(pose)) = (self.group(g).bodies.get(i), poses.get(i)) else {
+            return best;
+        };
+        let pa = match place(body, pose) {
+            Placement::Empty => return best,
+            Placement::Invalid => return 0.0,
+            Placement::At(p) => p,
+        };
+        for (b, p) in self.group(other).bodies.iter().zip(other_poses) {
+            match place(b, p) {
+                Placement::Empty => {}
+                Placement::Invalid => return 0.0,
+                Placement::At(pb) => best = placed_distance(&pa, &pb, best),
+            }
+            if best <= 0.0 {
+                return 0.0;
+            }
+        }
+        best
+    }
+
+    /// Smallest distance between any body of `a` (at `poses_a`) and any body of another group
+    /// `b` (at `poses_b`), capped at `cap`: `min(true distance, cap)`, 0 when two bodies touch
+    /// or a pose is not finite (see [`CollisionWorld::body_group_distance`], body by body, each
+    /// capped at the best so far, so a small cap is fast). A NaN or negative cap counts as 0.
+    pub fn group_group_distance(
+        &self,
+        a: GroupId,
+        poses_a: &[Pose],
+        b: GroupId,
+        poses_b: &[Pose],
+        cap: f64,
+    ) -> f64 {
+        let mut best = sanitize_margin(cap);
+        for i in 0..self.group(a).bodies.len() {
+            best = self.body_group_distance(a, i, poses_a, b, poses_b, best);
+            if best <= 0.0 {
+                return 0.0;
+            }
+        }
+        best
+    }
+
+    /// Smallest distance from any body of `g` to the static scene (0 when touching).
+    ///
+    /// Exact (up to the convex hulls of the bodies), so slower than
+    /// [`CollisionWorld::group_vs_static`]. `f64::INFINITY` when the group has no body with
+    /// shapes or the scene has no object.
+    pub fn min_distance_to_static(&self, g: GroupId, poses: &[Pose]) -> f64 {
+        let group = self.group(g);
+        debug_assert_eq!(poses.len(), group.bodies.len(), "one pose per body");
+        let mut best = f64::INFINITY;
+        for i in 0..group.bodies.len().min(poses.len()) {
+            best = self.body_static_distance(g, i, poses, best);
+            if best <= 0.0 {
+                return 0.0;
+            }
+        }
+        best
+    }
+
+    /// Smallest distance from the bodies of `g` that are **not** exempt (see
+    /// [`CollisionWorld::set_static_exempt`]) to the static scene, capped at `cap`: the result
+    /// is `min(true distance, cap)` (0 when touching), for distance-based motion checks.
+    ///
+    /// The cap prunes the search (objects, BVH nodes and triangles whose box is at least `cap`
+    /// away are skipped), so a small cap is much faster than
+    /// [`CollisionWorld::min_distance_to_static`], which also measures exempt bodies. A
+    /// non-finite pose of a non-exempt body gives 0 (when the scene has an object); a NaN or
+    /// negative cap counts as 0.
+    pub fn group_static_distance(&self, g: GroupId, poses: &[Pose], cap: f64) -> f64 {
+        let group = self.group(g);
+        debug_assert_eq!(poses.len(), group.bodies.len(), "one pose per body");
+        let mut best = sanitize_margin(cap);
+        for i in 0..group.bodies.len().min(poses.len()) {
+            if !group.exempt[i] {
+                best = self.body_static_distance(g, i, poses, best);
+                if best <= 0.0 {
+                    return 0.0;
+                }
+            }
+        }
+        best
+    }
+
+    /// Distance from body `i` of `g` (at `poses[i]`) to the static scene, capped at `cap`:
+    /// `min(true distance, cap)`, 0 when touching or at a non-finite pose (when the scene has
+    /// an object). Exemption is not consulted. A NaN or negative cap counts as 0; a missing
+    /// pose or a body without shapes gives the cap.
+    pub fn body_static_distance(&self, g: GroupId, i: usize, poses: &[Pose], cap: f64) -> f64 {
+        let mut best = sanitize_margin(cap);
+        let (Some(body), Some(pose)) = (self.group(g).bodies.get(i), poses.get(i)) else {
+            return best;
+        };
+        let placed = match place(body, pose) {
+            Placement::Empty => return best,
+            Placement::Invalid => {
+                return if self.first_solid_static().is_some() {
+                    0.0
+                } else {
+                    best
+                };
+            }
+            Placement::At(p) => p,
+        };
+        for s in &self.statics {
+            let Some(shape) = s.shape.as_deref() else {
+                continue;
+            };
+            if aabb_distance(&placed.aabb, &s.aabb) >= best {
+                continue;
+            }
+            if let Some(d) = static_distance(s, shape, &placed, best) {
+                best = d;
+                if best <= 0.0 {
+                    return 0.0;
+                }
+            }
+        }
+        best
+    }
+
+    /// Distance from body `i` of `g` (at `poses[i]`) to static object `object` alone, capped at
+    /// `cap` (as [`CollisionWorld::body_static_distance`] measures each object). The cap for an
+    /// object without geometry, a missing pose or a body without shapes; 0 at a non-finite pose.
+    pub fn body_object_distance(&self, g: GroupId, i: usize, poses: &[Pose], object: usize, cap: f64) -> f64 {
+        self.body_object_distance_hinted(g, i, poses, object, cap, DVec3::ZERO)
+    }
+
+    /// [`CollisionWorld::body_object_distance`] with a guess of the separating direction:
+    /// `towards`, in the world, from the body towards the object (zero for none). Any
+    /// direction gives a lower bound (the gap between the supports), which answers when it
+    /// reaches the cap; else it seeds GJK. Meshes keep their own axis cache and ignore it.
+    pub fn body_object_distance_hinted(
+        &self,
+        g: GroupId,
+        i: usize,
+        poses: &[Pose],
+        object: usize,
+        cap: f64,
+        towards: DVec3,
+    ) -> f64 {
+        let best = sanitize_margin(cap);
+        let (Some(body), Some(pose), Some(s)) = (
+            self.group(g).bodies.get(i),
+            poses.get(i),
+            self.statics.get(object),
+        ) else {
+            return best;
+        };
+        let Some(shape) = s.shape.as_deref() else {
+            return best;
+        };
+        let boxed = towards == DVec3::ZERO;
+        match place_with(body, pose, boxed) {
+            Placement::Empty => best,
+            Placement::Invalid => 0.0,
+            Placement::At(p) => {
+                if boxed && aabb_distance(&p.aabb, &s.aabb) >= best {
+                    return best;
+                }
+                static_distance_hinted(s, shape, &p, best, towards).map_or(best, |d| d.min(best))
+            }
+        }
+    }
+
+    /// Distance from body `i` of `g` (at `poses[i]`) to body `j` of group `other` standing at
+    /// `pose`, capped at `cap` (as [`CollisionWorld::body_group_distance`] measures each body).
+    #[allow(clippy::too_many_arguments)]
+    pub fn body_body_distance(
+        &self,
+        g: GroupId,
+        i: usize,
+        poses: &[Pose],
+        other: GroupId,
+        j: usize,
+        pose: &Pose,
+        cap: f64,
+    ) -> f64 {
+        let best = sanitize_margin(cap);
+        let (Some(a), Some(pa), Some(b)) = (
+            self.group(g).bodies.get(i),
+            poses.get(i),
+            self.group(other).bodies.get(j),
+        ) else {
+            return best;
+        };
+        match (place(a, pa), place(b, pose)) {
+            (Placement::Empty, _) | (_, Placement::Empty) => best,
+            (Placement::Invalid, _) | (_, Placement::Invalid) => 0.0,
+            (Placement::At(a), Placement::At(b)) => placed_distance(&a, &b, best),
+        }
+    }
+
+    /// Smallest distance between the checked self pairs of `g` (see
+    /// [`CollisionWorld::set_self_pairs`]), capped at `cap`: `min(true distance, cap)`, 0 when
+    /// a pair touches or a pose is not finite. `cap` (at least 0) when no pair is checked.
+    pub fn group_self_distance(&self, g: GroupId, poses: &[Pose], cap: f64) -> f64 {
+        let group = self.group(g);
+        debug_assert_eq!(poses.len(), group.bodies.len(), "one pose per body");
+        let mut best = sanitize_margin(cap);
+        for &(i, j) in &group.self_pairs {
+            best = self.pair_distance(g, i, j, poses, best);
+            if best <= 0.0 {
+                return 0.0;
+            }
+        }
+        best
+    }
+
+    /// Distance between bodies `i` and `j` of `g` (whether or not the pair is checked), capped
+    /// at `cap`: `min(true distance, cap)`, 0 when they touch or a pose is not finite. The cap
+    /// (at least 0) when `i == j`, a body has no shapes or a pose is missing.
+    pub fn pair_distance(&self, g: GroupId, i: usize, j: usize, poses: &[Pose], cap: f64) -> f64 {
+        self.pair_distance_hinted(g, i, j, poses, cap, DVec3::ZERO)
+    }
+
+    /// [`CollisionWorld::pair_distance`] with a guess of the separating direction: `towards`,
+    /// in the world, from body `i` towards body `j` (zero for none; see
+    /// [`CollisionWorld::body_object_distance_hinted`]).
+    #[allow(clippy::too_many_arguments)]
+    pub fn pair_distance_hinted(
+        &self,
+        g: GroupId,
+        i: usize,
+        j: usize,
+        poses: &[Pose],
+        cap: f64,
+        towards: DVec3,
+    ) -> f64 {
+        let group = self.group(g);
+        let best = sanitize_margin(cap);
+        let (Some(ba), Some(bb), Some(pa), Some(pb)) = (
+            group.bodies.get(i),
+            group.bodies.get(j),
+            poses.get(i),
+            poses.get(j),
+        ) else {
+            return best;
+        };
+        if i == j {
+            return best;
+        }
+        // A caller with a direction has run a broad phase: no box test.
+        let boxed = towards == DVec3::ZERO;
+        match (place_with(ba, pa, boxed), place_with(bb, pb, boxed)) {
+            (Placement::Empty, _) | (_, Placement::Empty) => best,
+            (Placement::Invalid, _) | (_, Placement::Invalid) => 0.0,
+            (Placement::At(a), Placement::At(b)) => {
+                if boxed && aabb_distance(&a.aabb, &b.aabb) >= best {
+                    return best;
+                }
+                let seed = a.pose.rotation.inverse() * towards;
+                hinted_distance(&a.pose.inv_mul(&b.pose), a.support, b.support, best, seed)
+            }
+        }
+    }
+}
+
+/// `min(distance between two placed bodies, best)` (0 when they touch); the AABB test first.
+fn placed_distance(a: &Placed, b: &Placed, best: f64) -> f64 {
+    if aabb_distance(&a.aabb, &b.aabb) >= best {
+        return best;
+    }
+    hinted_distance(&a.pose.inv_mul(&b.pose), a.support, b.support, best, DVec3::ZERO)
+}
