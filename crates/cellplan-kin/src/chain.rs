@@ -120,6 +120,63 @@ impl Chain {
     pub fn mid_configuration(&self) -> Vec<f64> {
         self.joints.iter().map(Joint::mid).collect()
     }
+
+    /// For each link `k`, the number of joints up to and including it: the joints that move
+    /// link `k` are `0..joints_to()[k]` (joints are numbered root to tip).
+    pub fn joints_to(&self) -> Vec<usize> {
+        self.links
+            .iter()
+            .scan(0, |n, l| {
+                if let Some(j) = l.joint {
+                    *n = (*n).max(j + 1);
+                }
+                Some(*n)
+            })
+            .collect()
+    }
+
+    /// For each joint, an upper bound (m) on the distance from its axis of any point of the
+    /// `bodies` it moves, valid in every configuration; 1 for a prismatic joint, 0 for a joint
+    /// that moves none. A body is `(link, reach)`: the index of the link it hangs on and the
+    /// largest distance of its points from that link's frame origin.
+    ///
+    /// Why it bounds: joint `j`'s axis passes through the origin `o_j` of the link it moves. A
+    /// point `p` of a body on link `k` downstream of `j` is `p = o_j + Σ_m R_m·t_m +
+    /// Σ_prismatic R·axis·q + R_k·p_local`, with `t_m` the fixed origin offsets of the links
+    /// after `j` up to `k`, so `|p − o_j| ≤ Σ_m |t_m| + Σ_prismatic max(|lower|, |upper|) +
+    /// reach`. Along a straight joint-space segment, `p` then moves at most
+    /// `Σ_j r_j·|b_j − a_j|`.
+    pub fn joint_radii(&self, bodies: &[(usize, f64)]) -> Vec<f64> {
+        let offset: Vec<f64> = self
+            .links
+            .iter()
+            .map(|l| {
+                let travel = l.joint.and_then(|j| self.joints.get(j)).map_or(0.0, |j| {
+                    if j.kind == JointKind::Prismatic {
+                        j.lower.abs().max(j.upper.abs())
+                    } else {
+                        0.0
+                    }
+                });
+                l.origin.translation.length() + travel
+            })
+            .collect();
+        (0..self.dof())
+            .map(|j| {
+                if self.joints[j].kind == JointKind::Prismatic {
+                    return 1.0;
+                }
+                let Some(lj) = self.joint_link(j) else {
+                    return 0.0;
+                };
+                bodies
+                    .iter()
+                    .filter(|&&(k, _)| k >= lj && k < offset.len())
+                    .map(|&(k, reach)| offset[lj + 1..=k].iter().sum::<f64>() + reach)
+                    .fold(0.0, f64::max)
+            })
+            .collect()
+    }
 }
 
 impl Joint {
@@ -231,6 +288,28 @@ mod tests {
                 joint("j3", JointKind::Prismatic, DVec3::X, 0.0, 0.2),
             ],
         }
+    }
+
+    #[test]
+    fn joints_to_and_joint_radii() {
+        let c = arm();
+        assert_eq!(c.joints_to(), [0, 1, 2, 3, 3]);
+        // A body of reach 0.1 on the tip, one on the base (moved by no joint).
+        let radii = c.joint_radii(&[(4, 0.1), (0, 5.0)]);
+        // j1: l2's 0.5 m, l3's 0.3 m plus its 0.2 m of travel, the reach.
+        assert!((radii[0] - 1.1).abs() < 1e-12, "{radii:?}");
+        assert!((radii[1] - 0.6).abs() < 1e-12, "{radii:?}");
+        assert_eq!(radii[2], 1.0);
+        // The bound holds: the tip's origin stays within radii[0] − 0.1 of j1's axis (z
+        // through the origin) wherever the joints are.
+        let mut poses = vec![Pose::IDENTITY; c.links.len()];
+        for k in 0..50 {
+            let t = k as f64 / 50.0;
+            c.fk_all(&[3.0 * t - 1.5, 12.0 * t, 0.2 * t], &mut poses);
+            let p = poses[4].translation;
+            assert!((p.x * p.x + p.y * p.y).sqrt() <= radii[0] - 0.1 + 1e-12);
+        }
+        assert_eq!(c.joint_radii(&[]), [0.0, 0.0, 1.0]);
     }
 
     #[test]

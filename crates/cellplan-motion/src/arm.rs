@@ -22,7 +22,7 @@
 //! guarantee of the segment check is unchanged.
 use crate::plan::{Clearance, JointSpace, StateValidity, narrow_step};
 use cellplan_geom::{BroadPhase, CollisionWorld, GroupId, PlacedCovers, Pose};
-use cellplan_kin::{Chain, JointKind};
+use cellplan_kin::Chain;
 use std::cell::RefCell;
 use std::ops::Range;
 
@@ -91,80 +91,30 @@ impl Arm<'_> {
                 .map(|&l| self.base * links.get(l).copied().unwrap_or(Pose::IDENTITY)),
         );
     }
-
-    /// For each chain link `k`, the number of joints up to and including it: the joints that
-    /// move link `k` are `0..joints_to[k]` (joints are numbered root to tip).
-    fn joints_to(&self) -> Vec<usize> {
-        self.chain
-            .links
-            .iter()
-            .scan(0, |n, l| {
-                if let Some(j) = l.joint {
-                    *n = (*n).max(j + 1);
-                }
-                Some(*n)
-            })
-            .collect()
-    }
 }
 
 /// For each joint, an upper bound (m) on the distance from its axis of any point of any body it
 /// moves, valid in every configuration (1 for a prismatic joint).
 ///
-/// Why it bounds motion: joint `j`'s axis passes through the origin `o_j` of the link it moves.
-/// A point `p` of a body on link `k` downstream of `j` is `p = o_j + Σ_m R_m·t_m +
-/// Σ_prismatic R·axis·q + R_k·p_local`, where `t_m` are the fixed origin offsets of the links
-/// after `j` up to `k` and `R` rotations, so `|p − o_j| ≤ Σ_m |t_m| + Σ_prismatic
-/// max(|lower|, |upper|) + |p_local|`, and `|p_local|` is at most `|c| + r` over the spheres
-/// `(c, r)` of the body's cover (they contain the body). Along a straight joint-space segment
-/// the velocity of `p` is `Σ_j q̇_j·(axis_j × (p − o_j))` (revolute) plus `q̇_j·axis_j`
-/// (prismatic), of norm at most `Σ_j r_j·|q̇_j|`; integrating, `p` moves at most
-/// `Σ_j r_j·|b_j − a_j|`. The root is fixed in the world, so the bound holds in world
-/// coordinates. A joint that moves no body gets 0.
+/// [`Chain::joint_radii`] (which says why it bounds motion) with each body's reach from its
+/// link's origin taken from its sphere cover: at most `|c| + r` over the spheres `(c, r)`,
+/// which contain the body. The root is fixed in the world, so the bound holds in world
+/// coordinates.
 pub fn joint_radii(arm: &Arm) -> Vec<f64> {
-    let chain = arm.chain;
     let bodies: Vec<(usize, f64)> = arm
         .body_links
         .iter()
         .enumerate()
         .filter_map(|(i, &link)| {
             let cover = arm.world.body_cover(arm.group, i);
-            let norm = cover
+            let reach = cover
                 .iter()
                 .map(|s| s.centre.length() + s.radius)
                 .fold(None, |m: Option<f64>, v| Some(m.map_or(v, |m| m.max(v))))?;
-            Some((link, norm))
+            Some((link, reach))
         })
         .collect();
-    let offset: Vec<f64> = chain
-        .links
-        .iter()
-        .map(|l| {
-            let travel = l.joint.and_then(|j| chain.joints.get(j)).map_or(0.0, |j| {
-                if j.kind == JointKind::Prismatic {
-                    j.lower.abs().max(j.upper.abs())
-                } else {
-                    0.0
-                }
-            });
-            l.origin.translation.length() + travel
-        })
-        .collect();
-    (0..chain.dof())
-        .map(|j| {
-            if chain.joints[j].kind == JointKind::Prismatic {
-                return 1.0;
-            }
-            let Some(lj) = chain.joint_link(j) else {
-                return 0.0;
-            };
-            bodies
-                .iter()
-                .filter(|&&(k, _)| k >= lj)
-                .map(|&(k, norm)| offset[lj + 1..=k].iter().sum::<f64>() + norm)
-                .fold(0.0, f64::max)
-        })
-        .collect()
+    arm.chain.joint_radii(&bodies)
 }
 
 /// The configurations that move the tool point `tcp` (a pose in the chain's tip frame) from
@@ -249,7 +199,7 @@ impl<'a> ArmValidity<'a> {
     /// the `parked` groups. Bodies on links before the first joint never move and are not
     /// checked against the scene (a robot's base stands on its floor).
     pub fn new(arm: Arm<'a>, margin: f64, parked: Vec<(GroupId, Vec<Pose>)>) -> Self {
-        let joints_to = arm.joints_to();
+        let joints_to = arm.chain.joints_to();
         let tip = arm.chain.links.len().saturating_sub(1);
         let moved_by = |i: usize| {
             let l = arm.body_links.get(i).copied().unwrap_or(tip).min(tip);

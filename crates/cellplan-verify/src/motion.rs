@@ -15,7 +15,7 @@
 //! obstacle that slips wholly inside a link's mesh between two samples would be missed, which a
 //! step far below the obstacles' size (1 mm against centimetres) rules out.
 use cellplan_geom::{DQuat, Pose, ShapeSpec};
-use cellplan_kin::{Chain, JointKind, RobotModel};
+use cellplan_kin::{Chain, RobotModel};
 use parry3d_f64::bounding_volume::Aabb;
 use parry3d_f64::query;
 use parry3d_f64::shape::{Ball, Cuboid, Cylinder, SharedShape, TriMesh};
@@ -113,44 +113,9 @@ impl<'a> ExactRobot<'a> {
             }
         }
         let chain = &model.chain;
-        let offsets: Vec<f64> = chain
-            .links
-            .iter()
-            .map(|l| {
-                let travel = l.joint.and_then(|j| chain.joints.get(j)).map_or(0.0, |j| {
-                    if j.kind == JointKind::Prismatic {
-                        j.lower.abs().max(j.upper.abs())
-                    } else {
-                        0.0
-                    }
-                });
-                l.origin.translation.length() + travel
-            })
-            .collect();
-        let radii = (0..chain.dof())
-            .map(|j| {
-                if chain.joints[j].kind == JointKind::Prismatic {
-                    return 1.0;
-                }
-                let Some(lj) = chain.joint_link(j) else { return 0.0 };
-                parts
-                    .iter()
-                    .filter(|p| p.link >= lj)
-                    .map(|p| offsets[lj + 1..=p.link].iter().sum::<f64>() + p.reach)
-                    .fold(0.0, f64::max)
-            })
-            .collect();
-        let mut moved = 0;
-        let joints_to: Vec<usize> = chain
-            .links
-            .iter()
-            .map(|l| {
-                if let Some(j) = l.joint {
-                    moved = moved.max(j + 1);
-                }
-                moved
-            })
-            .collect();
+        let bodies: Vec<(usize, f64)> = parts.iter().map(|p| (p.link, p.reach)).collect();
+        let radii = chain.joint_radii(&bodies);
+        let joints_to = chain.joints_to();
         let part_joints = parts.iter().map(|p| joints_to[p.link]).collect();
         let mut pairs = Vec::new();
         for i in 0..parts.len() {
