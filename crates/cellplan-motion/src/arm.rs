@@ -252,6 +252,40 @@ impl<'a> ArmValidity<'a> {
         d
     }
 
+    /// Runs `f` with the arm's body poses at `q` (and, with the broad phase on, its covers
+    /// placed there), in this thread's scratch.
+    fn posed<T>(&self, q: &[f64], f: impl FnOnce(&[Pose], &PlacedCovers) -> T) -> T {
+        LINKS.with_borrow_mut(|(links, bodies)| {
+            self.arm.body_poses(q, links, bodies);
+            COVERS.with_borrow_mut(|placed| {
+                if self.broad_phase {
+                    self.broad.place(bodies, placed);
+                }
+                f(bodies, placed)
+            })
+        })
+    }
+
+    /// Distance of moving body `i` to the scene and the parked groups, capped at `cap`: through
+    /// the broad phase when it is on, else exact for every object.
+    fn scene_part(&self, i: usize, bodies: &[Pose], placed: &PlacedCovers, cap: f64) -> f64 {
+        if self.broad_phase {
+            self.broad.scene_distance(self.arm.world, i, bodies, placed, cap)
+        } else {
+            self.body_scene_distance(i, bodies, cap)
+        }
+    }
+
+    /// Distance between bodies `i` and `j`, capped at `cap` (as [`Self::scene_part`]).
+    fn pair_part(&self, i: usize, j: usize, bodies: &[Pose], placed: &PlacedCovers, cap: f64) -> f64 {
+        if self.broad_phase {
+            self.broad
+                .pair_distance(self.arm.world, i, j, bodies, placed, cap)
+        } else {
+            self.arm.world.pair_distance(self.arm.group, i, j, bodies, cap)
+        }
+    }
+
     /// Whether `q` is valid: within the joint limits, every moving body farther than the
     /// margin from the scene and the parked groups, every checked self pair apart. Broad phase
     /// first, the exact test only for the parts it does not clear.
@@ -259,33 +293,18 @@ impl<'a> ArmValidity<'a> {
         if !self.arm.chain.within_limits(q, 1e-9) {
             return false;
         }
-        LINKS.with_borrow_mut(|(links, bodies)| {
-            self.arm.body_poses(q, links, bodies);
-            let world = self.arm.world;
-            let g = self.arm.group;
-            // Strictly farther than the margin, as the clearance (> 0) requires.
-            let need = measured_for(self.margin.max(0.0));
-            let tiny = 1e-9;
-            if !self.broad_phase {
-                return self
-                    .moving
+        // Strictly farther than the margin, as the clearance (> 0) requires.
+        let need = measured_for(self.margin.max(0.0));
+        let apart = measured_for(0.0);
+        let tiny = 1e-9;
+        self.posed(q, |bodies, placed| {
+            self.moving
+                .iter()
+                .all(|(i, _)| self.scene_part(*i, bodies, placed, need + tiny) > need)
+                && self
+                    .pairs
                     .iter()
-                    .all(|(i, _)| self.body_scene_distance(*i, bodies, need + tiny) > need)
-                    && self.pairs.iter().all(|&(i, j, _)| {
-                        world.pair_distance(g, i, j, bodies, measured_for(0.0) + tiny) > measured_for(0.0)
-                    });
-            }
-            COVERS.with_borrow_mut(|placed| {
-                let broad = &self.broad;
-                broad.place(bodies, placed);
-                self.moving
-                    .iter()
-                    .all(|(i, _)| broad.scene_distance(world, *i, bodies, placed, need + tiny) > need)
-                    && self.pairs.iter().all(|&(i, j, _)| {
-                        broad.pair_distance(world, i, j, bodies, placed, measured_for(0.0) + tiny)
-                            > measured_for(0.0)
-                    })
-            })
+                    .all(|&(i, j, _)| self.pair_part(i, j, bodies, placed, apart + tiny) > apart)
         })
     }
 
@@ -351,40 +370,22 @@ impl StateValidity for ArmValidity<'_> {
             });
             return;
         }
-        LINKS.with_borrow_mut(|(links, bodies)| {
-            self.arm.body_poses(q, links, bodies);
-            COVERS.with_borrow_mut(|placed| {
-                let world = self.arm.world;
-                let g = self.arm.group;
-                let margin = self.margin.max(0.0);
-                let broad = &self.broad;
-                if self.broad_phase {
-                    broad.place(bodies, placed);
-                }
-                for (i, joints) in &self.moving {
-                    let cap = self.cap + margin;
-                    let d = if self.broad_phase {
-                        broad.scene_distance(world, *i, bodies, placed, cap)
-                    } else {
-                        self.body_scene_distance(*i, bodies, cap)
-                    };
-                    out.push(Clearance {
-                        distance: trusted(d) - margin,
-                        joints: joints.clone(),
-                    });
-                }
-                for (i, j, joints) in &self.pairs {
-                    let d = if self.broad_phase {
-                        broad.pair_distance(world, *i, *j, bodies, placed, self.cap)
-                    } else {
-                        world.pair_distance(g, *i, *j, bodies, self.cap)
-                    };
-                    out.push(Clearance {
-                        distance: trusted(d),
-                        joints: joints.clone(),
-                    });
-                }
-            });
+        let margin = self.margin.max(0.0);
+        self.posed(q, |bodies, placed| {
+            for (i, joints) in &self.moving {
+                let d = self.scene_part(*i, bodies, placed, self.cap + margin);
+                out.push(Clearance {
+                    distance: trusted(d) - margin,
+                    joints: joints.clone(),
+                });
+            }
+            for (i, j, joints) in &self.pairs {
+                let d = self.pair_part(*i, *j, bodies, placed, self.cap);
+                out.push(Clearance {
+                    distance: trusted(d),
+                    joints: joints.clone(),
+                });
+            }
         });
     }
 
@@ -401,53 +402,32 @@ impl StateValidity for ArmValidity<'_> {
         if !self.arm.chain.within_limits(q, 1e-9) {
             return None;
         }
-        LINKS.with_borrow_mut(|(links, bodies)| {
-            self.arm.body_poses(q, links, bodies);
-            COVERS.with_borrow_mut(|placed| {
-                let world = self.arm.world;
-                let g = self.arm.group;
-                let margin = self.margin.max(0.0);
-                let broad = &self.broad;
-                if self.broad_phase {
-                    broad.place(bodies, placed);
-                }
-                let mut step = limit;
-                for (i, joints) in self.moving.iter().rev() {
-                    let b = bound(joints);
-                    let part = self.capped_part(
-                        |cap| {
-                            if self.broad_phase {
-                                broad.scene_distance(world, *i, bodies, placed, cap)
-                            } else {
-                                self.body_scene_distance(*i, bodies, cap)
-                            }
-                        },
-                        margin,
-                        b,
-                        step,
-                        floor,
-                    );
-                    step = narrow_step(step, part, b, floor)?;
-                }
-                for (i, j, joints) in &self.pairs {
-                    let b = bound(joints);
-                    let part = self.capped_part(
-                        |cap| {
-                            if self.broad_phase {
-                                broad.pair_distance(world, *i, *j, bodies, placed, cap)
-                            } else {
-                                world.pair_distance(g, *i, *j, bodies, cap)
-                            }
-                        },
-                        0.0,
-                        b,
-                        step,
-                        floor,
-                    );
-                    step = narrow_step(step, part, b, floor)?;
-                }
-                Some(step)
-            })
+        let margin = self.margin.max(0.0);
+        self.posed(q, |bodies, placed| {
+            let mut step = limit;
+            for (i, joints) in self.moving.iter().rev() {
+                let b = bound(joints);
+                let part = self.capped_part(
+                    |cap| self.scene_part(*i, bodies, placed, cap),
+                    margin,
+                    b,
+                    step,
+                    floor,
+                );
+                step = narrow_step(step, part, b, floor)?;
+            }
+            for (i, j, joints) in &self.pairs {
+                let b = bound(joints);
+                let part = self.capped_part(
+                    |cap| self.pair_part(*i, *j, bodies, placed, cap),
+                    0.0,
+                    b,
+                    step,
+                    floor,
+                );
+                step = narrow_step(step, part, b, floor)?;
+            }
+            Some(step)
         })
     }
 }

@@ -171,6 +171,17 @@ pub trait Planner {
     ) -> Result<PlannedPath, PlanError>;
 }
 
+/// The path from a tree's root to node `i`: `parent[k]` is `usize::MAX` at the root.
+pub(crate) fn path_to_root(nodes: &[Vec<f64>], parent: &[usize], mut i: usize) -> Vec<Vec<f64>> {
+    let mut out = Vec::new();
+    while i != usize::MAX {
+        out.push(nodes[i].clone());
+        i = parent[i];
+    }
+    out.reverse();
+    out
+}
+
 /// One leg: the straight segment if it is clear, else [`RrtConnect`] followed by
 /// [`shortcut`] (the [`Leg`] planner with the parameters and limits of `settings`). The counts
 /// in the result add up every stage.
@@ -181,12 +192,12 @@ pub fn plan_leg(
     goal: &[f64],
     settings: &PlanSettings,
 ) -> Result<PlannedPath, PlanError> {
-    let goals = [goal.to_vec()];
-    let problem = Problem::new(space, validity, start, &goals).with_min_clearance(settings.min_clearance);
-    let mut leg = Leg {
-        params: settings.params(),
-    };
-    leg.solve(&problem, &settings.termination()).into_planned()
+    settings.with_problem(space, validity, start, goal, |problem| {
+        let mut leg = Leg {
+            params: settings.params(),
+        };
+        leg.solve(problem, &settings.termination()).into_planned()
+    })
 }
 
 /// A leg that leaves its start along `exit` and arrives along `entry` — fixed polylines such as
@@ -244,6 +255,20 @@ pub fn plan_leg_via(
 }
 
 impl PlanSettings {
+    /// The one-goal query `start → goal` with these settings' minimum clearance, handed to `f`
+    /// (the older [`Planner`] interface on the planners of the registry).
+    pub(crate) fn with_problem<T>(
+        &self,
+        space: &JointSpace,
+        validity: &dyn StateValidity,
+        start: &[f64],
+        goal: &[f64],
+        f: impl FnOnce(&Problem) -> T,
+    ) -> T {
+        let goals = [goal.to_vec()];
+        f(&Problem::new(space, validity, start, &goals).with_min_clearance(self.min_clearance))
+    }
+
     /// The planner parameters of these settings (seed, range, shortcut iterations;
     /// post-processing on).
     pub fn params(&self) -> PlannerParams {

@@ -43,14 +43,8 @@ impl Tree {
     }
 
     /// Root-to-node path.
-    fn path_to(&self, mut i: usize) -> Vec<Vec<f64>> {
-        let mut out = Vec::new();
-        while i != usize::MAX {
-            out.push(self.nodes[i].clone());
-            i = self.parent[i];
-        }
-        out.reverse();
-        out
+    fn path_to(&self, i: usize) -> Vec<Vec<f64>> {
+        super::path_to_root(&self.nodes, &self.parent, i)
     }
 }
 
@@ -176,15 +170,15 @@ impl Planner for RrtConnect {
         goal: &[f64],
         settings: &PlanSettings,
     ) -> Result<PlannedPath, PlanError> {
-        let goals = [goal.to_vec()];
-        let problem = Problem::new(space, validity, start, &goals).with_min_clearance(settings.min_clearance);
         let params = PlannerParams {
             simplify: false,
             ..settings.params()
         };
-        solve_with(&problem, &settings.termination(), &params, |run, valid| {
-            search(run, &params, start, &goals, valid)
+        settings.with_problem(space, validity, start, goal, |problem| {
+            solve_with(problem, &settings.termination(), &params, |run, valid| {
+                search(run, &params, start, problem.goals, valid)
+            })
+            .into_planned()
         })
-        .into_planned()
     }
 }

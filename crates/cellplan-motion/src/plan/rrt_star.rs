@@ -62,14 +62,8 @@ impl Tree {
         }
     }
 
-    fn path_to(&self, mut i: usize) -> Vec<Vec<f64>> {
-        let mut out = Vec::new();
-        while i != usize::MAX {
-            out.push(self.nodes[i].clone());
-            i = self.parent[i];
-        }
-        out.reverse();
-        out
+    fn path_to(&self, i: usize) -> Vec<Vec<f64>> {
+        super::path_to_root(&self.nodes, &self.parent, i)
     }
 
     /// The goal node of least cost (the first on ties).

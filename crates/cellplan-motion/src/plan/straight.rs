@@ -54,8 +54,8 @@ impl Planner for Straight {
         goal: &[f64],
         settings: &PlanSettings,
     ) -> Result<PlannedPath, PlanError> {
-        let goals = [goal.to_vec()];
-        let problem = Problem::new(space, validity, start, &goals).with_min_clearance(settings.min_clearance);
-        Straight.solve(&problem, &settings.termination()).into_planned()
+        settings.with_problem(space, validity, start, goal, |problem| {
+            Straight.solve(problem, &settings.termination()).into_planned()
+        })
     }
 }
