@@ -267,6 +267,15 @@ impl CollisionWorld {
         &self.group(g).bodies[i].name
     }
 
+    /// The sphere cover of body `i` of group `g` (body frame; see [`crate::spheres`]); empty
+    /// for a body without shapes.
+    pub fn body_cover(&self, g: GroupId, i: usize) -> &[crate::Sphere] {
+        self.group(g).bodies[i]
+            .convex
+            .as_ref()
+            .map_or(&[], |c| c.cover.spheres.as_slice())
+    }
+
     /// The convex shape that stands for body `i` of group `g`, as a mesh in the body frame
     /// (for drawing and checks); `None` for a body without shapes.
     pub fn body_hull(&self, g: GroupId, i: usize) -> Option<Mesh> {
@@ -495,7 +504,6 @@ fn aabb_distance(a: &Aabb, b: &Aabb) -> f64 {
     gap.length()
 }
 
-mod bounds;
 mod broad;
 mod distance;
 mod narrow;

@@ -14,12 +14,12 @@
 //! # The broad phase
 //!
 //! A segment check asks each part only whether its clearance reaches `step · bound` (see
-//! [`StateValidity::segment_step`]). The world's sphere covers give a lower bound on every
-//! distance for a few point queries ([`CollisionWorld::body_static_bound`],
-//! [`CollisionWorld::pair_bound`]); when the bound already reaches what is asked, that answer
-//! is proven and the exact (GJK) distance is skipped. Only parts whose bound falls short pay
-//! for the exact query, which then decides. Bounds never exceed exact distances, so the
-//! guarantee of the segment check is unchanged.
+//! [`StateValidity::segment_step`]). The arm's [`BroadPhase`] gives a lower bound on every
+//! distance from the bodies' sphere covers, object by object and pair by pair; where the bound
+//! already reaches what is asked, that answer is proven and the exact (GJK) distance is
+//! skipped. Only the objects and pairs whose bound falls short pay for the exact query, which
+//! then decides. Bounds never exceed exact distances, so the guarantee of the segment check is
+//! unchanged.
 use crate::plan::{Clearance, JointSpace, StateValidity, narrow_step};
 use cellplan_geom::{BroadPhase, CollisionWorld, GroupId, PlacedCovers, Pose};
 use cellplan_kin::Chain;

@@ -1,9 +1,8 @@
 //! The broad phase of one body group against everything that stands still, precomputed:
 //! [`BroadPhase`] (the whole group placed at once, then each body against each object).
 //!
-//! [`CollisionWorld::body_static_bound`] and its kin answer one body at a time and look up
-//! shapes, covers and poses on every call. A motion planner asks the same group thousands of
-//! times per query, so [`BroadPhase`] does the lookups once:
+//! A motion planner asks the same group thousands of times per query, so [`BroadPhase`] does
+//! the lookups of shapes, covers and poses once:
 //!
 //! - each body's cover (see [`crate::spheres`]) is kept in one flat array, and
 //!   [`BroadPhase::place`] puts every cover in the world at once (one rotation matrix per
@@ -571,16 +570,29 @@ mod tests {
                 assert!(close(fast, exact), "body {i}: {fast} vs {exact} (cap {cap})");
                 let bound = broad.scene_bound(&world, i, &placed, cap);
                 assert!(bound <= exact + 1e-9, "bound {bound} above {exact}");
-                near += usize::from(exact > 0.0 && exact < cap.min(0.05));
+                assert!(bound <= cap.max(0.0));
+                if exact > 0.0 && exact < cap.min(0.05) {
+                    near += 1;
+                    // Tight enough to be of use near the objects.
+                    assert!(bound >= exact - 0.12, "bound {bound} far below {exact}");
+                }
                 touching += usize::from(exact == 0.0);
             }
             let exact = world.pair_distance(g, 0, 1, &poses, cap);
             let fast = broad.pair_distance(&world, 0, 1, &poses, &placed, cap);
             assert!(close(fast, exact), "pair: {fast} vs {exact} (cap {cap})");
+            let bound = broad.pair_bound(0, 1, &placed, cap);
+            assert!(bound <= exact + 1e-9, "pair bound {bound} above {exact}");
         }
         assert!(
             near > 50 && touching > 50,
             "the test places bodies near and on the objects ({near}, {touching})"
         );
+        // A non-finite pose is at distance 0, bound and exact alike.
+        let bad = [Pose::translation(f64::NAN, 0.0, 0.0), Pose::IDENTITY];
+        broad.place(&bad, &mut placed);
+        assert_eq!(broad.scene_bound(&world, 0, &placed, 1.0), 0.0);
+        assert_eq!(broad.scene_distance(&world, 0, &bad, &placed, 1.0), 0.0);
+        assert_eq!(broad.pair_bound(0, 1, &placed, 1.0), 0.0);
     }
 }
