@@ -79,17 +79,13 @@ pub fn plan_leg_with_margin(
 ) -> Result<PlannedPath, PlanError> {
     let space = joint_space(cell, robot);
     let validity = robot_validity(cell, robot, margin);
-    let error = match plan::plan_leg(&space, &validity, from, to, settings) {
+    let (mut samples, mut calls) = match plan::plan_leg(&space, &validity, from, to, settings) {
         Ok(path) => return Ok(path),
-        Err(e @ PlanError::NoPath { .. }) => e,
-        Err(e) => return Err(e),
-    };
-    let (mut samples, mut calls) = match error {
-        PlanError::NoPath {
+        Err(PlanError::NoPath {
             samples,
             validity_calls,
-        } => (samples, validity_calls),
-        _ => (0, 0),
+        }) => (samples, validity_calls),
+        Err(e) => return Err(e),
     };
     let chain = &robot.model.chain;
     for distance in RETRACT_DISTANCES {
