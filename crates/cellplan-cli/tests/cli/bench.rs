@@ -195,17 +195,10 @@ fn bench_minmax_refuses_a_malformed_instance() {
 fn bench_motion_plans_and_rechecks_exactly() {
     let dir = scratch("bench-motion");
     let scene = "bench/motion/mbm-ur5/box.json";
-    let out = cellplan(
+    let rows = json_ok(
         &["bench", "motion", scene, "--first", "2", "--json", "--with-paths"],
         &dir,
     );
-    assert_eq!(
-        out.status.code(),
-        Some(0),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let rows: Value = serde_json::from_slice(&out.stdout).unwrap();
     let rows = rows.as_array().unwrap();
     assert_eq!(rows.len(), 2);
     for row in rows {
@@ -235,24 +228,20 @@ fn bench_motion_plans_and_rechecks_exactly() {
     ]);
     let run = dir.join("peer.json");
     std::fs::write(&run, serde_json::to_string(&peer).unwrap()).unwrap();
-    let out = cellplan(
-        &[
-            "bench",
-            "motion",
-            scene,
-            "--recheck",
-            run.to_str().unwrap(),
-            "--json",
-        ],
-        &dir,
-    );
-    assert_eq!(
-        out.status.code(),
-        Some(0),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let checked: Value = serde_json::from_slice(&out.stdout).unwrap();
+    let recheck = || {
+        json_ok(
+            &[
+                "bench",
+                "motion",
+                scene,
+                "--recheck",
+                run.to_str().unwrap(),
+                "--json",
+            ],
+            &dir,
+        )
+    };
+    let checked = recheck();
     assert_eq!(checked[0]["exact_valid"], true);
     assert_eq!(
         checked[1]["exact_valid"], true,
@@ -264,18 +253,7 @@ fn bench_motion_plans_and_rechecks_exactly() {
     let cut = serde_json::json!([{"problem": rows[0]["problem"], "planner": "peer", "solved": true,
                                   "path": [rows[0]["path"][0], folded]}]);
     std::fs::write(&run, serde_json::to_string(&cut).unwrap()).unwrap();
-    let out = cellplan(
-        &[
-            "bench",
-            "motion",
-            scene,
-            "--recheck",
-            run.to_str().unwrap(),
-            "--json",
-        ],
-        &dir,
-    );
-    let checked: Value = serde_json::from_slice(&out.stdout).unwrap();
+    let checked = recheck();
     assert_eq!(checked[0]["exact_valid"], false, "{checked}");
     assert!(
         checked[0]["exact_contact"]

@@ -27,6 +27,18 @@ pub(crate) fn cellplan(args: &[&str], cache: &Path) -> Output {
         .expect("run cellplan")
 }
 
+/// Runs `cellplan args`, asserts exit 0 (showing stderr otherwise) and parses stdout as JSON.
+pub(crate) fn json_ok(args: &[&str], cache: &Path) -> Value {
+    let out = cellplan(args, cache);
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "cellplan {args:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&out.stdout).expect("stdout is JSON")
+}
+
 /// A fresh scratch folder per test (kept after the run, for a look at what a test wrote).
 pub(crate) fn scratch(name: &str) -> PathBuf {
     tempfile::Builder::new()
