@@ -293,6 +293,19 @@ fn render(doc: &output::Plan, working: &str) -> String {
         c.poses_changed,
         c.uncoordinated_cycle_time_s
     );
+    if let Some(p) = &doc.stats.passage_search {
+        s += &format!(
+            "passage orders: {} conflict boxes ({} exact distances), {} search nodes, {}\n",
+            p.boxes,
+            p.distances,
+            p.nodes,
+            if p.proven {
+                "the shortest schedule the boxes allow"
+            } else {
+                "node budget reached: the best schedule found"
+            }
+        );
+    }
     for k in &c.conflicts_before {
         s += &format!(
             "  {:.2}–{:.2} s {} & {} (scenario {}): {}; {}\n",

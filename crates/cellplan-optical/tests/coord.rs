@@ -67,6 +67,58 @@ fn every_strategy_gives_a_verified_conflict_free_plan() {
     }
 }
 
+/// The coordination diagram misses no contact: on a grid of position pairs (every 50 ms of
+/// each program) every pair of configurations closer than the clearance lies in a box of that
+/// robot pair, and so does every conflict the search on the clock found (both robots at the
+/// conflict's start, the programs having no waits). The boxes are not the whole square either.
+#[test]
+fn the_coordination_diagram_covers_every_contact() {
+    let f = fixture();
+    let (_, none) = document(Coordination::None);
+    let settings = coord::CoordSettings::default();
+    let boxes = coord::conflict_boxes(&f.cell, &f.table, &none.programs, &settings).unwrap();
+    assert!(!boxes.is_empty());
+    let inside = |a: usize, b: usize, sa: f64, sb: f64| {
+        boxes.iter().any(|x| {
+            x.robots == (a, b)
+                && x.a.0 - 1e-9 <= sa
+                && sa <= x.a.1 + 1e-9
+                && x.b.0 - 1e-9 <= sb
+                && sb <= x.b.1 + 1e-9
+        })
+    };
+    for c in &none.after {
+        assert!(inside(c.robots.0, c.robots.1, c.start, c.start), "{c:?}");
+    }
+    let margin = f.cell.planning.clearance + coord::REPLAY_SLACK;
+    let (ra, rb) = (&f.cell.robots[0], &f.cell.robots[1]);
+    let (ta, tb) = (&none.timed[0], &none.timed[1]);
+    let (mut sa_, mut sb_) = (Default::default(), Default::default());
+    let mut close = 0;
+    let step = 0.05;
+    let mut sa = 0.0;
+    while sa <= ta.end() {
+        ra.body_poses(&ta.trajectory.position(sa), &mut sa_);
+        let mut sb = 0.0;
+        while sb <= tb.end() {
+            rb.body_poses(&tb.trajectory.position(sb), &mut sb_);
+            let d = f
+                .cell
+                .world
+                .group_group_distance(ra.group, &sa_.bodies, rb.group, &sb_.bodies, 1.0);
+            if d <= margin {
+                close += 1;
+                assert!(inside(0, 1, sa, sb), "({sa}, {sb}) at {d} m is in no box");
+            }
+            sb += step;
+        }
+        sa += step;
+    }
+    assert!(close > 0);
+    let area: f64 = boxes.iter().map(|x| (x.a.1 - x.a.0) * (x.b.1 - x.b.0)).sum();
+    assert!(area < 0.5 * ta.end() * tb.end(), "{area}");
+}
+
 #[test]
 fn best_is_no_worse_than_the_baselines_here() {
     let cycle = |s: Coordination| document(s).0.cycle_time_s;

@@ -15,15 +15,21 @@
 //!     (valid poses are reachable, measure the MP, clear of the scene), the local paths
 //!     re-planned, and the conflict-free combination with the shortest time kept; the robots
 //!     do not stop, except where no perturbation clears a conflict (a reported fallback wait);
-//!   - `best` (ours): prioritised scheduling over every priority order (all of them up to 4
-//!     robots, else a few), where at each conflict the robot being scheduled either waits the
-//!     shortest time that clears it, or takes another measuring pose — a perturbed one or any
-//!     other candidate of the MP — whichever finishes first; the order with the shortest cycle
-//!     time (then Δt) wins.
+//!   - `best` (ours): coordination as scheduling. For every robot pair the coordination
+//!     diagram (`diagram`: boxes of positions along the two paths that cover every contact,
+//!     found by distance-bounded subdivision) and the order in which the two pass each box,
+//!     chosen by branch and bound for the shortest makespan (`schedule`; waits at any rest
+//!     before a box, a node budget, exact within it); then each wait cut as far as the exact
+//!     search on the clock allows. Where no order exists (a robot's home in another's way)
+//!     it falls back on prioritised resolution: every priority order (all up to 4 robots,
+//!     else a few), at each conflict the shortest wait or another measuring pose.
+mod diagram;
 mod perturb;
 pub mod program;
+mod schedule;
 pub mod timeline;
 
+pub use diagram::ConflictBox;
 pub use program::{Activity, Program, Timed, VisitPose, Wait, WaitReason};
 pub use timeline::{Conflict, Scenario, Timeline};
 
@@ -96,6 +102,12 @@ pub struct CoordSettings {
     /// program) and ranks it by that end; the two best orders are still tried with other
     /// poses. `None`: every order is resolved to the end.
     pub bar: Option<f64>,
+    /// Nodes of `best`'s search over passage orders (work, not time: the result does not
+    /// depend on the machine).
+    pub schedule_nodes: usize,
+    /// The shortest wait `best` adds (s): at least two trajectory sample steps, so that every
+    /// wait shows in the sampled trajectory of the plan.
+    pub min_wait: f64,
 }
 
 impl Default for CoordSettings {
@@ -107,6 +119,8 @@ impl Default for CoordSettings {
             perturb_evaluations: 12,
             seed: 0,
             bar: None,
+            schedule_nodes: 20_000,
+            min_wait: 0.05,
         }
     }
 }
@@ -134,6 +148,8 @@ pub struct Coordinated {
     pub after: Vec<Conflict>,
     /// Cycle time without coordination (s).
     pub uncoordinated_cycle: f64,
+    /// `best`'s search over passage orders, when it ran.
+    pub search: Option<crate::document::PassageSearch>,
     /// Wall seconds.
     pub compute_s: f64,
 }
@@ -249,7 +265,10 @@ pub fn coordinate(
             };
             (progs, res, priority)
         }
-        Coordination::Best => best(&ctx, programs)?,
+        Coordination::Best => match scheduled(&ctx, &programs)? {
+            Some(done) => done,
+            None => best(&ctx, programs)?,
+        },
     };
     let timed: Vec<Timed> = programs.iter().map(|p| ctx.timed(p)).collect::<Result<_, _>>()?;
     // Whatever the strategy claims, the result is searched once more.
@@ -286,6 +305,7 @@ pub fn coordinate(
         priority,
         after,
         uncoordinated_cycle,
+        search: res.search,
         compute_s: started.elapsed().as_secs_f64(),
     })
 }
@@ -310,6 +330,8 @@ pub(crate) struct Resolution {
     /// Set when the run stopped early because its programs already ended after the bar: the
     /// end so far (a lower bound of where waits alone would end).
     pub outrun: Option<f64>,
+    /// The search over passage orders (`best`).
+    pub search: Option<crate::document::PassageSearch>,
 }
 
 /// Most conflicts one strategy resolves before giving up (each resolution moves a conflict
@@ -561,6 +583,9 @@ pub(crate) fn add_wait(
     Ok(false)
 }
 
+/// Programs resolved by a strategy, its counts, and the priority order it used (if any).
+type Resolved = (Vec<Program>, Resolution, Vec<usize>);
+
 /// A resolved schedule: cycle time, Δt, programs, counts.
 type Scheduled = (f64, f64, Vec<Program>, Resolution);
 
@@ -571,7 +596,7 @@ type Scheduled = (f64, f64, Vec<Program>, Resolution);
 /// stops as soon as its programs end after the bar, and ranks by that end (a lower bound of
 /// its own finish). The two best orders by that ranking are still run with other poses allowed,
 /// without the bar, since another pose can end sooner than a wait.
-fn best(ctx: &Ctx, programs: Vec<Program>) -> Result<(Vec<Program>, Resolution, Vec<usize>), PlanError> {
+fn best(ctx: &Ctx, programs: Vec<Program>) -> Result<Resolved, PlanError> {
     let orders = priority_orders(&programs);
     let run = |order: &Vec<usize>, mode: Mode, bar: Option<f64>| -> Option<Scheduled> {
         let mut p = programs.clone();
@@ -616,6 +641,139 @@ fn best(ctx: &Ctx, programs: Vec<Program>) -> Result<(Vec<Program>, Resolution, 
         return Err(PlanError::NoPriorityOrder);
     };
     Ok((progs, res, orders[i].clone()))
+}
+
+/// Ours: the coordination diagram of every robot pair, and the passage orders through its
+/// conflict boxes with the shortest makespan (`schedule`); every wait at a rest. `None` when
+/// no order exists (then `best` falls back on prioritised resolution).
+fn scheduled(ctx: &Ctx, programs: &[Program]) -> Result<Option<Resolved>, PlanError> {
+    let paths: Vec<diagram::RobotPath> = programs
+        .iter()
+        .map(|p| diagram::RobotPath::new(ctx, p))
+        .collect::<Result<_, _>>()?;
+    let (boxes, work) = diagram::diagrams(ctx, &paths);
+    let tracks: Vec<schedule::Track> = paths.iter().map(|p| p.track()).collect();
+    let Some(s) = schedule::schedule(
+        &tracks,
+        &boxes,
+        ctx.settings.schedule_nodes,
+        ctx.settings.min_wait,
+    ) else {
+        return Ok(None);
+    };
+    let mut out = programs.to_vec();
+    let mut res = Resolution::default();
+    for ((prog, path), waits) in out.iter_mut().zip(&paths).zip(&s.waits) {
+        prog.waits.clear();
+        for (rest, &(d, by)) in path.rests.iter().zip(waits) {
+            if d > 0.0 {
+                prog.set_wait(Wait {
+                    leg: rest.leg,
+                    waypoint: rest.waypoint,
+                    duration: d,
+                    reason: WaitReason::GiveWay,
+                    for_robot: by,
+                });
+                res.waits += 1;
+            }
+        }
+    }
+    res.resolved = s.decisions;
+    res.search = Some(crate::document::PassageSearch {
+        boxes: boxes.len(),
+        distances: work.distances,
+        nodes: s.nodes,
+        proven: s.proven,
+    });
+    debug_assert!({
+        let timed: Vec<Timed> = out.iter().map(|p| ctx.timed(p)).collect::<Result<_, _>>()?;
+        (cycle_and_delta(&timed).0 - s.makespan).abs() < 1e-6
+    });
+    shrink_waits(ctx, &mut out)?;
+    res.waits = out.iter().map(|p| p.waits.len()).sum();
+    Ok(Some((out, res, Vec::new())))
+}
+
+/// The coordination diagrams of `programs` (their waits ignored): for every robot pair, boxes
+/// of positions (program time without waits) that cover every pair of positions at which the
+/// two come closer than the clearance (plus [`REPLAY_SLACK`]); see `diagram`.
+pub fn conflict_boxes(
+    cell: &Cell,
+    table: &CandidateTable,
+    programs: &[Program],
+    settings: &CoordSettings,
+) -> Result<Vec<ConflictBox>, PlanError> {
+    let ctx = Ctx::new(cell, table, settings);
+    let paths: Vec<diagram::RobotPath> = programs
+        .iter()
+        .map(|p| diagram::RobotPath::new(&ctx, p))
+        .collect::<Result<_, _>>()?;
+    Ok(diagram::diagrams(&ctx, &paths).0)
+}
+
+/// The boxes of the diagram are larger than the contacts they cover, so the schedule's waits
+/// are longer than needed: each wait, earliest first, is cut as far as the exact contact
+/// search on the clock allows (to 10 ms; to nothing, or at least [`CoordSettings::min_wait`]).
+fn shrink_waits(ctx: &Ctx, programs: &mut [Program]) -> Result<(), PlanError> {
+    let mut timed: Vec<Timed> = programs.iter().map(|p| ctx.timed(p)).collect::<Result<_, _>>()?;
+    let mut order: Vec<(f64, usize, usize)> = timed
+        .iter()
+        .enumerate()
+        .flat_map(|(r, t)| t.wait_starts.iter().enumerate().map(move |(i, &s)| (s, r, i)))
+        .collect();
+    order.sort_by(|a, b| a.0.total_cmp(&b.0).then((a.1, a.2).cmp(&(b.1, b.2))));
+    let keys: Vec<(usize, usize, usize)> = order
+        .iter()
+        .map(|&(_, r, i)| (r, programs[r].waits[i].leg, programs[r].waits[i].waypoint))
+        .collect();
+    let m = programs.len();
+    for (r, leg, waypoint) in keys {
+        let Some(w) = programs[r].wait_at(leg, waypoint).cloned() else {
+            continue;
+        };
+        let others: Vec<usize> = (0..m).filter(|&o| o != r).collect();
+        let start = timed[r].arrivals[leg][waypoint];
+        let try_with = |d: f64| -> Result<Option<(Program, Timed)>, PlanError> {
+            let mut p = programs[r].clone();
+            p.set_wait(Wait {
+                duration: d,
+                ..w.clone()
+            });
+            let tp = ctx.timed(&p)?;
+            let ok = ctx.clear(r, &tp, &timed, &others, start, f64::INFINITY);
+            Ok(ok.then_some((p, tp)))
+        };
+        let min = ctx.settings.min_wait;
+        let found = if let Some(x) = try_with(0.0)? {
+            Some(x)
+        } else if w.duration <= min + 0.01 {
+            None
+        } else {
+            // The shortest good duration to 10 ms (good ones need not form an interval; `hi`
+            // stays good).
+            let (mut lo, mut hi) = (min, w.duration);
+            let mut best = None;
+            if let Some(x) = try_with(min)? {
+                best = Some(x);
+                hi = min;
+            }
+            while hi - lo > 0.01 {
+                let mid = 0.5 * (lo + hi);
+                if let Some(x) = try_with(mid)? {
+                    best = Some(x);
+                    hi = mid;
+                } else {
+                    lo = mid;
+                }
+            }
+            best
+        };
+        if let Some((p, tp)) = found {
+            programs[r] = p;
+            timed[r] = tp;
+        }
+    }
+    Ok(())
 }
 
 /// `rank[r]`: the position of robot `r` in `order`.

@@ -233,6 +233,7 @@ fn stats(table: &CandidateTable, outcome: &Outcome, coordinated: &Coordinated) -
         local_sets_built: outcome.allocated.local_sets.0,
         local_sets_chosen: outcome.allocated.local_sets.1,
         conflicts_resolved: coordinated.resolved,
+        passage_search: coordinated.search,
     }
 }
 

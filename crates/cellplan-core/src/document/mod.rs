@@ -366,6 +366,24 @@ pub struct Stats {
     pub local_sets_chosen: usize,
     /// Conflicts coordination met and resolved (a resolution may meet new ones later on).
     pub conflicts_resolved: usize,
+    /// `best`'s search over passage orders, when it ran.
+    #[serde(default)]
+    pub passage_search: Option<PassageSearch>,
+}
+
+/// `best`'s search over the orders in which robots pass their conflict boxes.
+#[derive(Clone, Copy, Debug, Serialize, Deserialize, PartialEq, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct PassageSearch {
+    /// Conflict boxes of the coordination diagrams (every robot pair).
+    pub boxes: usize,
+    /// Exact robot–robot distances the diagrams asked.
+    pub distances: usize,
+    /// Nodes of the branch and bound.
+    pub nodes: usize,
+    /// Whether it ended within its node budget (the schedule is then the shortest the boxes
+    /// allow; else the best found).
+    pub proven: bool,
 }
 
 /// Wall-clock seconds per stage.

@@ -1,0 +1,412 @@
+//! The coordination diagram of two robots (O'Donnell & Lozano-Pérez): the pairs of positions
+//! along their two paths at which they would come closer than the clearance, whatever the
+//! clock, covered by axis-aligned boxes.
+//!
+//! A robot's *position* is the time of its program without waits: waits change when it is
+//! where, never where it goes. Between two waypoints a program moves along the straight joint
+//! segment (rest to rest), so over an interval of positions inside one segment every
+//! configuration lies on the segment between the configurations at the interval's ends, and no
+//! point of the robot moves farther from where it is at the interval's middle than
+//! `max over both ends of Σ_j r_j·|q_j(end) − q_j(middle)|` (the per-joint radii). A rectangle
+//! of positions is therefore free when the distance of the two robots at its centre exceeds the
+//! clearance plus both reaches: no contact is missed between samples. Rectangles that cannot
+//! be proven free are halved (along the robot that moves more) down to [`MIN_CELL`]; those
+//! left are in conflict. Each pair of pieces (one of each path) keeps the bounding box of its
+//! conflicts: a box per pair of pieces follows the shape of a long conflict as a staircase,
+//! where one bounding box of the whole would serialise the robots.
+use super::Ctx;
+use super::program::{Activity, Program, Timed};
+use crate::plan::PlanError;
+use cellplan_geom::{DVec3, Pose};
+use cellplan_model::robot::{Robot, Scratch};
+use rayon::prelude::*;
+use std::collections::HashMap;
+use std::rc::Rc;
+
+/// Smallest rectangle side (s of position) that is still halved.
+pub(crate) const MIN_CELL: f64 = 0.02;
+/// Distances are measured up to this (m) beyond what a rectangle needs.
+const DISTANCE_CAP: f64 = 2.0;
+/// How much the sphere covers may fall short before the exact distance is asked (m).
+const COVER_SLACK: f64 = 0.02;
+
+/// Where a robot can stand still: a waypoint it reaches at rest (every waypoint, since legs are
+/// timed rest to rest, except the last of each leg: that is the MP, whose measurement follows).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Rest {
+    /// Position (s).
+    pub at: f64,
+    /// The program's leg and waypoint (as [`super::Wait`] names them).
+    pub leg: usize,
+    /// Waypoint of the leg.
+    pub waypoint: usize,
+}
+
+/// One piece of a robot's path: moving along a straight joint segment, or standing.
+#[derive(Clone, Debug)]
+struct Piece {
+    from: f64,
+    to: f64,
+    moving: bool,
+}
+
+/// A robot's path as positions: its program without waits on the clock.
+pub(crate) struct RobotPath {
+    /// The robot (cell index).
+    pub robot: usize,
+    /// Length (s): the program's duration without waits.
+    pub len: f64,
+    /// Where it may wait, by position (the first is home at 0).
+    pub rests: Vec<Rest>,
+    pieces: Vec<Piece>,
+    timed: Timed,
+}
+
+impl RobotPath {
+    /// The path of `program` (its waits are ignored).
+    pub fn new(ctx: &Ctx, program: &Program) -> Result<RobotPath, PlanError> {
+        let mut bare = program.clone();
+        bare.waits.clear();
+        let timed = ctx.timed(&bare)?;
+        let mut rests = Vec::new();
+        for (k, at) in timed.arrivals.iter().enumerate() {
+            for (w, &a) in at.iter().enumerate() {
+                if w + 1 < bare.legs[k].waypoints.len() {
+                    rests.push(Rest {
+                        at: a,
+                        leg: k,
+                        waypoint: w,
+                    });
+                }
+            }
+        }
+        if rests.first().is_none_or(|r| r.at > 0.0) {
+            // A program without legs stands at home.
+            rests.insert(
+                0,
+                Rest {
+                    at: 0.0,
+                    leg: 0,
+                    waypoint: 0,
+                },
+            );
+        }
+        let pieces = timed
+            .spans
+            .iter()
+            .map(|s| Piece {
+                from: s.start,
+                to: s.end,
+                moving: matches!(s.what, Activity::Move { .. }),
+            })
+            .collect();
+        Ok(RobotPath {
+            robot: program.robot,
+            len: timed.end(),
+            rests,
+            pieces,
+            timed,
+        })
+    }
+
+    /// The path as the scheduler sees it.
+    pub fn track(&self) -> super::schedule::Track {
+        super::schedule::Track {
+            robot: self.robot,
+            len: self.len,
+            rests: self.rests.iter().map(|r| r.at).collect(),
+        }
+    }
+
+    fn at(&self, s: f64) -> Vec<f64> {
+        self.timed.trajectory.position(s.clamp(0.0, self.len))
+    }
+}
+
+/// Positions `[a.0, a.1]` of robot `robots.0` and `[b.0, b.1]` of robot `robots.1` at which
+/// the two may come closer than the clearance.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ConflictBox {
+    /// The robots (cell indices, first < second).
+    pub robots: (usize, usize),
+    /// Positions of the first robot.
+    pub a: (f64, f64),
+    /// Positions of the second robot.
+    pub b: (f64, f64),
+}
+
+/// What building the diagrams cost.
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct DiagramWork {
+    /// Rectangles looked at.
+    pub cells: usize,
+    /// Exact distance queries.
+    pub distances: usize,
+}
+
+/// One robot placed at a position: its configuration and body bounding spheres.
+struct Placed {
+    q: Vec<f64>,
+    poses: Vec<Pose>,
+    /// World bounding sphere of each body with shapes, and which body it is.
+    spheres: Vec<(DVec3, f64)>,
+    bodies: Vec<usize>,
+}
+
+/// Per robot, per body: one sphere (body frame) holding the body's sphere cover.
+fn body_spheres(ctx: &Ctx, robot: &Robot) -> Vec<Option<(DVec3, f64)>> {
+    let world = &ctx.cell.world;
+    (0..world.body_count(robot.group))
+        .map(|i| {
+            let cover = world.body_cover(robot.group, i);
+            if cover.is_empty() {
+                return None;
+            }
+            let centre = cover.iter().map(|s| s.centre).sum::<DVec3>() / cover.len() as f64;
+            let radius = cover
+                .iter()
+                .map(|s| (s.centre - centre).length() + s.radius)
+                .fold(0.0, f64::max);
+            Some((centre, radius))
+        })
+        .collect()
+}
+
+/// Per body, its sphere cover (body frame).
+fn covers(ctx: &Ctx, robot: &Robot) -> Vec<Vec<(DVec3, f64)>> {
+    let world = &ctx.cell.world;
+    (0..world.body_count(robot.group))
+        .map(|i| {
+            world
+                .body_cover(robot.group, i)
+                .iter()
+                .map(|s| (s.centre, s.radius))
+                .collect()
+        })
+        .collect()
+}
+
+struct PairDiagram<'a> {
+    ctx: &'a Ctx<'a>,
+    pa: &'a RobotPath,
+    pb: &'a RobotPath,
+    sa: Vec<Option<(DVec3, f64)>>,
+    sb: Vec<Option<(DVec3, f64)>>,
+    /// Per body of each robot, its sphere cover (body frame).
+    ca: Vec<Vec<(DVec3, f64)>>,
+    cb: Vec<Vec<(DVec3, f64)>>,
+    scratch: Scratch,
+    work: DiagramWork,
+    /// The bounding box of the conflicts found so far in the current pair of pieces.
+    found: Option<ConflictBox>,
+    /// Placements in the current pair of pieces, by robot (first or not) and position.
+    placed: HashMap<(bool, u64), Rc<Placed>>,
+}
+
+impl PairDiagram<'_> {
+    /// Robot `path` placed at position `s`, remembered for the current pair of pieces (halving
+    /// along one robot keeps the other where it was).
+    fn place(&mut self, path: &RobotPath, first: bool, s: f64) -> Rc<Placed> {
+        let key = (first, s.to_bits());
+        if let Some(p) = self.placed.get(&key) {
+            return Rc::clone(p);
+        }
+        let p = Rc::new(self.place_new(path, first, s));
+        self.placed.insert(key, Rc::clone(&p));
+        p
+    }
+
+    fn place_new(&mut self, path: &RobotPath, first: bool, s: f64) -> Placed {
+        let robot = &self.ctx.cell.robots[path.robot];
+        let q = path.at(s);
+        robot.body_poses(&q, &mut self.scratch);
+        let local = if first { &self.sa } else { &self.sb };
+        let (spheres, bodies) = local
+            .iter()
+            .zip(&self.scratch.bodies)
+            .enumerate()
+            .filter_map(|(i, (s, p))| s.map(|(c, r)| ((p.transform_point(c), r), i)))
+            .unzip();
+        Placed {
+            q,
+            poses: self.scratch.bodies.clone(),
+            spheres,
+            bodies,
+        }
+    }
+
+    /// Lower bound of the distance between the two placed robots from their sphere covers
+    /// (body spheres first), exact up to `cap` (farther is `cap`).
+    fn cover_distance(&self, xa: &Placed, xb: &Placed, cap: f64) -> f64 {
+        let mut best = cap;
+        for (i, (ca, ra)) in xa.spheres.iter().enumerate() {
+            for (j, (cb, rb)) in xb.spheres.iter().enumerate() {
+                if (*ca - *cb).length() - ra - rb >= best {
+                    continue;
+                }
+                let (bi, bj) = (xa.bodies[i], xb.bodies[j]);
+                let (pa, pb) = (&xa.poses[bi], &xb.poses[bj]);
+                let placed: Vec<(DVec3, f64)> = self.cb[bj]
+                    .iter()
+                    .map(|(c, r)| (pb.transform_point(*c), *r))
+                    .collect();
+                for (c, r) in &self.ca[bi] {
+                    let c = pa.transform_point(*c);
+                    for (d, q) in &placed {
+                        let gap = (c - *d).length() - r - q;
+                        if gap < best {
+                            best = gap;
+                        }
+                    }
+                }
+                if best <= 0.0 {
+                    return 0.0;
+                }
+            }
+        }
+        best
+    }
+
+    /// How far any point of the robot can be from where it is at `mid` while at positions in
+    /// `[from, to]` (inside one piece).
+    fn reach(&self, r: usize, mid: &[f64], path: &RobotPath, from: f64, to: f64, moving: bool) -> f64 {
+        if !moving || to <= from {
+            return 0.0;
+        }
+        let radii = &self.ctx.radii[r];
+        [from, to]
+            .iter()
+            .map(|&s| {
+                let q = path.at(s);
+                q.iter()
+                    .zip(mid)
+                    .zip(radii)
+                    .map(|((a, b), r)| r * (a - b).abs())
+                    .sum::<f64>()
+            })
+            .fold(0.0, f64::max)
+    }
+
+    /// Rectangle `[a0, a1] × [b0, b1]` inside pieces of the two paths: free, or halved, or
+    /// recorded as in conflict.
+    fn cell(&mut self, a: (f64, f64, bool), b: (f64, f64, bool)) {
+        // Inside what is already in conflict: nothing to learn.
+        if self
+            .found
+            .as_ref()
+            .is_some_and(|f| f.a.0 <= a.0 && a.1 <= f.a.1 && f.b.0 <= b.0 && b.1 <= f.b.1)
+        {
+            return;
+        }
+        self.work.cells += 1;
+        let margin = self.ctx.margin;
+        let (pa, pb) = (self.pa, self.pb);
+        let (ma, mb) = (0.5 * (a.0 + a.1), 0.5 * (b.0 + b.1));
+        let xa = self.place(pa, true, ma);
+        let xb = self.place(pb, false, mb);
+        let ra = self.reach(pa.robot, &xa.q, pa, a.0, a.1, a.2);
+        let rb = self.reach(pb.robot, &xb.q, pb, b.0, b.1, b.2);
+        let need = margin + ra + rb;
+        let split_a = a.2 && a.1 - a.0 > MIN_CELL;
+        let split_b = b.2 && b.1 - b.0 > MIN_CELL;
+        // The sphere covers hold the meshes: their distance is a lower bound. The exact
+        // distance only where the covers fall short by little, or nothing is left to halve.
+        let covers = self.cover_distance(&xa, &xb, need + COVER_SLACK);
+        if covers > need {
+            return;
+        }
+        if covers > need - COVER_SLACK || !(split_a || split_b) {
+            let world = &self.ctx.cell.world;
+            self.work.distances += 1;
+            let d = world.group_group_distance(
+                self.ctx.cell.robots[pa.robot].group,
+                &xa.poses,
+                self.ctx.cell.robots[pb.robot].group,
+                &xb.poses,
+                need + DISTANCE_CAP,
+            );
+            if d > need {
+                return;
+            }
+        }
+        match (split_a, split_b) {
+            (false, false) => {
+                let f = self.found.get_or_insert(ConflictBox {
+                    robots: (pa.robot, pb.robot),
+                    a: (a.0, a.1),
+                    b: (b.0, b.1),
+                });
+                f.a = (f.a.0.min(a.0), f.a.1.max(a.1));
+                f.b = (f.b.0.min(b.0), f.b.1.max(b.1));
+            }
+            (true, false) => self.halve_a(a, b),
+            (false, true) => self.halve_b(a, b),
+            (true, true) => {
+                if ra >= rb {
+                    self.halve_a(a, b)
+                } else {
+                    self.halve_b(a, b)
+                }
+            }
+        }
+    }
+
+    fn halve_a(&mut self, a: (f64, f64, bool), b: (f64, f64, bool)) {
+        let m = 0.5 * (a.0 + a.1);
+        self.cell((a.0, m, a.2), b);
+        self.cell((m, a.1, a.2), b);
+    }
+
+    fn halve_b(&mut self, a: (f64, f64, bool), b: (f64, f64, bool)) {
+        let m = 0.5 * (b.0 + b.1);
+        self.cell(a, (b.0, m, b.2));
+        self.cell(a, (m, b.1, b.2));
+    }
+}
+
+/// The conflict boxes of robots `pa` and `pb`, and the work done.
+fn pair_boxes(ctx: &Ctx, pa: &RobotPath, pb: &RobotPath) -> (Vec<ConflictBox>, DiagramWork) {
+    let cell = ctx.cell;
+    let mut d = PairDiagram {
+        ctx,
+        pa,
+        pb,
+        sa: body_spheres(ctx, &cell.robots[pa.robot]),
+        sb: body_spheres(ctx, &cell.robots[pb.robot]),
+        ca: covers(ctx, &cell.robots[pa.robot]),
+        cb: covers(ctx, &cell.robots[pb.robot]),
+        scratch: Scratch::default(),
+        work: DiagramWork::default(),
+        found: None,
+        placed: HashMap::new(),
+    };
+    let mut boxes = Vec::new();
+    for x in &pa.pieces {
+        for y in &pb.pieces {
+            d.cell((x.from, x.to, x.moving), (y.from, y.to, y.moving));
+            boxes.extend(d.found.take());
+            d.placed.clear();
+        }
+    }
+    (boxes, d.work)
+}
+
+/// The conflict boxes of every robot pair (pairs in order, in parallel; the result does not
+/// depend on the thread count).
+pub(crate) fn diagrams(ctx: &Ctx, paths: &[RobotPath]) -> (Vec<ConflictBox>, DiagramWork) {
+    let pairs: Vec<(usize, usize)> = (0..paths.len())
+        .flat_map(|a| (a + 1..paths.len()).map(move |b| (a, b)))
+        .collect();
+    let parts: Vec<(Vec<ConflictBox>, DiagramWork)> = pairs
+        .par_iter()
+        .map(|&(a, b)| pair_boxes(ctx, &paths[a], &paths[b]))
+        .collect();
+    let mut work = DiagramWork::default();
+    let mut boxes = Vec::new();
+    for (b, w) in parts {
+        work.cells += w.cells;
+        work.distances += w.distances;
+        boxes.extend(b);
+    }
+    (boxes, work)
+}
