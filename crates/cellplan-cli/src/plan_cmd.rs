@@ -358,7 +358,11 @@ fn render(doc: &output::Plan, working: &str) -> String {
     if !doc.unmeasured.is_empty() {
         s += "\nnot measured:\n";
         for u in &doc.unmeasured {
-            s += &format!("  {}: {}\n", u.task, u.reason);
+            s += &format!("  {}: {}", u.task, u.reason);
+            if let Some(d) = &u.detail {
+                s += &format!(" ({d})");
+            }
+            s += "\n";
         }
     }
     s

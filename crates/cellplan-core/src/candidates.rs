@@ -71,7 +71,11 @@ impl CandidateTable {
 /// the result does not depend on the thread count.
 pub fn generate(cell: &Cell) -> CandidateTable {
     let process = cell.process.as_ref();
-    let parked: Vec<_> = cell.robots.iter().map(|r| parked_others(cell, r)).collect();
+    let validity: Vec<_> = cell
+        .robots
+        .iter()
+        .map(|r| crate::motion::robot_validity(cell, r, cell.planning.clearance))
+        .collect();
     let table = cell
         .tasks
         .par_iter()
@@ -79,8 +83,8 @@ pub fn generate(cell: &Cell) -> CandidateTable {
             let poses = process.tool_poses(task);
             cell.robots
                 .par_iter()
-                .zip(&parked)
-                .map(|(robot, parked)| reach(cell, process, robot, task, &poses, parked))
+                .zip(&validity)
+                .map(|(robot, validity)| reach(cell, process, robot, task, &poses, validity))
                 .collect()
         })
         .collect();
@@ -115,16 +119,19 @@ pub fn parked_others(cell: &cellplan_model::Cell, robot: &Robot) -> Vec<(GroupId
         .collect()
 }
 
-/// The candidates of one robot for one task among the tool `poses`, clear of the `parked`
-/// robots (see [`parked_others`]): the process's pose check, IK within the joint limits, the
-/// process's checks of the reached pose and of each configuration, then collision.
+/// The candidates of one robot for one task among the tool `poses`: the process's pose
+/// check, IK within the joint limits, the process's checks of the reached pose and of each
+/// configuration, then collision — decided by `validity`, the robot's checker as the leg
+/// planner uses it ([`crate::motion::robot_validity`] at the cell's clearance, with the other
+/// robots parked at home, see [`parked_others`]): a configuration the planner would refuse to
+/// leave or reach is no candidate.
 pub fn reach(
     cell: &Cell,
     process: &dyn Process,
     robot: &Robot,
     task: &Task,
     poses: &[Pose],
-    parked: &[(GroupId, Vec<Pose>)],
+    validity: &crate::motion::RobotValidity,
 ) -> Reach {
     let world = &cell.world;
     let mut reach = Reach::default();
@@ -167,7 +174,7 @@ pub fn reach(
             let verdict = match verdicts.iter().find(|(p, _)| same_geometry(p, q)) {
                 Some((_, v)) => *v,
                 None => {
-                    let v = check_configuration(cell, process, robot, task, tcp, q, parked, &mut scratch);
+                    let v = check_configuration(cell, process, robot, task, tcp, q, validity, &mut scratch);
                     verdicts.push((q.clone(), v));
                     v
                 }
@@ -191,7 +198,7 @@ pub fn reach(
 }
 
 /// The process's checks of one configuration (the cheap ones first), then collision with the
-/// scene, the robot itself and the parked robots.
+/// scene, the robot itself and the parked robots, by the planner's own test.
 #[allow(clippy::too_many_arguments)]
 fn check_configuration(
     cell: &Cell,
@@ -200,24 +207,15 @@ fn check_configuration(
     task: &Task,
     tcp: &Pose,
     q: &[f64],
-    parked: &[(GroupId, Vec<Pose>)],
+    validity: &crate::motion::RobotValidity,
     scratch: &mut Scratch,
 ) -> Result<(), Rejection> {
-    let (world, clearance) = (&cell.world, cell.planning.clearance);
     robot.body_poses(q, scratch);
     process
-        .arm_check(world, robot, &scratch.bodies, task, tcp)
+        .arm_check(&cell.world, robot, &scratch.bodies, task, tcp)
         .map_err(Rejection::Reached)?;
-    if robot.contact_at(world, scratch, clearance).is_some() {
+    if !validity.is_valid(q) {
         return Err(Rejection::Collision);
-    }
-    for (group, poses) in parked {
-        if world
-            .group_vs_group(robot.group, &scratch.bodies, *group, poses, clearance)
-            .is_some()
-        {
-            return Err(Rejection::Collision);
-        }
     }
     Ok(())
 }

@@ -379,6 +379,19 @@ fn edited_plans_are_refused_or_caught() {
                 p.unmeasured.push(output::UnmeasuredTask {
                     task,
                     reason: "no-ik".into(),
+                    detail: None,
+                });
+            },
+            Some(ViolationKind::Unmeasured),
+        ),
+        (
+            "a task done and listed as without a path",
+            |p, r, _| {
+                let task = p.robots[r].tasks[0].task.clone();
+                p.unmeasured.push(output::UnmeasuredTask {
+                    task,
+                    reason: output::NO_PATH.into(),
+                    detail: Some("made up".into()),
                 });
             },
             Some(ViolationKind::Unmeasured),
@@ -694,4 +707,40 @@ fn sequencing_against_a_bar_stops_before_planning() {
     // A bar just above the real time does not stop it.
     let kept = run(real + 1.0, &mut planned.clone());
     assert!(!kept.beaten);
+}
+
+/// A leg the sampler cannot solve never loses the plan: with no samples at all, every leg
+/// that is not a straight segment fails; a task every order reaches only through such legs
+/// is given up by its robot, tried on the other robot, and listed unmeasured (`no-path`, with
+/// the planner's words) — the rest is planned and the verifier accepts the plan.
+#[test]
+fn a_task_without_a_path_is_given_up_and_the_rest_planned() {
+    let f = fixture();
+    let mut s = settings(Allocation::Balanced);
+    s.motion.max_samples = 1;
+    s.final_max_samples = 1;
+    s.alternatives = 1;
+    let outcome = plan::plan(&f.cell, &f.table, &s, &|_| {}).expect("a plan despite the legs");
+    let doc = build(&f.cell, &f.table, &outcome, &s);
+    assert!(
+        !outcome.unreached.is_empty(),
+        "this budget must leave some task without a path"
+    );
+    for u in &outcome.unreached {
+        let name = &f.cell.tasks[u.0.0].name;
+        let listed = doc.unmeasured.iter().find(|x| &x.task == name).expect("listed");
+        assert_eq!(listed.reason, output::NO_PATH);
+        assert!(
+            listed
+                .detail
+                .as_deref()
+                .is_some_and(|d| d.contains("no collision-free path"))
+        );
+        assert!(doc.robots.iter().all(|r| r.tasks.iter().all(|v| &v.task != name)));
+    }
+    let done: usize = doc.robots.iter().map(|r| r.tasks.len()).sum();
+    assert_eq!(done + doc.unmeasured.len(), f.cell.tasks.len());
+    assert!(done > 0);
+    check_plan(&f.cell, &doc);
+    verified(&f.cell, &doc);
 }

@@ -215,13 +215,18 @@ fn check_counts(cell: &Cell, table: &CandidateTable, plan: &Plan, count: &[usize
         }
         if let Some(&reason) = listed.get(name) {
             let expected = cellplan_core::document::unmeasured_reason(table, t);
-            if doable {
+            // A task robots can reach may be given up when the planner found no path to it:
+            // the plan says so (`no-path`); a search's failure is not a number to re-derive.
+            if doable && reason != cellplan_core::document::NO_PATH {
                 out.push(task_violation(
                     ViolationKind::Unmeasured,
                     name,
-                    "listed as undoable, but a robot has a candidate for it".into(),
+                    format!(
+                        "listed as undoable for `{reason}`, but a robot has a candidate for it (only `{}` may be said of such a task)",
+                        cellplan_core::document::NO_PATH
+                    ),
                 ));
-            } else if reason != expected {
+            } else if !doable && reason != expected {
                 out.push(task_violation(
                     ViolationKind::Unmeasured,
                     name,

@@ -162,8 +162,9 @@ pub(crate) struct Ctx<'a> {
     pub limits: Vec<Limits>,
     pub margin: f64,
     pub settings: &'a CoordSettings,
-    /// Per robot, the others parked at home (see [`crate::candidates::parked_others`]).
-    pub parked: Vec<Vec<(cellplan_geom::GroupId, Vec<cellplan_geom::Pose>)>>,
+    /// Per robot, its validity checker at the cell's clearance (the others parked at home),
+    /// as candidates are checked.
+    pub validity: Vec<crate::motion::RobotValidity<'a>>,
 }
 
 impl<'a> Ctx<'a> {
@@ -179,10 +180,10 @@ impl<'a> Ctx<'a> {
             limits: cell.robots.iter().map(limits_of).collect(),
             margin: cell.planning.clearance + REPLAY_SLACK,
             settings,
-            parked: cell
+            validity: cell
                 .robots
                 .iter()
-                .map(|r| crate::candidates::parked_others(cell, r))
+                .map(|r| crate::motion::robot_validity(cell, r, cell.planning.clearance))
                 .collect(),
         }
     }

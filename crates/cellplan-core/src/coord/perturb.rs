@@ -59,7 +59,7 @@ fn alternatives(ctx: &Ctx, program: &Program, v: usize, candidates: bool) -> Vec
         robot,
         task,
         &poses,
-        &ctx.parked[program.robot],
+        &ctx.validity[program.robot],
     );
     let base = wpr(orig.tcp.rotation);
     let base_pert = orig.perturbation.unwrap_or([0.0; 3]);

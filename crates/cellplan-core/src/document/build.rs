@@ -51,7 +51,7 @@ pub fn build(
         verified: false,
         coordination: coordination_out(cell, outcome, coordinated),
         robots,
-        unmeasured: unmeasured(cell, table),
+        unmeasured: unmeasured(cell, table, &outcome.unreached),
         stats: stats(table, outcome, coordinated),
         compute_s: compute_times(outcome, coordinated, load_s, candidates_s),
     }
@@ -201,13 +201,24 @@ fn coordination_out(cell: &Cell, outcome: &Outcome, coordinated: &Coordinated) -
     }
 }
 
-/// The tasks no robot can do, each with the furthest check any pose passed.
-fn unmeasured(cell: &Cell, table: &CandidateTable) -> Vec<UnmeasuredTask> {
+/// The tasks no robot can do, each with the furthest check any pose passed, and those no
+/// robot was given a path to (`no-path`, with the planner's words), in task order.
+fn unmeasured(cell: &Cell, table: &CandidateTable, unreached: &[(TaskId, String)]) -> Vec<UnmeasuredTask> {
     (0..cell.tasks.len())
-        .filter(|&t| table.robots_for(TaskId(t)).is_empty())
-        .map(|t| UnmeasuredTask {
-            task: cell.tasks[t].name.clone(),
-            reason: unmeasured_reason(table, t).to_string(),
+        .filter_map(|t| {
+            if table.robots_for(TaskId(t)).is_empty() {
+                Some((unmeasured_reason(table, t).to_string(), None))
+            } else {
+                unreached
+                    .iter()
+                    .find(|u| u.0 == TaskId(t))
+                    .map(|u| (super::NO_PATH.to_string(), Some(u.1.clone())))
+            }
+            .map(|(reason, detail)| UnmeasuredTask {
+                task: cell.tasks[t].name.clone(),
+                reason,
+                detail,
+            })
         })
         .collect()
 }

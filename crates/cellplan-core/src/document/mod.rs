@@ -342,9 +342,17 @@ pub struct UnmeasuredTask {
     /// Task id.
     pub task: String,
     /// The furthest check any robot's pose passed: the process's rejection code (`view-angle`,
-    /// `stripe`, … for the optical probe) or `no-ik`, `joint-limits`, `collision`.
+    /// `stripe`, … for the optical probe) or `no-ik`, `joint-limits`, `collision`; or
+    /// [`NO_PATH`] when robots have poses for it but the motion planner found no path to any
+    /// of them within its budget (see `detail`).
     pub reason: String,
+    /// The planner's words for `no-path` (which leg, why); absent otherwise.
+    #[serde(default)]
+    pub detail: Option<String>,
 }
+
+/// The reason of a task robots can reach but were given no path to.
+pub const NO_PATH: &str = "no-path";
 
 /// Counts of the search.
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq, JsonSchema)]

@@ -264,6 +264,9 @@ pub struct Outcome {
     pub robots: Vec<RobotResult>,
     /// Seconds per stage, in stage order.
     pub compute: Vec<(Stage, f64)>,
+    /// Tasks some robot has candidates for but no robot could be given a path to (each given
+    /// up by its robot, then tried on every other robot that can do it): why.
+    pub unreached: Vec<(TaskId, String)>,
 }
 
 /// Plan `cell` from its candidate table. `progress` is told when each stage starts.
@@ -379,6 +382,17 @@ pub fn plan(
             }
         }
     }
+    let unreached = reassign_dropped(
+        cell,
+        table,
+        &graphs,
+        settings,
+        deadline,
+        &mut sequences,
+        &mut allocated,
+        &mut planned,
+        &mut counts,
+    )?;
     for (s, c) in sequences.iter_mut().zip(&counts) {
         (s.legs_planned, s.legs_sampled, s.legs_failed) = *c;
     }
@@ -401,7 +415,78 @@ pub fn plan(
         allocated,
         robots,
         compute,
+        unreached,
     })
+}
+
+/// The tasks the robots gave up (no path), each tried on the other robots that have
+/// candidates for it, the least busy first: the first whose sequence then includes it, giving
+/// up nothing else, takes it. Returns the tasks nobody could take, with the first robot's
+/// reason.
+#[allow(clippy::too_many_arguments)]
+fn reassign_dropped(
+    cell: &Cell,
+    table: &CandidateTable,
+    graphs: &[RobotGraph],
+    settings: &PlanSettings,
+    deadline: Instant,
+    sequences: &mut [sequence::Sequence],
+    allocated: &mut allocate::Allocated,
+    planned: &mut [sequence::Planned],
+    counts: &mut [(usize, usize, usize)],
+) -> Result<Vec<(TaskId, String)>, PlanError> {
+    let dropped: Vec<(usize, TaskId, String)> = sequences
+        .iter_mut()
+        .enumerate()
+        .flat_map(|(r, s)| {
+            std::mem::take(&mut s.dropped)
+                .into_iter()
+                .map(move |(t, why)| (r, t, why))
+        })
+        .collect();
+    let mut unreached = Vec::new();
+    for (r, t, why) in dropped {
+        allocated.tasks[r].retain(|&x| x != t);
+        let mut others: Vec<usize> = table
+            .robots_for(t)
+            .into_iter()
+            .map(|id| id.0)
+            .filter(|&s| s != r)
+            .collect();
+        let time = |s: usize| sequence::order_cost(&graphs[s], &planned[s], &sequences[s].nodes);
+        let times: Vec<f64> = (0..sequences.len()).map(time).collect();
+        others.sort_by(|&a, &b| times[a].total_cmp(&times[b]).then(a.cmp(&b)));
+        let mut taken = false;
+        for s in others {
+            let mut tasks = allocated.tasks[s].clone();
+            tasks.push(t);
+            let seq = sequence::sequence(
+                cell,
+                &cell.robots[s],
+                &graphs[s],
+                &tasks,
+                settings,
+                deadline,
+                f64::INFINITY,
+                None,
+                &mut planned[s],
+            )?;
+            counts[s].0 += seq.legs_planned;
+            counts[s].1 += seq.legs_sampled;
+            counts[s].2 += seq.legs_failed;
+            if seq.dropped.is_empty() {
+                sequences[s] = seq;
+                allocated.tasks[s] = tasks;
+                taken = true;
+                break;
+            }
+        }
+        if !taken {
+            unreached.push((t, why));
+        }
+    }
+    unreached.sort_by_key(|u| u.0);
+    Ok(unreached)
 }
 
 /// The time `cell`'s process spends at `task` (s).

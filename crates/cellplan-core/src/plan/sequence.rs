@@ -49,6 +49,9 @@ pub struct Sequence {
     /// The search stopped because no order could finish below the bar it was given: `nodes`
     /// and `legs` are empty (the counts still say what was planned).
     pub beaten: bool,
+    /// Tasks given up (not in `nodes`): every order found needed a leg to or from them that
+    /// the planner could not solve with its full budget; with why.
+    pub dropped: Vec<(TaskId, String)>,
 }
 
 /// Kicks of the GTSP heuristic per sequencing round (fixed, for determinism).
@@ -69,6 +72,10 @@ pub type Planned = BTreeMap<(usize, usize), Result<Leg, LegError>>;
 /// then stay in `planned`. Pass `f64::INFINITY` to always finish. `first`, when given, is the
 /// first round's order, as [`best_order`] gives it for the same `planned` (already computed by
 /// a caller that looked before it leapt).
+///
+/// A task that every order still reaches through a leg without a path (after the full-budget
+/// retry) is given up: listed in [`Sequence::dropped`] with the planner's reason, and the rest
+/// sequenced without it. One hard task never loses the robot's sequence.
 #[allow(clippy::too_many_arguments)]
 pub fn sequence(
     cell: &Cell,
@@ -81,6 +88,94 @@ pub fn sequence(
     mut first: Option<Vec<usize>>,
     planned: &mut Planned,
 ) -> Result<Sequence, PlanError> {
+    let mut tasks = tasks.to_vec();
+    let mut dropped = Vec::new();
+    let (mut legs_planned, mut legs_sampled, mut legs_failed, mut rounds) = (0, 0, 0, 0);
+    loop {
+        let (mut seq, failed) = attempt(
+            cell,
+            robot,
+            graph,
+            &tasks,
+            settings,
+            deadline,
+            bar,
+            first.take(),
+            planned,
+        );
+        legs_planned += seq.legs_planned;
+        legs_sampled += seq.legs_sampled;
+        legs_failed += seq.legs_failed;
+        rounds += seq.rounds;
+        match failed {
+            None => {
+                seq.legs_planned = legs_planned;
+                seq.legs_sampled = legs_sampled;
+                seq.legs_failed = legs_failed;
+                seq.rounds = rounds;
+                seq.dropped = dropped;
+                return Ok(seq);
+            }
+            Some((a, b, e)) => {
+                let t = hardest_task(graph, planned, a, b);
+                tasks.retain(|&x| x != t);
+                dropped.push((
+                    t,
+                    format!(
+                        "no collision-free path from {} to {}: {e}",
+                        stop_of(cell, graph, a),
+                        stop_of(cell, graph, b)
+                    ),
+                ));
+            }
+        }
+    }
+}
+
+/// Of the two ends of a leg without a path, the task to give up: the one whose candidates'
+/// planned legs failed the most often (home is never given up).
+fn hardest_task(graph: &RobotGraph, planned: &Planned, a: usize, b: usize) -> TaskId {
+    let share = |n: usize| -> Option<(f64, TaskId)> {
+        let (task, _) = graph.node_task[n]?;
+        let nodes: Vec<usize> = (0..graph.len())
+            .filter(|&m| graph.node_task[m].is_some_and(|(t, _)| t == task))
+            .collect();
+        let (mut failed, mut all) = (0usize, 0usize);
+        for (&(x, y), leg) in planned {
+            if nodes.contains(&x) || nodes.contains(&y) {
+                all += 1;
+                failed += usize::from(leg.is_err());
+            }
+        }
+        Some((failed as f64 / all.max(1) as f64, task))
+    };
+    match (share(a), share(b)) {
+        (Some(x), Some(y)) => {
+            if x.0 > y.0 {
+                x.1
+            } else {
+                y.1
+            }
+        }
+        (Some(x), None) | (None, Some(x)) => x.1,
+        (None, None) => unreachable!("a leg from home to home always has a path (it stands still)"),
+    }
+}
+
+/// One run of the lazy loop on `tasks`; with the leg of the final order that still has no
+/// path, if any (then the sequence's nodes and legs are empty).
+#[allow(clippy::too_many_arguments)]
+fn attempt(
+    cell: &Cell,
+    robot: &Robot,
+    graph: &RobotGraph,
+    tasks: &[TaskId],
+    settings: &PlanSettings,
+    deadline: Instant,
+    bar: f64,
+    mut first: Option<Vec<usize>>,
+    planned: &mut Planned,
+) -> (Sequence, Option<(usize, usize, LegError)>) {
     let mut out = Sequence::default();
     // The best order whose every leg is planned, with its real time.
     let mut best: Option<(f64, Vec<usize>)> = None;
@@ -94,7 +189,7 @@ pub fn sequence(
         let optimistic = order_cost(graph, planned, &nodes);
         if optimistic >= bar {
             out.beaten = true;
-            return Ok(out);
+            return (out, None);
         }
         // No order can beat the best real one by more than the tolerance: stop.
         if let Some((b, order)) = &best
@@ -182,21 +277,14 @@ pub fn sequence(
     for (a, b) in legs_of(&nodes) {
         let leg = match planned.get(&key(a, b)) {
             Some(Ok(leg)) => leg.clone(),
-            Some(Err(e)) => {
-                return Err(PlanError::NoPath {
-                    robot: robot.name.clone(),
-                    from: stop_of(cell, graph, a),
-                    to: stop_of(cell, graph, b),
-                    source: e.clone(),
-                });
-            }
+            Some(Err(e)) => return (out, Some((a, b, e.clone()))),
             None => unreachable!("every leg of the final order is planned"),
         };
         legs.push(if (a, b) == key(a, b) { leg } else { reversed(leg) });
     }
     out.nodes = nodes;
     out.legs = legs;
-    Ok(out)
+    (out, None)
 }
 
 /// Give the sampled legs of a final sequence the full shortcutting (the lazy rounds used a few
