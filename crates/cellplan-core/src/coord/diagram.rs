@@ -9,8 +9,9 @@
 //! point of the robot moves farther from where it is at the interval's middle than
 //! `max over both ends of Σ_j r_j·|q_j(end) − q_j(middle)|` (the per-joint radii). A rectangle
 //! of positions is therefore free when the distance of the two robots at its centre exceeds the
-//! clearance plus both reaches: no contact is missed between samples. Rectangles that cannot
-//! be proven free are halved (along the robot that moves more) down to [`MIN_CELL`]; those
+//! clearance plus both reaches: no contact is missed between samples (the distance is bounded
+//! below by the robots' sphere covers, and measured exactly on the smallest rectangles only).
+//! Rectangles that cannot be proven free are halved (along the robot that moves more) down to [`MIN_CELL`]; those
 //! left are in conflict. Each pair of pieces (one of each path) keeps the bounding box of its
 //! conflicts: a box per pair of pieces follows the shape of a long conflict as a staircase,
 //! where one bounding box of the whole would serialise the robots.
@@ -25,10 +26,9 @@ use std::rc::Rc;
 
 /// Smallest rectangle side (s of position) that is still halved.
 pub(crate) const MIN_CELL: f64 = 0.02;
-/// Distances are measured up to this (m) beyond what a rectangle needs.
-const DISTANCE_CAP: f64 = 2.0;
-/// How much the sphere covers may fall short before the exact distance is asked (m).
-const COVER_SLACK: f64 = 0.02;
+/// Distances are measured up to this (m) beyond what a rectangle needs (a larger cap only
+/// costs work: the answer is whether the distance exceeds the need).
+const DISTANCE_SLACK: f64 = 1e-3;
 
 /// Where a robot can stand still: a waypoint it reaches at rest (every waypoint, since legs are
 /// timed rest to rest, except the last of each leg: that is the MP, whose measurement follows).
@@ -310,12 +310,13 @@ impl PairDiagram<'_> {
         let split_a = a.2 && a.1 - a.0 > MIN_CELL;
         let split_b = b.2 && b.1 - b.0 > MIN_CELL;
         // The sphere covers hold the meshes: their distance is a lower bound. The exact
-        // distance only where the covers fall short by little, or nothing is left to halve.
-        let covers = self.cover_distance(&xa, &xb, need + COVER_SLACK);
+        // distance only where nothing is left to halve (halving is cheaper than GJK, and
+        // the covers decide most rectangles once small).
+        let covers = self.cover_distance(&xa, &xb, need + DISTANCE_SLACK);
         if covers > need {
             return;
         }
-        if covers > need - COVER_SLACK || !(split_a || split_b) {
+        if !(split_a || split_b) {
             let world = &self.ctx.cell.world;
             self.work.distances += 1;
             let d = world.group_group_distance(
@@ -323,7 +324,7 @@ impl PairDiagram<'_> {
                 &xa.poses,
                 self.ctx.cell.robots[pb.robot].group,
                 &xb.poses,
-                need + DISTANCE_CAP,
+                need + DISTANCE_SLACK,
             );
             if d > need {
                 return;
