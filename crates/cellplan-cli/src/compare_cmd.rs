@@ -92,10 +92,11 @@ struct Report {
     summary: Vec<Summary>,
 }
 
-const ALLOCATIONS: [Allocation; 3] = [
+const ALLOCATIONS: [Allocation; 4] = [
     Allocation::Proximity,
     Allocation::LocalRobust,
     Allocation::Balanced,
+    Allocation::Zones,
 ];
 
 pub fn run(args: &CompareArgs) -> Result<(), Failure> {
@@ -120,8 +121,8 @@ pub fn run(args: &CompareArgs) -> Result<(), Failure> {
         }
         pb.set_message(format!("case {}/{cases}: candidates", case + 1));
         let table = candidates::generate(&cell);
-        // The balanced run, for ours.
-        let mut balanced = None;
+        // The zones run, for ours.
+        let mut zones = None;
         for allocation in ALLOCATIONS {
             pb.set_message(format!("case {}/{cases}: planning with {}", case + 1, allocation));
             let settings = PlanSettings {
@@ -163,11 +164,11 @@ pub fn run(args: &CompareArgs) -> Result<(), Failure> {
                 };
                 rows.push(row);
             }
-            if allocation == Allocation::Balanced {
-                balanced = Some((outcome, settings, plan_s));
+            if allocation == Allocation::Zones {
+                zones = Some((outcome, settings, plan_s));
             }
         }
-        rows.push(ours(&cell, &table, balanced, case, args.seed));
+        rows.push(ours(&cell, &table, zones, case, args.seed));
     }
     pb.finish_and_clear();
     let summary = summarise(&rows);
@@ -249,7 +250,7 @@ fn html(report: &Report) -> String {
                     }
                     CompareRow {
                         cells,
-                        ours: r.allocation == "balanced+proximity",
+                        ours: r.allocation == "zones+feedback",
                     }
                 })
                 .collect();
@@ -289,7 +290,7 @@ fn html(report: &Report) -> String {
                         f2(m.compute_mean_s),
                         f2(m.coordination_compute_mean_s),
                     ],
-                    ours: m.allocation == "balanced+proximity",
+                    ours: m.allocation == "zones+feedback",
                 })
                 .collect();
             let bars = report
@@ -331,24 +332,24 @@ fn html(report: &Report) -> String {
 }
 
 /// Ours, whole, as `cellplan plan` decides it ([`pipeline::coordinate`]): `best` coordination
-/// of the balanced allocation, with the proximity allocation planned and coordinated too and
-/// the shorter cycle kept (compute: the balanced planning and everything the pipeline did
-/// after it).
+/// of the zones allocation, planned again knowing what its measurements blocked the other
+/// robots, the shorter coordinated cycle kept (compute: the first zones planning and
+/// everything the pipeline did after it).
 fn ours(
     cell: &Cell,
     table: &CandidateTable,
-    balanced: Option<(plan::Outcome, PlanSettings, f64)>,
+    zones: Option<(plan::Outcome, PlanSettings, f64)>,
     case: usize,
     seed: u64,
 ) -> Row {
     let label = |row: Row| Row {
-        allocation: "balanced+proximity".into(),
+        allocation: "zones+feedback".into(),
         ..row
     };
-    let Some((outcome, settings, plan_s)) = balanced else {
+    let Some((outcome, settings, plan_s)) = zones else {
         return label(failed(
             case,
-            Allocation::Balanced,
+            Allocation::Zones,
             Coordination::Best,
             "no plan".into(),
         ));
@@ -359,19 +360,14 @@ fn ours(
         ..CoordSettings::default()
     };
     let lap = Instant::now();
-    match pipeline::coordinate(cell, table, outcome, settings, &cs) {
+    match pipeline::coordinate(cell, table, outcome, settings, &cs, &mut Default::default()) {
         Ok((outcome, settings, c)) => {
             let spent = plan_s + lap.elapsed().as_secs_f64();
             let doc = output::build(cell, table, &outcome, &c, &settings, 0.0, 0.0);
             let report = verify_with(cell, Some(table), &doc, &VerifySettings::default());
             label(row_of(case, &doc, report.ok, spent, c.compute_s))
         }
-        Err(e) => label(failed(
-            case,
-            Allocation::Balanced,
-            Coordination::Best,
-            e.to_string(),
-        )),
+        Err(e) => label(failed(case, Allocation::Zones, Coordination::Best, e.to_string())),
     }
 }
 

@@ -21,7 +21,7 @@ pub struct PlanArgs {
     #[arg(short, long, value_name = "DIR")]
     output: Option<PathBuf>,
     /// Allocation strategy.
-    #[arg(long, value_enum, default_value_t = Allocation::Balanced)]
+    #[arg(long, value_enum, default_value_t = Allocation::Zones)]
     allocation: Allocation,
     /// Set-cover method of the local-robust allocation.
     #[arg(long, value_enum, default_value_t = CoverMethod::Penalty)]
@@ -78,6 +78,8 @@ struct Summary<'a> {
     report_file: Option<String>,
     cycle_time_s: f64,
     delta_t_s: f64,
+    /// Whether Δt is within the cell's balance limit γ (true without one).
+    balance_limit_met: bool,
     lower_bound_s: f64,
     ratio_to_lower_bound: f64,
     robots: Vec<RobotSummary<'a>>,
@@ -162,10 +164,10 @@ pub fn run(args: &PlanArgs) -> Result<(), Failure> {
                 Step::Plan(Stage::Allocation) => format!("allocating {} to robots", words.tasks),
                 Step::Plan(Stage::Sequencing) => "sequencing and planning collision-free legs".into(),
                 Step::Plan(Stage::Timing) => "timing the trajectories".into(),
-                Step::Coordination { proximity_too: true } => {
-                    "coordinating the robots on one clock (and the proximity allocation against it)".into()
+                Step::Coordination { zones_too: true } => {
+                    "coordinating the robots on one clock (and the zones allocation against it)".into()
                 }
-                Step::Coordination { proximity_too: false } => "coordinating the robots on one clock".into(),
+                Step::Coordination { zones_too: false } => "coordinating the robots on one clock".into(),
                 Step::Verification => "verifying the plan".into(),
             })
         }
@@ -226,6 +228,7 @@ pub fn run(args: &PlanArgs) -> Result<(), Failure> {
             report_file: (!args.no_report).then(|| report_file.display().to_string()),
             cycle_time_s: doc.cycle_time_s,
             delta_t_s: doc.delta_t_s,
+            balance_limit_met: balance_met(&doc),
             lower_bound_s: doc.lower_bound_s,
             ratio_to_lower_bound: doc.ratio_to_lower_bound,
             robots: doc
@@ -262,6 +265,13 @@ pub fn run(args: &PlanArgs) -> Result<(), Failure> {
     } else {
         Err(Failure::Infeasible)
     }
+}
+
+/// Whether the plan's Δt is within γ (true when the cell sets none).
+fn balance_met(doc: &output::Plan) -> bool {
+    doc.settings
+        .balance_limit_s
+        .is_none_or(|g| doc.delta_t_s <= g + 1e-9)
 }
 
 fn render(doc: &output::Plan, working: &str) -> String {
@@ -333,6 +343,14 @@ fn render(doc: &output::Plan, working: &str) -> String {
         "\ncycle time {:.2} s   Δt {:.2} s   lower bound {:.2} s (ratio {:.3})\n",
         doc.cycle_time_s, doc.delta_t_s, doc.lower_bound_s, doc.ratio_to_lower_bound
     );
+    if !balance_met(doc)
+        && let Some(g) = doc.settings.balance_limit_s
+    {
+        s += &format!(
+            "balance limit γ = {g:.2} s not met: Δt {:.2} s (the shortest cycle found spreads the robots' end times more)\n",
+            doc.delta_t_s
+        );
+    }
     s += &format!(
         "legs planned {} ({} by the sampling planner), sequencing rounds {}\n",
         doc.stats.legs_planned, doc.stats.legs_sampled, doc.stats.sequencing_rounds

@@ -1,7 +1,8 @@
 //! The pipeline as `cellplan plan` runs it — candidates, allocation, sequencing with lazily
 //! planned legs, timing, coordination, the document and its verification — and the one place
-//! that decides what "ours" is: with `best` coordination and the balanced allocation, the
-//! proximity allocation is planned and coordinated too, and the shorter coordinated cycle wins.
+//! that decides what "ours" is: `best` coordination on the zones allocation, planned and
+//! coordinated twice (the second time each robot's time counts what its measurements blocked
+//! the others in the first), the shorter coordinated cycle kept.
 //! `cellplan compare` takes its "ours" row from here as well.
 use crate::candidates::{self, CandidateTable};
 use crate::check::{cap_error, idle_robot_error};
@@ -18,10 +19,11 @@ pub enum Step {
     Candidates,
     /// A planning stage.
     Plan(Stage),
-    /// Coordination (with `proximity_too` when ours also coordinates the proximity allocation).
+    /// Coordination (with `zones_too` when ours plans and coordinates the zones allocation a
+    /// second time).
     Coordination {
         /// Whether the proximity allocation is coordinated too.
-        proximity_too: bool,
+        zones_too: bool,
     },
     /// The verifier.
     Verification,
@@ -80,11 +82,13 @@ pub fn run<R>(
     if let Some(e) = idle_robot_error(cell, &table).or_else(|| cap_error(cell, &table)) {
         return Err(PipelineError::Input(Box::new(e)));
     }
-    let outcome = plan::plan(cell, &table, settings, &|s| progress(Step::Plan(s)))?;
+    let mut cache = plan::PlanCache::default();
+    let outcome = plan::plan_cached(cell, &table, settings, &|s| progress(Step::Plan(s)), &mut cache)?;
     progress(Step::Coordination {
-        proximity_too: ours_tries_proximity(settings, coord),
+        zones_too: ours_tries_zones(settings, coord),
     });
-    let (outcome, settings, coordinated) = coordinate(cell, &table, outcome, settings.clone(), coord)?;
+    let (outcome, settings, coordinated) =
+        coordinate(cell, &table, outcome, settings.clone(), coord, &mut cache)?;
     let mut plan = document::build(
         cell,
         &table,
@@ -102,65 +106,78 @@ pub fn run<R>(
     Ok(Run { table, plan, report })
 }
 
-/// Whether ours (`best` on the balanced allocation) also plans the proximity allocation.
-pub fn ours_tries_proximity(settings: &PlanSettings, coord: &CoordSettings) -> bool {
-    coord.strategy == Coordination::Best && settings.allocation == Allocation::Balanced
+/// Whether ours runs: `best` on the zones allocation, which then plans and coordinates the
+/// zones allocation a second time, knowing what its measurements blocked the other robots.
+pub fn ours_tries_zones(settings: &PlanSettings, coord: &CoordSettings) -> bool {
+    coord.strategy == Coordination::Best && settings.allocation == Allocation::Zones
 }
 
-/// What `cellplan plan` runs: `outcome` (planned with `settings`) coordinated with
-/// `coord`; with `best` and the balanced allocation (ours), the proximity allocation is planned
-/// and coordinated too, first, and its cycle is the bar of the balanced one
-/// ([`CoordSettings::bar`]); the shorter coordinated cycle (then Δt) wins, with the compute of
-/// both. Returns the winning run, its settings and its coordination.
+/// Weight of the blocking seconds (see [`crate::coord::Coordinated::blocking`]) in the zones
+/// allocation's second round.
+const BLOCKING_WEIGHT: f64 = 0.5;
+
+/// Per task and robot, the seconds `coordinated` says the robot's measurement there blocked
+/// the others, weighted (0 for pairs it did not see).
+fn blocking_penalty(cell: &Cell, outcome: &Outcome, coordinated: &Coordinated) -> Vec<Vec<f64>> {
+    let mut pen = vec![vec![0.0; cell.robots.len()]; cell.tasks.len()];
+    for (r, result) in outcome.robots.iter().enumerate() {
+        let Some(block) = coordinated.blocking.get(r) else {
+            continue;
+        };
+        for (v, visit) in result.program.visits.iter().enumerate() {
+            pen[visit.task.0][r] = BLOCKING_WEIGHT * block.get(v).copied().unwrap_or(0.0);
+        }
+    }
+    pen
+}
+
+/// What `cellplan plan` runs: `outcome` (planned with `settings`) coordinated with `coord`.
+/// With `best` and the zones allocation (ours), the zones allocation is planned again with
+/// what the first plan's measurements blocked the other robots
+/// ([`PlanSettings::task_penalty`]) and coordinated too; the shorter coordinated cycle (then
+/// Δt, then the first) wins, with the coordination compute of both. Returns the winning run,
+/// its settings and its coordination. `cache` holds what earlier runs on the cell planned (see
+/// [`plan::PlanCache`]).
 pub fn coordinate(
     cell: &Cell,
     table: &CandidateTable,
     outcome: Outcome,
     settings: PlanSettings,
     coord: &CoordSettings,
+    cache: &mut plan::PlanCache,
 ) -> Result<(Outcome, PlanSettings, Coordinated), PlanError> {
-    if !ours_tries_proximity(&settings, coord) {
+    if !ours_tries_zones(&settings, coord) {
         let c = coordinate_outcome(cell, table, &outcome, coord)?;
         return Ok((outcome, settings, c));
     }
-    // Robots in their own zones meet less: the nearest-robot allocation often wins.
-    let prox_settings = PlanSettings {
-        allocation: Allocation::Proximity,
+    let lap = Instant::now();
+    let first = coordinate_outcome(cell, table, &outcome, coord)?;
+    let again = PlanSettings {
+        task_penalty: blocking_penalty(cell, &outcome, &first),
         ..settings.clone()
     };
-    let prox = plan::plan(cell, table, &prox_settings, &|_| {})
-        .ok()
-        .and_then(|o| {
-            let c = coordinate_outcome(cell, table, &o, coord).ok()?;
-            Some((o, c))
-        });
-    let bar = prox.as_ref().map(|(_, c)| cycle_and_delta(&c.timed).0);
-    let lap = Instant::now();
-    let balanced = coordinate_outcome(cell, table, &outcome, &CoordSettings { bar, ..coord.clone() });
-    let balanced_s = lap.elapsed().as_secs_f64();
-    Ok(match (balanced, prox) {
-        (Ok(b), Some((po, mut pc))) => {
-            pc.compute_s += balanced_s;
-            if cycle_and_delta(&pc.timed) < cycle_and_delta(&b.timed) {
-                (po, prox_settings, pc)
-            } else {
-                let spent = pc.compute_s;
-                (
-                    outcome,
-                    settings,
-                    Coordinated {
-                        compute_s: spent,
-                        ..b
-                    },
-                )
-            }
+    let mut runs = vec![(outcome, settings, first)];
+    // A plan that fails the second time only loses the second try.
+    if let Ok(o) = plan::plan_cached(cell, table, &again, &|_| {}, cache)
+        && let Ok(c) = coordinate_outcome(cell, table, &o, coord)
+    {
+        runs.push((o, again, c));
+    }
+    let spent = lap.elapsed().as_secs_f64();
+    let key = |r: &(Outcome, PlanSettings, Coordinated)| cycle_and_delta(&r.2.timed);
+    let mut win = 0;
+    for i in 1..runs.len() {
+        if key(&runs[i]) < key(&runs[win]) {
+            win = i;
         }
-        (Ok(b), None) => (outcome, settings, b),
-        // The balanced coordination failed.
-        (Err(_), Some((po, mut pc))) => {
-            pc.compute_s += balanced_s;
-            (po, prox_settings, pc)
-        }
-        (Err(e), None) => return Err(e),
-    })
+    }
+    let (o, s, c) = runs.swap_remove(win);
+    Ok((
+        o,
+        s,
+        Coordinated {
+            compute_s: spent,
+            ..c
+        },
+    ))
 }

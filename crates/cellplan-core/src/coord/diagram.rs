@@ -58,6 +58,8 @@ pub(crate) struct RobotPath {
     pub len: f64,
     /// Where it may wait, by position (the first is home at 0).
     pub rests: Vec<Rest>,
+    /// Positions of each measurement (arrive, depart).
+    pub visits: Vec<(f64, f64)>,
     pieces: Vec<Piece>,
     timed: Timed,
 }
@@ -104,6 +106,7 @@ impl RobotPath {
             robot: program.robot,
             len: timed.end(),
             rests,
+            visits: timed.visits.clone(),
             pieces,
             timed,
         })
@@ -133,6 +136,25 @@ pub struct ConflictBox {
     pub a: (f64, f64),
     /// Positions of the second robot.
     pub b: (f64, f64),
+}
+
+/// Per robot, per visit: how much of the other robots' paths (s of position, summed over the
+/// boxes) conflicts with the robot standing at that measurement — the room its pose there
+/// takes from the others.
+pub(crate) fn blocking(paths: &[RobotPath], boxes: &[ConflictBox]) -> Vec<Vec<f64>> {
+    let mut out: Vec<Vec<f64>> = paths.iter().map(|p| vec![0.0; p.visits.len()]).collect();
+    let index = |r: usize| paths.iter().position(|p| p.robot == r);
+    for b in boxes {
+        for (me, mine, theirs) in [(b.robots.0, b.a, b.b), (b.robots.1, b.b, b.a)] {
+            let Some(i) = index(me) else { continue };
+            for (v, &(from, to)) in paths[i].visits.iter().enumerate() {
+                if mine.0 < to && from < mine.1 {
+                    out[i][v] += theirs.1 - theirs.0;
+                }
+            }
+        }
+    }
+    out
 }
 
 /// What building the diagrams cost.

@@ -150,6 +150,9 @@ pub struct Coordinated {
     pub uncoordinated_cycle: f64,
     /// `best`'s search over passage orders, when it ran.
     pub search: Option<crate::document::PassageSearch>,
+    /// Per robot, per visit (`best` only; else empty): seconds of the other robots' paths that
+    /// conflict with the robot measuring there (see `diagram::blocking`).
+    pub blocking: Vec<Vec<f64>>,
     /// Wall seconds.
     pub compute_s: f64,
 }
@@ -307,6 +310,7 @@ pub fn coordinate(
         after,
         uncoordinated_cycle,
         search: res.search,
+        blocking: res.blocking,
         compute_s: started.elapsed().as_secs_f64(),
     })
 }
@@ -323,7 +327,7 @@ pub fn coordinate_outcome(
 }
 
 /// Counts of a resolution.
-#[derive(Clone, Copy, Debug, Default)]
+#[derive(Clone, Debug, Default)]
 pub(crate) struct Resolution {
     pub resolved: usize,
     pub waits: usize,
@@ -333,6 +337,8 @@ pub(crate) struct Resolution {
     pub outrun: Option<f64>,
     /// The search over passage orders (`best`).
     pub search: Option<crate::document::PassageSearch>,
+    /// See [`Coordinated::blocking`].
+    pub blocking: Vec<Vec<f64>>,
 }
 
 /// Most conflicts one strategy resolves before giving up (each resolution moves a conflict
@@ -680,6 +686,7 @@ fn scheduled(ctx: &Ctx, programs: &[Program]) -> Result<Option<Resolved>, PlanEr
         }
     }
     res.resolved = s.decisions;
+    res.blocking = diagram::blocking(&paths, &boxes);
     res.search = Some(crate::document::PassageSearch {
         boxes: boxes.len(),
         distances: work.distances,

@@ -11,6 +11,10 @@
 //! - [`Allocation::Balanced`]: ours — allocation, order and candidate chosen together as a
 //!   min-max multi-robot routing with alternatives over the candidates' lower-bound move times
 //!   and the measuring time, within φ and γ.
+//! - [`Allocation::Zones`]: ours, for robots that share space — each robot keeps a compact
+//!   zone of its own (as Åblad et al. separate the robots' workspaces): the nearest-robot
+//!   allocation, then, while the busiest robot can give a task away and finish sooner, the
+//!   task at the edge of its zone nearest to a neighbour that can do it moves there.
 use super::graph::RobotGraph;
 use super::{PlanError, PlanSettings};
 use crate::candidates::CandidateTable;
@@ -35,6 +39,8 @@ pub enum Allocation {
     LocalRobust,
     /// Min-max routing with alternatives (ours).
     Balanced,
+    /// Nearest robot, then balanced by moving edge tasks to neighbours (ours).
+    Zones,
 }
 
 /// Name as on the command line and in the plan document (the serde name).
@@ -86,7 +92,7 @@ pub fn allocate(
     let mut tasks: Vec<Vec<TaskId>> = vec![Vec::new(); m];
     let mut local_sets = (0, 0);
     match settings.allocation {
-        Allocation::Proximity => {
+        Allocation::Proximity | Allocation::Zones => {
             // Exclusive tasks first (they have no choice), then the shared ones.
             let mut order: Vec<usize> = (0..cell.tasks.len())
                 .filter(|&t| !capable[t].is_empty())
@@ -105,6 +111,9 @@ pub fn allocate(
                     .find(|&r| tasks[r].len() < cap)
                     .ok_or_else(|| cap_error(cell, t, cap))?;
                 tasks[r].push(TaskId(t));
+            }
+            if settings.allocation == Allocation::Zones {
+                zones(cell, graphs, &capable, settings, &mut tasks);
             }
         }
         Allocation::LocalRobust => {
@@ -143,6 +152,145 @@ pub fn allocate(
         local_sets,
         lower_bound,
     })
+}
+
+/// Kicks of the GTSP heuristic for a robot's tour while zones are drawn (the sequencer
+/// optimises the final tours again).
+const ZONE_TOUR_ITERATIONS: usize = 400;
+
+/// A robot's tour under the lower-bound costs: nodes from home back home, and its time.
+struct Tour {
+    nodes: Vec<usize>,
+    time: f64,
+}
+
+impl Tour {
+    fn new(graph: &RobotGraph, tasks: &[TaskId], seed: u64) -> Tour {
+        let nodes =
+            super::sequence::best_order_with(graph, tasks, &Default::default(), seed, ZONE_TOUR_ITERATIONS);
+        let time = super::sequence::order_cost(graph, &Default::default(), &nodes);
+        Tour { nodes, time }
+    }
+
+    /// The tour's time without task `t`'s node (bypassed).
+    fn without(&self, graph: &RobotGraph, t: TaskId) -> f64 {
+        let Some(i) = self
+            .nodes
+            .iter()
+            .position(|&n| graph.node_task[n].is_some_and(|(x, _)| x == t))
+        else {
+            return self.time;
+        };
+        let prev = if i == 0 { 0 } else { self.nodes[i - 1] };
+        let next = self.nodes.get(i + 1).copied().unwrap_or(0);
+        let n = self.nodes[i];
+        let c = |a: usize, b: usize| graph.costs.get(a, b);
+        self.time - c(prev, n) - c(n, next) + c(prev, next) - graph.dwell[n]
+    }
+
+    /// The tour's time with task `t` inserted at its cheapest place and candidate.
+    fn with(&self, graph: &RobotGraph, t: TaskId) -> f64 {
+        let c = |a: usize, b: usize| graph.costs.get(a, b);
+        let mut stops = vec![0];
+        stops.extend(&self.nodes);
+        stops.push(0);
+        let mut best = f64::INFINITY;
+        for &n in &graph.alternatives[t.0] {
+            for w in stops.windows(2) {
+                best = best.min(c(w[0], n) + c(n, w[1]) - c(w[0], w[1]) + graph.dwell[n]);
+            }
+        }
+        self.time + best
+    }
+}
+
+/// [`Allocation::Zones`]: from the nearest-robot allocation in `tasks`, tasks move one at a
+/// time from a robot to another that can do them and has room, as long as that lowers the
+/// robots' lower-bound times sorted from the longest (leximax: the busiest robot first, then
+/// the next — so a robot may pass work on to make room for a busier neighbour's). Robots are
+/// looked at busiest first; of the moves that help, the task nearest to the receiving
+/// robot's own tasks (its base when it has none) moves — the edge of a zone, so zones stay
+/// compact. Tours are re-optimised after each move. A robot's time counts
+/// [`PlanSettings::task_penalty`] for each of its tasks.
+fn zones(
+    cell: &Cell,
+    graphs: &[RobotGraph],
+    capable: &[Vec<usize>],
+    settings: &PlanSettings,
+    tasks: &mut [Vec<TaskId>],
+) {
+    let m = graphs.len();
+    let cap = cell.planning.task_cap;
+    let seed = settings.seed;
+    let pen = |t: TaskId, r: usize| {
+        settings
+            .task_penalty
+            .get(t.0)
+            .and_then(|p| p.get(r))
+            .copied()
+            .unwrap_or(0.0)
+    };
+    let load = |r: usize, tasks: &[TaskId]| tasks.iter().map(|&t| pen(t, r)).sum::<f64>();
+    let mut tours: Vec<Tour> = (0..m).map(|r| Tour::new(&graphs[r], &tasks[r], seed)).collect();
+    let sorted = |times: &[f64]| {
+        let mut v = times.to_vec();
+        v.sort_by(|a, b| b.total_cmp(a));
+        v
+    };
+    // Strictly below, by more than rounding, in the first place that differs.
+    let lower = |a: &[f64], b: &[f64]| {
+        for (x, y) in a.iter().zip(b) {
+            if *x < *y - 1e-6 {
+                return true;
+            }
+            if *x > *y + 1e-6 {
+                return false;
+            }
+        }
+        false
+    };
+    for _ in 0..4 * cell.tasks.len() {
+        let times: Vec<f64> = (0..m).map(|r| tours[r].time + load(r, &tasks[r])).collect();
+        let now = sorted(&times);
+        let mut order: Vec<usize> = (0..m).collect();
+        order.sort_by(|&a, &b| times[b].total_cmp(&times[a]).then(a.cmp(&b)));
+        let mut pick: Option<(f64, usize, usize, usize)> = None;
+        for &from in &order {
+            for &t in &tasks[from] {
+                let gone = tours[from].without(&graphs[from], t) + load(from, &tasks[from]) - pen(t, from);
+                for &to in &capable[t.0] {
+                    if to == from || tasks[to].len() >= cap {
+                        continue;
+                    }
+                    let mut next = times.clone();
+                    next[from] = gone;
+                    next[to] = tours[to].with(&graphs[to], t) + load(to, &tasks[to]) + pen(t, to);
+                    if !lower(&sorted(&next), &now) {
+                        continue;
+                    }
+                    let p = cell.tasks[t.0].position;
+                    let near = tasks[to]
+                        .iter()
+                        .map(|x| (cell.tasks[x.0].position - p).length())
+                        .fold((cell.robots[to].base.translation - p).length(), f64::min);
+                    if pick.is_none_or(|(d, ..)| near < d) {
+                        pick = Some((near, from, t.0, to));
+                    }
+                }
+            }
+            if pick.is_some() {
+                break;
+            }
+        }
+        let Some((_, from, t, to)) = pick else {
+            break;
+        };
+        tasks[from].retain(|x| x.0 != t);
+        tasks[to].push(TaskId(t));
+        tasks[to].sort();
+        tours[from] = Tour::new(&graphs[from], &tasks[from], seed);
+        tours[to] = Tour::new(&graphs[to], &tasks[to], seed);
+    }
 }
 
 fn cap_error(cell: &Cell, t: usize, cap: usize) -> PlanError {
@@ -400,11 +548,15 @@ mod tests {
             Allocation::Proximity,
             Allocation::LocalRobust,
             Allocation::Balanced,
+            Allocation::Zones,
         ];
         // A new strategy must be added to `all`.
         for a in all {
             match a {
-                Allocation::Proximity | Allocation::LocalRobust | Allocation::Balanced => {}
+                Allocation::Proximity
+                | Allocation::LocalRobust
+                | Allocation::Balanced
+                | Allocation::Zones => {}
             }
         }
         for a in all {
@@ -419,7 +571,7 @@ mod tests {
         assert_eq!(<Allocation as clap::ValueEnum>::value_variants(), all);
         assert_eq!(
             all.map(|a| a.to_string()),
-            ["proximity", "local-robust", "balanced"]
+            ["proximity", "local-robust", "balanced", "zones"]
         );
     }
 }

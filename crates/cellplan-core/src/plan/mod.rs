@@ -64,12 +64,16 @@ pub struct PlanSettings {
     pub final_max_samples: usize,
     /// Time step of the trajectory samples written to the plan (s).
     pub sample_dt: f64,
+    /// Extra seconds the zones allocation counts for a robot doing a task, `[task][robot]`
+    /// (empty: none): what its measurement there cost the other robots in an earlier
+    /// coordination (see [`crate::coord::Coordinated::blocking`]).
+    pub task_penalty: Vec<Vec<f64>>,
 }
 
 impl Default for PlanSettings {
     fn default() -> Self {
         PlanSettings {
-            allocation: Allocation::Balanced,
+            allocation: Allocation::Zones,
             cover: CoverMethod::Penalty,
             move_model: MoveModel::Trapezoid,
             seed: 0,
@@ -90,6 +94,7 @@ impl Default for PlanSettings {
             final_shortcut_iterations: 40,
             final_max_samples: 20_000,
             sample_dt: 0.02,
+            task_penalty: Vec::new(),
         }
     }
 }
@@ -276,6 +281,27 @@ pub fn plan(
     settings: &PlanSettings,
     progress: &(dyn Fn(Stage) + Sync),
 ) -> Result<Outcome, PlanError> {
+    plan_cached(cell, table, settings, progress, &mut PlanCache::default())
+}
+
+/// What runs of [`plan_cached`] on one cell share: the robot graphs (they depend on the cell,
+/// the move model, `alternatives` and `roomy` only) and every leg planned so far. Each leg is
+/// a function of its robot, its two nodes and the settings, so a later run with the same
+/// settings plans only the legs no run planned before.
+#[derive(Clone, Debug, Default)]
+pub struct PlanCache {
+    graphs: Option<(MoveModel, usize, u64, Vec<RobotGraph>)>,
+    planned: Vec<sequence::Planned>,
+}
+
+/// [`plan`], sharing graphs and planned legs with earlier runs through `cache`.
+pub fn plan_cached(
+    cell: &Cell,
+    table: &CandidateTable,
+    settings: &PlanSettings,
+    progress: &(dyn Fn(Stage) + Sync),
+    cache: &mut PlanCache,
+) -> Result<Outcome, PlanError> {
     let started = Instant::now();
     let deadline = started + settings.time_limit;
     let mut compute = Vec::new();
@@ -286,20 +312,33 @@ pub fn plan(
     };
 
     progress(Stage::Costs);
-    let graphs: Vec<RobotGraph> = cell
-        .robots
-        .par_iter()
-        .map(|r| {
-            RobotGraph::new(
-                cell,
-                r,
-                table,
-                settings.move_model,
-                settings.alternatives,
-                settings.roomy,
-            )
-        })
-        .collect();
+    let key = (
+        settings.move_model,
+        settings.alternatives,
+        settings.roomy.to_bits(),
+    );
+    let graphs: Vec<RobotGraph> = match &cache.graphs {
+        Some((m, a, r, g)) if (*m, *a, *r) == key => g.clone(),
+        _ => {
+            let g: Vec<RobotGraph> = cell
+                .robots
+                .par_iter()
+                .map(|r| {
+                    RobotGraph::new(
+                        cell,
+                        r,
+                        table,
+                        settings.move_model,
+                        settings.alternatives,
+                        settings.roomy,
+                    )
+                })
+                .collect();
+            cache.graphs = Some((key.0, key.1, key.2, g.clone()));
+            cache.planned = vec![Default::default(); cell.robots.len()];
+            g
+        }
+    };
     tick(Stage::Costs, &mut compute);
 
     progress(Stage::Allocation);
@@ -307,7 +346,8 @@ pub fn plan(
     tick(Stage::Allocation, &mut compute);
 
     progress(Stage::Sequencing);
-    let mut planned: Vec<sequence::Planned> = vec![Default::default(); cell.robots.len()];
+    let mut planned: Vec<sequence::Planned> = std::mem::take(&mut cache.planned);
+    planned.resize_with(cell.robots.len(), Default::default);
     let mut counts = vec![(0usize, 0usize, 0usize); cell.robots.len()];
     let mut sequences = sequence_all(
         cell,
@@ -396,6 +436,7 @@ pub fn plan(
     for (s, c) in sequences.iter_mut().zip(&counts) {
         (s.legs_planned, s.legs_sampled, s.legs_failed) = *c;
     }
+    cache.planned = planned;
     sequences
         .par_iter_mut()
         .zip(&cell.robots)

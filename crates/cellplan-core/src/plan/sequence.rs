@@ -366,6 +366,17 @@ pub fn order_seed(settings: &PlanSettings, robot: &Robot) -> u64 {
 /// The best order (GTSP over the tasks' candidates) under the current costs: planned legs at
 /// their real time, the others at their lower bound.
 pub fn best_order(graph: &RobotGraph, tasks: &[TaskId], planned: &Planned, seed: u64) -> Vec<usize> {
+    best_order_with(graph, tasks, planned, seed, GTSP_ITERATIONS)
+}
+
+/// [`best_order`] with `iterations` kicks of the GTSP heuristic.
+pub fn best_order_with(
+    graph: &RobotGraph,
+    tasks: &[TaskId],
+    planned: &Planned,
+    seed: u64,
+    iterations: usize,
+) -> Vec<usize> {
     if tasks.is_empty() {
         return Vec::new();
     }
@@ -398,7 +409,7 @@ pub fn best_order(graph: &RobotGraph, tasks: &[TaskId], planned: &Planned, seed:
         &GtspParams {
             time_limit: Duration::from_secs(600),
             seed,
-            max_iterations: Some(GTSP_ITERATIONS),
+            max_iterations: Some(iterations),
             ..GtspParams::default()
         },
     );
