@@ -80,6 +80,8 @@ struct Summary<'a> {
     delta_t_s: f64,
     /// Whether Δt is within the cell's balance limit γ (true without one).
     balance_limit_met: bool,
+    /// Whether `--time-limit` stopped a search early (the plan then depends on machine speed).
+    time_limit_hit: bool,
     lower_bound_s: f64,
     ratio_to_lower_bound: f64,
     robots: Vec<RobotSummary<'a>>,
@@ -229,6 +231,7 @@ pub fn run(args: &PlanArgs) -> Result<(), Failure> {
             cycle_time_s: doc.cycle_time_s,
             delta_t_s: doc.delta_t_s,
             balance_limit_met: balance_met(&doc),
+            time_limit_hit: doc.stats.time_limit_hit,
             lower_bound_s: doc.lower_bound_s,
             ratio_to_lower_bound: doc.ratio_to_lower_bound,
             robots: doc
@@ -350,6 +353,9 @@ fn render(doc: &output::Plan, working: &str) -> String {
             "balance limit γ = {g:.2} s not met: Δt {:.2} s (the shortest cycle found spreads the robots' end times more)\n",
             doc.delta_t_s
         );
+    }
+    if doc.stats.time_limit_hit {
+        s += "time limit reached: a search stopped before its work budget, so this plan depends on this machine's speed (a longer --time-limit gives the plan the same input and seed always give)\n";
     }
     s += &format!(
         "legs planned {} ({} by the sampling planner), sequencing rounds {}\n",

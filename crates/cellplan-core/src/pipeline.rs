@@ -75,6 +75,7 @@ pub fn run<R>(
         }
         .into());
     }
+    let run_started = Instant::now();
     progress(Step::Candidates);
     let lap = Instant::now();
     let table = candidates::generate(cell);
@@ -82,6 +83,11 @@ pub fn run<R>(
     if let Some(e) = idle_robot_error(cell, &table).or_else(|| cap_error(cell, &table)) {
         return Err(PipelineError::Input(Box::new(e)));
     }
+    // One limit for the whole run, every stage.
+    let settings = &PlanSettings {
+        deadline: Some(settings.deadline.unwrap_or(run_started + settings.time_limit)),
+        ..settings.clone()
+    };
     let mut cache = plan::PlanCache::default();
     let outcome = plan::plan_cached(cell, &table, settings, &|s| progress(Step::Plan(s)), &mut cache)?;
     progress(Step::Coordination {
@@ -157,8 +163,11 @@ pub fn coordinate(
         ..settings.clone()
     };
     let mut runs = vec![(outcome, settings, first)];
+    // Past the deadline the second try is skipped, and the plan says the clock cut it.
+    if again.deadline.is_some_and(|d| Instant::now() >= d) {
+        runs[0].0.time_limit_hit = true;
     // A plan that fails the second time only loses the second try.
-    if let Ok(o) = plan::plan_cached(cell, table, &again, &|_| {}, cache)
+    } else if let Ok(o) = plan::plan_cached(cell, table, &again, &|_| {}, cache)
         && let Ok(c) = coordinate_outcome(cell, table, &o, coord)
     {
         runs.push((o, again, c));

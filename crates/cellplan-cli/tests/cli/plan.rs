@@ -46,6 +46,25 @@ fn plan_writes_a_plan_and_a_stable_summary() {
     assert!(out.status.success());
     let second: Value = serde_json::from_slice(&std::fs::read(again.join("plan.json")).unwrap()).unwrap();
     assert_eq!(plan["robots"], second["robots"]);
+    // The default budget is work, not the clock: the limit did not bind, and the summary
+    // says so; a limit that binds is said, and the plan it gives still verifies.
+    assert_eq!(summary["time_limit_hit"], false);
+    assert_eq!(plan["stats"]["time_limit_hit"], false);
+    let cut = dir.join("cut");
+    let cut_summary = json_ok(
+        &[
+            "plan",
+            cell.to_str().unwrap(),
+            "-o",
+            cut.to_str().unwrap(),
+            "--json",
+            "--time-limit",
+            "0.000001",
+        ],
+        &dir,
+    );
+    assert_eq!(cut_summary["time_limit_hit"], true);
+    assert_eq!(cut_summary["verified"], true);
     // The verifier accepts it (one robot: nothing to coordinate) ...
     let plan_file = out_dir.join("plan.json");
     let out = cellplan(

@@ -245,6 +245,7 @@ fn stats(table: &CandidateTable, outcome: &Outcome, coordinated: &Coordinated) -
         local_sets_chosen: outcome.allocated.local_sets.1,
         conflicts_resolved: coordinated.resolved,
         passage_search: coordinated.search,
+        time_limit_hit: outcome.time_limit_hit,
     }
 }
 

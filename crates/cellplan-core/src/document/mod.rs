@@ -377,6 +377,10 @@ pub struct Stats {
     /// `best`'s search over passage orders, when it ran.
     #[serde(default)]
     pub passage_search: Option<PassageSearch>,
+    /// Whether the wall-clock limit (`--time-limit`) stopped a search before its work budget:
+    /// then, and only then, the plan depends on the machine's speed.
+    #[serde(default)]
+    pub time_limit_hit: bool,
 }
 
 /// `best`'s search over the orders in which robots pass their conflict boxes.

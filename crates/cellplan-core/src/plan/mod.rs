@@ -64,6 +64,9 @@ pub struct PlanSettings {
     pub final_max_samples: usize,
     /// Time step of the trajectory samples written to the plan (s).
     pub sample_dt: f64,
+    /// When the whole run must end (set by the pipeline from `time_limit` at its start, so
+    /// that one limit bounds every stage); `None`: `time_limit` from the start of [`plan`].
+    pub deadline: Option<Instant>,
     /// Extra seconds the zones allocation counts for a robot doing a task, `[task][robot]`
     /// (empty: none): what its measurement there cost the other robots in an earlier
     /// coordination (see [`crate::coord::Coordinated::blocking`]).
@@ -95,6 +98,7 @@ impl Default for PlanSettings {
             final_max_samples: 20_000,
             sample_dt: 0.02,
             task_penalty: Vec::new(),
+            deadline: None,
         }
     }
 }
@@ -269,6 +273,9 @@ pub struct Outcome {
     pub robots: Vec<RobotResult>,
     /// Seconds per stage, in stage order.
     pub compute: Vec<(Stage, f64)>,
+    /// Whether the wall-clock limit stopped a search before its work budget (the plan then
+    /// depends on the machine's speed).
+    pub time_limit_hit: bool,
     /// Tasks some robot has candidates for but no robot could be given a path to (each given
     /// up by its robot, then tried on every other robot that can do it): why.
     pub unreached: Vec<(TaskId, String)>,
@@ -303,7 +310,7 @@ pub fn plan_cached(
     cache: &mut PlanCache,
 ) -> Result<Outcome, PlanError> {
     let started = Instant::now();
-    let deadline = started + settings.time_limit;
+    let deadline = settings.deadline.unwrap_or(started + settings.time_limit);
     let mut compute = Vec::new();
     let mut lap = Instant::now();
     let mut tick = |stage: Stage, compute: &mut Vec<(Stage, f64)>| {
@@ -343,6 +350,9 @@ pub fn plan_cached(
 
     progress(Stage::Allocation);
     let mut allocated = allocate::allocate(cell, table, &graphs, settings, None)?;
+    // The allocation searches stop at their iteration counts; past the deadline, the clock
+    // stopped them.
+    let mut clock_cut = Instant::now() >= deadline;
     tick(Stage::Allocation, &mut compute);
 
     progress(Stage::Sequencing);
@@ -386,6 +396,7 @@ pub fn plan_cached(
         let mut tried = vec![allocated.tasks.clone()];
         for round in 0..=settings.reallocation_rounds {
             if Instant::now() >= deadline {
+                clock_cut = true;
                 break;
             }
             let next = if round == 0 {
@@ -436,6 +447,7 @@ pub fn plan_cached(
     for (s, c) in sequences.iter_mut().zip(&counts) {
         (s.legs_planned, s.legs_sampled, s.legs_failed) = *c;
     }
+    let sequences_cut = sequences.iter().any(|s| s.clock_cut);
     cache.planned = planned;
     sequences
         .par_iter_mut()
@@ -457,6 +469,7 @@ pub fn plan_cached(
         robots,
         compute,
         unreached,
+        time_limit_hit: clock_cut || sequences_cut,
     })
 }
 

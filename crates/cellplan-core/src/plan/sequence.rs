@@ -52,6 +52,8 @@ pub struct Sequence {
     /// Tasks given up (not in `nodes`): every order found needed a leg to or from them that
     /// the planner could not solve with its full budget; with why.
     pub dropped: Vec<(TaskId, String)>,
+    /// Whether the deadline, not the round budget, ended the lazy loop.
+    pub clock_cut: bool,
 }
 
 /// Kicks of the GTSP heuristic per sequencing round (fixed, for determinism).
@@ -91,6 +93,7 @@ pub fn sequence(
     let mut tasks = tasks.to_vec();
     let mut dropped = Vec::new();
     let (mut legs_planned, mut legs_sampled, mut legs_failed, mut rounds) = (0, 0, 0, 0);
+    let mut clock_cut = false;
     loop {
         let (mut seq, failed) = attempt(
             cell,
@@ -107,12 +110,14 @@ pub fn sequence(
         legs_sampled += seq.legs_sampled;
         legs_failed += seq.legs_failed;
         rounds += seq.rounds;
+        clock_cut |= seq.clock_cut;
         match failed {
             None => {
                 seq.legs_planned = legs_planned;
                 seq.legs_sampled = legs_sampled;
                 seq.legs_failed = legs_failed;
                 seq.rounds = rounds;
+                seq.clock_cut |= clock_cut;
                 seq.dropped = dropped;
                 return Ok(seq);
             }
@@ -240,6 +245,7 @@ fn attempt(
             settings.lazy_rounds
         };
         if out.rounds >= rounds || Instant::now() >= deadline {
+            out.clock_cut = out.rounds < rounds;
             nodes = best.as_ref().map(|b| b.1.clone()).unwrap_or_default();
             break;
         }
