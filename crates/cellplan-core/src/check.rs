@@ -240,6 +240,35 @@ pub fn cap_error(cell: &Cell, table: &CandidateTable) -> Option<InputError> {
     )
 }
 
+/// A robot that can do more tasks than one robot's move-time graph holds
+/// ([`crate::plan::graph::MAX_GRAPH_NODES`]): refused before any memory is spent on it.
+pub fn graph_size_error(cell: &Cell, table: &CandidateTable) -> Option<InputError> {
+    let limit = crate::plan::graph::MAX_GRAPH_NODES - 1;
+    let (robot, n) = cell
+        .robots
+        .iter()
+        .map(|r| {
+            let n = cell
+                .tasks
+                .iter()
+                .filter(|t| !table.get(t.id, r.id).candidates.is_empty())
+                .count();
+            (r, n)
+        })
+        .find(|(_, n)| *n > limit)?;
+    Some(
+        InputError::new(
+            &cell.path,
+            format!(
+                "robot `{}` can do {n} of the cell's {} tasks; cellplan plans at most {limit} tasks a robot can do (its move-time graph is dense)",
+                robot.name,
+                cell.tasks.len()
+            ),
+        )
+        .hint("split the task list into several runs, or add robots so that each can do fewer tasks"),
+    )
+}
+
 /// The report as a table for people.
 pub fn render_text(cell: &Cell, table: &CandidateTable, r: &CheckReport) -> String {
     let mut s = String::new();

@@ -5,7 +5,7 @@
 //! the others in the first), the shorter coordinated cycle kept.
 //! `cellplan compare` takes its "ours" row from here as well.
 use crate::candidates::{self, CandidateTable};
-use crate::check::{cap_error, idle_robot_error};
+use crate::check::{cap_error, graph_size_error, idle_robot_error};
 use crate::coord::{CoordSettings, Coordinated, Coordination, coordinate_outcome, cycle_and_delta};
 use crate::document::{self, Plan};
 use crate::plan::{self, Allocation, Outcome, PlanError, PlanSettings, Stage};
@@ -80,7 +80,10 @@ pub fn run<R>(
     let lap = Instant::now();
     let table = candidates::generate(cell);
     let candidates_s = lap.elapsed().as_secs_f64();
-    if let Some(e) = idle_robot_error(cell, &table).or_else(|| cap_error(cell, &table)) {
+    if let Some(e) = idle_robot_error(cell, &table)
+        .or_else(|| cap_error(cell, &table))
+        .or_else(|| graph_size_error(cell, &table))
+    {
         return Err(PipelineError::Input(Box::new(e)));
     }
     // One limit for the whole run, every stage.

@@ -744,3 +744,37 @@ fn a_task_without_a_path_is_given_up_and_the_rest_planned() {
     check_plan(&f.cell, &doc);
     verified(&f.cell, &doc);
 }
+
+/// The zones allocation starts from the nearest robot and only hands tasks on while the
+/// robots' lower-bound times, sorted longest first, fall: its busiest robot is never busier
+/// (on those bounds) than the proximity allocation's, every task goes to a robot that can do
+/// it, and the plan it gives verifies.
+#[test]
+fn zones_never_make_the_busiest_robot_busier_than_proximity() {
+    let f = fixture();
+    let busiest = |allocation: Allocation| {
+        let s = settings(allocation);
+        let outcome = plan::plan(&f.cell, &f.table, &s, &|_| {}).expect("the reduced cell plans");
+        let worst = outcome
+            .graphs
+            .iter()
+            .zip(&outcome.allocated.tasks)
+            .map(|(g, tasks)| {
+                let order = plan::sequence::best_order(g, tasks, &Default::default(), 0);
+                plan::sequence::order_cost(g, &Default::default(), &order)
+            })
+            .fold(0.0, f64::max);
+        for (r, tasks) in outcome.allocated.tasks.iter().enumerate() {
+            for t in tasks {
+                assert!(!f.table.get(*t, cellplan_model::RobotId(r)).candidates.is_empty());
+            }
+        }
+        (worst, outcome, s)
+    };
+    let (prox, ..) = busiest(Allocation::Proximity);
+    let (zones, outcome, s) = busiest(Allocation::Zones);
+    assert!(zones <= prox + 1e-6, "zones {zones} vs proximity {prox}");
+    let doc = build(&f.cell, &f.table, &outcome, &s);
+    check_plan(&f.cell, &doc);
+    verified(&f.cell, &doc);
+}

@@ -172,37 +172,72 @@ impl Tour {
         Tour { nodes, time }
     }
 
-    /// The tour's time without task `t`'s node (bypassed).
-    fn without(&self, graph: &RobotGraph, t: TaskId) -> f64 {
+    /// The tour's time without task `t`'s node (bypassed), and where it was.
+    fn without_at(&self, graph: &RobotGraph, t: TaskId) -> (f64, Option<usize>) {
         let Some(i) = self
             .nodes
             .iter()
             .position(|&n| graph.node_task[n].is_some_and(|(x, _)| x == t))
         else {
-            return self.time;
+            return (self.time, None);
         };
         let prev = if i == 0 { 0 } else { self.nodes[i - 1] };
         let next = self.nodes.get(i + 1).copied().unwrap_or(0);
         let n = self.nodes[i];
         let c = |a: usize, b: usize| graph.costs.get(a, b);
-        self.time - c(prev, n) - c(n, next) + c(prev, next) - graph.dwell[n]
+        (
+            self.time - c(prev, n) - c(n, next) + c(prev, next) - graph.dwell[n],
+            Some(i),
+        )
+    }
+
+    /// The tour's time without task `t`'s node (bypassed).
+    fn without(&self, graph: &RobotGraph, t: TaskId) -> f64 {
+        self.without_at(graph, t).0
+    }
+
+    /// The tour's time with task `t` inserted at its cheapest place and candidate, and that
+    /// place (index in `nodes`) and node.
+    fn with_at(&self, graph: &RobotGraph, t: TaskId) -> (f64, usize, usize) {
+        let c = |a: usize, b: usize| graph.costs.get(a, b);
+        let mut best = (f64::INFINITY, 0, 0);
+        for &n in &graph.alternatives[t.0] {
+            for i in 0..=self.nodes.len() {
+                let a = if i == 0 { 0 } else { self.nodes[i - 1] };
+                let b = self.nodes.get(i).copied().unwrap_or(0);
+                let d = c(a, n) + c(n, b) - c(a, b) + graph.dwell[n];
+                if d < best.0 {
+                    best = (d, i, n);
+                }
+            }
+        }
+        (self.time + best.0, best.1, best.2)
     }
 
     /// The tour's time with task `t` inserted at its cheapest place and candidate.
     fn with(&self, graph: &RobotGraph, t: TaskId) -> f64 {
-        let c = |a: usize, b: usize| graph.costs.get(a, b);
-        let mut stops = vec![0];
-        stops.extend(&self.nodes);
-        stops.push(0);
-        let mut best = f64::INFINITY;
-        for &n in &graph.alternatives[t.0] {
-            for w in stops.windows(2) {
-                best = best.min(c(w[0], n) + c(n, w[1]) - c(w[0], w[1]) + graph.dwell[n]);
-            }
+        self.with_at(graph, t).0
+    }
+
+    /// Takes task `t` out (bypassed).
+    fn remove(&mut self, graph: &RobotGraph, t: TaskId) {
+        if let (time, Some(i)) = self.without_at(graph, t) {
+            self.nodes.remove(i);
+            self.time = time;
         }
-        self.time + best
+    }
+
+    /// Puts task `t` in at its cheapest place and candidate.
+    fn insert(&mut self, graph: &RobotGraph, t: TaskId) {
+        let (time, i, n) = self.with_at(graph, t);
+        self.nodes.insert(i, n);
+        self.time = time;
     }
 }
+
+/// Moves between re-optimisations of every zones tour (a move edits the two tours it
+/// touches by cheapest removal and insertion).
+const ZONE_REOPTIMISE_EVERY: usize = 8;
 
 /// [`Allocation::Zones`]: from the nearest-robot allocation in `tasks`, tasks move one at a
 /// time from a robot to another that can do them and has room, as long as that lowers the
@@ -210,7 +245,8 @@ impl Tour {
 /// the next — so a robot may pass work on to make room for a busier neighbour's). Robots are
 /// looked at busiest first; of the moves that help, the task nearest to the receiving
 /// robot's own tasks (its base when it has none) moves — the edge of a zone, so zones stay
-/// compact. Tours are re-optimised after each move. A robot's time counts
+/// compact. The two tours a move touches are edited (cheapest removal and insertion) and
+/// re-optimised every few moves, and all of them when no move helps. A robot's time counts
 /// [`PlanSettings::task_penalty`] for each of its tasks.
 fn zones(
     cell: &Cell,
@@ -249,6 +285,9 @@ fn zones(
         }
         false
     };
+    // Moves since the last re-optimisation of a tour; whether any tour is edited since all
+    // were re-optimised.
+    let (mut since, mut edited) = (0, false);
     for _ in 0..4 * cell.tasks.len() {
         let times: Vec<f64> = (0..m).map(|r| tours[r].time + load(r, &tasks[r])).collect();
         let now = sorted(&times);
@@ -283,13 +322,28 @@ fn zones(
             }
         }
         let Some((_, from, t, to)) = pick else {
-            break;
+            // No move helps on the edited tours: re-optimised ones may still offer one.
+            if !edited {
+                break;
+            }
+            (since, edited) = (0, false);
+            for r in 0..m {
+                tours[r] = Tour::new(&graphs[r], &tasks[r], seed);
+            }
+            continue;
         };
         tasks[from].retain(|x| x.0 != t);
         tasks[to].push(TaskId(t));
         tasks[to].sort();
-        tours[from] = Tour::new(&graphs[from], &tasks[from], seed);
-        tours[to] = Tour::new(&graphs[to], &tasks[to], seed);
+        tours[from].remove(&graphs[from], TaskId(t));
+        tours[to].insert(&graphs[to], TaskId(t));
+        since += 1;
+        edited = true;
+        if since >= ZONE_REOPTIMISE_EVERY {
+            since = 0;
+            tours[from] = Tour::new(&graphs[from], &tasks[from], seed);
+            tours[to] = Tour::new(&graphs[to], &tasks[to], seed);
+        }
     }
 }
 

@@ -123,9 +123,22 @@ pub fn select(
     chosen
 }
 
+/// Most nodes of one robot's graph: its move-time matrix is dense (nodes² times, 128 MiB at
+/// this size), so a robot that can do many tasks keeps fewer candidates per task (at least
+/// one), and a robot that can do more tasks than this is refused before planning (see
+/// [`crate::check::graph_size_error`]).
+pub const MAX_GRAPH_NODES: usize = 4096;
+
+/// Candidates kept per task for a robot that can do `doable` tasks, asked for `per_task`:
+/// as many as fit in [`MAX_GRAPH_NODES`] (at least one).
+pub fn per_task_within(per_task: usize, doable: usize) -> usize {
+    per_task.min((MAX_GRAPH_NODES.saturating_sub(1) / doable.max(1)).max(1))
+}
+
 impl RobotGraph {
     /// The graph of `robot` over the candidates of `table`, at most `per_task` per task (see
-    /// [`select`]), preferring candidates at least `roomy` (m) farther from the static scene
+    /// [`select`]; fewer when the robot can do so many tasks that they would not fit in
+    /// [`MAX_GRAPH_NODES`], see [`per_task_within`]), preferring candidates at least `roomy` (m) farther from the static scene
     /// than the process clearance asks, whose self pairs are that far apart too (or as far
     /// as at home, if less).
     pub fn new(
@@ -145,6 +158,12 @@ impl RobotGraph {
             MoveModel::Trapezoid => move_time,
             MoveModel::Instant => move_time_instant,
         };
+        let doable = table
+            .table
+            .iter()
+            .filter(|row| !row[robot.id.0].candidates.is_empty())
+            .count();
+        let per_task = per_task_within(per_task, doable);
         let mut q = vec![robot.home.clone()];
         let mut node_task = vec![None];
         let mut alternatives = vec![Vec::new(); table.table.len()];
@@ -189,5 +208,25 @@ impl RobotGraph {
     /// Whether there is only the home.
     pub fn is_empty(&self) -> bool {
         self.q.len() <= 1
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The kept candidates per task shrink so that a robot's graph stays within its node
+    /// budget, never below one; small cells keep what they ask for.
+    #[test]
+    fn graphs_keep_within_their_node_budget() {
+        assert_eq!(per_task_within(24, 45), 24);
+        assert_eq!(per_task_within(24, 0), 24);
+        for doable in [100, 500, 700, 2000, MAX_GRAPH_NODES - 1] {
+            let k = per_task_within(24, doable);
+            assert!(k >= 1 && 1 + k * doable <= MAX_GRAPH_NODES, "{doable}: {k}");
+            // One more per task would not fit (or the ask is met).
+            assert!(k == 24 || 1 + (k + 1) * doable > MAX_GRAPH_NODES, "{doable}: {k}");
+        }
+        assert_eq!(per_task_within(24, 10 * MAX_GRAPH_NODES), 1);
     }
 }
