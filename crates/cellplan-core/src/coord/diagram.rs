@@ -257,6 +257,27 @@ impl PairDiagram<'_> {
         }
     }
 
+    /// The swept spheres of one piece of `path` (see [`Swept`]).
+    fn swept(&mut self, path: &RobotPath, first: bool, piece: &Piece) -> Swept {
+        let mid = 0.5 * (piece.from + piece.to);
+        let placed = self.place(path, first, mid);
+        let reach = self.reach(path.robot, &placed.q, path, piece.from, piece.to, piece.moving);
+        let bodies: Vec<(DVec3, f64)> = placed.spheres.iter().map(|&(c, r)| (c, r + reach)).collect();
+        let centre = if bodies.is_empty() {
+            DVec3::ZERO
+        } else {
+            bodies.iter().map(|b| b.0).sum::<DVec3>() / bodies.len() as f64
+        };
+        let radius = bodies
+            .iter()
+            .map(|b| (b.0 - centre).length() + b.1)
+            .fold(0.0, f64::max);
+        Swept {
+            bodies,
+            all: (centre, radius),
+        }
+    }
+
     /// Lower bound of the distance between the two placed robots from their sphere covers
     /// (body spheres first), exact up to `cap` (farther is `cap`).
     fn cover_distance(&self, xa: &Placed, xb: &Placed, cap: f64) -> f64 {
@@ -403,15 +424,45 @@ fn pair_boxes(ctx: &Ctx, pa: &RobotPath, pb: &RobotPath) -> (Vec<ConflictBox>, D
         found: None,
         placed: HashMap::new(),
     };
+    // Each piece's swept body spheres (placed at its middle, grown by its reach) and one
+    // sphere around them: most pairs of pieces are far apart, and a sphere test says so
+    // without placing the robots again.
+    let swept_a: Vec<Swept> = pa.pieces.iter().map(|x| d.swept(pa, true, x)).collect();
+    let swept_b: Vec<Swept> = pb.pieces.iter().map(|y| d.swept(pb, false, y)).collect();
+    d.placed.clear();
+    let margin = ctx.margin;
     let mut boxes = Vec::new();
-    for x in &pa.pieces {
-        for y in &pb.pieces {
+    for (x, sx) in pa.pieces.iter().zip(&swept_a) {
+        for (y, sy) in pb.pieces.iter().zip(&swept_b) {
+            if !sx.may_meet(sy, margin) {
+                continue;
+            }
             d.cell((x.from, x.to, x.moving), (y.from, y.to, y.moving));
             boxes.extend(d.found.take());
             d.placed.clear();
         }
     }
     (boxes, d.work)
+}
+
+/// Where a robot can be while on one piece of its path: its body spheres at the piece's
+/// middle grown by the piece's reach, and one sphere around them all.
+struct Swept {
+    bodies: Vec<(DVec3, f64)>,
+    all: (DVec3, f64),
+}
+
+impl Swept {
+    /// Whether the two could come within `margin` (false only when they cannot).
+    fn may_meet(&self, other: &Swept, margin: f64) -> bool {
+        let apart = |a: &(DVec3, f64), b: &(DVec3, f64)| (a.0 - b.0).length() - a.1 - b.1 > margin;
+        if apart(&self.all, &other.all) {
+            return false;
+        }
+        self.bodies
+            .iter()
+            .any(|a| other.bodies.iter().any(|b| !apart(a, b)))
+    }
 }
 
 /// The conflict boxes of every robot pair (pairs in order, in parallel; the result does not

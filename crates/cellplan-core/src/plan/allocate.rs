@@ -157,6 +157,11 @@ pub fn allocate(
 /// Kicks of the GTSP heuristic for a robot's tour while zones are drawn (the sequencer
 /// optimises the final tours again).
 const ZONE_TOUR_ITERATIONS: usize = 400;
+/// Kicks × tasks of one zones tour re-optimisation, at most (fewer kicks for long tours).
+const ZONE_TOUR_WORK: usize = 20_000;
+/// Insertion and removal evaluations (node visits) the zones search may spend: the bound
+/// that keeps large cells fast; it stops there, deterministically.
+const ZONE_SEARCH_WORK: usize = 300_000_000;
 
 /// A robot's tour under the lower-bound costs: nodes from home back home, and its time.
 struct Tour {
@@ -166,8 +171,9 @@ struct Tour {
 
 impl Tour {
     fn new(graph: &RobotGraph, tasks: &[TaskId], seed: u64) -> Tour {
-        let nodes =
-            super::sequence::best_order_with(graph, tasks, &Default::default(), seed, ZONE_TOUR_ITERATIONS);
+        // Long tours get fewer kicks: the work per kick grows with the tour.
+        let kicks = (ZONE_TOUR_WORK / (tasks.len() + 1)).clamp(20, ZONE_TOUR_ITERATIONS);
+        let nodes = super::sequence::best_order_with(graph, tasks, &Default::default(), seed, kicks);
         let time = super::sequence::order_cost(graph, &Default::default(), &nodes);
         Tour { nodes, time }
     }
@@ -288,7 +294,11 @@ fn zones(
     // Moves since the last re-optimisation of a tour; whether any tour is edited since all
     // were re-optimised.
     let (mut since, mut edited) = (0, false);
+    let mut work = 0usize;
     for _ in 0..4 * cell.tasks.len() {
+        if work > ZONE_SEARCH_WORK {
+            break;
+        }
         let times: Vec<f64> = (0..m).map(|r| tours[r].time + load(r, &tasks[r])).collect();
         let now = sorted(&times);
         let mut order: Vec<usize> = (0..m).collect();
@@ -296,11 +306,13 @@ fn zones(
         let mut pick: Option<(f64, usize, usize, usize)> = None;
         for &from in &order {
             for &t in &tasks[from] {
+                work += tours[from].nodes.len();
                 let gone = tours[from].without(&graphs[from], t) + load(from, &tasks[from]) - pen(t, from);
                 for &to in &capable[t.0] {
                     if to == from || tasks[to].len() >= cap {
                         continue;
                     }
+                    work += (tours[to].nodes.len() + 1) * graphs[to].alternatives[t.0].len();
                     let mut next = times.clone();
                     next[from] = gone;
                     next[to] = tours[to].with(&graphs[to], t) + load(to, &tasks[to]) + pen(t, to);
