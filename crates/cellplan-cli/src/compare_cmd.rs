@@ -132,7 +132,9 @@ pub fn run(args: &CompareArgs) -> Result<(), Failure> {
                 ..PlanSettings::default()
             };
             let started = Instant::now();
-            let outcome = match plan::plan(&cell, &table, &settings, &|_| {}) {
+            // The zones run keeps its legs for ours, as `cellplan plan` does.
+            let mut cache = plan::PlanCache::default();
+            let outcome = match plan::plan_cached(&cell, &table, &settings, &|_| {}, &mut cache) {
                 Ok(o) => o,
                 Err(e) => {
                     for c in Coordination::RESOLVING {
@@ -165,7 +167,7 @@ pub fn run(args: &CompareArgs) -> Result<(), Failure> {
                 rows.push(row);
             }
             if allocation == Allocation::Zones {
-                zones = Some((outcome, settings, plan_s));
+                zones = Some((outcome, settings, plan_s, cache));
             }
         }
         rows.push(ours(&cell, &table, zones, case, args.seed));
@@ -338,7 +340,7 @@ fn html(report: &Report) -> String {
 fn ours(
     cell: &Cell,
     table: &CandidateTable,
-    zones: Option<(plan::Outcome, PlanSettings, f64)>,
+    zones: Option<(plan::Outcome, PlanSettings, f64, plan::PlanCache)>,
     case: usize,
     seed: u64,
 ) -> Row {
@@ -346,7 +348,7 @@ fn ours(
         allocation: "zones+feedback".into(),
         ..row
     };
-    let Some((outcome, settings, plan_s)) = zones else {
+    let Some((outcome, settings, plan_s, mut cache)) = zones else {
         return label(failed(
             case,
             Allocation::Zones,
@@ -360,7 +362,7 @@ fn ours(
         ..CoordSettings::default()
     };
     let lap = Instant::now();
-    match pipeline::coordinate(cell, table, outcome, settings, &cs, &mut Default::default()) {
+    match pipeline::coordinate(cell, table, outcome, settings, &cs, &mut cache) {
         Ok((outcome, settings, c)) => {
             let spent = plan_s + lap.elapsed().as_secs_f64();
             let doc = output::build(cell, table, &outcome, &c, &settings, 0.0, 0.0);
