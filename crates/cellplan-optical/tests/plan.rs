@@ -743,6 +743,22 @@ fn a_task_without_a_path_is_given_up_and_the_rest_planned() {
     assert!(done > 0);
     check_plan(&f.cell, &doc);
     verified(&f.cell, &doc);
+    // With the robots at (or next to) their task cap, a task given up stays unmeasured rather
+    // than push a robot over its cap (a random task set of `compare` once did: 15 MPs under
+    // φ = 14, which the verifier rejected).
+    let path = example_copy("plan-test-capped", "autobody-2r-small", 8, |text| {
+        let t = text.replace("task_cap = 14", "task_cap = 4");
+        assert!(t.contains("task_cap = 4"));
+        t
+    });
+    let cell = load(&path, &LoadOptions::default()).expect("the capped cell loads");
+    let table = generate(&cell);
+    let outcome = plan::plan(&cell, &table, &s, &|_| {}).expect("a plan despite the legs");
+    assert!(!outcome.unreached.is_empty());
+    assert!(outcome.allocated.tasks.iter().all(|t| t.len() <= 4));
+    let doc = build(&cell, &table, &outcome, &s);
+    check_plan(&cell, &doc);
+    verified(&cell, &doc);
 }
 
 /// The zones allocation starts from the nearest robot and only hands tasks on while the

@@ -474,7 +474,7 @@ pub fn plan_cached(
 }
 
 /// The tasks the robots gave up (no path), each tried on the other robots that have
-/// candidates for it, the least busy first: the first whose sequence then includes it, giving
+/// candidates for it and room under the task cap, the least busy first: the first whose sequence then includes it, giving
 /// up nothing else, takes it. Returns the tasks nobody could take, with the first robot's
 /// reason.
 #[allow(clippy::too_many_arguments)]
@@ -505,7 +505,7 @@ fn reassign_dropped(
             .robots_for(t)
             .into_iter()
             .map(|id| id.0)
-            .filter(|&s| s != r)
+            .filter(|&s| s != r && allocated.tasks[s].len() < cell.planning.task_cap)
             .collect();
         let time = |s: usize| sequence::order_cost(&graphs[s], &planned[s], &sequences[s].nodes);
         let times: Vec<f64> = (0..sequences.len()).map(time).collect();
