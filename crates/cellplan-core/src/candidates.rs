@@ -171,10 +171,16 @@ pub fn reach(
         let mut furthest: Option<Rejection> = None;
         let mut any = false;
         for q in &solutions {
+            // The pose the joints reach, which the verifier checks: a numeric IK solution
+            // misses the asked pose by its tolerance, and a pose on the edge of what the
+            // process accepts may fall outside.
+            let reached = robot.tcp_pose(q);
             let verdict = match verdicts.iter().find(|(p, _)| same_geometry(p, q)) {
                 Some((_, v)) => *v,
                 None => {
-                    let v = check_configuration(cell, process, robot, task, tcp, q, validity, &mut scratch);
+                    let v = check_reached(cell, process, task, tcp, &reached).and_then(|()| {
+                        check_configuration(cell, process, robot, task, &reached, q, validity, &mut scratch)
+                    });
                     verdicts.push((q.clone(), v));
                     v
                 }
@@ -184,7 +190,7 @@ pub fn reach(
                     any = true;
                     reach.candidates.push(Candidate {
                         q: q.clone(),
-                        tcp: *tcp,
+                        tcp: reached,
                     });
                 }
                 Err(r) => furthest = furthest.max(Some(r)),
@@ -195,6 +201,26 @@ pub fn reach(
         }
     }
     reach
+}
+
+/// The process's checks of the pose the joints reach, when it is not the pose asked for (the
+/// asked pose passed them already).
+fn check_reached(
+    cell: &Cell,
+    process: &dyn Process,
+    task: &Task,
+    asked: &Pose,
+    reached: &Pose,
+) -> Result<(), Rejection> {
+    let same = (reached.translation - asked.translation).length() <= 1e-12
+        && reached.rotation.dot(asked.rotation).abs() >= 1.0 - 1e-15;
+    if same {
+        return Ok(());
+    }
+    process.pose_check(task, reached).map_err(Rejection::Pose)?;
+    process
+        .reached_check(&cell.world, task, reached)
+        .map_err(Rejection::Reached)
 }
 
 /// The process's checks of one configuration (the cheap ones first), then collision with the

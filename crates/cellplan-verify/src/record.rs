@@ -12,7 +12,9 @@ use cellplan_model::Cell;
 use cellplan_model::robot::Robot;
 
 /// How far a conflict's stated tool position may lie from the track before coordination
-/// (m): the tracks are sampled every 0.1 s and interpolated.
+/// (m), beyond how far the track's two samples around it lie apart: the tracks are sampled
+/// every 0.1 s and interpolated, and a tool that moves fast (a metre in a sample step, on a
+/// robot's first move out of home) can be anywhere near that chord.
 const TRACK_TOL: f64 = 0.05;
 
 /// The record checks; returns the recomputed cycle time and Δt.
@@ -242,8 +244,8 @@ fn conflict_problem(plan: &Plan, x: &ConflictOut) -> Option<String> {
             .uncoordinated_probe
             .iter()
             .find(|t| t.robot == rp.name)
-            && let Some(p) = track_at(track, x.start_s)
-            && (p - DVec3::from(x.probe_xyz[side])).length() > TRACK_TOL
+            && let Some((p, span)) = track_at(track, x.start_s)
+            && (p - DVec3::from(x.probe_xyz[side])).length() > TRACK_TOL + span
         {
             return Some(format!(
                 "{}'s tool position {:?} is not where its track puts it then",
@@ -255,7 +257,9 @@ fn conflict_problem(plan: &Plan, x: &ConflictOut) -> Option<String> {
 }
 
 /// The track's position at `t`, linearly interpolated (held after its end).
-fn track_at(track: &ProbeTrack, t: f64) -> Option<DVec3> {
+/// The track's position at `t` (linear between its samples) and the distance between the two
+/// samples around `t`.
+fn track_at(track: &ProbeTrack, t: f64) -> Option<(DVec3, f64)> {
     let n = track.xyz.len();
     if n == 0 {
         return None;
@@ -265,5 +269,5 @@ fn track_at(track: &ProbeTrack, t: f64) -> Option<DVec3> {
     let j = (i + 1).min(n - 1);
     let w = (f - i as f64).clamp(0.0, 1.0);
     let (a, b) = (DVec3::from(track.xyz[i]), DVec3::from(track.xyz[j]));
-    Some(a + (b - a) * w)
+    Some((a + (b - a) * w, (b - a).length()))
 }
