@@ -35,13 +35,16 @@ pub fn joint_radii(cell: &Cell, robot: &Robot) -> Vec<f64> {
 }
 
 /// The validity checker of `robot` in its cell keeping `margin` (m) from the static scene and
-/// from the other robots parked at home.
+/// `margin` + [`crate::coord::REPLAY_SLACK`] from the other robots parked at home — what the
+/// coordination keeps between robots, so that a robot standing at home is never in the way of
+/// a path planned past it.
 pub fn robot_validity<'a>(cell: &'a Cell, robot: &'a Robot, margin: f64) -> RobotValidity<'a> {
     ArmValidity::new(
         robot.arm(&cell.world),
         margin,
         crate::candidates::parked_others(cell, robot),
     )
+    .with_parked_extra(crate::coord::REPLAY_SLACK)
 }
 
 /// One leg of `robot` from `from` to `to`, keeping the process clearance from the static

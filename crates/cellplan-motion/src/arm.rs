@@ -190,6 +190,8 @@ pub struct ArmValidity<'a> {
     pairs: Vec<(usize, usize, Range<usize>)>,
     /// Other groups standing still (obstacles like the scene), with their body poses.
     parked: Vec<(GroupId, Vec<Pose>)>,
+    /// Distance (m) kept from the parked groups beyond the margin.
+    parked_extra: f64,
     /// The arm's covers against the scene and the parked groups.
     broad: BroadPhase,
 }
@@ -235,7 +237,17 @@ impl<'a> ArmValidity<'a> {
             moving,
             pairs,
             parked,
+            parked_extra: 0.0,
         }
+    }
+
+    /// The same checker keeping `extra` (m, ≥ 0) more than the margin from the parked groups
+    /// (robots that will move later keep the slack their coordination needs).
+    pub fn with_parked_extra(mut self, extra: f64) -> Self {
+        let extra = if extra.is_finite() { extra.max(0.0) } else { 0.0 };
+        self.broad = BroadPhase::with_parked_extra(self.arm.world, self.arm.group, &self.parked, extra);
+        self.parked_extra = extra;
+        self
     }
 
     /// Distance of body `i` (posed in `bodies`) to the scene and the parked groups, capped.
@@ -243,11 +255,12 @@ impl<'a> ArmValidity<'a> {
         let world = self.arm.world;
         let g = self.arm.group;
         let mut d = world.body_static_distance(g, i, bodies, cap);
+        let extra = self.parked_extra;
         for (other, poses) in &self.parked {
             if d <= 0.0 {
                 break;
             }
-            d = world.body_group_distance(g, i, bodies, *other, poses, d);
+            d = (world.body_group_distance(g, i, bodies, *other, poses, d + extra) - extra).max(0.0);
         }
         d
     }

@@ -61,7 +61,8 @@ pub(crate) struct RobotPath {
     /// Positions of each measurement (arrive, depart).
     pub visits: Vec<(f64, f64)>,
     pieces: Vec<Piece>,
-    timed: Timed,
+    /// The program on the clock, without its waits.
+    pub timed: Timed,
 }
 
 impl RobotPath {
@@ -136,6 +137,10 @@ pub struct ConflictBox {
     pub a: (f64, f64),
     /// Positions of the second robot.
     pub b: (f64, f64),
+    /// Whether a robot standing still at an end of its interval — `[a start, a end, b start,
+    /// b end]` — is certified clear of the other robot anywhere in the other's interval (so a
+    /// robot may wait at a rest there). Only ends at rests are certified; the others are false.
+    pub open: [bool; 4],
 }
 
 /// Per robot, per visit: how much of the other robots' paths (s of position, summed over the
@@ -379,6 +384,7 @@ impl PairDiagram<'_> {
                     robots: (pa.robot, pb.robot),
                     a: (a.0, a.1),
                     b: (b.0, b.1),
+                    open: [false; 4],
                 });
                 f.a = (f.a.0.min(a.0), f.a.1.max(a.1));
                 f.b = (f.b.0.min(b.0), f.b.1.max(b.1));
@@ -391,6 +397,72 @@ impl PairDiagram<'_> {
                 } else {
                     self.halve_b(a, b)
                 }
+            }
+        }
+    }
+
+    /// Whether rectangle `[a0, a1] × [b0, b1]` is certified free (as [`Self::cell`] decides,
+    /// halving until it is or a smallest rectangle is not).
+    fn certify(&mut self, a: (f64, f64, bool), b: (f64, f64, bool)) -> bool {
+        self.work.cells += 1;
+        let (pa, pb) = (self.pa, self.pb);
+        let xa = self.place(pa, true, 0.5 * (a.0 + a.1));
+        let xb = self.place(pb, false, 0.5 * (b.0 + b.1));
+        let ra = self.reach(pa.robot, &xa.q, pa, a.0, a.1, a.2);
+        let rb = self.reach(pb.robot, &xb.q, pb, b.0, b.1, b.2);
+        let need = self.ctx.margin + ra + rb;
+        let split_a = a.2 && a.1 - a.0 > MIN_CELL;
+        let split_b = b.2 && b.1 - b.0 > MIN_CELL;
+        if self.cover_distance(&xa, &xb, need + DISTANCE_SLACK) > need {
+            return true;
+        }
+        if !(split_a || split_b) {
+            self.work.distances += 1;
+            let robots = &self.ctx.cell.robots;
+            let d = self.ctx.cell.world.group_group_distance(
+                robots[pa.robot].group,
+                &xa.poses,
+                robots[pb.robot].group,
+                &xb.poses,
+                need + DISTANCE_SLACK,
+            );
+            return d > need;
+        }
+        if split_a && (!split_b || ra >= rb) {
+            let m = 0.5 * (a.0 + a.1);
+            self.certify((a.0, m, a.2), b) && self.certify((m, a.1, a.2), b)
+        } else {
+            let m = 0.5 * (b.0 + b.1);
+            self.certify(a, (b.0, m, b.2)) && self.certify(a, (m, b.1, b.2))
+        }
+    }
+
+    /// Marks the ends of `f` (found in pieces `x` of the first robot and `y` of the second)
+    /// at which a robot standing still is clear of the other's whole interval. Only ends at
+    /// the ends of moving pieces are looked at: those are where rests are.
+    ///
+    /// Home is clear by construction: every leg and every measurement pose was planned with
+    /// the other robots parked at home, keeping the cell's clearance (see
+    /// [`crate::motion::robot_validity`]); the rectangles, by contrast, are conservative by
+    /// the robots' reach over a smallest rectangle and by [`super::REPLAY_SLACK`], and would
+    /// otherwise let a robot's home seem to block a path that was planned past it.
+    fn open_ends(&mut self, f: &mut ConflictBox, x: &Piece, y: &Piece) {
+        const AT: f64 = 1e-9;
+        let (la, lb) = (self.pa.len, self.pb.len);
+        if x.moving {
+            if f.a.0 <= x.from + AT {
+                f.open[0] = x.from <= AT || self.certify((x.from, x.from, false), (f.b.0, f.b.1, y.moving));
+            }
+            if f.a.1 >= x.to - AT {
+                f.open[1] = x.to >= la - AT || self.certify((x.to, x.to, false), (f.b.0, f.b.1, y.moving));
+            }
+        }
+        if y.moving {
+            if f.b.0 <= y.from + AT {
+                f.open[2] = y.from <= AT || self.certify((f.a.0, f.a.1, x.moving), (y.from, y.from, false));
+            }
+            if f.b.1 >= y.to - AT {
+                f.open[3] = y.to >= lb - AT || self.certify((f.a.0, f.a.1, x.moving), (y.to, y.to, false));
             }
         }
     }
@@ -438,7 +510,10 @@ fn pair_boxes(ctx: &Ctx, pa: &RobotPath, pb: &RobotPath) -> (Vec<ConflictBox>, D
                 continue;
             }
             d.cell((x.from, x.to, x.moving), (y.from, y.to, y.moving));
-            boxes.extend(d.found.take());
+            if let Some(mut f) = d.found.take() {
+                d.open_ends(&mut f, x, y);
+                boxes.push(f);
+            }
             d.placed.clear();
         }
     }
@@ -468,19 +543,36 @@ impl Swept {
 /// The conflict boxes of every robot pair (pairs in order, in parallel; the result does not
 /// depend on the thread count).
 pub(crate) fn diagrams(ctx: &Ctx, paths: &[RobotPath]) -> (Vec<ConflictBox>, DiagramWork) {
+    let mut parts = Vec::new();
+    diagrams_reusing(ctx, paths, &mut parts)
+}
+
+/// Boxes of one robot pair, and what they cost (see [`diagrams_reusing`]).
+pub(crate) type PairBoxes = Option<(Vec<ConflictBox>, DiagramWork)>;
+
+/// As [`diagrams`], keeping each pair's boxes in `parts` (pairs `(a, b)`, `a < b`, in order);
+/// a pair whose entry is already there is not built again (clear the entries of pairs whose
+/// paths changed). The work counts what was built this time.
+pub(crate) fn diagrams_reusing(
+    ctx: &Ctx,
+    paths: &[RobotPath],
+    parts: &mut Vec<PairBoxes>,
+) -> (Vec<ConflictBox>, DiagramWork) {
     let pairs: Vec<(usize, usize)> = (0..paths.len())
         .flat_map(|a| (a + 1..paths.len()).map(move |b| (a, b)))
         .collect();
-    let parts: Vec<(Vec<ConflictBox>, DiagramWork)> = pairs
+    parts.resize(pairs.len(), None);
+    let todo: Vec<usize> = (0..pairs.len()).filter(|&i| parts[i].is_none()).collect();
+    let built: Vec<(Vec<ConflictBox>, DiagramWork)> = todo
         .par_iter()
-        .map(|&(a, b)| pair_boxes(ctx, &paths[a], &paths[b]))
+        .map(|&i| pair_boxes(ctx, &paths[pairs[i].0], &paths[pairs[i].1]))
         .collect();
     let mut work = DiagramWork::default();
-    let mut boxes = Vec::new();
-    for (b, w) in parts {
-        work.cells += w.cells;
-        work.distances += w.distances;
-        boxes.extend(b);
+    for (i, part) in todo.into_iter().zip(built) {
+        work.cells += part.1.cells;
+        work.distances += part.1.distances;
+        parts[i] = Some(part);
     }
+    let boxes = parts.iter().flatten().flat_map(|p| p.0.iter().cloned()).collect();
     (boxes, work)
 }

@@ -9,8 +9,11 @@
 //! `X(b, j) + b1 − p_j ≥ X(a, i) + a2 − p_i` with `i` the last rest at or before `a2` and `j`
 //! the last rest before `b1` — a difference constraint. For chosen orders the earliest times
 //! are longest paths, and the makespan `max_r X(r, last) + len_r − p_last` is their maximum.
-//! A robot home for good (`a2` at the end of its path) can never pass first; a robot that
-//! conflicts while still at home (`b1 = 0`) can never pass second.
+//! A robot home for good (`a2` at the end of its path) can never pass first, nor can a robot
+//! that conflicts while still at home (`b1 = 0`) pass second — unless the diagram certified
+//! that the robot standing still there is clear of the other's whole interval
+//! (`ConflictBox::open`); at such an end at a rest, arriving is enough to have passed, and
+//! waiting there is allowed before entering.
 //!
 //! Branch and bound: the earliest times under the orders chosen so far are a lower bound of
 //! every completion; a box that neither order satisfies at those times is branched on (the
@@ -105,14 +108,22 @@ impl<'a> Search<'a> {
             }
             v
         };
-        // `x` passes `[x1, x2]` before `y` reaches `y1`.
-        let first = |x: usize, (_, x2): (f64, f64), y: usize, (y1, _): (f64, f64)| -> Option<Edge> {
+        // `x` passes `[x1, x2]` before `y` reaches `y1`. Where `x` may stand at `x2`
+        // (`x_open`), arriving there is enough; where `y` may stand at `y1` (`y_open`), it may
+        // wait there.
+        let first = |x: usize,
+                     (_, x2): (f64, f64),
+                     x_open: bool,
+                     y: usize,
+                     (y1, _): (f64, f64),
+                     y_open: bool|
+         -> Option<Edge> {
             let (px, py) = (&paths[x], &paths[y]);
-            if x2 >= px.len - EPS || y1 <= EPS {
+            if (x2 >= px.len - EPS && !x_open) || (y1 <= EPS && !y_open) {
                 return None;
             }
-            let i = rest_before(px, x2, false);
-            let j = rest_before(py, y1, true);
+            let i = rest_before(px, x2, x_open);
+            let j = rest_before(py, y1, !y_open);
             Some(Edge {
                 from: offset[x] + i,
                 to: offset[y] + j,
@@ -124,8 +135,8 @@ impl<'a> Search<'a> {
             .map(|b| {
                 let (a, c) = (index[b.robots.0], index[b.robots.1]);
                 Choice {
-                    first_a: first(a, b.a, c, b.b),
-                    first_b: first(c, b.b, a, b.a),
+                    first_a: first(a, b.a, b.open[1], c, b.b, b.open[2]),
+                    first_b: first(c, b.b, b.open[3], a, b.a, b.open[0]),
                 }
             })
             .collect();
@@ -299,7 +310,14 @@ impl<'a> Search<'a> {
         }
         children.sort_by(|p, q| p.0.total_cmp(&q.0));
         for (_, e, y) in children {
-            if self.nodes >= self.budget && self.best.is_some() {
+            // Without a schedule yet the search may go on a while longer (the first dive
+            // usually finds one; a search that does not is proving there is none).
+            let cap = if self.best.is_some() {
+                self.budget
+            } else {
+                self.budget.saturating_mul(NO_SCHEDULE_FACTOR)
+            };
+            if self.nodes >= cap {
                 return;
             }
             self.out[e.from].push(e);
@@ -311,24 +329,102 @@ impl<'a> Search<'a> {
     }
 }
 
+/// How many times its budget the search may spend while it has no schedule at all.
+const NO_SCHEDULE_FACTOR: usize = 10;
+
+/// The infeasible core's search stops after this many searches' budgets of nodes.
+const CORE_SEARCHES: usize = 40;
+
+/// What the search found.
+#[derive(Clone, Debug)]
+pub(crate) enum Found {
+    /// A schedule.
+    Schedule(Schedule),
+    /// Proof that no order of passing exists (waits only at the rests).
+    Infeasible,
+    /// Neither, within the budget.
+    Unknown,
+}
+
 /// The schedule of `paths` (one per robot) passing `boxes` with the shortest makespan found in
-/// `budget` nodes; `None` when no order of passing exists (a robot's home in another's way).
+/// `budget` nodes; `None` when none was found (no order of passing exists — a robot's home in
+/// another's way, or no rest where a robot could let another pass — or none within the budget).
 pub(crate) fn schedule(
     paths: &[Track],
     boxes: &[ConflictBox],
     budget: usize,
     min_wait: f64,
 ) -> Option<Schedule> {
+    match search(paths, boxes, budget, min_wait).0 {
+        Found::Schedule(s) => Some(s),
+        Found::Infeasible | Found::Unknown => None,
+    }
+}
+
+/// A small set of boxes that no order can pass (indices into `boxes`), when `boxes` are
+/// infeasible: a deletion filter in halving chunks (a set whose feasibility the search cannot
+/// decide within `budget` counts as feasible, so the core is infeasible for certain). Each
+/// test is one search; after [`CORE_SEARCHES`] searches' worth of nodes the filter stops and
+/// the boxes left (infeasible, not always minimal) are the core.
+pub(crate) fn infeasible_core(
+    paths: &[Track],
+    boxes: &[ConflictBox],
+    budget: usize,
+    min_wait: f64,
+) -> Vec<usize> {
+    let spent = std::cell::Cell::new(0usize);
+    let limit = budget.max(1).saturating_mul(CORE_SEARCHES);
+    let infeasible = |keep: &[usize]| -> bool {
+        let b: Vec<ConflictBox> = keep.iter().map(|&i| boxes[i].clone()).collect();
+        let (found, nodes) = search(paths, &b, budget, min_wait);
+        spent.set(spent.get() + nodes);
+        matches!(found, Found::Infeasible)
+    };
+    let mut keep: Vec<usize> = (0..boxes.len()).collect();
+    if !infeasible(&keep) {
+        return Vec::new();
+    }
+    let mut chunk = keep.len().div_ceil(2).max(1);
+    loop {
+        let mut i = 0;
+        while i < keep.len() {
+            if spent.get() >= limit {
+                return keep;
+            }
+            let end = (i + chunk).min(keep.len());
+            let trial: Vec<usize> = keep[..i].iter().chain(&keep[end..]).copied().collect();
+            if infeasible(&trial) {
+                keep = trial;
+            } else {
+                i = end;
+            }
+        }
+        if chunk == 1 {
+            return keep;
+        }
+        chunk = chunk.div_ceil(2);
+    }
+}
+
+/// The search, and the nodes it took.
+fn search(paths: &[Track], boxes: &[ConflictBox], budget: usize, min_wait: f64) -> (Found, usize) {
     let mut s = Search::new(paths, boxes, budget.max(1), min_wait.max(0.0));
     if s.choices
         .iter()
         .any(|c| c.first_a.is_none() && c.first_b.is_none())
     {
-        return None;
+        return (Found::Infeasible, 0);
     }
     let x = s.initial();
     s.dive(x);
-    let (makespan, x, chosen) = s.best.take()?;
+    let Some((makespan, x, chosen)) = s.best.take() else {
+        let found = if s.nodes >= s.budget.saturating_mul(NO_SCHEDULE_FACTOR) {
+            Found::Unknown
+        } else {
+            Found::Infeasible
+        };
+        return (found, s.nodes);
+    };
     let mut waits = Vec::with_capacity(paths.len());
     for (r, p) in paths.iter().enumerate() {
         let o = s.offset[r];
@@ -349,13 +445,15 @@ pub(crate) fn schedule(
         }
         waits.push(w);
     }
-    Some(Schedule {
+    let nodes = s.nodes;
+    let found = Found::Schedule(Schedule {
         waits,
         makespan,
-        nodes: s.nodes,
+        nodes,
         decisions: chosen.len(),
-        proven: s.nodes < s.budget,
-    })
+        proven: nodes < s.budget,
+    });
+    (found, nodes)
 }
 
 #[cfg(test)]
@@ -371,7 +469,12 @@ mod tests {
     }
 
     fn boxed(robots: (usize, usize), a: (f64, f64), b: (f64, f64)) -> ConflictBox {
-        ConflictBox { robots, a, b }
+        ConflictBox {
+            robots,
+            a,
+            b,
+            open: [false; 4],
+        }
     }
 
     /// Where robot `r` is at time `t` under the schedule (position), and when it ends.
@@ -465,6 +568,59 @@ mod tests {
 
     /// Three robots, boxes chained so that the greedy choice at the first box is wrong: the
     /// search finds the order a brute force over all orders finds.
+    /// A robot certified clear while standing at home (`open`) may let the other pass there,
+    /// at its start and at its end; without the certificate no order exists.
+    #[test]
+    fn a_robot_clear_at_home_may_wait_there() {
+        let tracks = [track(0, 10.0, &[0.0]), track(1, 10.0, &[0.0])];
+        // Both conflict while leaving home.
+        let mut b = boxed((0, 1), (0.0, 3.0), (0.0, 3.0));
+        assert!(schedule(&tracks, std::slice::from_ref(&b), 1000, 0.05).is_none());
+        b.open = [true, false, false, false];
+        let s = schedule(&tracks, std::slice::from_ref(&b), 1000, 0.05).unwrap();
+        assert!((s.waits[0][0].0 - 3.0).abs() < 1e-9, "{s:?}");
+        assert!((s.makespan - 13.0).abs() < 1e-9);
+        assert_clear(&tracks, std::slice::from_ref(&b), &s);
+        // Both conflict while coming home: robot 1, clear once home, may arrive first.
+        let mut b = boxed((0, 1), (8.0, 10.0), (7.0, 10.0));
+        assert!(schedule(&tracks, std::slice::from_ref(&b), 1000, 0.05).is_none());
+        b.open = [false, false, false, true];
+        let s = schedule(&tracks, std::slice::from_ref(&b), 1000, 0.05).unwrap();
+        // Robot 0 may reach 8 only when robot 1 is home (10): a 2 s wait at home.
+        assert!((s.waits[0][0].0 - 2.0).abs() < 1e-9, "{s:?}");
+        assert_clear(&tracks, std::slice::from_ref(&b), &s);
+    }
+
+    /// Robot 0 must be past 2 before robot 1 reaches 4 (its home blocks robot 1 there) and
+    /// must not reach 3 before robot 1 is past 7 (its end home blocks robot 1 there): without
+    /// a rest between 2 and 3 no order exists, and the core is exactly those two boxes (the
+    /// third, far away, is not in it); with a rest at 2.5 robot 0 waits there (until 6.5:
+    /// it reaches 3 when robot 1 is past 7).
+    #[test]
+    fn the_infeasible_core_shows_where_a_stop_is_missing() {
+        let boxes = [
+            boxed((0, 1), (0.0, 2.0), (4.0, 6.0)),
+            boxed((0, 1), (3.0, 10.0), (5.0, 7.0)),
+            boxed((0, 2), (0.0, 1.0), (8.0, 9.0)),
+        ];
+        let tracks = [
+            track(0, 10.0, &[0.0]),
+            track(1, 10.0, &[0.0]),
+            track(2, 10.0, &[0.0]),
+        ];
+        assert!(schedule(&tracks, &boxes, 1000, 0.05).is_none());
+        assert_eq!(infeasible_core(&tracks, &boxes, 1000, 0.05), vec![0, 1]);
+        let stopped = [
+            track(0, 10.0, &[0.0, 2.5]),
+            track(1, 10.0, &[0.0]),
+            track(2, 10.0, &[0.0]),
+        ];
+        let s = schedule(&stopped, &boxes, 1000, 0.05).unwrap();
+        assert!((s.waits[0][1].0 - 4.0).abs() < 1e-9, "{s:?}");
+        assert_clear(&stopped, &boxes, &s);
+        assert!(infeasible_core(&stopped, &boxes, 1000, 0.05).is_empty());
+    }
+
     #[test]
     fn the_search_matches_brute_force() {
         let tracks = [

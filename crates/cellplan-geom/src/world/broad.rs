@@ -54,12 +54,13 @@ enum Kind {
     /// other convex shapes: solids).
     Other,
     /// Body `body` of group `group`, standing at `pose`; its cover in the world is
-    /// `parked[spheres]`.
+    /// `parked[spheres]` (grown by `extra`); distances to it count `extra` less.
     Body {
         group: GroupId,
         body: usize,
         pose: Pose,
         spheres: Range<usize>,
+        extra: f64,
     },
 }
 
@@ -103,6 +104,18 @@ impl BroadPhase {
     /// The broad phase of group `g` against `world`'s static objects and the `parked` groups
     /// (each with the poses of its bodies, standing still).
     pub fn new(world: &CollisionWorld, g: GroupId, parked: &[(GroupId, Vec<Pose>)]) -> BroadPhase {
+        BroadPhase::with_parked_extra(world, g, parked, 0.0)
+    }
+
+    /// As [`BroadPhase::new`], with distances to the parked bodies counted `extra` (m, ≥ 0)
+    /// less than they are: those bodies are kept `extra` farther away than the scene.
+    pub fn with_parked_extra(
+        world: &CollisionWorld,
+        g: GroupId,
+        parked: &[(GroupId, Vec<Pose>)],
+        extra: f64,
+    ) -> BroadPhase {
+        let extra = if extra.is_finite() { extra.max(0.0) } else { 0.0 };
         let mut local = Vec::new();
         let mut ranges = Vec::new();
         let mut outer = Vec::new();
@@ -166,10 +179,11 @@ impl BroadPhase {
                 let (mins, maxs) = if pose.is_finite() {
                     parked_spheres.extend(world.body_cover(*other, j).iter().map(|s| Sphere {
                         centre: pose.transform_point(s.centre),
-                        radius: s.radius,
+                        radius: s.radius + extra,
                     }));
                     let c = pose.transform_point(o.centre);
-                    (c - DVec3::splat(o.radius), c + DVec3::splat(o.radius))
+                    let r = o.radius + extra;
+                    (c - DVec3::splat(r), c + DVec3::splat(r))
                 } else {
                     // Never dismissed by its box: the exact query says 0.
                     (DVec3::splat(f64::NEG_INFINITY), DVec3::splat(f64::INFINITY))
@@ -183,6 +197,7 @@ impl BroadPhase {
                         body: j,
                         pose: *pose,
                         spheres: start..parked_spheres.len(),
+                        extra,
                     },
                 });
             }
@@ -229,7 +244,9 @@ impl BroadPhase {
     /// `cap`: `min(true distance, cap)`, 0 when touching or at a non-finite pose (when there is
     /// an object), the cap for a body without shapes. Equal to the smaller of
     /// [`CollisionWorld::body_static_distance`] and [`CollisionWorld::body_group_distance`]
-    /// over the parked groups; the exact query runs only for objects whose bound falls short.
+    /// over the parked groups (less the parked bodies' extra, see
+    /// [`BroadPhase::with_parked_extra`]); the exact query runs only for objects whose bound
+    /// falls short.
     pub fn scene_distance(
         &self,
         world: &CollisionWorld,
@@ -253,8 +270,14 @@ impl BroadPhase {
             }
             let d = match &object.kind {
                 Kind::Body {
-                    group, body, pose, ..
-                } => world.body_body_distance(self.group, i, poses, *group, *body, pose, best),
+                    group,
+                    body,
+                    pose,
+                    extra,
+                    ..
+                } => (world.body_body_distance(self.group, i, poses, *group, *body, pose, best + extra)
+                    - extra)
+                    .max(0.0),
                 _ => world.body_object_distance_hinted(self.group, i, poses, object.index, best, towards),
             };
             best = best.min(d);
