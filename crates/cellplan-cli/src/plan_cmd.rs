@@ -32,9 +32,11 @@ pub struct PlanArgs {
     /// Seed of every random choice.
     #[arg(long, default_value_t = 0)]
     seed: u64,
-    /// Budget of the search stages in seconds (they also stop after fixed iteration counts).
-    #[arg(long, value_name = "S", default_value_t = 30.0)]
-    time_limit: f64,
+    /// Wall-clock limit of the whole run in seconds. By default there is none: every search
+    /// stops at its work budget, so the plan depends only on the cell and the seed (not on
+    /// the machine or the thread count); when a limit binds, the output says so.
+    #[arg(long, value_name = "S")]
+    time_limit: Option<f64>,
     /// ε of paper 000 eq. 4 in metres: MPs closer than this may share a local robust set.
     #[arg(long, value_name = "M", default_value_t = 0.3)]
     local_set_radius: f64,
@@ -106,7 +108,10 @@ struct RobotSummary<'a> {
 
 pub fn run(args: &PlanArgs) -> Result<(), Failure> {
     let start = Instant::now();
-    if !(args.time_limit.is_finite() && args.time_limit > 0.0 && args.time_limit <= 1e6) {
+    if args
+        .time_limit
+        .is_some_and(|t| !(t.is_finite() && t > 0.0 && t <= 1e6))
+    {
         return Err(Failure::Usage(
             "--time-limit must be a number of seconds above 0 and at most 1e6".into(),
         ));
@@ -142,7 +147,9 @@ pub fn run(args: &PlanArgs) -> Result<(), Failure> {
         cover: args.cover,
         move_model: args.move_model,
         seed: args.seed,
-        time_limit: Duration::from_secs_f64(args.time_limit),
+        time_limit: args
+            .time_limit
+            .map_or(PlanSettings::NO_TIME_LIMIT, Duration::from_secs_f64),
         local_set_radius: args.local_set_radius,
         lazy_rounds: args.lazy_rounds.max(1),
         reallocation_rounds: args.reallocation_rounds,

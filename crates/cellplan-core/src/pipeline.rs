@@ -88,7 +88,7 @@ pub fn run<R>(
     }
     // One limit for the whole run, every stage.
     let settings = &PlanSettings {
-        deadline: Some(settings.deadline.unwrap_or(run_started + settings.time_limit)),
+        deadline: Some(settings.deadline.unwrap_or(settings.deadline_from(run_started))),
         ..settings.clone()
     };
     let mut cache = plan::PlanCache::default();

@@ -259,3 +259,84 @@ fn the_plan_keeps_the_probe_tracks_before_coordination() {
     let waited: f64 = doc.robots.iter().map(|r| r.waiting_s).sum();
     assert!(waited > 0.0 && c.waits > 0);
 }
+
+/// A stop (what `best` adds where a robot has no rest to let another pass) splits a moving
+/// segment at the configuration the robot has there: the joint path is the same, the robot
+/// comes to rest there once more, and the program gets longer; inside a measurement there is
+/// nothing to split.
+#[test]
+fn a_stop_splits_a_segment_on_the_same_joint_path() {
+    let f = fixture();
+    let (_, none) = document(Coordination::None);
+    let robot = &f.cell.robots[0];
+    let limits = cellplan_core::plan::graph::limits_of(robot);
+    let program = none.programs[0].clone();
+    let timed = &none.timed[0];
+    let span = timed
+        .spans
+        .iter()
+        .find(|s| matches!(s.what, coord::Activity::Move { .. }) && s.end - s.start > 0.2)
+        .expect("a segment to split");
+    let coord::Activity::Move { leg, segment } = span.what else {
+        unreachable!()
+    };
+    let at = 0.5 * (span.start + span.end);
+    let mut stopped = program.clone();
+    assert!(stopped.stop_at(timed, at, &limits).unwrap());
+    let (old, new) = (&program.legs[leg].waypoints, &stopped.legs[leg].waypoints);
+    assert_eq!(new.len(), old.len() + 1);
+    let (a, b, m) = (&old[segment], &old[segment + 1], &new[segment + 1]);
+    assert_eq!(m, &timed.trajectory.position(at));
+    // On the segment: m = a + λ (b − a), 0 < λ < 1, in every joint.
+    let d: Vec<f64> = a.iter().zip(b).map(|(x, y)| y - x).collect();
+    let k = (0..d.len())
+        .max_by(|&i, &j| d[i].abs().total_cmp(&d[j].abs()))
+        .unwrap();
+    let lambda = (m[k] - a[k]) / d[k];
+    assert!(lambda > 0.0 && lambda < 1.0, "{lambda}");
+    for j in 0..d.len() {
+        assert!((a[j] + lambda * d[j] - m[j]).abs() < 1e-9, "joint {j}");
+    }
+    assert!(!stopped.legs[leg].straight);
+    let again = stopped.timed(&limits).unwrap();
+    assert!(again.end() > timed.end() + 1e-6, "a stop costs time");
+    // Every configuration of the new program lies on the old joint path of that leg.
+    let on_old = |q: &[f64]| {
+        old.windows(2).any(|w| {
+            let d: Vec<f64> = w[0].iter().zip(&w[1]).map(|(x, y)| y - x).collect();
+            let len2: f64 = d.iter().map(|x| x * x).sum();
+            let t = if len2 > 0.0 {
+                (q.iter()
+                    .zip(&w[0])
+                    .zip(&d)
+                    .map(|((q, a), d)| (q - a) * d)
+                    .sum::<f64>()
+                    / len2)
+                    .clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
+            q.iter()
+                .zip(&w[0])
+                .zip(&d)
+                .all(|((q, a), d)| (a + t * d - q).abs() < 1e-7)
+        })
+    };
+    for s in again
+        .spans
+        .iter()
+        .filter(|s| matches!(s.what, coord::Activity::Move { leg: l, .. } if l == leg))
+    {
+        for i in 0..=10 {
+            let q = again
+                .trajectory
+                .position(s.start + (s.end - s.start) * i as f64 / 10.0);
+            assert!(on_old(&q), "{q:?} is off the leg's path");
+        }
+    }
+    // Inside a measurement: nothing to split.
+    let (arrive, depart) = timed.visits[0];
+    let mut same = program.clone();
+    assert!(!same.stop_at(timed, 0.5 * (arrive + depart), &limits).unwrap());
+    assert_eq!(same, program);
+}

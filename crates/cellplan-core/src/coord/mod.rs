@@ -831,16 +831,11 @@ fn add_stops(
                 stops.push((leg, segment, at));
             }
         }
-        // Latest first, so earlier indices stay valid.
+        // Latest first, so earlier indices stay valid; one per segment.
         stops.sort_by(|x, y| (y.0, y.1).cmp(&(x.0, x.1)).then(y.2.total_cmp(&x.2)));
         stops.dedup_by(|x, y| (x.0, x.1) == (y.0, y.1));
-        for (leg, segment, at) in stops {
-            let q = timed.trajectory.position(at);
-            let l = &prog.legs[leg];
-            let mut waypoints = l.waypoints.clone();
-            waypoints.insert(segment + 1, q);
-            prog.legs[leg] = program::ProgramLeg::new(waypoints, false, &ctx.limits[r])?;
-            changed[i] = true;
+        for (_, _, at) in stops {
+            changed[i] |= prog.stop_at(timed, at, &ctx.limits[r])?;
         }
     }
     Ok(changed)

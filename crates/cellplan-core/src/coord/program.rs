@@ -280,6 +280,26 @@ impl Program {
         }
     }
 
+    /// Adds a stop where the program (timed as `timed`, without waits) is at time `at`, if it
+    /// is moving along a segment there: the segment is split at that configuration — the same
+    /// joint path, one more rest — and its leg timed again under `limits`. Returns whether a
+    /// stop was added. Waits keep their places only before it (they are cleared by callers
+    /// that add stops: the program is scheduled again).
+    pub fn stop_at(&mut self, timed: &Timed, at: f64, limits: &Limits) -> Result<bool, PlanError> {
+        let span = &timed.spans[timed.span_at(at)];
+        let Activity::Move { leg, segment } = span.what else {
+            return Ok(false);
+        };
+        if at <= span.start || at >= span.end {
+            return Ok(false);
+        }
+        let q = timed.trajectory.position(at);
+        let mut waypoints = self.legs[leg].waypoints.clone();
+        waypoints.insert(segment + 1, q);
+        self.legs[leg] = ProgramLeg::new(waypoints, false, limits)?;
+        Ok(true)
+    }
+
     /// The wait at a waypoint, if any.
     pub fn wait_at(&self, leg: usize, waypoint: usize) -> Option<&Wait> {
         self.waits.iter().find(|w| w.leg == leg && w.waypoint == waypoint)

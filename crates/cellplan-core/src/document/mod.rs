@@ -73,8 +73,10 @@ pub struct SettingsOut {
     pub move_model: plan::MoveModel,
     /// Seed.
     pub seed: u64,
-    /// Search budget (s).
-    pub time_limit_s: f64,
+    /// Wall-clock limit of the run (s); absent when none was given (the searches stopped at
+    /// their work budgets).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub time_limit_s: Option<f64>,
     /// ε of the local robust sets (m).
     pub local_set_radius_m: f64,
     /// Candidates kept per task and robot for allocation and sequencing.

@@ -162,13 +162,15 @@ fn validate_top(plan: &Plan) -> Result<(), DocumentError> {
         ("cycle_time_s", plan.cycle_time_s),
         ("delta_t_s", plan.delta_t_s),
         ("lower_bound_s", plan.lower_bound_s),
-        ("settings.time_limit_s", plan.settings.time_limit_s),
         (
             "coordination.uncoordinated_cycle_time_s",
             plan.coordination.uncoordinated_cycle_time_s,
         ),
     ] {
         time(&top, key, v)?;
+    }
+    if let Some(v) = plan.settings.time_limit_s {
+        time(&top, "settings.time_limit_s", v)?;
     }
     if !(plan.ratio_to_lower_bound.is_finite() && plan.ratio_to_lower_bound >= 0.0) {
         return Err(invalid(top(), "`ratio_to_lower_bound` is not a finite ratio"));

@@ -34,8 +34,9 @@ pub struct PlanSettings {
     pub move_model: MoveModel,
     /// Seed of every random choice.
     pub seed: u64,
-    /// Budget of the search stages (allocation search and lazy sequencing); they also stop
-    /// after fixed iteration counts, so the plan only depends on the budget when it cuts.
+    /// Wall-clock limit of the whole run (every stage); the searches stop at their work
+    /// budgets, so the plan depends on this only when it cuts (then `time_limit_hit`).
+    /// Default: [`PlanSettings::NO_TIME_LIMIT`].
     pub time_limit: Duration,
     /// ε of eq. 4 (m): MPs closer than this may form a local robust set.
     pub local_set_radius: f64,
@@ -73,6 +74,19 @@ pub struct PlanSettings {
     pub task_penalty: Vec<Vec<f64>>,
 }
 
+impl PlanSettings {
+    /// The `time_limit` meaning none (a year): the searches stop at their work budgets.
+    pub const NO_TIME_LIMIT: Duration = Duration::from_secs(365 * 24 * 3600);
+
+    /// When a run started at `start` must end under `time_limit`.
+    pub fn deadline_from(&self, start: Instant) -> Instant {
+        start
+            .checked_add(self.time_limit)
+            .or_else(|| start.checked_add(Self::NO_TIME_LIMIT))
+            .unwrap_or(start)
+    }
+}
+
 impl Default for PlanSettings {
     fn default() -> Self {
         PlanSettings {
@@ -80,7 +94,7 @@ impl Default for PlanSettings {
             cover: CoverMethod::Penalty,
             move_model: MoveModel::Trapezoid,
             seed: 0,
-            time_limit: Duration::from_secs(30),
+            time_limit: PlanSettings::NO_TIME_LIMIT,
             local_set_radius: 0.3,
             balanced_iterations: 200,
             alternatives: 24,
@@ -310,7 +324,7 @@ pub fn plan_cached(
     cache: &mut PlanCache,
 ) -> Result<Outcome, PlanError> {
     let started = Instant::now();
-    let deadline = settings.deadline.unwrap_or(started + settings.time_limit);
+    let deadline = settings.deadline.unwrap_or(settings.deadline_from(started));
     let mut compute = Vec::new();
     let mut lap = Instant::now();
     let mut tick = |stage: Stage, compute: &mut Vec<(Stage, f64)>| {
