@@ -152,7 +152,7 @@ fn settings_out(cell: &Cell, settings: &PlanSettings, coordinated: &Coordinated)
         move_model: settings.move_model,
         seed: settings.seed,
         time_limit_s: (settings.time_limit < PlanSettings::NO_TIME_LIMIT)
-            .then(|| settings.time_limit.as_secs_f64()),
+            .then_some(settings.time_limit.as_secs_f64()),
         local_set_radius_m: settings.local_set_radius,
         alternatives: settings.alternatives,
         roomy_m: settings.roomy,
