@@ -283,36 +283,41 @@ impl PairDiagram<'_> {
         }
     }
 
-    /// Lower bound of the distance between the two placed robots from their sphere covers
-    /// (body spheres first), exact up to `cap` (farther is `cap`).
-    fn cover_distance(&self, xa: &Placed, xb: &Placed, cap: f64) -> f64 {
-        let mut best = cap;
+    /// The body pairs of the two placed robots whose sphere covers (body spheres first) come
+    /// within `need`: every other pair is farther than `need` (the covers hold the meshes).
+    fn close_pairs(&self, xa: &Placed, xb: &Placed, need: f64) -> Vec<(usize, usize)> {
+        let mut out = Vec::new();
         for (i, (ca, ra)) in xa.spheres.iter().enumerate() {
             for (j, (cb, rb)) in xb.spheres.iter().enumerate() {
-                if (*ca - *cb).length() - ra - rb >= best {
+                if (*ca - *cb).length() - ra - rb > need {
                     continue;
                 }
                 let (bi, bj) = (xa.bodies[i], xb.bodies[j]);
                 let (pa, pb) = (&xa.poses[bi], &xb.poses[bj]);
-                let placed: Vec<(DVec3, f64)> = self.cb[bj]
-                    .iter()
-                    .map(|(c, r)| (pb.transform_point(*c), *r))
-                    .collect();
-                for (c, r) in &self.ca[bi] {
+                let close = self.ca[bi].iter().any(|(c, r)| {
                     let c = pa.transform_point(*c);
-                    for (d, q) in &placed {
-                        let gap = (c - *d).length() - r - q;
-                        if gap < best {
-                            best = gap;
-                        }
-                    }
-                }
-                if best <= 0.0 {
-                    return 0.0;
+                    self.cb[bj]
+                        .iter()
+                        .any(|(d, q)| (c - pb.transform_point(*d)).length() - r - q <= need)
+                });
+                if close {
+                    out.push((bi, bj));
                 }
             }
         }
-        best
+        out
+    }
+
+    /// Whether the two placed robots are farther apart than `need`, exactly (up to the convex
+    /// hulls), asking only the body pairs `close` (the others are farther by their covers).
+    fn apart(&mut self, xa: &Placed, xb: &Placed, close: &[(usize, usize)], need: f64) -> bool {
+        self.work.distances += 1;
+        let robots = &self.ctx.cell.robots;
+        let (ga, gb) = (robots[self.pa.robot].group, robots[self.pb.robot].group);
+        let world = &self.ctx.cell.world;
+        close.iter().all(|&(i, j)| {
+            world.body_body_distance(ga, i, &xa.poses, gb, j, &xb.poses[j], need + DISTANCE_SLACK) > need
+        })
     }
 
     /// How far any point of the robot can be from where it is at `mid` while at positions in
@@ -359,24 +364,14 @@ impl PairDiagram<'_> {
         let split_b = b.2 && b.1 - b.0 > MIN_CELL;
         // The sphere covers hold the meshes: their distance is a lower bound. The exact
         // distance only where nothing is left to halve (halving is cheaper than GJK, and
-        // the covers decide most rectangles once small).
-        let covers = self.cover_distance(&xa, &xb, need + DISTANCE_SLACK);
-        if covers > need {
+        // the covers decide most rectangles once small), and only for the body pairs whose
+        // covers come close.
+        let close = self.close_pairs(&xa, &xb, need);
+        if close.is_empty() {
             return;
         }
-        if !(split_a || split_b) {
-            let world = &self.ctx.cell.world;
-            self.work.distances += 1;
-            let d = world.group_group_distance(
-                self.ctx.cell.robots[pa.robot].group,
-                &xa.poses,
-                self.ctx.cell.robots[pb.robot].group,
-                &xb.poses,
-                need + DISTANCE_SLACK,
-            );
-            if d > need {
-                return;
-            }
+        if !(split_a || split_b) && self.apart(&xa, &xb, &close, need) {
+            return;
         }
         match (split_a, split_b) {
             (false, false) => {
@@ -413,20 +408,12 @@ impl PairDiagram<'_> {
         let need = self.ctx.margin + ra + rb;
         let split_a = a.2 && a.1 - a.0 > MIN_CELL;
         let split_b = b.2 && b.1 - b.0 > MIN_CELL;
-        if self.cover_distance(&xa, &xb, need + DISTANCE_SLACK) > need {
+        let close = self.close_pairs(&xa, &xb, need);
+        if close.is_empty() {
             return true;
         }
         if !(split_a || split_b) {
-            self.work.distances += 1;
-            let robots = &self.ctx.cell.robots;
-            let d = self.ctx.cell.world.group_group_distance(
-                robots[pa.robot].group,
-                &xa.poses,
-                robots[pb.robot].group,
-                &xb.poses,
-                need + DISTANCE_SLACK,
-            );
-            return d > need;
+            return self.apart(&xa, &xb, &close, need);
         }
         if split_a && (!split_b || ra >= rb) {
             let m = 0.5 * (a.0 + a.1);
