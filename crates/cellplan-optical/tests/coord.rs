@@ -53,8 +53,13 @@ fn every_strategy_gives_a_verified_conflict_free_plan() {
         assert!(c.resolved >= 1);
         // Resolving costs time or nothing; never less than the robots passing through each other.
         assert!(doc.cycle_time_s >= free - 1e-9, "{}", strategy);
-        // The waits are in the document where the strategy made them.
+        // The waits are in the document where the strategy made them, none shorter than the
+        // shortest allowed (a shorter one would not show between two trajectory samples).
         let waits: usize = doc.robots.iter().map(|r| r.waits.len()).sum();
+        let min_wait = coord::CoordSettings::default().min_wait;
+        for w in doc.robots.iter().flat_map(|r| &r.waits) {
+            assert!(w.duration_s >= min_wait - 1e-9, "{}: {w:?}", strategy);
+        }
         assert_eq!(waits > 0, c.programs.iter().any(|p| !p.waits.is_empty()));
         if strategy == Coordination::DelayStartup {
             assert!(

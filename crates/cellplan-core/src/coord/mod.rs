@@ -551,19 +551,24 @@ pub(crate) fn add_wait(
                 }
             }
             WaitSearch::Shortest => {
-                let mut lo = 0.0;
-                let mut hi = 0.05;
+                // Never a wait shorter than the shortest allowed (it would not show between
+                // two trajectory samples): the search starts there.
+                let floor = (ctx.settings.min_wait - base).max(0.0);
+                let mut lo = floor;
+                let mut hi = floor + 0.05;
                 let ok = loop {
                     if check(hi)? {
                         break true;
                     }
                     lo = hi;
-                    hi *= 1.5;
+                    hi = floor + (hi - floor) * 1.5;
                     if hi > limit {
                         break false;
                     }
                 };
-                if ok {
+                if ok && floor > 0.0 && check(floor)? {
+                    Some(floor)
+                } else if ok {
                     // Shrink to 10 ms (good delays need not form an interval; `hi` stays good).
                     while hi - lo > 0.01 {
                         let mid = 0.5 * (lo + hi);
