@@ -624,7 +624,8 @@ fn baselines_if_shorter(
             continue;
         }
         let s = score(&progs)?;
-        if s.0 < kept.0.0 - 1e-9 || (s.0 <= kept.0.0 + 1e-9 && s.1 < kept.0.1 - 1e-9) {
+        // Shorter by more than a millisecond (a tie keeps the schedule).
+        if s.0 < kept.0.0 - 1e-3 || (s.0 <= kept.0.0 + 1e-3 && s.1 < kept.0.1 - 1e-3) {
             kept = (s, (progs, res, cell_order.to_vec()));
         }
     }

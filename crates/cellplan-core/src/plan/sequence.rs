@@ -250,11 +250,13 @@ fn attempt(
             break;
         }
     }
-    // Legs of the final order the quick planner gave up on get the full search budget.
+    // Legs of the final order the quick planner gave up on get the full search budget — once:
+    // a leg that failed with it (in this run or an earlier one sharing `planned`) would fail
+    // the same way again (the sampler's seed is the leg's), and invalid ends stay invalid.
     let retry: Vec<(usize, usize)> = legs_of(&nodes)
         .into_iter()
         .map(|(a, b)| key(a, b))
-        .filter(|k| matches!(planned.get(k), Some(Err(_))))
+        .filter(|k| worth_full_budget(planned.get(k), settings.final_max_samples))
         .collect::<std::collections::BTreeSet<_>>()
         .into_iter()
         .collect();
@@ -291,6 +293,16 @@ fn attempt(
     out.nodes = nodes;
     out.legs = legs;
     (out, None)
+}
+
+/// Whether a leg planned as `planned` says is worth the full sample budget `full`: the sampler
+/// gave up on it with fewer samples than that (not an invalid end, not a full-budget failure).
+fn worth_full_budget(planned: Option<&Result<Leg, LegError>>, full: usize) -> bool {
+    matches!(
+        planned,
+        Some(Err(LegError::Motion(cellplan_motion::plan::PlanError::NoPath { samples, .. })))
+            if *samples < full
+    )
 }
 
 /// Give the sampled legs of a final sequence the full shortcutting (the lazy rounds used a few
@@ -484,4 +496,29 @@ fn leg_seed(seed: u64, robot: usize, a: usize, b: usize) -> u64 {
         }
     }
     h
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use cellplan_motion::plan::PlanError as Motion;
+
+    /// A leg is retried with the full budget only after a quick failure: not after a failure
+    /// with the full budget (it would fail the same way: the seed is the leg's), not when an
+    /// end is invalid, not when it has a path or was never planned.
+    #[test]
+    fn only_quick_failures_get_the_full_budget() {
+        let no_path = |samples| {
+            Err(LegError::Motion(Motion::NoPath {
+                samples,
+                validity_calls: 10 * samples,
+            }))
+        };
+        assert!(worth_full_budget(Some(&no_path(180)), 20_000));
+        assert!(!worth_full_budget(Some(&no_path(20_000)), 20_000));
+        assert!(!worth_full_budget(Some(&no_path(60_180)), 20_000));
+        let invalid = Err(LegError::Motion(Motion::GoalInvalid { clearance: -0.01 }));
+        assert!(!worth_full_budget(Some(&invalid), 20_000));
+        assert!(!worth_full_budget(None, 20_000));
+    }
 }
