@@ -213,6 +213,14 @@ fn covers(ctx: &Ctx, robot: &Robot) -> Vec<Vec<(DVec3, f64)>> {
         .collect()
 }
 
+/// What a rectangle of two pieces' positions is (see [`PairDiagram::judge`]).
+enum Rect {
+    Free,
+    Conflict,
+    HalveA,
+    HalveB,
+}
+
 struct PairDiagram<'a> {
     ctx: &'a Ctx<'a>,
     pa: &'a RobotPath,
@@ -340,6 +348,42 @@ impl PairDiagram<'_> {
             .fold(0.0, f64::max)
     }
 
+    /// What rectangle `[a0, a1] × [b0, b1]` (inside pieces of the two paths) is: free (the
+    /// sphere covers, or the exact distance, exceed the clearance plus both robots' reach over
+    /// it), to be halved (along the robot that moves more), or — once nothing is left to halve
+    /// — in conflict.
+    fn judge(&mut self, a: (f64, f64, bool), b: (f64, f64, bool)) -> Rect {
+        self.work.cells += 1;
+        let (pa, pb) = (self.pa, self.pb);
+        let xa = self.place(pa, true, 0.5 * (a.0 + a.1));
+        let xb = self.place(pb, false, 0.5 * (b.0 + b.1));
+        let ra = self.reach(pa.robot, &xa.q, pa, a.0, a.1, a.2);
+        let rb = self.reach(pb.robot, &xb.q, pb, b.0, b.1, b.2);
+        let need = self.ctx.margin + ra + rb;
+        let split_a = a.2 && a.1 - a.0 > MIN_CELL;
+        let split_b = b.2 && b.1 - b.0 > MIN_CELL;
+        // The sphere covers hold the meshes: their distance is a lower bound. The exact
+        // distance only where nothing is left to halve (halving is cheaper than GJK, and
+        // the covers decide most rectangles once small), and only for the body pairs whose
+        // covers come close.
+        let close = self.close_pairs(&xa, &xb, need);
+        if close.is_empty() {
+            return Rect::Free;
+        }
+        if !(split_a || split_b) {
+            return if self.apart(&xa, &xb, &close, need) {
+                Rect::Free
+            } else {
+                Rect::Conflict
+            };
+        }
+        if split_a && (!split_b || ra >= rb) {
+            Rect::HalveA
+        } else {
+            Rect::HalveB
+        }
+    }
+
     /// Rectangle `[a0, a1] × [b0, b1]` inside pieces of the two paths: free, or halved, or
     /// recorded as in conflict.
     fn cell(&mut self, a: (f64, f64, bool), b: (f64, f64, bool)) {
@@ -351,32 +395,12 @@ impl PairDiagram<'_> {
         {
             return;
         }
-        self.work.cells += 1;
-        let margin = self.ctx.margin;
-        let (pa, pb) = (self.pa, self.pb);
-        let (ma, mb) = (0.5 * (a.0 + a.1), 0.5 * (b.0 + b.1));
-        let xa = self.place(pa, true, ma);
-        let xb = self.place(pb, false, mb);
-        let ra = self.reach(pa.robot, &xa.q, pa, a.0, a.1, a.2);
-        let rb = self.reach(pb.robot, &xb.q, pb, b.0, b.1, b.2);
-        let need = margin + ra + rb;
-        let split_a = a.2 && a.1 - a.0 > MIN_CELL;
-        let split_b = b.2 && b.1 - b.0 > MIN_CELL;
-        // The sphere covers hold the meshes: their distance is a lower bound. The exact
-        // distance only where nothing is left to halve (halving is cheaper than GJK, and
-        // the covers decide most rectangles once small), and only for the body pairs whose
-        // covers come close.
-        let close = self.close_pairs(&xa, &xb, need);
-        if close.is_empty() {
-            return;
-        }
-        if !(split_a || split_b) && self.apart(&xa, &xb, &close, need) {
-            return;
-        }
-        match (split_a, split_b) {
-            (false, false) => {
+        match self.judge(a, b) {
+            Rect::Free => {}
+            Rect::Conflict => {
+                let robots = (self.pa.robot, self.pb.robot);
                 let f = self.found.get_or_insert(ConflictBox {
-                    robots: (pa.robot, pb.robot),
+                    robots,
                     a: (a.0, a.1),
                     b: (b.0, b.1),
                     open: [false; 4],
@@ -384,43 +408,25 @@ impl PairDiagram<'_> {
                 f.a = (f.a.0.min(a.0), f.a.1.max(a.1));
                 f.b = (f.b.0.min(b.0), f.b.1.max(b.1));
             }
-            (true, false) => self.halve_a(a, b),
-            (false, true) => self.halve_b(a, b),
-            (true, true) => {
-                if ra >= rb {
-                    self.halve_a(a, b)
-                } else {
-                    self.halve_b(a, b)
-                }
-            }
+            Rect::HalveA => self.halve_a(a, b),
+            Rect::HalveB => self.halve_b(a, b),
         }
     }
 
     /// Whether rectangle `[a0, a1] × [b0, b1]` is certified free (as [`Self::cell`] decides,
     /// halving until it is or a smallest rectangle is not).
     fn certify(&mut self, a: (f64, f64, bool), b: (f64, f64, bool)) -> bool {
-        self.work.cells += 1;
-        let (pa, pb) = (self.pa, self.pb);
-        let xa = self.place(pa, true, 0.5 * (a.0 + a.1));
-        let xb = self.place(pb, false, 0.5 * (b.0 + b.1));
-        let ra = self.reach(pa.robot, &xa.q, pa, a.0, a.1, a.2);
-        let rb = self.reach(pb.robot, &xb.q, pb, b.0, b.1, b.2);
-        let need = self.ctx.margin + ra + rb;
-        let split_a = a.2 && a.1 - a.0 > MIN_CELL;
-        let split_b = b.2 && b.1 - b.0 > MIN_CELL;
-        let close = self.close_pairs(&xa, &xb, need);
-        if close.is_empty() {
-            return true;
-        }
-        if !(split_a || split_b) {
-            return self.apart(&xa, &xb, &close, need);
-        }
-        if split_a && (!split_b || ra >= rb) {
-            let m = 0.5 * (a.0 + a.1);
-            self.certify((a.0, m, a.2), b) && self.certify((m, a.1, a.2), b)
-        } else {
-            let m = 0.5 * (b.0 + b.1);
-            self.certify(a, (b.0, m, b.2)) && self.certify(a, (m, b.1, b.2))
+        match self.judge(a, b) {
+            Rect::Free => true,
+            Rect::Conflict => false,
+            Rect::HalveA => {
+                let m = 0.5 * (a.0 + a.1);
+                self.certify((a.0, m, a.2), b) && self.certify((m, a.1, a.2), b)
+            }
+            Rect::HalveB => {
+                let m = 0.5 * (b.0 + b.1);
+                self.certify(a, (b.0, m, b.2)) && self.certify(a, (m, b.1, b.2))
+            }
         }
     }
 
