@@ -7,13 +7,17 @@
 //!   for the robot's arm) — joint limits, distance of the moving bodies to the static scene and
 //!   to the other robots parked at home, minus the margin, and the distance of the robot's
 //!   checked self pairs — split by the joints that can reduce each part.
-//! - [`plan_leg`]: one leg, straight if clear, else RRT-Connect with shortcutting.
+//! - [`plan_leg`]: one leg, straight if clear, else RRT-Connect with shortcutting;
+//!   [`plan_leg_with_margin`] adds the robot's shared roadmap ([`robot_roadmap`]) and the
+//!   retract along the tool axis.
 //!
 //! Robots moving at the same time are not obstacles here: coordinating them is a later stage.
 use cellplan_model::Cell;
 use cellplan_model::robot::Robot;
 use cellplan_motion::arm::{self, ArmValidity};
-use cellplan_motion::plan::{self, JointSpace, PlanError, PlanSettings, PlannedPath};
+use cellplan_motion::plan::{
+    self, JointSpace, PlanError, PlanSettings, PlannedPath, SharedRoadmap, SharedRoadmapSettings,
+};
 
 pub use cellplan_motion::arm::DEFAULT_CLEARANCE_CAP;
 pub use cellplan_motion::plan::{Planner, RrtConnect, Straight};
@@ -48,7 +52,7 @@ pub fn robot_validity<'a>(cell: &'a Cell, robot: &'a Robot, margin: f64) -> Robo
 }
 
 /// One leg of `robot` from `from` to `to`, keeping the process clearance from the static
-/// scene (see [`plan_leg_with_margin`]).
+/// scene (see [`plan_leg_with_margin`]; no roadmap).
 pub fn plan_leg(
     cell: &Cell,
     robot: &Robot,
@@ -56,7 +60,7 @@ pub fn plan_leg(
     to: &[f64],
     settings: &PlanSettings,
 ) -> Result<PlannedPath, PlanError> {
-    plan_leg_with_margin(cell, robot, from, to, cell.planning.clearance, settings)
+    plan_leg_with_margin(cell, robot, from, to, cell.planning.clearance, settings, None)
 }
 
 /// How far (m) a leg the sampler cannot solve backs the tool out along its axis at either end
@@ -66,53 +70,93 @@ pub const RETRACT_DISTANCES: [f64; 2] = [0.1, 0.25];
 /// The step (m) of the tool along its axis in a retract.
 const RETRACT_STEP: f64 = 0.01;
 
+/// The robot's roadmap in its cell (the other robots parked at home), for [`plan_leg_with_margin`]:
+/// its nodes are `seeds` (the robot's task candidates and home: where its legs start and end)
+/// and uniform samples seeded by `seed`, checked with the process clearance.
+pub fn robot_roadmap(cell: &Cell, robot: &Robot, seeds: &[Vec<f64>], seed: u64) -> SharedRoadmap {
+    let space = joint_space(cell, robot);
+    let validity = robot_validity(cell, robot, cell.planning.clearance);
+    let settings = SharedRoadmapSettings {
+        seed,
+        min_clearance: PlanSettings::default().min_clearance,
+        ..SharedRoadmapSettings::default()
+    };
+    SharedRoadmap::build(&space, &validity, seeds, &settings).0
+}
+
 /// One leg keeping `margin` (m) from the static scene: the straight joint segment if it is
 /// clear, else RRT-Connect, shortcut (see [`cellplan_motion::plan::plan_leg`]). When the
 /// sampler finds no path, the tool backs out along its axis at both ends (a probe at its
 /// stand-off from a surface, deep in an opening, leaves it the way it came) by each of
 /// [`RETRACT_DISTANCES`] in turn, and the sampler plans between the two retracted poses
-/// ([`cellplan_motion::plan::plan_leg_via`]); the first that succeeds is the leg.
-pub fn plan_leg_with_margin(
+/// ([`cellplan_motion::plan::plan_leg_via_with`]). When none of those succeeds and a
+/// `roadmap` of the robot is given (built by [`robot_roadmap`] with the same margin), the
+/// same variants are tried through its shortest valid paths. The first that succeeds is the
+/// leg. The roadmap is asked for lazily (built on first need).
+pub fn plan_leg_with_margin<'r>(
     cell: &Cell,
     robot: &Robot,
     from: &[f64],
     to: &[f64],
     margin: f64,
     settings: &PlanSettings,
+    roadmap: Option<&dyn Fn() -> &'r SharedRoadmap>,
 ) -> Result<PlannedPath, PlanError> {
     let space = joint_space(cell, robot);
     let validity = robot_validity(cell, robot, margin);
-    let (mut samples, mut calls) = match plan::plan_leg(&space, &validity, from, to, settings) {
-        Ok(path) => return Ok(path),
-        Err(PlanError::NoPath {
-            samples,
-            validity_calls,
-        }) => (samples, validity_calls),
-        Err(e) => return Err(e),
-    };
     let chain = &robot.model.chain;
+    // The variants: direct, then retracted by each distance (exit and entry polylines).
+    type Polyline = Vec<Vec<f64>>;
+    let mut variants: Vec<Option<(Polyline, Polyline)>> = vec![None];
     for distance in RETRACT_DISTANCES {
-        let (Some(exit), Some(mut entry)) = (
+        if let (Some(exit), Some(mut entry)) = (
             arm::tool_retract(chain, &robot.tool.tcp, from, distance, RETRACT_STEP),
             arm::tool_retract(chain, &robot.tool.tcp, to, distance, RETRACT_STEP),
-        ) else {
-            continue;
-        };
-        entry.reverse();
-        match plan::plan_leg_via(&space, &validity, &exit, &entry, settings) {
-            Ok(mut path) => {
-                path.samples += samples;
-                path.validity_calls += calls;
-                return Ok(path);
+        ) {
+            entry.reverse();
+            variants.push(Some((exit, entry)));
+        }
+    }
+    let sampler = |a: &[f64], b: &[f64]| plan::plan_leg(&space, &validity, a, b, settings);
+    let through_roadmap = |a: &[f64], b: &[f64]| match roadmap {
+        Some(r) => plan::roadmap_leg(&space, &validity, r(), a, b, settings),
+        None => Err(PlanError::NoPath {
+            samples: 0,
+            validity_calls: 0,
+        }),
+    };
+    let (mut samples, mut calls) = (0, 0);
+    // Every variant with the sampler first (the legs it solves keep its paths), then every
+    // variant through the roadmap.
+    let passes: [&plan::LegPlanner; 2] = [&sampler, &through_roadmap];
+    for (pass, middle) in passes.into_iter().enumerate() {
+        if pass == 1 && roadmap.is_none() {
+            break;
+        }
+        for variant in &variants {
+            let result = match variant {
+                None => middle(from, to),
+                Some((exit, entry)) => {
+                    plan::plan_leg_via_with(&space, &validity, exit, entry, settings, middle)
+                }
+            };
+            match result {
+                Ok(mut path) => {
+                    path.samples += samples;
+                    path.validity_calls += calls;
+                    return Ok(path);
+                }
+                Err(PlanError::NoPath {
+                    samples: s,
+                    validity_calls: c,
+                }) => {
+                    samples += s;
+                    calls += c;
+                }
+                // An invalid end: no variant of the direct leg can help.
+                Err(e) if variant.is_none() => return Err(e),
+                Err(_) => {}
             }
-            Err(PlanError::NoPath {
-                samples: s,
-                validity_calls: c,
-            }) => {
-                samples += s;
-                calls += c;
-            }
-            Err(_) => {}
         }
     }
     Err(PlanError::NoPath {

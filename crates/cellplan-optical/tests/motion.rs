@@ -2,7 +2,9 @@
 //! legs from home to measuring candidates and back, and a blocked leg solved by RRT-Connect —
 //! every path re-checked densely (1 mm Cartesian steps) with `Robot::contact_at`.
 use cellplan_core::candidates::generate;
-use cellplan_core::motion::{RobotValidity, joint_space, plan_leg, robot_validity};
+use cellplan_core::motion::{
+    RobotValidity, joint_space, plan_leg, plan_leg_with_margin, robot_roadmap, robot_validity,
+};
 use cellplan_model::robot::Scratch;
 use cellplan_model::{Cell, LoadOptions, Robot, TaskId};
 use cellplan_motion::plan::{PlanError, PlanSettings, Planner, StateValidity, Straight};
@@ -221,6 +223,60 @@ fn blocked_leg_is_solved_by_rrt_connect() {
         path.samples,
         path.validity_calls
     );
+}
+
+/// A leg the sampler gives up on (a budget of no samples: only the straight segment, which is
+/// blocked) is found through the robot's shared roadmap, passes the dense re-check, and is the
+/// same from a fresh roadmap as from one that other legs have used (their edge checks cached)
+/// — the roadmap's answers do not depend on which legs were asked before, on which thread. The
+/// cell's leg planner with the roadmap gives a valid leg too.
+#[test]
+fn a_leg_the_sampler_gives_up_on_goes_through_the_roadmap() {
+    use cellplan_motion::plan::{plan_leg as sample_leg, roadmap_leg};
+    let f = fixture();
+    let cell = &f.cell;
+    let s = PlanSettings {
+        seed: 7,
+        max_samples: 0,
+        ..PlanSettings::default()
+    };
+    let mut solved = 0;
+    for (robot, candidates) in cell.robots.iter().zip(&f.candidates) {
+        let space = joint_space(cell, robot);
+        let v = robot_validity(cell, robot, margin(cell));
+        let goals: Vec<&Vec<f64>> = candidates
+            .iter()
+            .filter(|q| v.clearance(q) > s.min_clearance)
+            .filter(|q| {
+                matches!(
+                    sample_leg(&space, &v, &robot.home, q, &s),
+                    Err(PlanError::NoPath { .. })
+                )
+            })
+            .take(3)
+            .collect();
+        let mut seeds = vec![robot.home.clone()];
+        seeds.extend(candidates.iter().cloned());
+        let warm = robot_roadmap(cell, robot, &seeds, 11);
+        assert!(warm.len() > seeds.len() / 2, "{} nodes", warm.len());
+        for goal in goals {
+            let Ok(path) = roadmap_leg(&space, &v, &warm, &robot.home, goal, &s) else {
+                continue;
+            };
+            assert_eq!(path.waypoints.first(), Some(&robot.home));
+            assert_eq!(path.waypoints.last(), Some(goal));
+            dense_contact_free(cell, robot, &path.waypoints).unwrap();
+            let cold = robot_roadmap(cell, robot, &seeds, 11);
+            let again = roadmap_leg(&space, &v, &cold, &robot.home, goal, &s).unwrap();
+            assert_eq!(again.waypoints, path.waypoints);
+            let get = || &warm;
+            let leg =
+                plan_leg_with_margin(cell, robot, &robot.home, goal, margin(cell), &s, Some(&get)).unwrap();
+            dense_contact_free(cell, robot, &leg.waypoints).unwrap();
+            solved += 1;
+        }
+    }
+    assert!(solved >= 3, "{solved} legs through the roadmap");
 }
 
 #[test]

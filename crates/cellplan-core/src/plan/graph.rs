@@ -4,8 +4,10 @@ use crate::candidates::CandidateTable;
 use cellplan_model::Cell;
 use cellplan_model::robot::Robot;
 use cellplan_model::tasks::TaskId;
+use cellplan_motion::plan::SharedRoadmap;
 use cellplan_motion::timing::{Limits, move_time, move_time_instant};
 use cellplan_solve::CostMatrix;
+use std::sync::{Arc, OnceLock};
 
 /// How the time of a move between two configurations is estimated before it is planned.
 #[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
@@ -34,7 +36,14 @@ pub struct RobotGraph {
     pub costs: CostMatrix,
     /// The joint limits used for timing.
     pub limits: Limits,
+    /// The robot's roadmap in the cell (see [`RobotGraph::roadmap`]), built on first need and
+    /// shared by the legs planned on any thread.
+    pub roadmap: Arc<OnceLock<SharedRoadmap>>,
 }
+
+/// At most this many of a graph's configurations become roadmap nodes (evenly spread over the
+/// graph's nodes, home first).
+const MAX_ROADMAP_SEEDS: usize = 1500;
 
 /// The joint limits of a robot.
 pub fn limits_of(robot: &Robot) -> Limits {
@@ -136,6 +145,18 @@ pub fn per_task_within(per_task: usize, doable: usize) -> usize {
 }
 
 impl RobotGraph {
+    /// The robot's shared roadmap ([`crate::motion::robot_roadmap`]): the graph's
+    /// configurations (home and the candidates kept, at most [`MAX_ROADMAP_SEEDS`] of them)
+    /// and uniform samples seeded by `seed`. Built the first time it is asked for; the same
+    /// for every caller.
+    pub fn roadmap(&self, cell: &Cell, robot: &Robot, seed: u64) -> &SharedRoadmap {
+        self.roadmap.get_or_init(|| {
+            let stride = self.q.len().div_ceil(MAX_ROADMAP_SEEDS).max(1);
+            let seeds: Vec<Vec<f64>> = self.q.iter().step_by(stride).cloned().collect();
+            crate::motion::robot_roadmap(cell, robot, &seeds, seed)
+        })
+    }
+
     /// The graph of `robot` over the candidates of `table`, at most `per_task` per task (see
     /// [`select`]; fewer when the robot can do so many tasks that they would not fit in
     /// [`MAX_GRAPH_NODES`], see [`per_task_within`]), preferring candidates at least `roomy` (m) farther from the static scene
@@ -197,6 +218,7 @@ impl RobotGraph {
             alternatives,
             costs,
             limits,
+            roadmap: Arc::default(),
         }
     }
 

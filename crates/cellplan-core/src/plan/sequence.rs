@@ -220,7 +220,7 @@ fn attempt(
         }
         let results: Vec<((usize, usize), Result<Leg, LegError>)> = new
             .par_iter()
-            .map(|&(a, b)| ((a, b), plan_leg(cell, robot, graph, a, b, settings)))
+            .map(|&(a, b)| ((a, b), plan_leg(cell, robot, graph, a, b, settings, true)))
             .collect();
         for (k, r) in results {
             match &r {
@@ -270,7 +270,7 @@ fn attempt(
                 },
                 ..settings.clone()
             };
-            ((a, b), plan_leg(cell, robot, graph, a, b, &full))
+            ((a, b), plan_leg(cell, robot, graph, a, b, &full, true))
         })
         .collect();
     for (k, r) in retried {
@@ -468,13 +468,24 @@ fn plan_leg(
     a: usize,
     b: usize,
     settings: &PlanSettings,
+    with_roadmap: bool,
 ) -> Result<Leg, LegError> {
     let started = Instant::now();
     let motion = MotionSettings {
         seed: leg_seed(settings.seed, robot.id.0, a, b),
         ..settings.motion.clone()
     };
-    let path = crate::motion::plan_leg(cell, robot, &graph.q[a], &graph.q[b], &motion)?;
+    let roadmap_seed = leg_seed(settings.seed, robot.id.0, usize::MAX, usize::MAX);
+    let roadmap = || graph.roadmap(cell, robot, roadmap_seed);
+    let path = crate::motion::plan_leg_with_margin(
+        cell,
+        robot,
+        &graph.q[a],
+        &graph.q[b],
+        cell.planning.clearance,
+        &motion,
+        with_roadmap.then_some(&roadmap as &dyn Fn() -> _),
+    )?;
     let timed = time_path_exact(&path.waypoints, &graph.limits)?;
     Ok(Leg {
         waypoints: path.waypoints,

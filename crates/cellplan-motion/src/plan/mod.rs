@@ -59,6 +59,7 @@ mod problem;
 mod registry;
 mod rrt_connect;
 mod rrt_star;
+mod shared_roadmap;
 mod simplify;
 mod space;
 mod straight;
@@ -70,6 +71,7 @@ pub use problem::{PlanResult, Problem, Status, Termination, Work};
 pub use registry::{Entry, Leg, MotionPlanner, PlannerParams, UnknownPlanner, planner, planners};
 pub use rrt_connect::RrtConnect;
 pub use rrt_star::RrtStar;
+pub use shared_roadmap::{RoadmapPath, SharedRoadmap, SharedRoadmapSettings};
 use simplify::shortcut_with;
 pub use simplify::{path_length, shortcut};
 pub use space::JointSpace;
@@ -214,6 +216,24 @@ pub fn plan_leg_via(
     entry: &[Vec<f64>],
     settings: &PlanSettings,
 ) -> Result<PlannedPath, PlanError> {
+    plan_leg_via_with(space, validity, exit, entry, settings, &|from, to| {
+        plan_leg(space, validity, from, to, settings)
+    })
+}
+
+/// A planner of one leg between two valid configurations (the sampler, a roadmap…).
+pub type LegPlanner<'a> = dyn Fn(&[f64], &[f64]) -> Result<PlannedPath, PlanError> + 'a;
+
+/// [`plan_leg_via`] with another planner between the inner ends of `exit` and `entry`
+/// (`middle(from, to)`, whose path must pass [`check_segment`] segment by segment).
+pub fn plan_leg_via_with(
+    space: &JointSpace,
+    validity: &dyn StateValidity,
+    exit: &[Vec<f64>],
+    entry: &[Vec<f64>],
+    settings: &PlanSettings,
+    middle: &LegPlanner,
+) -> Result<PlannedPath, PlanError> {
     let (Some(from), Some(to)) = (exit.last(), entry.first()) else {
         return Err(PlanError::NoPath {
             samples: 0,
@@ -231,7 +251,7 @@ pub fn plan_leg_via(
             });
         }
     }
-    let middle = plan_leg(space, validity, from, to, settings).map_err(|e| match e {
+    let middle = middle(from, to).map_err(|e| match e {
         PlanError::NoPath {
             samples,
             validity_calls,
@@ -250,6 +270,33 @@ pub fn plan_leg_via(
         waypoints,
         straight: false,
         samples: middle.samples,
+        validity_calls: calls,
+    })
+}
+
+/// One leg through a [`SharedRoadmap`] built in the same scene, space and validity: its
+/// shortest valid path from `start` to `goal` (both valid), shortened by [`shortcut`] with
+/// `settings`; [`PlanError::NoPath`] (no samples) when the roadmap has none within its budget.
+pub fn roadmap_leg(
+    space: &JointSpace,
+    validity: &dyn StateValidity,
+    roadmap: &SharedRoadmap,
+    start: &[f64],
+    goal: &[f64],
+    settings: &PlanSettings,
+) -> Result<PlannedPath, PlanError> {
+    let found = roadmap.query(space, validity, start, goal);
+    let Some(mut waypoints) = found.waypoints else {
+        return Err(PlanError::NoPath {
+            samples: 0,
+            validity_calls: found.validity_calls,
+        });
+    };
+    let calls = found.validity_calls + shortcut(space, validity, &mut waypoints, settings);
+    Ok(PlannedPath {
+        straight: waypoints.len() == 2,
+        waypoints,
+        samples: 0,
         validity_calls: calls,
     })
 }

@@ -1,0 +1,506 @@
+//! A roadmap of one robot in one static scene, shared by every leg query of that robot, from
+//! any thread: [`SharedRoadmap`].
+//!
+//! The inspection planner asks hundreds of legs of each robot in a scene that does not change
+//! while it plans them (the other robots stand at home). A sampler starts every leg from
+//! nothing; a roadmap keeps what one leg learnt for the next. [`super::Roadmap`] does that for
+//! queries asked one after the other; this one is asked by many threads at once, and must
+//! give each query the same answer whichever queries ran before it:
+//!
+//! - **Frozen nodes.** The nodes are fixed when the roadmap is built: the configurations given
+//!   (a robot's task candidates: where its legs start and end) and uniform samples (seeded),
+//!   each checked valid, every node linked to its `k` nearest.
+//! - **Cached edges.** An edge is checked ([`super::check_segment`]) the first time a query
+//!   needs it and its verdict kept (one atomic byte per edge). A verdict depends only on the
+//!   edge, so concurrent first checks store the same value.
+//! - **Queries that do not see the cache's history.** A query links its start and goal to
+//!   their nearest nodes and runs lazy PRM (Bohlin & Kavraki 2000): the shortest path under
+//!   the edges it has not itself found invalid, its edges checked from the start on (through
+//!   the cache), the first invalid one set aside, search again. It does not skip the edges that
+//!   other queries found invalid, so the sequence of paths it tries — and its budget, counted
+//!   in edges examined — is the same with a cold or a warm cache: only the cost of the checks
+//!   differs. The answer, the shortest valid path of the roadmap within the budget, depends on
+//!   the query alone.
+use super::{JointSpace, StateValidity, check_segment};
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+use std::cmp::{Ordering as CmpOrdering, Reverse};
+use std::collections::{BTreeSet, BinaryHeap};
+use std::sync::atomic::{AtomicU8, Ordering};
+
+/// An edge's verdict: not checked yet.
+const UNKNOWN: u8 = 0;
+/// Checked: valid.
+const VALID: u8 = 1;
+/// Checked: invalid.
+const INVALID: u8 = 2;
+
+/// How a [`SharedRoadmap`] is built and queried.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SharedRoadmapSettings {
+    /// Uniform samples drawn (the invalid ones are dropped).
+    pub samples: usize,
+    /// Each node is linked to this many nearest nodes.
+    pub neighbours: usize,
+    /// A query's start and goal are each linked to this many nearest nodes.
+    pub connect: usize,
+    /// A query gives up after examining this many edges (cached or not).
+    pub max_edges: usize,
+    /// Seed of the uniform samples.
+    pub seed: u64,
+    /// Clearance (m) below which a configuration counts as invalid (as in
+    /// [`super::check_segment`]).
+    pub min_clearance: f64,
+}
+
+impl Default for SharedRoadmapSettings {
+    fn default() -> Self {
+        SharedRoadmapSettings {
+            samples: 600,
+            neighbours: 10,
+            connect: 10,
+            max_edges: 300,
+            seed: 0,
+            min_clearance: 1e-4,
+        }
+    }
+}
+
+/// A frozen roadmap with a shared cache of edge verdicts (see the module documentation).
+#[derive(Debug)]
+pub struct SharedRoadmap {
+    nodes: Vec<Vec<f64>>,
+    /// Per node: (neighbour, edge index), sorted by neighbour.
+    adjacent: Vec<Vec<(u32, u32)>>,
+    /// Per edge: its two nodes and its length.
+    edges: Vec<(u32, u32, f64)>,
+    verdicts: Vec<AtomicU8>,
+    settings: SharedRoadmapSettings,
+}
+
+/// The outcome of a [`SharedRoadmap::query`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct RoadmapPath {
+    /// From the start to the goal, inclusive; `None` when the roadmap has no path within the
+    /// budget.
+    pub waypoints: Option<Vec<Vec<f64>>>,
+    /// Edges examined (the budget's measure: the same whatever the cache holds).
+    pub edges_examined: usize,
+    /// Validity calls made by this query (fewer when other queries checked its edges first).
+    pub validity_calls: usize,
+}
+
+#[derive(Clone, Copy, PartialEq)]
+struct Key(f64);
+impl Eq for Key {}
+impl PartialOrd for Key {
+    fn partial_cmp(&self, other: &Self) -> Option<CmpOrdering> {
+        Some(self.cmp(other))
+    }
+}
+impl Ord for Key {
+    fn cmp(&self, other: &Self) -> CmpOrdering {
+        self.0.total_cmp(&other.0)
+    }
+}
+
+/// The `k` nodes of `nodes` nearest to `q` (by the space's metric; ties by index), skipping
+/// `skip`, nearest first.
+fn nearest(space: &JointSpace, nodes: &[Vec<f64>], q: &[f64], k: usize, skip: usize) -> Vec<(f64, usize)> {
+    let mut near: Vec<(f64, usize)> = nodes
+        .iter()
+        .enumerate()
+        .filter(|&(i, _)| i != skip)
+        .map(|(i, p)| (space.distance(p, q), i))
+        .collect();
+    let k = k.min(near.len());
+    if k == 0 {
+        return Vec::new();
+    }
+    near.select_nth_unstable_by(k - 1, |a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+    near.truncate(k);
+    near.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+    near
+}
+
+impl SharedRoadmap {
+    /// Builds the roadmap from `seeds` (the valid ones are kept) and `settings.samples` uniform
+    /// samples of `space` (seeded by `settings.seed`; the valid ones are kept), each node
+    /// linked to its `settings.neighbours` nearest. Single-threaded and deterministic. Returns
+    /// the roadmap and the validity calls made.
+    pub fn build(
+        space: &JointSpace,
+        validity: &dyn StateValidity,
+        seeds: &[Vec<f64>],
+        settings: &SharedRoadmapSettings,
+    ) -> (SharedRoadmap, usize) {
+        let floor = settings.min_clearance.max(1e-9);
+        let mut calls = 0;
+        let mut nodes: Vec<Vec<f64>> = Vec::new();
+        let mut seen = BTreeSet::new();
+        for q in seeds {
+            if q.len() != space.dim() || !space.contains(q) {
+                continue;
+            }
+            let bits: Vec<u64> = q.iter().map(|x| x.to_bits()).collect();
+            if !seen.insert(bits) {
+                continue;
+            }
+            calls += 1;
+            if validity.clearance(q) >= floor {
+                nodes.push(q.clone());
+            }
+        }
+        let mut rng = ChaCha8Rng::seed_from_u64(settings.seed ^ 0x524f_4144_4d41_5053);
+        for _ in 0..settings.samples {
+            let q: Vec<f64> = (0..space.dim())
+                .map(|j| {
+                    use rand::RngExt;
+                    let (lo, hi) = (space.lower[j], space.upper[j]);
+                    if lo < hi { rng.random_range(lo..hi) } else { lo }
+                })
+                .collect();
+            calls += 1;
+            if validity.is_valid(&q) && validity.clearance(&q) >= floor {
+                calls += 1;
+                nodes.push(q);
+            }
+        }
+        let mut pairs = BTreeSet::new();
+        for (i, q) in nodes.iter().enumerate() {
+            for (_, j) in nearest(space, &nodes, q, settings.neighbours, i) {
+                pairs.insert((i.min(j) as u32, i.max(j) as u32));
+            }
+        }
+        let mut adjacent = vec![Vec::new(); nodes.len()];
+        let mut edges = Vec::with_capacity(pairs.len());
+        for (a, b) in pairs {
+            let e = edges.len() as u32;
+            let length = space.distance(&nodes[a as usize], &nodes[b as usize]);
+            edges.push((a, b, length));
+            adjacent[a as usize].push((b, e));
+            adjacent[b as usize].push((a, e));
+        }
+        let verdicts = (0..edges.len()).map(|_| AtomicU8::new(UNKNOWN)).collect();
+        (
+            SharedRoadmap {
+                nodes,
+                adjacent,
+                edges,
+                verdicts,
+                settings: settings.clone(),
+            },
+            calls,
+        )
+    }
+
+    /// Number of nodes.
+    pub fn len(&self) -> usize {
+        self.nodes.len()
+    }
+
+    /// Whether it has no node.
+    pub fn is_empty(&self) -> bool {
+        self.nodes.is_empty()
+    }
+
+    /// Number of edges.
+    pub fn edge_count(&self) -> usize {
+        self.edges.len()
+    }
+
+    /// Number of edges checked so far (by any query).
+    pub fn checked_edges(&self) -> usize {
+        self.verdicts
+            .iter()
+            .filter(|v| v.load(Ordering::Relaxed) != UNKNOWN)
+            .count()
+    }
+
+    /// The shortest valid path of the roadmap from `start` to `goal` (both valid, the caller
+    /// checked them), through their `connect` nearest nodes; see the module documentation.
+    /// `validity` and `space` must be those the roadmap was built with.
+    pub fn query(
+        &self,
+        space: &JointSpace,
+        validity: &dyn StateValidity,
+        start: &[f64],
+        goal: &[f64],
+    ) -> RoadmapPath {
+        let floor = self.settings.min_clearance;
+        let n = self.nodes.len();
+        // Query nodes: n is the start, n + 1 the goal; their edges are the query's own.
+        let (s, g) = (n, n + 1);
+        let mut extra: Vec<(usize, usize, f64)> = Vec::new();
+        for (end, q) in [(s, start), (g, goal)] {
+            for (d, i) in nearest(space, &self.nodes, q, self.settings.connect, usize::MAX) {
+                extra.push((end, i, d));
+            }
+        }
+        let direct = space.distance(start, goal);
+        extra.push((s, g, direct));
+        // Verdicts of the query's own edges (0 unknown, 1 valid, 2 invalid).
+        let mut extra_verdict = vec![UNKNOWN; extra.len()];
+        let mut set_aside: BTreeSet<u32> = BTreeSet::new();
+        let mut extra_aside = vec![false; extra.len()];
+        let (mut examined, mut calls) = (0, 0);
+        let point = |i: usize| -> &[f64] {
+            if i == s {
+                start
+            } else if i == g {
+                goal
+            } else {
+                &self.nodes[i]
+            }
+        };
+        loop {
+            let Some(path) = self.shortest(space, start, goal, &extra, &extra_aside, &set_aside) else {
+                return RoadmapPath {
+                    waypoints: None,
+                    edges_examined: examined,
+                    validity_calls: calls,
+                };
+            };
+            let mut broken = false;
+            for hop in &path {
+                if examined >= self.settings.max_edges {
+                    return RoadmapPath {
+                        waypoints: None,
+                        edges_examined: examined,
+                        validity_calls: calls,
+                    };
+                }
+                examined += 1;
+                let valid = match *hop {
+                    Hop::Query(k) => {
+                        if extra_verdict[k] == UNKNOWN {
+                            let (a, b, _) = extra[k];
+                            let c = check_segment(space, validity, point(a), point(b), floor);
+                            calls += c.calls;
+                            extra_verdict[k] = if c.valid { VALID } else { INVALID };
+                        }
+                        let ok = extra_verdict[k] == VALID;
+                        if !ok {
+                            extra_aside[k] = true;
+                        }
+                        ok
+                    }
+                    Hop::Roadmap(e) => {
+                        let slot = &self.verdicts[e as usize];
+                        let mut v = slot.load(Ordering::Relaxed);
+                        if v == UNKNOWN {
+                            let (a, b, _) = self.edges[e as usize];
+                            let c = check_segment(
+                                space,
+                                validity,
+                                &self.nodes[a as usize],
+                                &self.nodes[b as usize],
+                                floor,
+                            );
+                            calls += c.calls;
+                            v = if c.valid { VALID } else { INVALID };
+                            slot.store(v, Ordering::Relaxed);
+                        }
+                        if v != VALID {
+                            set_aside.insert(e);
+                        }
+                        v == VALID
+                    }
+                };
+                if !valid {
+                    broken = true;
+                    break;
+                }
+            }
+            if !broken {
+                let mut waypoints = vec![start.to_vec()];
+                let mut at = s;
+                for hop in &path {
+                    let next = match *hop {
+                        Hop::Query(k) => {
+                            let (a, b, _) = extra[k];
+                            if a == at { b } else { a }
+                        }
+                        Hop::Roadmap(e) => {
+                            let (a, b, _) = self.edges[e as usize];
+                            let (a, b) = (a as usize, b as usize);
+                            if a == at { b } else { a }
+                        }
+                    };
+                    waypoints.push(point(next).to_vec());
+                    at = next;
+                }
+                return RoadmapPath {
+                    waypoints: Some(waypoints),
+                    edges_examined: examined,
+                    validity_calls: calls,
+                };
+            }
+        }
+    }
+
+    /// A* from the start (node `n`) to the goal (`n + 1`) over the roadmap's edges and the
+    /// query's own (`extra`), leaving out those set aside; the hops in order.
+    fn shortest(
+        &self,
+        space: &JointSpace,
+        start: &[f64],
+        goal: &[f64],
+        extra: &[(usize, usize, f64)],
+        extra_aside: &[bool],
+        set_aside: &BTreeSet<u32>,
+    ) -> Option<Vec<Hop>> {
+        let n = self.nodes.len();
+        let (s, g) = (n, n + 1);
+        let h = |i: usize| -> f64 {
+            if i == g {
+                0.0
+            } else if i == s {
+                space.distance(start, goal)
+            } else {
+                space.distance(&self.nodes[i], goal)
+            }
+        };
+        // The query's edges by node.
+        let mut query_at: Vec<Vec<(usize, usize)>> = vec![Vec::new(); n + 2];
+        for (k, &(a, b, _)) in extra.iter().enumerate() {
+            if !extra_aside[k] {
+                query_at[a].push((b, k));
+                query_at[b].push((a, k));
+            }
+        }
+        let mut dist = vec![f64::INFINITY; n + 2];
+        let mut prev: Vec<Option<(usize, Hop)>> = vec![None; n + 2];
+        let mut closed = vec![false; n + 2];
+        let mut queue = BinaryHeap::new();
+        dist[s] = 0.0;
+        queue.push(Reverse((Key(h(s)), s)));
+        while let Some(Reverse((_, i))) = queue.pop() {
+            if closed[i] {
+                continue;
+            }
+            closed[i] = true;
+            if i == g {
+                let mut hops = Vec::new();
+                let mut k = g;
+                while let Some((p, hop)) = prev[k] {
+                    hops.push(hop);
+                    k = p;
+                }
+                hops.reverse();
+                return Some(hops);
+            }
+            let mut relax =
+                |j: usize, length: f64, hop: Hop, queue: &mut BinaryHeap<Reverse<(Key, usize)>>| {
+                    let nd = dist[i] + length;
+                    if nd < dist[j] {
+                        dist[j] = nd;
+                        prev[j] = Some((i, hop));
+                        queue.push(Reverse((Key(nd + h(j)), j)));
+                    }
+                };
+            for &(j, k) in &query_at[i] {
+                relax(j, extra[k].2, Hop::Query(k), &mut queue);
+            }
+            if i < n {
+                for &(j, e) in &self.adjacent[i] {
+                    if !set_aside.contains(&e) {
+                        relax(j as usize, self.edges[e as usize].2, Hop::Roadmap(e), &mut queue);
+                    }
+                }
+            }
+        }
+        None
+    }
+}
+
+/// One hop of a query's path.
+#[derive(Clone, Copy, Debug)]
+enum Hop {
+    /// A query edge (index into its list).
+    Query(usize),
+    /// A roadmap edge.
+    Roadmap(u32),
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A unit square with a wall at x = 0.5 from y = 0 to 0.8: paths must go round its top.
+    fn wall(q: &[f64]) -> f64 {
+        let (x, y) = (q[0], q[1]);
+        // Distance to the segment x = 0.5, y in [0, 0.8] (a thin wall).
+        let dy = if y > 0.8 { y - 0.8 } else { 0.0 };
+        ((x - 0.5).powi(2) + dy * dy).sqrt() - 0.02
+    }
+
+    fn space() -> JointSpace {
+        JointSpace::new(vec![0.0, 0.0], vec![1.0, 1.0], vec![1.0, 1.0])
+    }
+
+    #[test]
+    fn a_query_finds_a_valid_path_round_the_wall_whatever_the_cache_holds() {
+        let space = space();
+        let settings = SharedRoadmapSettings {
+            samples: 300,
+            neighbours: 8,
+            connect: 8,
+            max_edges: 2000,
+            seed: 3,
+            min_clearance: 1e-4,
+        };
+        let (roadmap, _) = SharedRoadmap::build(&space, &wall, &[], &settings);
+        assert!(roadmap.len() > 200, "most samples are valid ({})", roadmap.len());
+        let (start, goal) = (vec![0.2, 0.2], vec![0.8, 0.2]);
+        let cold = roadmap.query(&space, &wall, &start, &goal);
+        let path = cold.waypoints.clone().expect("a path round the wall");
+        assert_eq!(path.first(), Some(&start));
+        assert_eq!(path.last(), Some(&goal));
+        for w in path.windows(2) {
+            assert!(check_segment(&space, &wall, &w[0], &w[1], 1e-4).valid);
+        }
+        // It goes over the wall's top.
+        assert!(path.iter().any(|q| q[1] > 0.8));
+        // Warm: other queries have checked edges since; the answer and its budget are the same.
+        for k in 0..10 {
+            let a = vec![0.1 + 0.03 * k as f64, 0.1];
+            let b = vec![0.9, 0.1 + 0.05 * k as f64];
+            roadmap.query(&space, &wall, &a, &b);
+        }
+        let warm = roadmap.query(&space, &wall, &start, &goal);
+        assert_eq!(warm.waypoints, cold.waypoints);
+        assert_eq!(warm.edges_examined, cold.edges_examined);
+        assert!(warm.validity_calls <= cold.validity_calls);
+        assert!(roadmap.checked_edges() > 0);
+    }
+
+    #[test]
+    fn a_budget_too_small_gives_no_path_and_seeds_become_nodes() {
+        let space = space();
+        let settings = SharedRoadmapSettings {
+            samples: 0,
+            max_edges: 1,
+            ..SharedRoadmapSettings::default()
+        };
+        // Only the seeds: one valid each side of the wall, one inside it (dropped), a duplicate.
+        let seeds = vec![vec![0.2, 0.9], vec![0.8, 0.9], vec![0.5, 0.5], vec![0.2, 0.9]];
+        let (roadmap, _) = SharedRoadmap::build(&space, &wall, &seeds, &settings);
+        assert_eq!(roadmap.len(), 2);
+        assert_eq!(roadmap.edge_count(), 1);
+        let found = roadmap.query(&space, &wall, &[0.2, 0.2], &[0.8, 0.2]);
+        assert_eq!(found.waypoints, None);
+        assert_eq!(found.edges_examined, 1);
+        // With a budget, over the two seeds.
+        let settings = SharedRoadmapSettings {
+            samples: 0,
+            ..SharedRoadmapSettings::default()
+        };
+        let (roadmap, _) = SharedRoadmap::build(&space, &wall, &seeds, &settings);
+        let path = roadmap
+            .query(&space, &wall, &[0.2, 0.2], &[0.8, 0.2])
+            .waypoints
+            .expect("over the seeds");
+        assert_eq!(path.len(), 4);
+    }
+}
