@@ -220,7 +220,7 @@ fn attempt(
         }
         let results: Vec<((usize, usize), Result<Leg, LegError>)> = new
             .par_iter()
-            .map(|&(a, b)| ((a, b), plan_leg(cell, robot, graph, a, b, settings, true)))
+            .map(|&(a, b)| ((a, b), plan_leg(cell, robot, graph, a, b, settings)))
             .collect();
         for (k, r) in results {
             match &r {
@@ -270,7 +270,7 @@ fn attempt(
                 },
                 ..settings.clone()
             };
-            ((a, b), plan_leg(cell, robot, graph, a, b, &full, true))
+            ((a, b), plan_leg(cell, robot, graph, a, b, &full))
         })
         .collect();
     for (k, r) in retried {
@@ -468,7 +468,6 @@ fn plan_leg(
     a: usize,
     b: usize,
     settings: &PlanSettings,
-    with_roadmap: bool,
 ) -> Result<Leg, LegError> {
     let started = Instant::now();
     let motion = MotionSettings {
@@ -484,7 +483,7 @@ fn plan_leg(
         &graph.q[b],
         cell.planning.clearance,
         &motion,
-        with_roadmap.then_some(&roadmap as &dyn Fn() -> _),
+        Some(&roadmap),
     )?;
     let timed = time_path_exact(&path.waypoints, &graph.limits)?;
     Ok(Leg {

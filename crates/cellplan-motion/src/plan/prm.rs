@@ -34,9 +34,9 @@ struct Edge {
     checked: bool,
 }
 
-/// An `f64` ordered by `total_cmp`, for the search queue.
+/// An `f64` ordered by `total_cmp`, for the search queues of the roadmaps.
 #[derive(Clone, Copy, PartialEq)]
-struct Key(f64);
+pub(super) struct Key(pub(super) f64);
 
 impl Eq for Key {}
 

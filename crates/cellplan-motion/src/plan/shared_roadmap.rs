@@ -21,10 +21,11 @@
 //!   in edges examined — is the same with a cold or a warm cache: only the cost of the checks
 //!   differs. The answer, the shortest valid path of the roadmap within the budget, depends on
 //!   the query alone.
+use super::prm::Key;
 use super::{JointSpace, StateValidity, check_segment};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
-use std::cmp::{Ordering as CmpOrdering, Reverse};
+use std::cmp::Reverse;
 use std::collections::{BTreeSet, BinaryHeap};
 use std::sync::atomic::{AtomicU8, Ordering};
 
@@ -88,20 +89,6 @@ pub struct RoadmapPath {
     pub edges_examined: usize,
     /// Validity calls made by this query (fewer when other queries checked its edges first).
     pub validity_calls: usize,
-}
-
-#[derive(Clone, Copy, PartialEq)]
-struct Key(f64);
-impl Eq for Key {}
-impl PartialOrd for Key {
-    fn partial_cmp(&self, other: &Self) -> Option<CmpOrdering> {
-        Some(self.cmp(other))
-    }
-}
-impl Ord for Key {
-    fn cmp(&self, other: &Self) -> CmpOrdering {
-        self.0.total_cmp(&other.0)
-    }
 }
 
 /// The `k` nodes of `nodes` nearest to `q` (by the space's metric; ties by index), skipping
