@@ -7,7 +7,8 @@ For each cell (release binary, `cargo build --release` first; standard library o
 1. `cellplan plan CELL -o OUT --json --no-report`: exit code (0 every MP measured, 3 some MPs
    unmeasured — both fine; anything else is a failure and its last error line is reported),
    wall time and peak RSS (`/usr/bin/time -f '%e %M'`, else the clock and getrusage), cycle
-   time, lower bound, ratio, Δt, MPs, robots, unmeasured MPs;
+   time, lower bound, ratio, Δt, MPs, robots, unmeasured MPs, and the leg queries that found
+   no path (the plan's `stats.legs_failed`);
 2. `cellplan verify OUT/plan.json CELL --json` must exit 0;
 3. `cellplan --threads 1 plan CELL -o OUT1 --json --no-report` must give the same exit code and a
    plan.json equal to the first apart from compute times (`compute_s` and wall-time fields are
@@ -164,6 +165,11 @@ def bench_cell(name, out_root, timeout, threads1):
                ratio=s["ratio_to_lower_bound"], delta_t_s=s["delta_t_s"],
                robots=len(s["robots"]), unmeasured=len(s["unmeasured"]),
                mps=sum(r["tasks"] for r in s["robots"]) + len(s["unmeasured"]))
+    try:
+        stats = json.loads((out / "plan.json").read_text())["stats"]
+        row.update(legs_failed=stats["legs_failed"], legs_planned=stats["legs_planned"])
+    except (OSError, ValueError, KeyError):
+        pass
     vrc, vo, ve, vwall, _ = run([str(BIN), "verify", str(out / "plan.json"), str(cell), "--json"],
                                 timeout)
     row["verify_exit"] = vrc
@@ -221,8 +227,8 @@ def counted(r):
 
 def table(rows):
     lines = ["| cell | robots | MPs | exit | unmeasured | cycle s | lower bound s | ratio | Δt s | "
-             "wall s | peak RSS MB | verify | threads 1 | threads-1 wall s |",
-             "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+             "wall s | peak RSS MB | verify | threads 1 | threads-1 wall s | failed leg queries |",
+             "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for r in rows:
         same = r.get("threads1_same")
         lines.append(
@@ -231,7 +237,8 @@ def table(rows):
             f"{fmt(r.get('ratio'), '{:.3f}')} | {fmt(r.get('delta_t_s'))} | {fmt(r['wall_s'], '{:.1f}')} | "
             f"{fmt(r['peak_rss_mb'], '{:.0f}')} | "
             f"{'–' if 'verify_exit' not in r else ('ok' if r['verify_exit'] == 0 else 'FAIL')} | "
-            f"{'–' if same is None else ('same' if same else 'DIFFERS')} | {fmt(r.get('threads1_wall_s'), '{:.1f}')} |")
+            f"{'–' if same is None else ('same' if same else 'DIFFERS')} | {fmt(r.get('threads1_wall_s'), '{:.1f}')} | "
+            f"{fmt(r.get('legs_failed'), '{}')} |")
     ratios = [r["ratio"] for r in rows if counted(r)]
     lines.append("")
     lines.append(f"mean cycle/lower-bound ratio: {sum(ratios) / len(ratios):.3f} over the {len(ratios)} cells "
