@@ -38,17 +38,25 @@ pub fn joint_radii(cell: &Cell, robot: &Robot) -> Vec<f64> {
     arm::joint_radii(&robot.arm(&cell.world))
 }
 
+/// Distance (m) a leg keeps from the robots parked at home beyond what the coordination asks
+/// between robots (the clearance and [`crate::coord::REPLAY_SLACK`]). The coordination's
+/// timeline steps through time conservatively and counts a pass as a contact when its step
+/// falls below 0.1 ms; a leg grazing a parked robot at exactly the coordination's distance
+/// would be such a pass — a conflict no schedule can remove, since the parked robot stands
+/// there from the start. Robot points move less than 1 mm in 0.1 ms at up to 10 m/s.
+pub const HOME_STEP_SLACK: f64 = 0.002;
+
 /// The validity checker of `robot` in its cell keeping `margin` (m) from the static scene and
-/// `margin` + [`crate::coord::REPLAY_SLACK`] from the other robots parked at home — what the
-/// coordination keeps between robots, so that a robot standing at home is never in the way of
-/// a path planned past it.
+/// `margin` + [`crate::coord::REPLAY_SLACK`] + [`HOME_STEP_SLACK`] from the other robots parked
+/// at home — more than the coordination keeps between robots, so that a robot standing at
+/// home is never in the way of a path planned past it.
 pub fn robot_validity<'a>(cell: &'a Cell, robot: &'a Robot, margin: f64) -> RobotValidity<'a> {
     ArmValidity::new(
         robot.arm(&cell.world),
         margin,
         crate::candidates::parked_others(cell, robot),
     )
-    .with_parked_extra(crate::coord::REPLAY_SLACK)
+    .with_parked_extra(crate::coord::REPLAY_SLACK + HOME_STEP_SLACK)
 }
 
 /// One leg of `robot` from `from` to `to`, keeping the process clearance from the static

@@ -124,6 +124,48 @@ fn the_coordination_diagram_covers_every_contact() {
     assert!(area < 0.5 * ta.end() * tb.end(), "{area}");
 }
 
+/// Every robot's motion keeps the coordination's distance, and `HOME_STEP_SLACK` more, from
+/// every other robot standing at home (sampled along the uncoordinated timelines): a robot at
+/// home is never in another's way, with room for the timeline's conservative steps.
+#[test]
+fn robots_keep_more_than_the_coordination_distance_from_the_homes() {
+    let f = fixture();
+    let (_, none) = document(Coordination::None);
+    let need = f.cell.planning.clearance + coord::REPLAY_SLACK + cellplan_core::motion::HOME_STEP_SLACK;
+    let mut at_home = Default::default();
+    let mut moving = Default::default();
+    let mut samples = 0;
+    for (a, ta) in none.timed.iter().enumerate() {
+        for (b, rb) in f.cell.robots.iter().enumerate() {
+            if a == b {
+                continue;
+            }
+            rb.body_poses(&rb.home, &mut at_home);
+            let ra = &f.cell.robots[a];
+            let mut t = 0.0;
+            while t <= ta.end() {
+                ra.body_poses(&ta.trajectory.position(t), &mut moving);
+                let d = f.cell.world.group_group_distance(
+                    ra.group,
+                    &moving.bodies,
+                    rb.group,
+                    &at_home.bodies,
+                    1.0,
+                );
+                assert!(
+                    d >= need - 1e-6,
+                    "{} at {t} s is {d} m from {} at home",
+                    ra.name,
+                    rb.name
+                );
+                samples += 1;
+                t += 0.02;
+            }
+        }
+    }
+    assert!(samples > 100);
+}
+
 #[test]
 fn best_is_no_worse_than_the_baselines_here() {
     let cycle = |s: Coordination| document(s).0.cycle_time_s;
