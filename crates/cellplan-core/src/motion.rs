@@ -80,7 +80,8 @@ const RETRACT_STEP: f64 = 0.01;
 
 /// The robot's roadmap in its cell (the other robots parked at home), for [`plan_leg_with_margin`]:
 /// its nodes are `seeds` (the robot's task candidates and home: where its legs start and end)
-/// and uniform samples seeded by `seed`, checked with the process clearance.
+/// and samples seeded by `seed` (half uniform, half near the seeds), checked with the process
+/// clearance.
 pub fn robot_roadmap(cell: &Cell, robot: &Robot, seeds: &[Vec<f64>], seed: u64) -> SharedRoadmap {
     let space = joint_space(cell, robot);
     let validity = robot_validity(cell, robot, cell.planning.clearance);

@@ -709,8 +709,8 @@ fn sequencing_against_a_bar_stops_before_planning() {
     assert!(!kept.beaten);
 }
 
-/// A leg the sampler cannot solve never loses the plan: with no samples at all, every leg
-/// that is not a straight segment fails; a task every order reaches only through such legs
+/// A leg the sampler cannot solve never loses the plan: with no samples at all (and no
+/// roadmap), every leg that is not a straight segment fails; a task every order reaches only through such legs
 /// is given up by its robot, tried on the other robot, and listed unmeasured (`no-path`, with
 /// the planner's words) — the rest is planned and the verifier accepts the plan.
 #[test]
@@ -719,6 +719,7 @@ fn a_task_without_a_path_is_given_up_and_the_rest_planned() {
     let mut s = settings(Allocation::Balanced);
     s.motion.max_samples = 1;
     s.final_max_samples = 1;
+    s.roadmap = false;
     s.alternatives = 1;
     let outcome = plan::plan(&f.cell, &f.table, &s, &|_| {}).expect("a plan despite the legs");
     let doc = build(&f.cell, &f.table, &outcome, &s);

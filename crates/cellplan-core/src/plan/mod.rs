@@ -63,6 +63,9 @@ pub struct PlanSettings {
     /// Sample budget for legs of the final orders that the lazy rounds' budget
     /// (`motion.max_samples`) did not solve.
     pub final_max_samples: usize,
+    /// Whether a leg the sampler cannot solve goes through the robot's shared roadmap
+    /// ([`graph::RobotGraph::roadmap`]); on by default.
+    pub roadmap: bool,
     /// Time step of the trajectory samples written to the plan (s).
     pub sample_dt: f64,
     /// When the whole run must end (set by the pipeline from `time_limit` at its start, so
@@ -110,6 +113,7 @@ impl Default for PlanSettings {
             },
             final_shortcut_iterations: 40,
             final_max_samples: 20_000,
+            roadmap: true,
             sample_dt: 0.02,
             task_penalty: Vec::new(),
             deadline: None,

@@ -483,7 +483,7 @@ fn plan_leg(
         &graph.q[b],
         cell.planning.clearance,
         &motion,
-        Some(&roadmap),
+        settings.roadmap.then_some(&roadmap as &dyn Fn() -> _),
     )?;
     let timed = time_path_exact(&path.waypoints, &graph.limits)?;
     Ok(Leg {

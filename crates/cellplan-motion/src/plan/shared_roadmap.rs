@@ -8,8 +8,11 @@
 //! give each query the same answer whichever queries ran before it:
 //!
 //! - **Frozen nodes.** The nodes are fixed when the roadmap is built: the configurations given
-//!   (a robot's task candidates: where its legs start and end) and uniform samples (seeded),
-//!   each checked valid, every node linked to its `k` nearest.
+//!   (a robot's task candidates: where its legs start and end) and seeded samples — half
+//!   uniform over the joint limits, half within [`NEAR`] of a random given configuration on
+//!   every joint (paths between the robot's work postures stay near them instead of swinging
+//!   through the whole joint space) — each checked valid, every node linked to its `k`
+//!   nearest.
 //! - **Cached edges.** An edge is checked ([`super::check_segment`]) the first time a query
 //!   needs it and its verdict kept (one atomic byte per edge). A verdict depends only on the
 //!   edge, so concurrent first checks store the same value.
@@ -29,6 +32,9 @@ use std::cmp::Reverse;
 use std::collections::{BTreeSet, BinaryHeap};
 use std::sync::atomic::{AtomicU8, Ordering};
 
+/// Half the samples are drawn within this (rad, or joint units) of a seed on every joint.
+pub const NEAR: f64 = 0.5;
+
 /// An edge's verdict: not checked yet.
 const UNKNOWN: u8 = 0;
 /// Checked: valid.
@@ -39,7 +45,7 @@ const INVALID: u8 = 2;
 /// How a [`SharedRoadmap`] is built and queried.
 #[derive(Clone, Debug, PartialEq)]
 pub struct SharedRoadmapSettings {
-    /// Uniform samples drawn (the invalid ones are dropped).
+    /// Samples drawn, half uniform, half near the seeds (the invalid ones are dropped).
     pub samples: usize,
     /// Each node is linked to this many nearest nodes.
     pub neighbours: usize,
@@ -47,7 +53,7 @@ pub struct SharedRoadmapSettings {
     pub connect: usize,
     /// A query gives up after examining this many edges (cached or not).
     pub max_edges: usize,
-    /// Seed of the uniform samples.
+    /// Seed of the samples.
     pub seed: u64,
     /// Clearance (m) below which a configuration counts as invalid (as in
     /// [`super::check_segment`]).
@@ -111,8 +117,9 @@ fn nearest(space: &JointSpace, nodes: &[Vec<f64>], q: &[f64], k: usize, skip: us
 }
 
 impl SharedRoadmap {
-    /// Builds the roadmap from `seeds` (the valid ones are kept) and `settings.samples` uniform
-    /// samples of `space` (seeded by `settings.seed`; the valid ones are kept), each node
+    /// Builds the roadmap from `seeds` (the valid ones are kept) and `settings.samples` samples
+    /// of `space` (seeded by `settings.seed`; every other one uniform, the rest within [`NEAR`]
+    /// of a valid seed on every joint; the valid ones are kept), each node
     /// linked to its `settings.neighbours` nearest. Single-threaded and deterministic. Returns
     /// the roadmap and the validity calls made.
     pub fn build(
@@ -139,12 +146,23 @@ impl SharedRoadmap {
             }
         }
         let mut rng = ChaCha8Rng::seed_from_u64(settings.seed ^ 0x524f_4144_4d41_5053);
-        for _ in 0..settings.samples {
+        let seeded = nodes.len();
+        for k in 0..settings.samples {
+            use rand::RngExt;
+            let near = (seeded > 0 && k % 2 == 0).then(|| rng.random_range(0..seeded));
             let q: Vec<f64> = (0..space.dim())
                 .map(|j| {
-                    use rand::RngExt;
                     let (lo, hi) = (space.lower[j], space.upper[j]);
-                    if lo < hi { rng.random_range(lo..hi) } else { lo }
+                    match near {
+                        Some(n) => (nodes[n][j] + rng.random_range(-NEAR..NEAR)).clamp(lo, hi),
+                        None => {
+                            if lo < hi {
+                                rng.random_range(lo..hi)
+                            } else {
+                                lo
+                            }
+                        }
+                    }
                 })
                 .collect();
             calls += 1;
