@@ -1,0 +1,380 @@
+//! Our coordination strategy, `best`: the passage orders scheduled on the coordination
+//! diagrams with stops where they help ([`scheduled`]), every priority order resolved by the
+//! shortest waits when no schedule is found ([`best`]), the paper's fixed-priority baseline
+//! kept where it ends sooner ([`baselines_if_shorter`]), and the schedule's waits cut to what
+//! the exact timeline needs ([`shrink_waits`]).
+use super::program::{Program, Timed, Wait};
+use super::*;
+
+/// `found` (by `best`), or the paper's fixed-priority baseline (cell order, shortest waits on
+/// the exact timeline, run only until it ends after `found`) where it ends sooner (then Δt):
+/// the diagram's boxes are conservative, and on a small cell waits placed on the exact
+/// timeline can give a shorter cycle. (Delay-startup, the other baseline, only delays starts:
+/// it costs twice as much and was never the shorter of the two on the example cells.)
+pub(super) fn baselines_if_shorter(
+    ctx: &Ctx,
+    programs: &[Program],
+    found: Resolved,
+    cell_order: &[usize],
+) -> Result<Resolved, PlanError> {
+    let score = |progs: &[Program]| -> Result<(f64, f64), PlanError> {
+        let timed: Vec<Timed> = progs.iter().map(|p| ctx.timed(p)).collect::<Result<_, _>>()?;
+        Ok(cycle_and_delta(&timed))
+    };
+    let mut kept = (score(&found.0)?, found);
+    for mode in [Mode::GiveWay] {
+        let mut progs = programs.to_vec();
+        let bar = Some(kept.0.0 + 1e-9);
+        let Ok(res) = resolve(ctx, &mut progs, &rank_of(cell_order), mode, bar) else {
+            continue;
+        };
+        if res.outrun.is_some() {
+            continue;
+        }
+        let s = score(&progs)?;
+        // Shorter by more than a millisecond (a tie keeps the schedule).
+        if s.0 < kept.0.0 - 1e-3 || (s.0 <= kept.0.0 + 1e-3 && s.1 < kept.0.1 - 1e-3) {
+            kept = (s, (progs, res, cell_order.to_vec()));
+        }
+    }
+    Ok(kept.1)
+}
+
+/// Programs resolved by a strategy, its counts, and the priority order it used (if any).
+pub(super) type Resolved = (Vec<Program>, Resolution, Vec<usize>);
+
+/// A resolved schedule: cycle time, Δt, programs, counts.
+type Scheduled = (f64, f64, Vec<Program>, Resolution);
+
+/// Our strategy: every priority order resolved by the shortest waits; the two best orders
+/// again with other poses allowed; the shortest cycle time (then Δt) kept.
+///
+/// With a bar (`CoordSettings::bar`, the cycle of another plan of the cell), a waits-only run
+/// stops as soon as its programs end after the bar, and ranks by that end (a lower bound of
+/// its own finish). The two best orders by that ranking are still run with other poses allowed,
+/// without the bar, since another pose can end sooner than a wait.
+pub(super) fn best(ctx: &Ctx, programs: Vec<Program>) -> Result<Resolved, PlanError> {
+    let orders = priority_orders(&programs);
+    let run = |order: &Vec<usize>, mode: Mode, bar: Option<f64>| -> Option<Scheduled> {
+        let mut p = programs.clone();
+        let res = resolve(ctx, &mut p, &rank_of(order), mode, bar).ok()?;
+        if let Some(end) = res.outrun {
+            return Some((end, f64::INFINITY, Vec::new(), res));
+        }
+        let timed: Vec<Timed> = p.iter().map(|p| ctx.timed(p)).collect::<Result<_, _>>().ok()?;
+        let (c, d) = cycle_and_delta(&timed);
+        Some((c, d, p, res))
+    };
+    let waits: Vec<Option<Scheduled>> = orders
+        .par_iter()
+        .map(|o| run(o, Mode::GiveWay, ctx.settings.bar))
+        .collect();
+    let mut ranked: Vec<(f64, f64, usize)> = waits
+        .iter()
+        .enumerate()
+        .filter_map(|(i, r)| r.as_ref().map(|r| (r.0, r.1, i)))
+        .collect();
+    ranked.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.total_cmp(&b.1)).then(a.2.cmp(&b.2)));
+    let top: Vec<usize> = ranked.iter().take(2).map(|r| r.2).collect();
+    let reposed: Vec<Option<Scheduled>> = top
+        .par_iter()
+        .map(|&i| run(&orders[i], Mode::GiveWayOrRepose, None))
+        .collect();
+    // Each of the top orders with other poses, then with waits only (where that run finished).
+    let mut waits = waits;
+    let mut results: Vec<(Scheduled, usize)> = Vec::new();
+    for (&i, r) in top.iter().zip(reposed) {
+        results.extend(r.map(|r| (r, i)));
+    }
+    for &i in &top {
+        results.extend(waits[i].take().filter(|r| r.3.outrun.is_none()).map(|r| (r, i)));
+    }
+    let Some(((_, _, progs, res), i)) = results.into_iter().min_by(|a, b| {
+        a.0.0
+            .total_cmp(&b.0.0)
+            .then(a.0.1.total_cmp(&b.0.1))
+            .then(a.1.cmp(&b.1))
+    }) else {
+        return Err(PlanError::NoPriorityOrder);
+    };
+    Ok((progs, res, orders[i].clone()))
+}
+
+/// Ours: the coordination diagram of every robot pair, and the passage orders through its
+/// conflict boxes with the shortest makespan (`schedule`); every wait at a rest. `None` when
+/// no order exists (then `best` falls back on prioritised resolution).
+///
+/// Waits are at rests only; when no order exists because a robot has no rest where it could let
+/// another pass (it must leave one box before the other robot has passed and reach the next
+/// before it has), the robots of an infeasible core of boxes get a stop in the middle of each
+/// stretch of path between two of the core's boxes that has none (the segment is split: the
+/// same joint path, one more stop), and the diagram is built again, up to [`STOP_ROUNDS`]
+/// times.
+pub(super) fn scheduled(ctx: &Ctx, programs: &[Program]) -> Result<Option<Resolved>, PlanError> {
+    let mut programs = programs.to_vec();
+    let mut round = 0;
+    let mut parts = Vec::new();
+    let mut distances = 0;
+    let (paths, boxes, s) = loop {
+        let paths: Vec<diagram::RobotPath> = programs
+            .iter()
+            .map(|p| diagram::RobotPath::new(ctx, p))
+            .collect::<Result<_, _>>()?;
+        let (boxes, work) = diagram::diagrams_reusing(ctx, &paths, &mut parts);
+        distances += work.distances;
+        let tracks: Vec<schedule::Track> = paths.iter().map(|p| p.track()).collect();
+        let (nodes, min_wait) = (ctx.settings.schedule_nodes, ctx.settings.min_wait);
+        if let Some(s) = schedule::schedule(&tracks, &boxes, nodes, min_wait) {
+            break (paths, boxes, s);
+        }
+        if round == STOP_ROUNDS {
+            return Ok(None);
+        }
+        round += 1;
+        let core = schedule::infeasible_core(&tracks, &boxes, nodes, min_wait);
+        let core: Vec<&ConflictBox> = core.iter().map(|&i| &boxes[i]).collect();
+        let changed = add_stops(ctx, &mut programs, &paths, &core)?;
+        if changed.iter().all(|&c| !c) {
+            return Ok(None);
+        }
+        // The pairs of robots whose paths changed are built again.
+        let m = programs.len();
+        let mut i = 0;
+        for a in 0..m {
+            for b in a + 1..m {
+                if changed[a] || changed[b] {
+                    parts[i] = None;
+                }
+                i += 1;
+            }
+        }
+    };
+    let mut out = programs;
+    let mut res = Resolution::default();
+    for ((prog, path), waits) in out.iter_mut().zip(&paths).zip(&s.waits) {
+        prog.waits.clear();
+        for (rest, &(d, by)) in path.rests.iter().zip(waits) {
+            if d > 0.0 {
+                prog.set_wait(Wait {
+                    leg: rest.leg,
+                    waypoint: rest.waypoint,
+                    duration: d,
+                    reason: WaitReason::GiveWay,
+                    for_robot: by,
+                });
+                res.waits += 1;
+            }
+        }
+    }
+    res.resolved = s.decisions;
+    res.blocking = diagram::blocking(&paths, &boxes);
+    res.search = Some(crate::document::PassageSearch {
+        boxes: boxes.len(),
+        distances,
+        nodes: s.nodes,
+        proven: s.proven,
+    });
+    debug_assert!({
+        let timed: Vec<Timed> = out.iter().map(|p| ctx.timed(p)).collect::<Result<_, _>>()?;
+        (cycle_and_delta(&timed).0 - s.makespan).abs() < 1e-6
+    });
+    shrink_waits(ctx, &mut out)?;
+    res.waits = out.iter().map(|p| p.waits.len()).sum();
+    Ok(Some((out, res, Vec::new())))
+}
+
+/// How many times `scheduled` adds stops before it gives up on passage orders.
+const STOP_ROUNDS: usize = 12;
+
+/// The shortest stretch of path (s of position) a stop is added in.
+const MIN_STOP_GAP: f64 = 0.05;
+
+/// Adds a stop in each stretch of moving path between two successive boxes of `core` (on the
+/// same robot's positions) that has no rest in it; returns, per program, whether it changed.
+fn add_stops(
+    ctx: &Ctx,
+    programs: &mut [Program],
+    paths: &[diagram::RobotPath],
+    core: &[&ConflictBox],
+) -> Result<Vec<bool>, PlanError> {
+    let mut changed = vec![false; programs.len()];
+    for (i, (prog, path)) in programs.iter_mut().zip(paths).enumerate() {
+        let r = prog.robot;
+        let mut spans: Vec<(f64, f64)> = core
+            .iter()
+            .filter_map(|b| {
+                if b.robots.0 == r {
+                    Some(b.a)
+                } else if b.robots.1 == r {
+                    Some(b.b)
+                } else {
+                    None
+                }
+            })
+            .collect();
+        spans.sort_by(|x, y| x.0.total_cmp(&y.0).then(x.1.total_cmp(&y.1)));
+        // Merged, then the gaps between them.
+        let mut merged: Vec<(f64, f64)> = Vec::new();
+        for (a, b) in spans {
+            match merged.last_mut() {
+                Some(m) if a <= m.1 => m.1 = m.1.max(b),
+                _ => merged.push((a, b)),
+            }
+        }
+        let timed = &path.timed;
+        // (leg, segment, position) of each new stop.
+        let mut stops: Vec<(usize, usize, f64)> = Vec::new();
+        for g in merged.windows(2) {
+            let (g0, g1) = (g[0].1, g[1].0);
+            if path.rests.iter().any(|x| x.at > g0 + 1e-6 && x.at < g1 - 1e-6) {
+                continue;
+            }
+            // The longest moving stretch inside the gap.
+            let pick = timed
+                .spans
+                .iter()
+                .filter_map(|sp| match sp.what {
+                    Activity::Move { leg, segment } => {
+                        let (lo, hi) = (sp.start.max(g0), sp.end.min(g1));
+                        (hi - lo >= MIN_STOP_GAP).then_some((hi - lo, leg, segment, 0.5 * (lo + hi)))
+                    }
+                    _ => None,
+                })
+                .max_by(|x, y| x.0.total_cmp(&y.0));
+            if let Some((_, leg, segment, at)) = pick {
+                stops.push((leg, segment, at));
+            }
+        }
+        // Latest first, so earlier indices stay valid; one per segment.
+        stops.sort_by(|x, y| (y.0, y.1).cmp(&(x.0, x.1)).then(y.2.total_cmp(&x.2)));
+        stops.dedup_by(|x, y| (x.0, x.1) == (y.0, y.1));
+        for (_, _, at) in stops {
+            changed[i] |= prog.stop_at(timed, at, &ctx.limits[r])?;
+        }
+    }
+    Ok(changed)
+}
+
+/// The coordination diagrams of `programs` (their waits ignored): for every robot pair, boxes
+/// of positions (program time without waits) that cover every pair of positions at which the
+/// two come closer than the clearance (plus [`REPLAY_SLACK`]); see `diagram`.
+pub fn conflict_boxes(
+    cell: &Cell,
+    table: &CandidateTable,
+    programs: &[Program],
+    settings: &CoordSettings,
+) -> Result<Vec<ConflictBox>, PlanError> {
+    let ctx = Ctx::new(cell, table, settings);
+    let paths: Vec<diagram::RobotPath> = programs
+        .iter()
+        .map(|p| diagram::RobotPath::new(&ctx, p))
+        .collect::<Result<_, _>>()?;
+    Ok(diagram::diagrams(&ctx, &paths).0)
+}
+
+/// The boxes of the diagram are larger than the contacts they cover, so the schedule's waits
+/// are longer than needed: each wait, earliest first, is cut as far as the exact contact
+/// search on the clock allows (to 10 ms; to nothing, or at least [`CoordSettings::min_wait`]).
+fn shrink_waits(ctx: &Ctx, programs: &mut [Program]) -> Result<(), PlanError> {
+    let mut timed: Vec<Timed> = programs.iter().map(|p| ctx.timed(p)).collect::<Result<_, _>>()?;
+    let mut order: Vec<(f64, usize, usize)> = timed
+        .iter()
+        .enumerate()
+        .flat_map(|(r, t)| t.wait_starts.iter().enumerate().map(move |(i, &s)| (s, r, i)))
+        .collect();
+    order.sort_by(|a, b| a.0.total_cmp(&b.0).then((a.1, a.2).cmp(&(b.1, b.2))));
+    let keys: Vec<(usize, usize, usize)> = order
+        .iter()
+        .map(|&(_, r, i)| (r, programs[r].waits[i].leg, programs[r].waits[i].waypoint))
+        .collect();
+    let m = programs.len();
+    for (r, leg, waypoint) in keys {
+        let Some(w) = programs[r].wait_at(leg, waypoint).cloned() else {
+            continue;
+        };
+        let others: Vec<usize> = (0..m).filter(|&o| o != r).collect();
+        let start = timed[r].arrivals[leg][waypoint];
+        let try_with = |d: f64| -> Result<Option<(Program, Timed)>, PlanError> {
+            let mut p = programs[r].clone();
+            p.set_wait(Wait {
+                duration: d,
+                ..w.clone()
+            });
+            let tp = ctx.timed(&p)?;
+            let ok = ctx.clear(r, &tp, &timed, &others, start, f64::INFINITY);
+            Ok(ok.then_some((p, tp)))
+        };
+        let min = ctx.settings.min_wait;
+        let found = if let Some(x) = try_with(0.0)? {
+            Some(x)
+        } else if w.duration <= min + 0.01 {
+            None
+        } else {
+            // The shortest good duration to 10 ms (good ones need not form an interval; `hi`
+            // stays good).
+            let (mut lo, mut hi) = (min, w.duration);
+            let mut best = None;
+            if let Some(x) = try_with(min)? {
+                best = Some(x);
+                hi = min;
+            }
+            while hi - lo > 0.01 {
+                let mid = 0.5 * (lo + hi);
+                if let Some(x) = try_with(mid)? {
+                    best = Some(x);
+                    hi = mid;
+                } else {
+                    lo = mid;
+                }
+            }
+            best
+        };
+        if let Some((p, tp)) = found {
+            programs[r] = p;
+            timed[r] = tp;
+        }
+    }
+    Ok(())
+}
+
+/// `rank[r]`: the position of robot `r` in `order`.
+pub(super) fn rank_of(order: &[usize]) -> Vec<usize> {
+    let mut rank = vec![0; order.len()];
+    for (i, &r) in order.iter().enumerate() {
+        rank[r] = i;
+    }
+    rank
+}
+
+/// Priority orders tried by `best`: all permutations up to 4 robots; beyond, shortest program
+/// first, cell order, and longest first.
+fn priority_orders(programs: &[Program]) -> Vec<Vec<usize>> {
+    let m = programs.len();
+    if m <= 4 {
+        let mut out = Vec::new();
+        permutations(&mut (0..m).collect(), 0, &mut out);
+        return out;
+    }
+    let mut by_time: Vec<usize> = (0..m).collect();
+    by_time.sort_by(|&a, &b| {
+        programs[a]
+            .duration()
+            .total_cmp(&programs[b].duration())
+            .then(a.cmp(&b))
+    });
+    let mut rev = by_time.clone();
+    rev.reverse();
+    vec![by_time, (0..m).collect(), rev]
+}
+
+fn permutations(v: &mut Vec<usize>, k: usize, out: &mut Vec<Vec<usize>>) {
+    if k == v.len() {
+        out.push(v.clone());
+        return;
+    }
+    for i in k..v.len() {
+        v.swap(k, i);
+        permutations(v, k + 1, out);
+        v.swap(k, i);
+    }
+}
