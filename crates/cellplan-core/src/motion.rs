@@ -114,18 +114,23 @@ pub fn plan_leg_with_margin<'r>(
     let space = joint_space(cell, robot);
     let validity = robot_validity(cell, robot, margin);
     let chain = &robot.model.chain;
-    // The variants: direct, then retracted by each distance (exit and entry polylines).
+    // The retracted variants (exit and entry polylines), made only once the direct leg has
+    // failed: most legs never need them.
     type Polyline = Vec<Vec<f64>>;
-    let mut variants: Vec<Option<(Polyline, Polyline)>> = vec![None];
-    for distance in RETRACT_DISTANCES {
-        if let (Some(exit), Some(mut entry)) = (
-            arm::tool_retract(chain, &robot.tool.tcp, from, distance, RETRACT_STEP),
-            arm::tool_retract(chain, &robot.tool.tcp, to, distance, RETRACT_STEP),
-        ) {
-            entry.reverse();
-            variants.push(Some((exit, entry)));
-        }
-    }
+    let retracts = std::cell::OnceCell::<Vec<(Polyline, Polyline)>>::new();
+    let retracted = || {
+        retracts.get_or_init(|| {
+            RETRACT_DISTANCES
+                .iter()
+                .filter_map(|&distance| {
+                    let exit = arm::tool_retract(chain, &robot.tool.tcp, from, distance, RETRACT_STEP)?;
+                    let mut entry = arm::tool_retract(chain, &robot.tool.tcp, to, distance, RETRACT_STEP)?;
+                    entry.reverse();
+                    Some((exit, entry))
+                })
+                .collect()
+        })
+    };
     let sampler = |a: &[f64], b: &[f64]| plan::plan_leg(&space, &validity, a, b, settings);
     let through_roadmap = |a: &[f64], b: &[f64]| match roadmap {
         Some(r) => plan::roadmap_leg(&space, &validity, r(), a, b, settings),
@@ -136,19 +141,15 @@ pub fn plan_leg_with_margin<'r>(
     };
     let (mut samples, mut calls) = (0, 0);
     // Every variant with the sampler first (the legs it solves keep its paths), then every
-    // variant through the roadmap.
+    // variant through the roadmap: the direct leg, then each retract.
     let passes: [&plan::LegPlanner; 2] = [&sampler, &through_roadmap];
-    for (pass, middle) in passes.into_iter().enumerate() {
-        if pass == 1 && roadmap.is_none() {
-            break;
-        }
-        for variant in &variants {
-            let result = match variant {
-                None => middle(from, to),
-                Some((exit, entry)) => {
-                    plan::plan_leg_via_with(&space, &validity, exit, entry, settings, middle)
-                }
-            };
+    for middle in passes.into_iter().take(if roadmap.is_some() { 2 } else { 1 }) {
+        let direct = std::iter::once_with(|| middle(from, to));
+        // Lazy: the retracts are made only when the direct leg has failed.
+        let via = std::iter::once_with(retracted)
+            .flatten()
+            .map(|(exit, entry)| plan::plan_leg_via_with(&space, &validity, exit, entry, settings, middle));
+        for (k, result) in direct.chain(via).enumerate() {
             match result {
                 Ok(mut path) => {
                     path.samples += samples;
@@ -163,7 +164,7 @@ pub fn plan_leg_with_margin<'r>(
                     calls += c;
                 }
                 // An invalid end: no variant of the direct leg can help.
-                Err(e) if variant.is_none() => return Err(e),
+                Err(e) if k == 0 => return Err(e),
                 Err(_) => {}
             }
         }

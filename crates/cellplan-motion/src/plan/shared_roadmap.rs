@@ -244,10 +244,9 @@ impl SharedRoadmap {
         }
         let direct = space.distance(start, goal);
         extra.push((s, g, direct));
-        // Verdicts of the query's own edges (0 unknown, 1 valid, 2 invalid).
+        // Verdicts of the query's own edges; an invalid one is set aside.
         let mut extra_verdict = vec![UNKNOWN; extra.len()];
         let mut set_aside: BTreeSet<u32> = BTreeSet::new();
-        let mut extra_aside = vec![false; extra.len()];
         let (mut examined, mut calls) = (0, 0);
         let point = |i: usize| -> &[f64] {
             if i == s {
@@ -258,52 +257,34 @@ impl SharedRoadmap {
                 &self.nodes[i]
             }
         };
-        loop {
-            let Some(path) = self.shortest(space, start, goal, &extra, &extra_aside, &set_aside) else {
-                return RoadmapPath {
-                    waypoints: None,
-                    edges_examined: examined,
-                    validity_calls: calls,
-                };
+        let waypoints = 'search: loop {
+            let Some(path) = self.shortest(space, start, goal, &extra, &extra_verdict, &set_aside) else {
+                break 'search None;
             };
-            let mut broken = false;
-            for hop in &path {
+            for &(hop, _) in &path {
                 if examined >= self.settings.max_edges {
-                    return RoadmapPath {
-                        waypoints: None,
-                        edges_examined: examined,
-                        validity_calls: calls,
-                    };
+                    break 'search None;
                 }
                 examined += 1;
-                let valid = match *hop {
+                // The verdict from the query's own cache or the shared one, checked if unknown.
+                let mut check = |a: usize, b: usize| {
+                    let c = check_segment(space, validity, point(a), point(b), floor);
+                    calls += c.calls;
+                    if c.valid { VALID } else { INVALID }
+                };
+                let valid = match hop {
                     Hop::Query(k) => {
                         if extra_verdict[k] == UNKNOWN {
-                            let (a, b, _) = extra[k];
-                            let c = check_segment(space, validity, point(a), point(b), floor);
-                            calls += c.calls;
-                            extra_verdict[k] = if c.valid { VALID } else { INVALID };
+                            extra_verdict[k] = check(extra[k].0, extra[k].1);
                         }
-                        let ok = extra_verdict[k] == VALID;
-                        if !ok {
-                            extra_aside[k] = true;
-                        }
-                        ok
+                        extra_verdict[k] == VALID
                     }
                     Hop::Roadmap(e) => {
                         let slot = &self.verdicts[e as usize];
                         let mut v = slot.load(Ordering::Relaxed);
                         if v == UNKNOWN {
                             let (a, b, _) = self.edges[e as usize];
-                            let c = check_segment(
-                                space,
-                                validity,
-                                &self.nodes[a as usize],
-                                &self.nodes[b as usize],
-                                floor,
-                            );
-                            calls += c.calls;
-                            v = if c.valid { VALID } else { INVALID };
+                            v = check(a as usize, b as usize);
                             slot.store(v, Ordering::Relaxed);
                         }
                         if v != VALID {
@@ -313,48 +294,32 @@ impl SharedRoadmap {
                     }
                 };
                 if !valid {
-                    broken = true;
-                    break;
+                    continue 'search;
                 }
             }
-            if !broken {
-                let mut waypoints = vec![start.to_vec()];
-                let mut at = s;
-                for hop in &path {
-                    let next = match *hop {
-                        Hop::Query(k) => {
-                            let (a, b, _) = extra[k];
-                            if a == at { b } else { a }
-                        }
-                        Hop::Roadmap(e) => {
-                            let (a, b, _) = self.edges[e as usize];
-                            let (a, b) = (a as usize, b as usize);
-                            if a == at { b } else { a }
-                        }
-                    };
-                    waypoints.push(point(next).to_vec());
-                    at = next;
-                }
-                return RoadmapPath {
-                    waypoints: Some(waypoints),
-                    edges_examined: examined,
-                    validity_calls: calls,
-                };
-            }
+            let mut waypoints = vec![start.to_vec()];
+            waypoints.extend(path.iter().map(|&(_, next)| point(next).to_vec()));
+            break 'search Some(waypoints);
+        };
+        RoadmapPath {
+            waypoints,
+            edges_examined: examined,
+            validity_calls: calls,
         }
     }
 
     /// A* from the start (node `n`) to the goal (`n + 1`) over the roadmap's edges and the
-    /// query's own (`extra`), leaving out those set aside; the hops in order.
+    /// query's own (`extra`), leaving out those set aside and the query edges found invalid;
+    /// the hops in order, each with the node it reaches.
     fn shortest(
         &self,
         space: &JointSpace,
         start: &[f64],
         goal: &[f64],
         extra: &[(usize, usize, f64)],
-        extra_aside: &[bool],
+        extra_verdict: &[u8],
         set_aside: &BTreeSet<u32>,
-    ) -> Option<Vec<Hop>> {
+    ) -> Option<Vec<(Hop, usize)>> {
         let n = self.nodes.len();
         let (s, g) = (n, n + 1);
         let h = |i: usize| -> f64 {
@@ -369,7 +334,7 @@ impl SharedRoadmap {
         // The query's edges by node.
         let mut query_at: Vec<Vec<(usize, usize)>> = vec![Vec::new(); n + 2];
         for (k, &(a, b, _)) in extra.iter().enumerate() {
-            if !extra_aside[k] {
+            if extra_verdict[k] != INVALID {
                 query_at[a].push((b, k));
                 query_at[b].push((a, k));
             }
@@ -389,7 +354,7 @@ impl SharedRoadmap {
                 let mut hops = Vec::new();
                 let mut k = g;
                 while let Some((p, hop)) = prev[k] {
-                    hops.push(hop);
+                    hops.push((hop, k));
                     k = p;
                 }
                 hops.reverse();
