@@ -191,7 +191,13 @@ fn check_plan(cell: &Cell, doc: &output::Plan) {
     assert!((doc.cycle_time_s - cycle).abs() < 1e-9);
     let spread = cycle - times.iter().copied().fold(f64::INFINITY, f64::min);
     assert!((doc.delta_t_s - spread).abs() < 1e-9);
-    assert!(doc.lower_bound_s > 0.0 && doc.lower_bound_s <= doc.cycle_time_s + 1e-9);
+    assert!(
+        doc.lower_bound_s > 0.0 && doc.lower_bound_s <= doc.cycle_time_s + 1e-9,
+        "lower bound {} above the cycle time {} ({} unmeasured)",
+        doc.lower_bound_s,
+        doc.cycle_time_s,
+        doc.unmeasured.len()
+    );
 }
 
 fn dist(a: &[f64], b: &[f64]) -> f64 {
@@ -707,6 +713,113 @@ fn sequencing_against_a_bar_stops_before_planning() {
     // A bar just above the real time does not stop it.
     let kept = run(real + 1.0, &mut planned.clone());
     assert!(!kept.beaten);
+}
+
+/// What the planned legs say is used before any search: a leg between two nodes that planned
+/// legs join is those legs end to end (shortcut), from one end to the other and clear of the
+/// scene at the clearance (re-sampled at 1 mrad), with no sampling; a node a full search from
+/// home's component did not reach is never searched again, and once two candidates of a task
+/// are such nodes, none of its other candidates outside home's component is.
+#[test]
+fn planned_legs_join_nodes_and_unreached_nodes_are_not_searched_again() {
+    use cellplan_motion::plan::PlanError as Motion;
+    use plan::sequence::{Leg, Planned, Reach};
+    let f = fixture();
+    let cell = &f.cell;
+    let s = settings(Allocation::Balanced);
+    let robot = &cell.robots[0];
+    let graph = plan::graph::RobotGraph::new(cell, robot, &f.table, plan::MoveModel::Trapezoid, 8, s.roomy);
+    let full = s.final_max_samples;
+    // Two candidates with straight legs home → a → b (planned the way the sequencer plans).
+    let none = Planned::new();
+    let reach = Reach::of(cell, &graph, &none, full);
+    let straight = |a: usize, b: usize| {
+        reach
+            .leg(cell, robot, &graph, &none, a, b, &s, false)
+            .ok()
+            .filter(|l| l.straight)
+    };
+    let nodes: Vec<usize> = (1..graph.len()).collect();
+    let (a, b, home_a, a_b) = nodes
+        .iter()
+        .filter_map(|&a| straight(0, a).map(|l| (a, l)))
+        .find_map(|(a, home_a)| {
+            nodes
+                .iter()
+                .filter(|&&b| b > a && graph.node_task[b].map(|x| x.0) != graph.node_task[a].map(|x| x.0))
+                .find_map(|&b| straight(a, b).map(|l| (a, b, home_a.clone(), l)))
+        })
+        .expect("two candidates with straight legs from home");
+    let mut planned = Planned::new();
+    planned.insert((0, a), Ok(home_a.clone()));
+    planned.insert((a, b), Ok(a_b.clone()));
+    let reach = Reach::of(cell, &graph, &planned, full);
+    assert!(reach.joined(0, b) && !reach.is_cut_off(b));
+    let joined: Leg = reach
+        .leg(cell, robot, &graph, &planned, 0, b, &s, true)
+        .expect("the planned legs join home and b");
+    assert_eq!(joined.samples, 0, "no sampling for joined nodes");
+    assert!(dist(&joined.waypoints[0], &graph.q[0]) < 1e-12);
+    assert!(dist(joined.waypoints.last().unwrap(), &graph.q[b]) < 1e-12);
+    let mut scratch = Scratch::default();
+    for w in joined.waypoints.windows(2) {
+        let steps = (dist(&w[0], &w[1]) / 1e-3).ceil().max(1.0) as usize;
+        for k in 0..=steps {
+            let t = k as f64 / steps as f64;
+            let q: Vec<f64> = w[0].iter().zip(&w[1]).map(|(x, y)| x + t * (y - x)).collect();
+            assert!(robot.within_limits(&q));
+            robot.body_poses(&q, &mut scratch);
+            assert!(
+                robot
+                    .contact_at(&cell.world, &scratch, cell.planning.clearance - 1e-6)
+                    .is_none(),
+                "the joined leg comes closer than the clearance at {q:?}"
+            );
+        }
+    }
+    // A full search from home's component that found nothing cuts the node off; a search
+    // between two nodes outside it does not.
+    let task_nodes = |n: usize| graph.alternatives[graph.node_task[n].unwrap().0.0].clone();
+    let other = (1..graph.len())
+        .find(|&n| {
+            !reach.joined(n, 0)
+                && task_nodes(n).len() >= 4
+                && task_nodes(n).iter().all(|&m| !reach.joined(m, 0))
+        })
+        .expect("a task with four candidates outside home's component");
+    let siblings = task_nodes(other);
+    let failed = |samples| {
+        Err(plan::LegError::Motion(Motion::NoPath {
+            samples,
+            validity_calls: 10 * samples,
+        }))
+    };
+    let mut cut = planned.clone();
+    cut.insert((a, siblings[0]), failed(full));
+    cut.insert(
+        (siblings[2].min(siblings[3]), siblings[2].max(siblings[3])),
+        failed(full),
+    );
+    let reach = Reach::of(cell, &graph, &cut, full);
+    assert!(reach.is_cut_off(siblings[0]));
+    assert!(
+        !reach.is_cut_off(siblings[1]),
+        "one cut-off candidate leaves the task's others"
+    );
+    assert!(!reach.is_cut_off(siblings[2]) && !reach.is_cut_off(siblings[3]));
+    match reach.leg(cell, robot, &graph, &cut, b, siblings[0], &s, true) {
+        Err(plan::LegError::Unreached(u)) => assert_eq!(u.samples, full),
+        other => panic!("a cut-off node is searched again: {other:?}"),
+    }
+    // A quick failure is no proof.
+    let mut quick = planned.clone();
+    quick.insert((a, siblings[0]), failed(60));
+    assert!(!Reach::of(cell, &graph, &quick, full).is_cut_off(siblings[0]));
+    // Two candidates cut off: the task is given up on this robot.
+    cut.insert((0, siblings[1]), failed(full));
+    let reach = Reach::of(cell, &graph, &cut, full);
+    assert!(siblings.iter().all(|&n| reach.is_cut_off(n)));
+    assert!(!reach.is_cut_off(a) && !reach.is_cut_off(b) && !reach.is_cut_off(0));
 }
 
 /// A leg the sampler cannot solve never loses the plan: with no samples at all (and no

@@ -10,6 +10,7 @@ use cellplan_core::plan::graph::RobotGraph;
 use cellplan_geom::DVec3;
 use cellplan_model::Cell;
 use cellplan_model::robot::Robot;
+use cellplan_model::tasks::TaskId;
 
 /// How far a conflict's stated tool position may lie from the track before coordination
 /// (m), beyond how far the track's two samples around it lie apart: the tracks are sampled
@@ -75,7 +76,19 @@ fn lower_bound(cell: &Cell, table: &CandidateTable, plan: &Plan, totals: &mut dy
         .iter()
         .map(|r| RobotGraph::new(cell, r, table, s.move_model, s.alternatives, s.roomy_m))
         .collect();
-    match allocate::lower_bound(cell, table, &graphs) {
+    // The tasks the plan does not measure are left out of the bound.
+    let measured: std::collections::BTreeSet<&str> = plan
+        .robots
+        .iter()
+        .flat_map(|r| r.tasks.iter().map(|v| v.task.as_str()))
+        .collect();
+    let left_out: Vec<TaskId> = cell
+        .tasks
+        .iter()
+        .filter(|t| !measured.contains(t.name.as_str()))
+        .map(|t| t.id)
+        .collect();
+    match allocate::lower_bound(cell, table, &graphs, &left_out) {
         Ok(lb) => {
             if (plan.lower_bound_s - lb).abs() > 1e-6 * (1.0 + lb) {
                 totals(format!(

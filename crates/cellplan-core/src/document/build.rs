@@ -37,7 +37,14 @@ pub fn build(
         })
         .collect();
     let (cycle, delta) = cycle_and_delta(&robots);
-    let lb = outcome.allocated.lower_bound;
+    // The bound holds for the tasks the plan does: the ones given up are left out of it.
+    let left_out: Vec<TaskId> = outcome.unreached.iter().map(|(t, _)| *t).collect();
+    let lb = if left_out.is_empty() {
+        outcome.allocated.lower_bound
+    } else {
+        crate::plan::allocate::lower_bound(cell, table, &outcome.graphs, &left_out)
+            .unwrap_or(outcome.allocated.lower_bound)
+    };
     Plan {
         format: FORMAT.to_string(),
         version: VERSION,

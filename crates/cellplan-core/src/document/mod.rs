@@ -42,7 +42,8 @@ pub struct Plan {
     /// Largest difference between robot times (s).
     pub delta_t_s: f64,
     /// A lower bound of the cycle time over the candidates the planner considered (s): the
-    /// min-max bound of paper 000's allocation problem on lower-bound move times.
+    /// min-max bound of paper 000's allocation problem on lower-bound move times, over the
+    /// tasks the plan measures.
     pub lower_bound_s: f64,
     /// `cycle_time_s / lower_bound_s` (1 when the bound is 0).
     pub ratio_to_lower_bound: f64,

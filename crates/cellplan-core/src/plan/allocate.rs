@@ -366,11 +366,24 @@ fn cap_error(cell: &Cell, t: usize, cap: usize) -> PlanError {
     }
 }
 
-/// The lower bound of the min-max problem on the graphs' lower-bound costs: what
-/// [`Allocated::lower_bound`] reports, recomputed by the verifier.
-pub fn lower_bound(cell: &Cell, table: &CandidateTable, graphs: &[RobotGraph]) -> Result<f64, PlanError> {
+/// The lower bound of the min-max problem on the graphs' lower-bound costs over the measurable
+/// tasks except `left_out` (the tasks a plan gives up: a bound of a plan holds for the tasks it
+/// does): [`Allocated::lower_bound`] when nothing is left out. The plan document states it
+/// for the tasks the plan measures, and the verifier recomputes it so.
+pub fn lower_bound(
+    cell: &Cell,
+    table: &CandidateTable,
+    graphs: &[RobotGraph],
+    left_out: &[TaskId],
+) -> Result<f64, PlanError> {
     let capable: Vec<Vec<usize>> = (0..cell.tasks.len())
-        .map(|t| table.robots_for(TaskId(t)).into_iter().map(|r| r.0).collect())
+        .map(|t| {
+            if left_out.contains(&TaskId(t)) {
+                Vec::new()
+            } else {
+                table.robots_for(TaskId(t)).into_iter().map(|r| r.0).collect()
+            }
+        })
         .collect();
     Ok(minmax::lower_bound(&min_max_problem(cell, graphs, &capable)?.0))
 }

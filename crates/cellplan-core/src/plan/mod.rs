@@ -130,6 +130,31 @@ pub enum LegError {
     /// The path could not be timed.
     #[error(transparent)]
     Timing(#[from] cellplan_motion::timing::TimingError),
+    /// Not searched: a full search from a pose the robot reaches from home found no path to
+    /// one of the leg's ends, so no leg to that end can be part of a tour.
+    #[error("{0}")]
+    Unreached(Box<Unreached>),
+}
+
+/// See [`LegError::Unreached`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct Unreached {
+    /// The pose the search started from (a label: `home` or the task).
+    pub from: String,
+    /// The end it did not reach.
+    pub to: String,
+    /// The samples that search drew.
+    pub samples: usize,
+}
+
+impl std::fmt::Display for Unreached {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "not searched again: the full search from {}", self.from)?;
+        if self.from != Stop::Home.to_string() {
+            write!(f, ", which the robot reaches from home,")?;
+        }
+        write!(f, " found no path to {} ({} samples)", self.to, self.samples)
+    }
 }
 
 /// Where a robot stands between legs: at home or at a task. In the Plan document: `"home"` or

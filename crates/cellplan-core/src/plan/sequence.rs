@@ -218,9 +218,15 @@ fn attempt(
             nodes = best.as_ref().map(|b| b.1.clone()).unwrap_or_default();
             break;
         }
+        let reach = Reach::of(cell, graph, planned, settings.final_max_samples);
         let results: Vec<((usize, usize), Result<Leg, LegError>)> = new
             .par_iter()
-            .map(|&(a, b)| ((a, b), plan_leg(cell, robot, graph, a, b, settings)))
+            .map(|&(a, b)| {
+                (
+                    (a, b),
+                    reach.leg(cell, robot, graph, planned, a, b, settings, false),
+                )
+            })
             .collect();
         for (k, r) in results {
             match &r {
@@ -253,33 +259,56 @@ fn attempt(
     // Legs of the final order the quick planner gave up on get the full search budget — once:
     // a leg that failed with it (in this run or an earlier one sharing `planned`) would fail
     // the same way again (the sampler's seed is the leg's), and invalid ends stay invalid.
-    let retry: Vec<(usize, usize)> = legs_of(&nodes)
+    //
+    // They go in phases, each made after the last one's results are in: a phase takes, for
+    // each end outside home's component, one leg that joins it to that component, so that an
+    // end one search did not reach is cut off (see [`Reach`]) before more searches are spent
+    // on it; legs between two such ends wait until no other leg is left.
+    let mut retry: std::collections::BTreeSet<(usize, usize)> = legs_of(&nodes)
         .into_iter()
         .map(|(a, b)| key(a, b))
         .filter(|k| worth_full_budget(planned.get(k), settings.final_max_samples))
-        .collect::<std::collections::BTreeSet<_>>()
-        .into_iter()
         .collect();
-    let retried: Vec<((usize, usize), Result<Leg, LegError>)> = retry
-        .par_iter()
-        .map(|&(a, b)| {
-            let full = PlanSettings {
-                motion: MotionSettings {
-                    max_samples: settings.final_max_samples,
-                    ..settings.motion.clone()
-                },
-                ..settings.clone()
-            };
-            ((a, b), plan_leg(cell, robot, graph, a, b, &full))
-        })
-        .collect();
-    for (k, r) in retried {
-        if r.is_ok() {
-            out.legs_failed -= 1;
-            out.legs_planned += 1;
-            out.legs_sampled += 1;
+    let full = PlanSettings {
+        motion: MotionSettings {
+            max_samples: settings.final_max_samples,
+            ..settings.motion.clone()
+        },
+        ..settings.clone()
+    };
+    while !retry.is_empty() {
+        let reach = Reach::of(cell, graph, planned, settings.final_max_samples);
+        let mut taken = std::collections::BTreeSet::new();
+        let mut phase: Vec<(usize, usize)> = Vec::new();
+        for &(a, b) in &retry {
+            let outside: Vec<usize> = [a, b].into_iter().filter(|&n| !reach.joined(n, 0)).collect();
+            let ready = reach.is_cut_off(a)
+                || reach.is_cut_off(b)
+                || match outside[..] {
+                    [] => true,
+                    [n] => taken.insert(n),
+                    _ => false,
+                };
+            if ready {
+                phase.push((a, b));
+            }
         }
-        planned.insert(k, r);
+        if phase.is_empty() {
+            phase = retry.iter().copied().collect();
+        }
+        let retried: Vec<((usize, usize), Result<Leg, LegError>)> = phase
+            .par_iter()
+            .map(|&(a, b)| ((a, b), reach.leg(cell, robot, graph, planned, a, b, &full, true)))
+            .collect();
+        for (k, r) in retried {
+            if r.is_ok() {
+                out.legs_failed -= 1;
+                out.legs_planned += 1;
+                out.legs_sampled += 1;
+            }
+            retry.remove(&k);
+            planned.insert(k, r);
+        }
     }
     let mut legs = Vec::new();
     for (a, b) in legs_of(&nodes) {
@@ -494,6 +523,241 @@ fn plan_leg(
         validity_calls: path.validity_calls,
         compute_s: started.elapsed().as_secs_f64(),
     })
+}
+
+/// Candidates of one task cut off (see [`Reach`]) after which all of its candidates are.
+const TASK_CUT_OFF: usize = 2;
+
+/// What the legs planned so far say about where a robot can go: which nodes its planned legs
+/// join (the same component: a path between them exists, the planned legs end to end), and
+/// which nodes a full search from home's component did not reach.
+///
+/// It is made from `planned` between batches of legs (never while a batch runs), so a leg's
+/// result depends on the legs planned before its batch and not on which thread planned what.
+pub struct Reach {
+    /// Union–find parents over the graph's nodes, through the legs with a path.
+    parent: Vec<usize>,
+    /// Nodes outside home's component that a full-budget search from a node inside it did not
+    /// reach: the node, the search's start and its samples.
+    cut_off: BTreeMap<usize, (usize, usize)>,
+    /// Labels of the cut-off nodes and their searches' starts, for the reason.
+    labels: BTreeMap<usize, String>,
+}
+
+impl Reach {
+    /// What `planned` says; `full` is the sample budget of a full search.
+    pub fn of(cell: &Cell, graph: &RobotGraph, planned: &Planned, full: usize) -> Self {
+        let mut parent: Vec<usize> = (0..graph.len()).collect();
+        fn root(parent: &mut [usize], mut x: usize) -> usize {
+            while parent[x] != x {
+                parent[x] = parent[parent[x]];
+                x = parent[x];
+            }
+            x
+        }
+        for (&(a, b), leg) in planned {
+            if leg.is_ok() {
+                let (ra, rb) = (root(&mut parent, a), root(&mut parent, b));
+                if ra != rb {
+                    parent[ra.max(rb)] = ra.min(rb);
+                }
+            }
+        }
+        for x in 0..parent.len() {
+            parent[x] = root(&mut parent, x);
+        }
+        let home = parent[0];
+        let mut cut_off = BTreeMap::new();
+        let mut labels = BTreeMap::new();
+        for (&(a, b), leg) in planned {
+            let Err(LegError::Motion(cellplan_motion::plan::PlanError::NoPath { samples, .. })) = leg else {
+                continue;
+            };
+            if *samples < full {
+                continue;
+            }
+            let (inside, outside) = match (parent[a] == home, parent[b] == home) {
+                (true, false) => (a, b),
+                (false, true) => (b, a),
+                _ => continue,
+            };
+            if let std::collections::btree_map::Entry::Vacant(e) = cut_off.entry(outside) {
+                e.insert((inside, *samples));
+                for n in [inside, outside] {
+                    labels
+                        .entry(n)
+                        .or_insert_with(|| stop_of(cell, graph, n).to_string());
+                }
+            }
+        }
+        // A task with two candidates cut off is given up on this robot: its other candidates
+        // outside home's component are cut off too (citing the first search), so that a task
+        // in a pocket costs two full searches, not one per candidate.
+        let mut per_task: BTreeMap<usize, Vec<usize>> = BTreeMap::new();
+        for &n in cut_off.keys() {
+            if let Some((t, _)) = graph.node_task[n] {
+                per_task.entry(t.0).or_default().push(n);
+            }
+        }
+        for (t, nodes) in per_task {
+            if nodes.len() < TASK_CUT_OFF {
+                continue;
+            }
+            let first = cut_off[&nodes[0]];
+            for &n in &graph.alternatives[t] {
+                if parent[n] != home && !cut_off.contains_key(&n) {
+                    cut_off.insert(n, first);
+                    labels
+                        .entry(n)
+                        .or_insert_with(|| stop_of(cell, graph, n).to_string());
+                }
+            }
+        }
+        Reach {
+            parent,
+            cut_off,
+            labels,
+        }
+    }
+
+    /// Whether `n` is cut off.
+    pub fn is_cut_off(&self, n: usize) -> bool {
+        self.cut_off.contains_key(&n)
+    }
+
+    /// Whether planned legs join `a` and `b`.
+    pub fn joined(&self, a: usize, b: usize) -> bool {
+        self.parent[a] == self.parent[b]
+    }
+
+    /// The leg from `a` to `b`: none when an end is cut off; the planned legs joined end to end
+    /// and shortcut when `full` (a full-budget search) and they join the two; else the motion
+    /// planner, and, when it finds no path and planned legs join the ends, those legs.
+    #[allow(clippy::too_many_arguments)]
+    pub fn leg(
+        &self,
+        cell: &Cell,
+        robot: &Robot,
+        graph: &RobotGraph,
+        planned: &Planned,
+        a: usize,
+        b: usize,
+        settings: &PlanSettings,
+        full: bool,
+    ) -> Result<Leg, LegError> {
+        for end in [a, b] {
+            if let Some(&(from, samples)) = self.cut_off.get(&end) {
+                return Err(LegError::Unreached(Box::new(super::Unreached {
+                    from: self.labels[&from].clone(),
+                    to: self.labels[&end].clone(),
+                    samples,
+                })));
+            }
+        }
+        if full && self.joined(a, b) {
+            return joined_leg(cell, robot, graph, planned, a, b, settings);
+        }
+        match plan_leg(cell, robot, graph, a, b, settings) {
+            Err(LegError::Motion(cellplan_motion::plan::PlanError::NoPath { .. })) if self.joined(a, b) => {
+                joined_leg(cell, robot, graph, planned, a, b, settings)
+            }
+            r => r,
+        }
+    }
+}
+
+/// The leg from `a` to `b` through planned legs: the quickest chain of them (by their times),
+/// end to end, then shortcut (every change checked with the leg's clearance) and timed. Every
+/// planned leg keeps the clearance and every joint is a graph node (a checked pose), so the
+/// chain does too.
+fn joined_leg(
+    cell: &Cell,
+    robot: &Robot,
+    graph: &RobotGraph,
+    planned: &Planned,
+    a: usize,
+    b: usize,
+    settings: &PlanSettings,
+) -> Result<Leg, LegError> {
+    let started = Instant::now();
+    // Dijkstra over the planned legs.
+    let mut adj: BTreeMap<usize, Vec<(usize, f64)>> = BTreeMap::new();
+    for (&(x, y), leg) in planned {
+        if let Ok(l) = leg {
+            adj.entry(x).or_default().push((y, l.duration));
+            adj.entry(y).or_default().push((x, l.duration));
+        }
+    }
+    let mut dist: BTreeMap<usize, (f64, usize)> = BTreeMap::new();
+    let mut heap = std::collections::BinaryHeap::new();
+    dist.insert(a, (0.0, a));
+    heap.push((std::cmp::Reverse(OrdF64(0.0)), a));
+    while let Some((std::cmp::Reverse(OrdF64(d)), x)) = heap.pop() {
+        if x == b {
+            break;
+        }
+        if dist.get(&x).is_some_and(|&(best, _)| d > best) {
+            continue;
+        }
+        for &(y, w) in adj.get(&x).map(Vec::as_slice).unwrap_or(&[]) {
+            let nd = d + w;
+            if dist.get(&y).is_none_or(|&(best, _)| nd < best) {
+                dist.insert(y, (nd, x));
+                heap.push((std::cmp::Reverse(OrdF64(nd)), y));
+            }
+        }
+    }
+    let mut chain = vec![b];
+    while let Some(&last) = chain.last()
+        && last != a
+    {
+        chain.push(dist[&last].1);
+    }
+    chain.reverse();
+    let mut waypoints: Vec<Vec<f64>> = vec![graph.q[a].clone()];
+    for w in chain.windows(2) {
+        let (x, y) = (w[0], w[1]);
+        let Some(Ok(leg)) = planned.get(&key(x, y)) else {
+            unreachable!("the chain follows planned legs")
+        };
+        let mut points = leg.waypoints.clone();
+        if (x, y) != key(x, y) {
+            points.reverse();
+        }
+        waypoints.extend(points.into_iter().skip(1));
+    }
+    let space = crate::motion::joint_space(cell, robot);
+    let validity = crate::motion::robot_validity(cell, robot, cell.planning.clearance);
+    let motion = MotionSettings {
+        seed: leg_seed(settings.seed, robot.id.0, a, b) ^ 2,
+        shortcut_iterations: settings.final_shortcut_iterations,
+        ..settings.motion.clone()
+    };
+    cellplan_motion::plan::shortcut(&space, &validity, &mut waypoints, &motion);
+    let timed = time_path_exact(&waypoints, &graph.limits)?;
+    Ok(Leg {
+        waypoints,
+        duration: timed.trajectory.duration(),
+        straight: false,
+        samples: 0,
+        validity_calls: 0,
+        compute_s: started.elapsed().as_secs_f64(),
+    })
+}
+
+/// An `f64` ordered by `total_cmp`, for the heap.
+#[derive(Clone, Copy, PartialEq)]
+struct OrdF64(f64);
+impl Eq for OrdF64 {}
+impl PartialOrd for OrdF64 {
+    fn partial_cmp(&self, other: &Self) -> Option<std::cmp::Ordering> {
+        Some(self.cmp(other))
+    }
+}
+impl Ord for OrdF64 {
+    fn cmp(&self, other: &Self) -> std::cmp::Ordering {
+        self.0.total_cmp(&other.0)
+    }
 }
 
 /// A seed per leg, so that a leg's path does not depend on which thread plans it or when.

@@ -96,6 +96,10 @@ pub struct BroadPhase {
     ranges: Vec<Range<usize>>,
     outer: Vec<Option<Sphere>>,
     objects: Vec<Object>,
+    /// The objects in runs (the static objects, then each parked group's bodies), each with
+    /// the box around its objects' boxes: a body farther from a run's box than what is asked
+    /// skips the whole run.
+    runs: Vec<(DVec3, DVec3, Range<usize>)>,
     /// The covers of the parked bodies, in the world.
     parked: Vec<Sphere>,
 }
@@ -165,6 +169,20 @@ impl BroadPhase {
                 kind,
             });
         }
+        let mut runs = Vec::new();
+        let mut run_start = 0;
+        let mut close_run = |objects: &[Object], runs: &mut Vec<(DVec3, DVec3, Range<usize>)>| {
+            if objects.len() > run_start {
+                let run = &objects[run_start..];
+                let mins = run.iter().fold(DVec3::splat(f64::INFINITY), |m, o| m.min(o.mins));
+                let maxs = run
+                    .iter()
+                    .fold(DVec3::splat(f64::NEG_INFINITY), |m, o| m.max(o.maxs));
+                runs.push((mins, maxs, run_start..objects.len()));
+            }
+            run_start = objects.len();
+        };
+        close_run(&objects, &mut runs);
         let mut parked_spheres = Vec::new();
         for (other, poses) in parked {
             for (j, pose) in poses.iter().enumerate().take(world.body_count(*other)) {
@@ -201,6 +219,7 @@ impl BroadPhase {
                     },
                 });
             }
+            close_run(&objects, &mut runs);
         }
         BroadPhase {
             group: g,
@@ -208,6 +227,7 @@ impl BroadPhase {
             ranges,
             outer,
             objects,
+            runs,
             parked: parked_spheres,
         }
     }
@@ -260,29 +280,35 @@ impl BroadPhase {
             Ok(body) => body,
             Err(answer) => return answer,
         };
-        for object in &self.objects {
-            if point_box_distance(outer.centre, object.mins, object.maxs) - outer.radius >= best {
+        for (mins, maxs, run) in &self.runs {
+            // The whole run is farther than what is asked.
+            if point_box_distance(outer.centre, *mins, *maxs) - outer.radius >= best {
                 continue;
             }
-            let (bound, towards) = self.object_bound(world, object, spheres, best);
-            if bound >= best {
-                continue;
-            }
-            let d = match &object.kind {
-                Kind::Body {
-                    group,
-                    body,
-                    pose,
-                    extra,
-                    ..
-                } => (world.body_body_distance(self.group, i, poses, *group, *body, pose, best + extra)
-                    - extra)
-                    .max(0.0),
-                _ => world.body_object_distance_hinted(self.group, i, poses, object.index, best, towards),
-            };
-            best = best.min(d);
-            if best <= 0.0 {
-                return 0.0;
+            for object in &self.objects[run.clone()] {
+                if point_box_distance(outer.centre, object.mins, object.maxs) - outer.radius >= best {
+                    continue;
+                }
+                let (bound, towards) = self.object_bound(world, object, spheres, best);
+                if bound >= best {
+                    continue;
+                }
+                let d = match &object.kind {
+                    Kind::Body {
+                        group,
+                        body,
+                        pose,
+                        extra,
+                        ..
+                    } => (world.body_body_distance(self.group, i, poses, *group, *body, pose, best + extra)
+                        - extra)
+                        .max(0.0),
+                    _ => world.body_object_distance_hinted(self.group, i, poses, object.index, best, towards),
+                };
+                best = best.min(d);
+                if best <= 0.0 {
+                    return 0.0;
+                }
             }
         }
         best
@@ -314,13 +340,18 @@ impl BroadPhase {
             Ok(body) => body,
             Err(answer) => return answer,
         };
-        for object in &self.objects {
-            if point_box_distance(outer.centre, object.mins, object.maxs) - outer.radius >= best {
+        for (mins, maxs, run) in &self.runs {
+            if point_box_distance(outer.centre, *mins, *maxs) - outer.radius >= best {
                 continue;
             }
-            best = best.min(self.object_bound(world, object, spheres, best).0);
-            if best <= 0.0 {
-                return 0.0;
+            for object in &self.objects[run.clone()] {
+                if point_box_distance(outer.centre, object.mins, object.maxs) - outer.radius >= best {
+                    continue;
+                }
+                best = best.min(self.object_bound(world, object, spheres, best).0);
+                if best <= 0.0 {
+                    return 0.0;
+                }
             }
         }
         best
