@@ -732,7 +732,7 @@ fn planned_legs_join_nodes_and_unreached_nodes_are_not_searched_again() {
     let full = s.final_max_samples;
     // Two candidates with straight legs home → a → b (planned the way the sequencer plans).
     let none = Planned::new();
-    let reach = Reach::of(cell, &graph, &none, full);
+    let reach = Reach::of(&graph, &none, full);
     let straight = |a: usize, b: usize| {
         reach
             .leg(cell, robot, &graph, &none, a, b, &s, false)
@@ -753,7 +753,7 @@ fn planned_legs_join_nodes_and_unreached_nodes_are_not_searched_again() {
     let mut planned = Planned::new();
     planned.insert((0, a), Ok(home_a.clone()));
     planned.insert((a, b), Ok(a_b.clone()));
-    let reach = Reach::of(cell, &graph, &planned, full);
+    let reach = Reach::of(&graph, &planned, full);
     assert!(reach.joined(0, b) && !reach.is_cut_off(b));
     let joined: Leg = reach
         .leg(cell, robot, &graph, &planned, 0, b, &s, true)
@@ -800,7 +800,7 @@ fn planned_legs_join_nodes_and_unreached_nodes_are_not_searched_again() {
         (siblings[2].min(siblings[3]), siblings[2].max(siblings[3])),
         failed(full),
     );
-    let reach = Reach::of(cell, &graph, &cut, full);
+    let reach = Reach::of(&graph, &cut, full);
     assert!(reach.is_cut_off(siblings[0]));
     assert!(
         !reach.is_cut_off(siblings[1]),
@@ -814,10 +814,10 @@ fn planned_legs_join_nodes_and_unreached_nodes_are_not_searched_again() {
     // A quick failure is no proof.
     let mut quick = planned.clone();
     quick.insert((a, siblings[0]), failed(60));
-    assert!(!Reach::of(cell, &graph, &quick, full).is_cut_off(siblings[0]));
+    assert!(!Reach::of(&graph, &quick, full).is_cut_off(siblings[0]));
     // Two candidates cut off: the task is given up on this robot.
     cut.insert((0, siblings[1]), failed(full));
-    let reach = Reach::of(cell, &graph, &cut, full);
+    let reach = Reach::of(&graph, &cut, full);
     assert!(siblings.iter().all(|&n| reach.is_cut_off(n)));
     assert!(!reach.is_cut_off(a) && !reach.is_cut_off(b) && !reach.is_cut_off(0));
 }

@@ -178,6 +178,8 @@ struct Placed {
     /// World bounding sphere of each body with shapes, and which body it is.
     spheres: Vec<(DVec3, f64)>,
     bodies: Vec<usize>,
+    /// Each body's sphere cover in the world (empty for a body without shapes).
+    covers: Vec<Vec<(DVec3, f64)>>,
 }
 
 /// Per robot, per body: one sphere (body frame) holding the body's sphere cover.
@@ -262,11 +264,17 @@ impl PairDiagram<'_> {
             .enumerate()
             .filter_map(|(i, (s, p))| s.map(|(c, r)| ((p.transform_point(c), r), i)))
             .unzip();
+        let covers = if first { &self.ca } else { &self.cb }
+            .iter()
+            .zip(&self.scratch.bodies)
+            .map(|(cover, p)| cover.iter().map(|&(c, r)| (p.transform_point(c), r)).collect())
+            .collect();
         Placed {
             q,
             poses: self.scratch.bodies.clone(),
             spheres,
             bodies,
+            covers,
         }
     }
 
@@ -301,12 +309,10 @@ impl PairDiagram<'_> {
                     continue;
                 }
                 let (bi, bj) = (xa.bodies[i], xb.bodies[j]);
-                let (pa, pb) = (&xa.poses[bi], &xb.poses[bj]);
-                let close = self.ca[bi].iter().any(|(c, r)| {
-                    let c = pa.transform_point(*c);
-                    self.cb[bj]
+                let close = xa.covers[bi].iter().any(|(c, r)| {
+                    xb.covers[bj]
                         .iter()
-                        .any(|(d, q)| (c - pb.transform_point(*d)).length() - r - q <= need)
+                        .any(|(d, q)| (*c - *d).length() - r - q <= need)
                 });
                 if close {
                     out.push((bi, bj));

@@ -218,7 +218,7 @@ fn attempt(
             nodes = best.as_ref().map(|b| b.1.clone()).unwrap_or_default();
             break;
         }
-        let reach = Reach::of(cell, graph, planned, settings.final_max_samples);
+        let reach = Reach::of(graph, planned, settings.final_max_samples);
         let results: Vec<((usize, usize), Result<Leg, LegError>)> = new
             .par_iter()
             .map(|&(a, b)| {
@@ -277,7 +277,7 @@ fn attempt(
         ..settings.clone()
     };
     while !retry.is_empty() {
-        let reach = Reach::of(cell, graph, planned, settings.final_max_samples);
+        let reach = Reach::of(graph, planned, settings.final_max_samples);
         let mut taken = std::collections::BTreeSet::new();
         let mut phase: Vec<(usize, usize)> = Vec::new();
         for &(a, b) in &retry {
@@ -540,13 +540,11 @@ pub struct Reach {
     /// Nodes outside home's component that a full-budget search from a node inside it did not
     /// reach: the node, the search's start and its samples.
     cut_off: BTreeMap<usize, (usize, usize)>,
-    /// Labels of the cut-off nodes and their searches' starts, for the reason.
-    labels: BTreeMap<usize, String>,
 }
 
 impl Reach {
     /// What `planned` says; `full` is the sample budget of a full search.
-    pub fn of(cell: &Cell, graph: &RobotGraph, planned: &Planned, full: usize) -> Self {
+    pub fn of(graph: &RobotGraph, planned: &Planned, full: usize) -> Self {
         let mut parent: Vec<usize> = (0..graph.len()).collect();
         fn root(parent: &mut [usize], mut x: usize) -> usize {
             while parent[x] != x {
@@ -568,7 +566,6 @@ impl Reach {
         }
         let home = parent[0];
         let mut cut_off = BTreeMap::new();
-        let mut labels = BTreeMap::new();
         for (&(a, b), leg) in planned {
             let Err(LegError::Motion(cellplan_motion::plan::PlanError::NoPath { samples, .. })) = leg else {
                 continue;
@@ -583,11 +580,6 @@ impl Reach {
             };
             if let std::collections::btree_map::Entry::Vacant(e) = cut_off.entry(outside) {
                 e.insert((inside, *samples));
-                for n in [inside, outside] {
-                    labels
-                        .entry(n)
-                        .or_insert_with(|| stop_of(cell, graph, n).to_string());
-                }
             }
         }
         // A task with two candidates cut off is given up on this robot: its other candidates
@@ -607,22 +599,36 @@ impl Reach {
             for &n in &graph.alternatives[t] {
                 if parent[n] != home && !cut_off.contains_key(&n) {
                     cut_off.insert(n, first);
-                    labels
-                        .entry(n)
-                        .or_insert_with(|| stop_of(cell, graph, n).to_string());
                 }
             }
         }
-        Reach {
-            parent,
-            cut_off,
-            labels,
-        }
+        Reach { parent, cut_off }
     }
 
     /// Whether `n` is cut off.
     pub fn is_cut_off(&self, n: usize) -> bool {
         self.cut_off.contains_key(&n)
+    }
+
+    /// Why `n` is not searched again, when it is cut off.
+    pub fn why(&self, cell: &Cell, graph: &RobotGraph, n: usize) -> Option<LegError> {
+        let &(from, samples) = self.cut_off.get(&n)?;
+        Some(self.unreached(cell, graph, n, from, samples))
+    }
+
+    fn unreached(
+        &self,
+        cell: &Cell,
+        graph: &RobotGraph,
+        end: usize,
+        from: usize,
+        samples: usize,
+    ) -> LegError {
+        LegError::Unreached(Box::new(super::Unreached {
+            from: stop_of(cell, graph, from).to_string(),
+            to: stop_of(cell, graph, end).to_string(),
+            samples,
+        }))
     }
 
     /// Whether planned legs join `a` and `b`.
@@ -647,11 +653,7 @@ impl Reach {
     ) -> Result<Leg, LegError> {
         for end in [a, b] {
             if let Some(&(from, samples)) = self.cut_off.get(&end) {
-                return Err(LegError::Unreached(Box::new(super::Unreached {
-                    from: self.labels[&from].clone(),
-                    to: self.labels[&end].clone(),
-                    samples,
-                })));
+                return Err(self.unreached(cell, graph, end, from, samples));
             }
         }
         if full && self.joined(a, b) {
