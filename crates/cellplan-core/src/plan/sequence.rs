@@ -610,12 +610,6 @@ impl Reach {
         self.cut_off.contains_key(&n)
     }
 
-    /// Why `n` is not searched again, when it is cut off.
-    pub fn why(&self, cell: &Cell, graph: &RobotGraph, n: usize) -> Option<LegError> {
-        let &(from, samples) = self.cut_off.get(&n)?;
-        Some(self.unreached(cell, graph, n, from, samples))
-    }
-
     fn unreached(
         &self,
         cell: &Cell,

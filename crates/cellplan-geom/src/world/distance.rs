@@ -2,7 +2,7 @@
 //! between bodies and the static scene, between bodies of one group and of two groups.
 use super::narrow::{hinted_distance, static_distance, static_distance_hinted};
 use super::{CollisionWorld, GroupId, Placed, Placement, aabb_distance, place, place_with, sanitize_margin};
-use crate::{DVec3, Pose};
+use crate::{DVec3, Pose, Sphere};
 
 impl CollisionWorld {
     /// Distance from body `i` of `g` (at `poses[i]`) to every body of group `other` (at
@@ -42,8 +42,10 @@ impl CollisionWorld {
 
     /// Smallest distance between any body of `a` (at `poses_a`) and any body of another group
     /// `b` (at `poses_b`), capped at `cap`: `min(true distance, cap)`, 0 when two bodies touch
-    /// or a pose is not finite (see [`CollisionWorld::body_group_distance`], body by body, each
-    /// capped at the best so far, so a small cap is fast). A NaN or negative cap counts as 0.
+    /// or a pose is not finite (as [`CollisionWorld::body_group_distance`] body by body would
+    /// give it, each capped at the best so far, so a small cap is fast: every body is placed
+    /// once, and the exact query runs only for the body pairs whose sphere covers come closer
+    /// than the best so far). A NaN or negative cap counts as 0.
     pub fn group_group_distance(
         &self,
         a: GroupId,
@@ -53,10 +55,58 @@ impl CollisionWorld {
         cap: f64,
     ) -> f64 {
         let mut best = sanitize_margin(cap);
-        for i in 0..self.group(a).bodies.len() {
-            best = self.body_group_distance(a, i, poses_a, b, poses_b, best);
-            if best <= 0.0 {
-                return 0.0;
+        // Each body placed once, with its sphere cover in the world; a body pair whose covers
+        // are already at least `best` apart needs no exact query (the covers hold the bodies).
+        let placed = |g: GroupId, poses: &[Pose]| -> Vec<(Placement<'_>, Vec<Sphere>)> {
+            self.group(g)
+                .bodies
+                .iter()
+                .zip(poses)
+                .map(|(body, pose)| {
+                    let p = place(body, pose);
+                    let cover = match p {
+                        Placement::At(_) => body
+                            .convex
+                            .as_ref()
+                            .map(|c| {
+                                c.cover
+                                    .spheres
+                                    .iter()
+                                    .map(|s| Sphere {
+                                        centre: pose.transform_point(s.centre),
+                                        radius: s.radius,
+                                    })
+                                    .collect()
+                            })
+                            .unwrap_or_default(),
+                        _ => Vec::new(),
+                    };
+                    (p, cover)
+                })
+                .collect()
+        };
+        let pa = placed(a, poses_a);
+        let pb = placed(b, poses_b);
+        for (x, cover_x) in &pa {
+            let x = match x {
+                Placement::Empty => continue,
+                Placement::Invalid => return 0.0,
+                Placement::At(x) => x,
+            };
+            for (y, cover_y) in &pb {
+                match y {
+                    Placement::Empty => {}
+                    Placement::Invalid => return 0.0,
+                    Placement::At(y) => {
+                        if !covers_within(cover_x, cover_y, best) {
+                            continue;
+                        }
+                        best = placed_distance(x, y, best);
+                    }
+                }
+                if best <= 0.0 {
+                    return 0.0;
+                }
             }
         }
         best
@@ -279,6 +329,18 @@ impl CollisionWorld {
 }
 
 /// `min(distance between two placed bodies, best)` (0 when they touch); the AABB test first.
+/// Whether two sphere covers may come closer than `d`: false when every sphere pair is at
+/// least `d` apart (empty covers: true, nothing is known).
+fn covers_within(a: &[Sphere], b: &[Sphere], d: f64) -> bool {
+    if a.is_empty() || b.is_empty() {
+        return true;
+    }
+    a.iter().any(|p| {
+        b.iter()
+            .any(|q| (p.centre - q.centre).length() - p.radius - q.radius < d)
+    })
+}
+
 fn placed_distance(a: &Placed, b: &Placed, best: f64) -> f64 {
     if aabb_distance(&a.aabb, &b.aabb) >= best {
         return best;

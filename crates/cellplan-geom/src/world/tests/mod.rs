@@ -428,6 +428,42 @@ fn group_group_distance_is_the_closest_pair() {
     assert_eq!(w.group_group_distance(a, &pa, b, &pb, 10.0), 0.0);
 }
 
+/// The group distance (each body placed once, exact queries only where the sphere covers come
+/// close) is the smallest body-to-group distance, at any poses and caps.
+#[test]
+fn group_group_distance_is_the_smallest_body_distance_at_random_poses() {
+    use rand::{RngExt, SeedableRng};
+    let (w, a, b, _, _) = two_groups();
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
+    let pose = |rng: &mut rand_chacha::ChaCha8Rng| {
+        let t = DVec3::new(
+            rng.random_range(-2.0..2.0),
+            rng.random_range(-1.0..7.0),
+            rng.random_range(-2.0..2.0),
+        );
+        let axis = DVec3::new(rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0), 1.0).normalize();
+        Pose {
+            translation: t,
+            rotation: DQuat::from_axis_angle(axis, rng.random_range(-3.0..3.0)),
+        }
+    };
+    let (mut near, mut touching) = (0, 0);
+    for _ in 0..400 {
+        let pa: Vec<Pose> = (0..3).map(|_| pose(&mut rng)).collect();
+        let pb: Vec<Pose> = (0..2).map(|_| pose(&mut rng)).collect();
+        for cap in [0.05, 0.5, 10.0] {
+            let d = w.group_group_distance(a, &pa, b, &pb, cap);
+            let by_body = (0..3)
+                .map(|i| w.body_group_distance(a, i, &pa, b, &pb, cap))
+                .fold(cap, f64::min);
+            assert!((d - by_body).abs() < 1e-9, "{d} against {by_body} (cap {cap})");
+            near += usize::from(d > 0.0 && d < cap);
+            touching += usize::from(d == 0.0);
+        }
+    }
+    assert!(near > 50 && touching > 50, "{near} near, {touching} touching");
+}
+
 #[test]
 fn ray_hits_group_bodies() {
     let (w, g) = three_boxes();
