@@ -7,7 +7,7 @@ use super::{LegError, PlanError, PlanSettings};
 use cellplan_model::Cell;
 use cellplan_model::robot::Robot;
 use cellplan_model::tasks::TaskId;
-use cellplan_motion::plan::PlanSettings as MotionSettings;
+use cellplan_motion::plan::{Key, PlanSettings as MotionSettings};
 use cellplan_motion::timing::time_path_exact;
 use cellplan_solve::{CostMatrix, Gtsp, GtspParams};
 use rayon::prelude::*;
@@ -472,22 +472,37 @@ fn polish_leg(
     mut leg: Leg,
     settings: &PlanSettings,
 ) -> Leg {
-    let space = crate::motion::joint_space(cell, robot);
-    let validity = crate::motion::robot_validity(cell, robot, cell.planning.clearance);
-    let motion = MotionSettings {
-        seed: leg_seed(settings.seed, robot.id.0, k.0, k.1) ^ 1,
-        shortcut_iterations: settings.final_shortcut_iterations,
-        ..settings.motion.clone()
-    };
-    let mut waypoints = leg.waypoints.clone();
-    cellplan_motion::plan::shortcut(&space, &validity, &mut waypoints, &motion);
-    if let Ok(timed) = time_path_exact(&waypoints, &graph.limits)
-        && timed.trajectory.duration() < leg.duration
+    let seed = leg_seed(settings.seed, robot.id.0, k.0, k.1) ^ 1;
+    if let Ok((waypoints, duration)) =
+        shortcut_and_time(cell, robot, graph, leg.waypoints.clone(), seed, settings)
+        && duration < leg.duration
     {
-        leg.duration = timed.trajectory.duration();
+        leg.duration = duration;
         leg.waypoints = waypoints;
     }
     leg
+}
+
+/// `waypoints` shortcut with the full iteration count (seeded by `seed`, every change checked
+/// at the process clearance) and timed under the robot's limits: the path and its time.
+fn shortcut_and_time(
+    cell: &Cell,
+    robot: &Robot,
+    graph: &RobotGraph,
+    mut waypoints: Vec<Vec<f64>>,
+    seed: u64,
+    settings: &PlanSettings,
+) -> Result<(Vec<Vec<f64>>, f64), LegError> {
+    let space = crate::motion::joint_space(cell, robot);
+    let validity = crate::motion::robot_validity(cell, robot, cell.planning.clearance);
+    let motion = MotionSettings {
+        seed,
+        shortcut_iterations: settings.final_shortcut_iterations,
+        ..settings.motion.clone()
+    };
+    cellplan_motion::plan::shortcut(&space, &validity, &mut waypoints, &motion);
+    let duration = time_path_exact(&waypoints, &graph.limits)?.trajectory.duration();
+    Ok((waypoints, duration))
 }
 
 fn plan_leg(
@@ -610,14 +625,7 @@ impl Reach {
         self.cut_off.contains_key(&n)
     }
 
-    fn unreached(
-        &self,
-        cell: &Cell,
-        graph: &RobotGraph,
-        end: usize,
-        from: usize,
-        samples: usize,
-    ) -> LegError {
+    fn unreached(cell: &Cell, graph: &RobotGraph, end: usize, from: usize, samples: usize) -> LegError {
         LegError::Unreached(Box::new(super::Unreached {
             from: stop_of(cell, graph, from).to_string(),
             to: stop_of(cell, graph, end).to_string(),
@@ -647,7 +655,7 @@ impl Reach {
     ) -> Result<Leg, LegError> {
         for end in [a, b] {
             if let Some(&(from, samples)) = self.cut_off.get(&end) {
-                return Err(self.unreached(cell, graph, end, from, samples));
+                return Err(Self::unreached(cell, graph, end, from, samples));
             }
         }
         if full && self.joined(a, b) {
@@ -687,8 +695,8 @@ fn joined_leg(
     let mut dist: BTreeMap<usize, (f64, usize)> = BTreeMap::new();
     let mut heap = std::collections::BinaryHeap::new();
     dist.insert(a, (0.0, a));
-    heap.push((std::cmp::Reverse(OrdF64(0.0)), a));
-    while let Some((std::cmp::Reverse(OrdF64(d)), x)) = heap.pop() {
+    heap.push((std::cmp::Reverse(Key(0.0)), a));
+    while let Some((std::cmp::Reverse(Key(d)), x)) = heap.pop() {
         if x == b {
             break;
         }
@@ -699,7 +707,7 @@ fn joined_leg(
             let nd = d + w;
             if dist.get(&y).is_none_or(|&(best, _)| nd < best) {
                 dist.insert(y, (nd, x));
-                heap.push((std::cmp::Reverse(OrdF64(nd)), y));
+                heap.push((std::cmp::Reverse(Key(nd)), y));
             }
         }
     }
@@ -722,38 +730,16 @@ fn joined_leg(
         }
         waypoints.extend(points.into_iter().skip(1));
     }
-    let space = crate::motion::joint_space(cell, robot);
-    let validity = crate::motion::robot_validity(cell, robot, cell.planning.clearance);
-    let motion = MotionSettings {
-        seed: leg_seed(settings.seed, robot.id.0, a, b) ^ 2,
-        shortcut_iterations: settings.final_shortcut_iterations,
-        ..settings.motion.clone()
-    };
-    cellplan_motion::plan::shortcut(&space, &validity, &mut waypoints, &motion);
-    let timed = time_path_exact(&waypoints, &graph.limits)?;
+    let seed = leg_seed(settings.seed, robot.id.0, a, b) ^ 2;
+    let (waypoints, duration) = shortcut_and_time(cell, robot, graph, waypoints, seed, settings)?;
     Ok(Leg {
         waypoints,
-        duration: timed.trajectory.duration(),
+        duration,
         straight: false,
         samples: 0,
         validity_calls: 0,
         compute_s: started.elapsed().as_secs_f64(),
     })
-}
-
-/// An `f64` ordered by `total_cmp`, for the heap.
-#[derive(Clone, Copy, PartialEq)]
-struct OrdF64(f64);
-impl Eq for OrdF64 {}
-impl PartialOrd for OrdF64 {
-    fn partial_cmp(&self, other: &Self) -> Option<std::cmp::Ordering> {
-        Some(self.cmp(other))
-    }
-}
-impl Ord for OrdF64 {
-    fn cmp(&self, other: &Self) -> std::cmp::Ordering {
-        self.0.total_cmp(&other.0)
-    }
 }
 
 /// A seed per leg, so that a leg's path does not depend on which thread plans it or when.

@@ -65,7 +65,7 @@ mod space;
 mod straight;
 mod validity;
 
-pub use prm::{Prm, Roadmap};
+pub use prm::{Key, Prm, Roadmap};
 use problem::solve_with;
 pub use problem::{PlanResult, Problem, Status, Termination, Work};
 pub use registry::{Entry, Leg, MotionPlanner, PlannerParams, UnknownPlanner, planner, planners};

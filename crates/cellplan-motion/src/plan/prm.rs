@@ -34,9 +34,10 @@ struct Edge {
     checked: bool,
 }
 
-/// An `f64` ordered by `total_cmp`, for the search queues of the roadmaps.
-#[derive(Clone, Copy, PartialEq)]
-pub(super) struct Key(pub(super) f64);
+/// An `f64` ordered by `total_cmp`, for search queues (the roadmaps', and any shortest-path
+/// search over costs).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Key(pub f64);
 
 impl Eq for Key {}
 
