@@ -25,7 +25,7 @@ pub(crate) mod testing;
 
 pub use cell::{Cell, Object, Planning};
 pub use error::InputError;
-pub use load::{LoadOptions, load};
+pub use load::{LoadOptions, load, process_kind};
 pub use process::{
     ColumnUnit, Figure, Process, ProcessEntry, ProcessInput, ProcessReason, Registry, Rejection, Relation,
     TaskColumn, Words, Work,

@@ -152,6 +152,36 @@ pub fn load(path: &Path, registry: &Registry, opts: &LoadOptions) -> Result<Cell
     })
 }
 
+/// The `[process] kind` of a cell file, read before anything else so that the binary can hand
+/// cells whose machines are not robot arms (paper 004's gantries) to their own loader.
+pub fn process_kind(path: &Path) -> Result<String, InputError> {
+    #[derive(serde::Deserialize)]
+    struct Head {
+        process: Option<toml::Spanned<Kind>>,
+    }
+    #[derive(serde::Deserialize)]
+    struct Kind {
+        kind: Option<String>,
+    }
+    let text = read_bounded(path, MAX_CELL_FILE).map_err(|e| {
+        InputError::new(path, format!("cannot read the cell file: {e}"))
+            .hint("give the path of a cell TOML file, e.g. examples/autobody-4r/cell.toml")
+    })?;
+    let head: Head = toml::from_str(&text).map_err(|e| {
+        InputError::at_span(path, &text, e.span().unwrap_or(0..0), format!("invalid cell file: {}", e.message().trim()))
+            .hint("docs/cell-format.md lists every key and its type")
+    })?;
+    let Some(process) = head.process else {
+        return Err(InputError::new(path, "the cell file has no `[process]` table")
+            .hint("add `[process]` with `kind = \"optical-inspection\"` or `kind = \"pcb-assembly\"` (docs/cell-format.md)"));
+    };
+    let span = process.span();
+    process.into_inner().kind.ok_or_else(|| {
+        InputError::at_span(path, &text, span, "`[process]` has no `kind`")
+            .hint("add `kind = \"optical-inspection\"` or `kind = \"pcb-assembly\"` (docs/cell-format.md)")
+    })
+}
+
 /// Reads the cell file (at most [`MAX_CELL_FILE`] bytes) and parses it as TOML.
 fn read_spec(path: &Path) -> Result<(String, CellSpec), InputError> {
     let text = read_bounded(path, MAX_CELL_FILE).map_err(|e| {

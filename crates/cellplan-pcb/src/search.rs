@@ -1,0 +1,604 @@
+//! Our optimiser: a good start built from the board's geometry, then an iterated local search on
+//! the true cycle-time model (order moves, bin swaps — the quadratic assignment of types to
+//! bins —, robot re-assignment, the fixed devices' positions), every candidate scored with our
+//! rendezvous rule ([`crate::rendezvous::Greedy`]) and the exact safety delay; finally the
+//! rendezvous themselves are polished one meeting at a time on the whole schedule.
+//!
+//! Two chains with their own seeds run side by side and the better is kept, so the result does
+//! not depend on the number of threads. The budget is counted in simulations.
+use crate::cell::PcbCell;
+use crate::rendezvous::Greedy;
+use crate::sim::{Decision, DelayRule, Given, simulate, slot_lookup};
+use rand::{RngExt, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+
+/// Search settings.
+#[derive(Clone, Copy, Debug)]
+pub struct SearchSettings {
+    /// Simulations in all (both chains).
+    pub evaluations: usize,
+    /// Seed.
+    pub seed: u64,
+}
+
+impl Default for SearchSettings {
+    fn default() -> Self {
+        SearchSettings {
+            evaluations: 200_000,
+            seed: 0,
+        }
+    }
+}
+
+/// The delay rule of our optimiser.
+pub fn rule(cell: &PcbCell) -> DelayRule {
+    if cell.robots.len() == 2 && cell.collision_avoidance {
+        DelayRule::Exact
+    } else {
+        DelayRule::Off
+    }
+}
+
+/// Whether robot `r` can place component `c` (two robots: its own feeder stocks the type).
+pub fn robot_can(cell: &PcbCell, lookup: &[Vec<Option<usize>>; 2], r: usize, c: usize) -> bool {
+    if cell.place_box(r, c).is_none() {
+        return false;
+    }
+    if cell.robots.len() == 1 {
+        return true;
+    }
+    lookup[r][cell.type_of[c]].is_some_and(|slot| cell.pick_range(r, r, slot).is_some())
+}
+
+/// Bins ordered from the middle of the feeder outward.
+fn center_out(bins: usize) -> Vec<usize> {
+    let mid = (bins as f64 - 1.0) / 2.0;
+    let mut v: Vec<usize> = (0..bins).collect();
+    v.sort_by(|&a, &b| {
+        (a as f64 - mid)
+            .abs()
+            .total_cmp(&(b as f64 - mid).abs())
+            .then(a.cmp(&b))
+    });
+    v
+}
+
+/// The bins the cell gives; else, with one robot, each type in the feeder on its components'
+/// side of the board, most used types in the middle bins; with two robots every type in both
+/// feeders where they hold all types, else split the same way.
+pub fn default_slots(cell: &PcbCell) -> [Vec<Option<usize>>; 2] {
+    let mut slots = [vec![None; cell.feeders[0].bins], vec![None; cell.feeders[1].bins]];
+    if !cell.given_bins.is_empty() {
+        for b in &cell.given_bins {
+            slots[b.feeder][b.slot] = Some(b.kind);
+        }
+        return slots;
+    }
+    let nt = cell.types.len();
+    let mut count = vec![0usize; nt];
+    let mut mean_x = vec![0.0f64; nt];
+    for (c, &t) in cell.type_of.iter().enumerate() {
+        count[t] += 1;
+        mean_x[t] += cell.components[c].position[0];
+    }
+    for t in 0..nt {
+        mean_x[t] /= count[t].max(1) as f64;
+    }
+    let mut by_use: Vec<usize> = (0..nt).collect();
+    by_use.sort_by(|&a, &b| count[b].cmp(&count[a]).then(a.cmp(&b)));
+    let order = [center_out(cell.feeders[0].bins), center_out(cell.feeders[1].bins)];
+    if cell.robots.len() == 2 && cell.feeders.iter().all(|f| f.bins >= nt) {
+        for f in 0..2 {
+            for (k, &t) in by_use.iter().enumerate() {
+                slots[f][order[f][k]] = Some(t);
+            }
+        }
+        return slots;
+    }
+    let mid = cell.board.size[0] / 2.0;
+    let mut used = [0usize; 2];
+    for &t in &by_use {
+        let prefer = if mean_x[t] < mid { 0 } else { 1 };
+        let f = if used[prefer] < cell.feeders[prefer].bins {
+            prefer
+        } else {
+            1 - prefer
+        };
+        slots[f][order[f][used[f]]] = Some(t);
+        used[f] += 1;
+    }
+    slots
+}
+
+/// Puts every meeting of a fixed device at one position: the given fractions of the common
+/// feasible range, or else the current position of its first use, clipped. `None` if the
+/// device has no position that serves all its meetings.
+pub fn fix_devices(cell: &PcbCell, d: &mut Decision, fractions: Option<[f64; 4]>) -> Option<()> {
+    let lookup = slot_lookup(cell, d);
+    let n = cell.len();
+    if !cell.configuration.feeders_move() {
+        for f in 0..2 {
+            let mut range = cell.feeders[f].travel;
+            let mut first = None;
+            for &c in &d.order {
+                if d.feeder[c] != f {
+                    continue;
+                }
+                first.get_or_insert(c);
+                let slot = lookup[f][cell.type_of[c]]?;
+                let r = cell.pick_range(d.robot[c], f, slot)?;
+                range = [range[0].max(r[0]), range[1].min(r[1])];
+            }
+            if range[0] > range[1] {
+                return None;
+            }
+            let Some(first) = first else { continue };
+            let pos = match fractions {
+                Some(fr) => range[0] + fr[f] * (range[1] - range[0]),
+                None => d.carriage[first].clamp(range[0], range[1]),
+            };
+            for c in 0..n {
+                if d.feeder[c] == f {
+                    d.carriage[c] = pos;
+                }
+            }
+        }
+    }
+    if !cell.configuration.table_moves() && n > 0 {
+        let mut bx = [cell.table.x, cell.table.y];
+        for c in 0..n {
+            let b = cell.place_box(d.robot[c], c)?;
+            for a in 0..2 {
+                bx[a] = [bx[a][0].max(b[a][0]), bx[a][1].min(b[a][1])];
+            }
+        }
+        if bx[0][0] > bx[0][1] || bx[1][0] > bx[1][1] {
+            return None;
+        }
+        let first = d.order[0];
+        let pos = match fractions {
+            Some(fr) => [
+                bx[0][0] + fr[2] * (bx[0][1] - bx[0][0]),
+                bx[1][0] + fr[3] * (bx[1][1] - bx[1][0]),
+            ],
+            None => [
+                d.table[first][0].clamp(bx[0][0], bx[0][1]),
+                d.table[first][1].clamp(bx[1][0], bx[1][1]),
+            ],
+        };
+        for t in d.table.iter_mut() {
+            *t = pos;
+        }
+    }
+    Some(())
+}
+
+/// Nearest-neighbour tour over board points, then 2-opt (Euclidean, open path).
+fn board_tour(cell: &PcbCell, members: &[usize]) -> Vec<usize> {
+    if members.len() < 3 {
+        return members.to_vec();
+    }
+    let p = |c: usize| cell.components[c].position;
+    let d = |a: usize, b: usize| crate::sim::dist(p(a), p(b));
+    let mut left: Vec<usize> = members.to_vec();
+    // Start at the lowest-left point.
+    left.sort_by(|&a, &b| {
+        (p(a)[0] + p(a)[1])
+            .total_cmp(&(p(b)[0] + p(b)[1]))
+            .then(a.cmp(&b))
+    });
+    let mut tour = vec![left.remove(0)];
+    while !left.is_empty() {
+        let last = *tour.last().unwrap_or(&0);
+        let (k, _) = left
+            .iter()
+            .enumerate()
+            .min_by(|x, y| d(last, *x.1).total_cmp(&d(last, *y.1)))
+            .unwrap_or((0, &0));
+        tour.push(left.remove(k));
+    }
+    let n = tour.len();
+    let mut improved = true;
+    let mut rounds = 0;
+    while improved && rounds < 50 {
+        improved = false;
+        rounds += 1;
+        for i in 0..n - 2 {
+            for j in i + 2..n {
+                let a = d(tour[i], tour[i + 1]);
+                let b = if j + 1 < n { d(tour[j], tour[j + 1]) } else { 0.0 };
+                let a2 = d(tour[i], tour[j]);
+                let b2 = if j + 1 < n {
+                    d(tour[i + 1], tour[j + 1])
+                } else {
+                    0.0
+                };
+                if a2 + b2 < a + b - 1e-12 {
+                    tour[i + 1..=j].reverse();
+                    improved = true;
+                }
+            }
+        }
+    }
+    tour
+}
+
+/// Our starting decision.
+pub fn initial(cell: &PcbCell) -> Decision {
+    let n = cell.len();
+    let slots = default_slots(cell);
+    let mut d = Decision {
+        order: Vec::new(),
+        robot: vec![0; n],
+        feeder: vec![0; n],
+        slots,
+        carriage: cell_home_carriages(cell),
+        table: vec![cell.table.home; n],
+    };
+    let lookup = slot_lookup(cell, &d);
+    if cell.robots.len() == 1 {
+        for c in 0..n {
+            d.feeder[c] = if lookup[0][cell.type_of[c]].is_some() {
+                0
+            } else {
+                1
+            };
+        }
+        d.order = board_tour(cell, &(0..n).collect::<Vec<_>>());
+    } else {
+        // Left half of the board to the left robot, where it can.
+        let mut by_x: Vec<usize> = (0..n).collect();
+        by_x.sort_by(|&a, &b| {
+            cell.components[a].position[0]
+                .total_cmp(&cell.components[b].position[0])
+                .then(a.cmp(&b))
+        });
+        for (k, &c) in by_x.iter().enumerate() {
+            let want = if k < n / 2 { 0 } else { 1 };
+            let r = if robot_can(cell, &lookup, want, c) {
+                want
+            } else {
+                1 - want
+            };
+            d.robot[c] = r;
+            d.feeder[c] = r;
+        }
+        let tours: Vec<Vec<usize>> = (0..2)
+            .map(|r| board_tour(cell, &(0..n).filter(|&c| d.robot[c] == r).collect::<Vec<_>>()))
+            .collect();
+        let (mut a, mut b) = (tours[0].iter(), tours[1].iter());
+        loop {
+            match (a.next(), b.next()) {
+                (None, None) => break,
+                (x, y) => {
+                    d.order.extend(x);
+                    d.order.extend(y);
+                }
+            }
+        }
+    }
+    for c in 0..n {
+        let slot = lookup[d.feeder[c]][cell.type_of[c]].unwrap_or(0);
+        if let Some(r) = cell.pick_range(d.robot[c], d.feeder[c], slot) {
+            d.carriage[c] = 0.5 * (r[0] + r[1]);
+        }
+        if let Some(bx) = cell.place_box(d.robot[c], c) {
+            d.table[c] = [0.5 * (bx[0][0] + bx[0][1]), 0.5 * (bx[1][0] + bx[1][1])];
+        }
+    }
+    let _ = fix_devices(cell, &mut d, Some([0.5; 4]));
+    record_rendezvous(cell, &mut d);
+    d
+}
+
+fn cell_home_carriages(cell: &PcbCell) -> Vec<f64> {
+    vec![cell.feeders[0].home; cell.len()]
+}
+
+/// Scores a decision with our rendezvous rule (fixed devices where the decision puts them).
+pub fn evaluate(cell: &PcbCell, d: &Decision) -> f64 {
+    simulate(cell, d, &mut Greedy, rule(cell)).makespan
+}
+
+/// Writes the rendezvous our rule chooses into the decision (so it stands alone).
+pub fn record_rendezvous(cell: &PcbCell, d: &mut Decision) {
+    let s = simulate(cell, d, &mut Greedy, rule(cell));
+    for cy in &s.cycles {
+        d.carriage[cy.component] = cy.carriage;
+        d.table[cy.component] = cy.table;
+    }
+}
+
+/// The progress of a run: (simulations, best assembly time).
+pub type Trace = Vec<(usize, f64)>;
+
+/// Runs our optimiser from `start` (or our own start); returns the best decision (with its
+/// rendezvous recorded), its assembly time under [`Given`] rendezvous, and the trace.
+pub fn run(cell: &PcbCell, settings: &SearchSettings, start: Option<&Decision>) -> (Decision, f64, Trace) {
+    let start = start.cloned().unwrap_or_else(|| initial(cell));
+    let half = settings.evaluations / 2;
+    let ((d0, v0, t0), (d1, v1, t1)) = rayon::join(
+        || chain(cell, &start, half, settings.seed.wrapping_mul(2).wrapping_add(1)),
+        || {
+            chain(
+                cell,
+                &start,
+                settings.evaluations - half,
+                settings.seed.wrapping_mul(2).wrapping_add(2),
+            )
+        },
+    );
+    // Merge the traces by simulations spent (both chains run at once).
+    let mut trace: Trace = Vec::new();
+    let mut all: Vec<(usize, f64)> = t0
+        .iter()
+        .map(|&(e, v)| (e * 2, v))
+        .chain(t1.iter().map(|&(e, v)| (e * 2, v)))
+        .collect();
+    all.sort_by(|a, b| a.0.cmp(&b.0).then(a.1.total_cmp(&b.1)));
+    for (e, v) in all {
+        if trace.last().is_none_or(|l: &(usize, f64)| v < l.1 - 1e-12) {
+            trace.push((e, v));
+        }
+    }
+    if v1 < v0 - 1e-12 {
+        (d1, v1, trace)
+    } else {
+        (d0, v0, trace)
+    }
+}
+
+/// Moves of the local search.
+fn neighbour(cell: &PcbCell, d: &Decision, rng: &mut ChaCha8Rng, step: &mut [f64; 2]) -> Option<Decision> {
+    let n = d.order.len();
+    let mut x = d.clone();
+    let can_bins = cell.given_bins.is_empty();
+    let two = cell.robots.len() == 2;
+    let fixed = !cell.configuration.feeders_move() || !cell.configuration.table_moves();
+    let roll: f64 = rng.random();
+    let near = |rng: &mut ChaCha8Rng, i: usize| -> usize {
+        if rng.random::<f64>() < 0.7 {
+            let lo = i.saturating_sub(12);
+            let hi = (i + 12).min(n - 1);
+            rng.random_range(lo..=hi)
+        } else {
+            rng.random_range(0..n)
+        }
+    };
+    if n < 2 {
+        return None;
+    }
+    if roll < 0.35 {
+        let i = rng.random_range(0..n);
+        let j = near(rng, i);
+        let c = x.order.remove(i);
+        x.order.insert(j.min(n - 1), c);
+    } else if roll < 0.5 {
+        let i = rng.random_range(0..n);
+        let j = near(rng, i);
+        x.order.swap(i, j);
+    } else if roll < 0.65 {
+        let i = rng.random_range(0..n);
+        let j = near(rng, i);
+        x.order[i.min(j)..=i.max(j)].reverse();
+    } else if roll < 0.8 && can_bins {
+        // Swap two bins: within a feeder, or (one robot) across the two.
+        let f = rng.random_range(0..2);
+        let g = if two { f } else { rng.random_range(0..2) };
+        let a = rng.random_range(0..x.slots[f].len());
+        let b = rng.random_range(0..x.slots[g].len());
+        if f == g {
+            x.slots[f].swap(a, b);
+        } else {
+            let (lo, hi) = x.slots.split_at_mut(1);
+            let (s0, s1) = if f == 0 {
+                (&mut lo[0][a], &mut hi[0][b])
+            } else {
+                (&mut hi[0][a], &mut lo[0][b])
+            };
+            std::mem::swap(s0, s1);
+        }
+        let lookup = slot_lookup(cell, &x);
+        for c in 0..n {
+            let t = cell.type_of[c];
+            if two {
+                if lookup[x.robot[c]][t].is_none() {
+                    return None;
+                }
+            } else {
+                x.feeder[c] = if lookup[0][t].is_some() {
+                    0
+                } else if lookup[1][t].is_some() {
+                    1
+                } else {
+                    return None;
+                };
+            }
+        }
+        if !two {
+            // Which bin of each type: every bin must still be within the robot's reach.
+            for c in 0..n {
+                let slot = lookup[x.feeder[c]][cell.type_of[c]]?;
+                cell.pick_range(0, x.feeder[c], slot)?;
+            }
+        }
+    } else if roll < 0.9 && two {
+        let c = rng.random_range(0..n);
+        let lookup = slot_lookup(cell, &x);
+        let r = 1 - x.robot[c];
+        if !robot_can(cell, &lookup, r, c) {
+            return None;
+        }
+        x.robot[c] = r;
+        x.feeder[c] = r;
+    } else if fixed {
+        // Nudge a fixed device.
+        let which = rng.random_range(0..3);
+        let g = gauss(rng);
+        if which < 2 && !cell.configuration.feeders_move() {
+            let f = which;
+            let s = step[0];
+            for c in 0..n {
+                if x.feeder[c] == f {
+                    x.carriage[c] += g * s;
+                }
+            }
+            let first = x.order.iter().find(|&&c| x.feeder[c] == f).copied();
+            let Some(first) = first else { return None };
+            let pos = x.carriage[first];
+            fix_devices(cell, &mut x, None)?;
+            if (x.carriage[first] - pos).abs() > 1e-12 {
+                step[0] *= 0.9;
+            }
+        } else if !cell.configuration.table_moves() {
+            let s = step[1];
+            let h = gauss(rng);
+            for t in x.table.iter_mut() {
+                t[0] += g * s;
+                t[1] += h * s;
+            }
+            fix_devices(cell, &mut x, None)?;
+        } else {
+            return None;
+        }
+    } else {
+        return None;
+    }
+    if fixed {
+        fix_devices(cell, &mut x, None)?;
+    }
+    Some(x)
+}
+
+fn gauss(rng: &mut ChaCha8Rng) -> f64 {
+    let u: f64 = rng.random::<f64>().max(1e-12);
+    let v: f64 = rng.random();
+    (-2.0 * u.ln()).sqrt() * (std::f64::consts::TAU * v).cos()
+}
+
+fn chain(cell: &PcbCell, start: &Decision, budget: usize, seed: u64) -> (Decision, f64, Trace) {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let mut cur = start.clone();
+    let mut cur_v = evaluate(cell, &cur);
+    let mut best = cur.clone();
+    let mut best_v = cur_v;
+    let mut evals = 1;
+    let mut trace: Trace = vec![(evals, best_v)];
+    let mut stale = 0usize;
+    let n = cell.len().max(1);
+    let mut step = [0.01, 0.01];
+    // Keep a fifth of the budget for the rendezvous polish.
+    let search_budget = budget - budget / 5;
+    while evals < search_budget {
+        let Some(x) = neighbour(cell, &cur, &mut rng, &mut step) else {
+            evals += 1;
+            continue;
+        };
+        let v = evaluate(cell, &x);
+        evals += 1;
+        if v <= cur_v + 1e-12 {
+            if v < cur_v - 1e-12 {
+                stale = 0;
+            } else {
+                stale += 1;
+            }
+            cur = x;
+            cur_v = v;
+            if v < best_v - 1e-12 {
+                best = cur.clone();
+                best_v = v;
+                trace.push((evals, best_v));
+            }
+        } else {
+            stale += 1;
+        }
+        if stale > 20 * n {
+            // Kick: a double bridge on the best order.
+            cur = best.clone();
+            let m = cur.order.len();
+            if m >= 8 {
+                let mut cuts = [
+                    rng.random_range(1..m),
+                    rng.random_range(1..m),
+                    rng.random_range(1..m),
+                ];
+                cuts.sort();
+                let [a, b, c] = cuts;
+                let o = &cur.order;
+                cur.order = [&o[..a], &o[b..c], &o[a..b], &o[c..]].concat();
+            }
+            cur_v = evaluate(cell, &cur);
+            evals += 1;
+            stale = 0;
+        }
+    }
+    record_rendezvous(cell, &mut best);
+    let polish_budget = budget.saturating_sub(evals);
+    let (best, best_v, spent) = polish(cell, best, polish_budget);
+    if let Some(last) = trace.last()
+        && best_v < last.1 - 1e-12
+    {
+        trace.push((evals + spent, best_v));
+    }
+    (best, best_v, trace)
+}
+
+/// Coordinate descent on the recorded rendezvous of moving devices, on the whole schedule
+/// (which sees what the greedy rule cannot: a meeting placed for the next cycle's sake).
+pub fn polish(cell: &PcbCell, mut d: Decision, budget: usize) -> (Decision, f64, usize) {
+    let eval = |d: &Decision| simulate(cell, d, &mut Given(d), rule(cell)).makespan;
+    let mut best = eval(&d);
+    let mut spent = 1;
+    let lookup = slot_lookup(cell, &d);
+    let moving_feeders = cell.configuration.feeders_move();
+    let moving_table = cell.configuration.table_moves();
+    let mut step = 0.004;
+    while spent < budget && step > 1e-5 {
+        let mut improved = false;
+        for k in 0..d.order.len() {
+            let c = d.order[k];
+            let r = d.robot[c];
+            let f = d.feeder[c];
+            let mut tries: Vec<(usize, f64)> = Vec::new();
+            if moving_feeders {
+                tries.extend([(0, step), (0, -step)]);
+            }
+            if moving_table {
+                tries.extend([(1, step), (1, -step), (2, step), (2, -step)]);
+            }
+            for (axis, delta) in tries {
+                if spent >= budget {
+                    break;
+                }
+                let mut x = d.clone();
+                match axis {
+                    0 => {
+                        let Some(slot) = lookup[f][cell.type_of[c]] else {
+                            continue;
+                        };
+                        let Some(rg) = cell.pick_range(r, f, slot) else {
+                            continue;
+                        };
+                        x.carriage[c] = (x.carriage[c] + delta).clamp(rg[0], rg[1]);
+                    }
+                    a => {
+                        let Some(bx) = cell.place_box(r, c) else { continue };
+                        let i = a - 1;
+                        x.table[c][i] = (x.table[c][i] + delta).clamp(bx[i][0], bx[i][1]);
+                    }
+                }
+                let v = eval(&x);
+                spent += 1;
+                if v < best - 1e-12 {
+                    best = v;
+                    d = x;
+                    improved = true;
+                }
+            }
+        }
+        if !improved {
+            step /= 2.0;
+        }
+    }
+    (d, best, spent)
+}
