@@ -7,6 +7,7 @@
 mod bench;
 mod bench_motion;
 mod compare_cmd;
+mod pcb_cmd;
 mod plan_cmd;
 mod report_cmd;
 mod verify_cmd;

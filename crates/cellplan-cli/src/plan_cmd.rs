@@ -16,10 +16,10 @@ use std::time::{Duration, Instant};
 #[derive(Args)]
 pub struct PlanArgs {
     /// The cell file (TOML).
-    cell: PathBuf,
+    pub cell: PathBuf,
     /// Output folder (default: out/<cell name>/); the plan goes to plan.json in it.
     #[arg(short, long, value_name = "DIR")]
-    output: Option<PathBuf>,
+    pub output: Option<PathBuf>,
     /// Allocation strategy.
     #[arg(long, value_enum, default_value_t = Allocation::Zones)]
     allocation: Allocation,
@@ -31,12 +31,12 @@ pub struct PlanArgs {
     move_model: MoveModel,
     /// Seed of every random choice.
     #[arg(long, default_value_t = 0)]
-    seed: u64,
+    pub seed: u64,
     /// Wall-clock limit of the whole run in seconds. By default there is none: every search
     /// stops at its work budget, so the plan depends only on the cell and the seed (not on
     /// the machine or the thread count); when a limit binds, the output says so.
     #[arg(long, value_name = "S")]
-    time_limit: Option<f64>,
+    pub time_limit: Option<f64>,
     /// ε of paper 000 eq. 4 in metres: MPs closer than this may share a local robust set.
     #[arg(long, value_name = "M", default_value_t = 0.3)]
     local_set_radius: f64,
@@ -55,17 +55,32 @@ pub struct PlanArgs {
     coordination: Coordination,
     /// Write the plan even if `cellplan verify` rejects it.
     #[arg(long)]
-    no_verify: bool,
+    pub no_verify: bool,
     /// Do not write report.html (the HTML report) beside the plan.
     #[arg(long)]
-    no_report: bool,
+    pub no_report: bool,
     /// No progress output and no table.
     #[arg(long, short)]
-    quiet: bool,
+    pub quiet: bool,
     /// Print a JSON summary (stable keys: cycle_time_s, delta_t_s, lower_bound_s, robots,
     /// unmeasured, compute_s).
     #[arg(long)]
-    json: bool,
+    pub json: bool,
+    /// PCB assembly: the optimiser (`best` ours, `ga` paper 004's GA).
+    #[arg(long, value_enum, default_value_t = crate::pcb_cmd::OptimizerArg::Best)]
+    pub optimizer: crate::pcb_cmd::OptimizerArg,
+    /// PCB assembly: which devices move (default: the cell's `configuration`).
+    #[arg(long, value_enum)]
+    pub configuration: Option<crate::pcb_cmd::ConfigurationArg>,
+    /// PCB assembly: plan a two-robot cell with its first robot alone (1), or as given.
+    #[arg(long, value_name = "N")]
+    pub robots: Option<usize>,
+    /// PCB assembly: motion model (default: the cell's `motion`).
+    #[arg(long, value_enum)]
+    pub motion: Option<crate::pcb_cmd::MotionArg>,
+    /// PCB assembly: simulations the optimiser may spend (the work budget).
+    #[arg(long, value_name = "N", default_value_t = 200_000)]
+    pub evaluations: usize,
     /// Cache folder for self-collision pair lists.
     #[arg(long, value_name = "DIR")]
     cache_dir: Option<PathBuf>,
@@ -107,6 +122,9 @@ struct RobotSummary<'a> {
 }
 
 pub fn run(args: &PlanArgs) -> Result<(), Failure> {
+    if crate::pcb_cmd::is_pcb(&args.cell)? {
+        return crate::pcb_cmd::plan(args);
+    }
     let start = Instant::now();
     if args
         .time_limit

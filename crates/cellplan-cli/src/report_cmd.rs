@@ -139,6 +139,17 @@ pub fn write_report(
 }
 
 pub fn run_report(args: &ReportArgs) -> Result<(), Failure> {
+    if let Some(cell) = &args.cell
+        && crate::pcb_cmd::is_pcb(cell)?
+    {
+        let out = args
+            .output
+            .clone()
+            .unwrap_or_else(|| args.plan.parent().unwrap_or(Path::new(".")).join("report.html"));
+        crate::pcb_cmd::report(&args.plan, cell, &out)?;
+        eprintln!("report written to {}", out.display());
+        return Ok(());
+    }
     let start = Instant::now();
     let plan = read_plan(&args.plan)?;
     let cell = load_cell(&args.plan, &plan, &args.cell)?;

@@ -408,6 +408,9 @@ pub fn skipped_because(c: &Component, sel: &Selection) -> Option<&'static str> {
         Some("do not populate")
     } else if c.excluded {
         Some("excluded from position files")
+    } else if c.reference.contains('*') {
+        // KiCad's `REF**`: a footprint never annotated (mounting holes, logos, test pads).
+        Some("not annotated (reference with `*`)")
     } else if c.side != sel.side {
         Some("other side")
     } else if !sel.mounts.contains(&c.mount) {

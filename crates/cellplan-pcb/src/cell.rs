@@ -181,6 +181,8 @@ pub struct Robot {
     pub home: [f64; 2],
     /// X travel (m), already narrowed so that it never reaches the other robot's feeder.
     pub x: [f64; 2],
+    /// X travel as the cell gives it (m).
+    pub x_given: [f64; 2],
     /// Y travel (m).
     pub y: [f64; 2],
 }
@@ -291,6 +293,60 @@ impl PcbCell {
     /// Whether there is nothing to place.
     pub fn is_empty(&self) -> bool {
         self.components.is_empty()
+    }
+
+    /// The same cell run another way: with its first robot alone (`robots` = 1 on a two-robot
+    /// cell, the robot then reaching both feeders), in another configuration or motion model.
+    pub fn variant(
+        &self,
+        robots: usize,
+        configuration: Configuration,
+        motion: MotionModel,
+    ) -> Result<PcbCell, String> {
+        let mut cell = self.clone();
+        match (robots, self.robots.len()) {
+            (1, 2) => {
+                cell.robots.truncate(1);
+                cell.robots[0].x = cell.robots[0].x_given;
+                cell.collision_avoidance = false;
+            }
+            (a, b) if a == b => {}
+            (a, b) => {
+                return Err(format!(
+                    "the cell has {b} robot(s); it cannot be planned with {a}"
+                ));
+            }
+        }
+        cell.configuration = configuration;
+        cell.motion = motion;
+        cell.reachable()?;
+        Ok(cell)
+    }
+
+    /// Every bin reachable by a robot that serves its feeder, every component placeable by
+    /// some robot.
+    pub fn reachable(&self) -> Result<(), String> {
+        for f in 0..2 {
+            for slot in 0..self.feeders[f].bins {
+                if !(0..self.robots.len())
+                    .any(|r| self.feeders_of(r).contains(&f) && self.pick_range(r, f, slot).is_some())
+                {
+                    return Err(format!(
+                        "bin {slot} of feeder {} is out of the robots' reach",
+                        self.feeders[f].name
+                    ));
+                }
+            }
+        }
+        for c in 0..self.len() {
+            if !(0..self.robots.len()).any(|r| self.place_box(r, c).is_some()) {
+                return Err(format!(
+                    "component {} cannot be brought under a robot",
+                    self.components[c].reference
+                ));
+            }
+        }
+        Ok(())
     }
 
     /// The feeders robot `r` picks from (one robot: both; two: its own).
@@ -558,6 +614,7 @@ pub fn load(path: &Path) -> Result<PcbCell, InputError> {
                 ctx.length(&s, "home", r.home[1])?,
             ],
             x: ctx.range(&s, "x", r.x)?,
+            x_given: ctx.range(&s, "x", r.x)?,
             y: ctx.range(&s, "y", r.y)?,
         });
     }
@@ -763,7 +820,15 @@ pub fn load(path: &Path) -> Result<PcbCell, InputError> {
             .err(p.board.span(), format!("nothing to place: no footprint of {} is on the {side:?} side with a mounting placed here", board_path.display()))
             .hint("set `side`, `mounts` (e.g. [\"smd\", \"through-hole\"]) or `components`"));
     }
+    let mut seen: std::collections::HashMap<&str, usize> = std::collections::HashMap::new();
     for c in &components {
+        if let Some(first) = seen.insert(c.reference.as_str(), c.line) {
+            return Err(InputError::at_line(&board_path, Some(c.line), format!(
+                "two footprints to place are both `{}` (the other on line {first})",
+                c.reference
+            ))
+            .hint("annotate the board in KiCad so that every placed footprint has its own reference, or leave these out with `mounts` or `components`"));
+        }
         if c.reference.is_empty() {
             return Err(
                 InputError::at_line(&board_path, Some(c.line), "a footprint without a reference")

@@ -32,6 +32,8 @@ pub struct GaSettings {
     pub mutation: f64,
     /// Seed.
     pub seed: u64,
+    /// Wall-clock safety net.
+    pub deadline: Option<std::time::Instant>,
 }
 
 impl Default for GaSettings {
@@ -42,6 +44,7 @@ impl Default for GaSettings {
             crossover: 0.9,
             mutation: 0.3,
             seed: 0,
+            deadline: None,
         }
     }
 }
@@ -61,8 +64,9 @@ struct Genome {
 /// The progress of a run: (evaluations, best assembly time) each time the best improves.
 pub type Trace = Vec<(usize, f64)>;
 
-/// Runs the GA; returns the best decision, its assembly time and the trace.
-pub fn run(cell: &PcbCell, settings: &GaSettings) -> (Decision, f64, Trace) {
+/// Runs the GA; returns the best decision, its assembly time, the trace and whether the
+/// deadline stopped it.
+pub fn run(cell: &PcbCell, settings: &GaSettings) -> (Decision, f64, Trace, bool) {
     let n = cell.len();
     let mut rng = ChaCha8Rng::seed_from_u64(settings.seed ^ 0x6a09_e667_f3bc_c908);
     let n_bins = cell.feeders[0].bins + cell.feeders[1].bins;
@@ -103,7 +107,12 @@ pub fn run(cell: &PcbCell, settings: &GaSettings) -> (Decision, f64, Trace) {
     let mut trace: Trace = Vec::new();
     let mut best_i = argmin(&fit);
     trace.push((evals, fit[best_i]));
+    let mut hit = false;
     while evals < settings.evaluations {
+        if settings.deadline.is_some_and(|d| std::time::Instant::now() > d) {
+            hit = true;
+            break;
+        }
         let mut order_idx: Vec<usize> = (0..pop_n).collect();
         order_idx.sort_by(|&a, &b| fit[a].total_cmp(&fit[b]));
         let mut next: Vec<Genome> = order_idx.iter().take(2).map(|&i| pop[i].clone()).collect();
@@ -142,11 +151,11 @@ pub fn run(cell: &PcbCell, settings: &GaSettings) -> (Decision, f64, Trace) {
     }
     let best = decode(&pop[best_i]).unwrap_or_else(|| crate::search::initial(cell));
     let value = simulate(cell, &best, &mut Given(&best), rule(cell)).makespan;
-    (best, value, trace)
+    (best, value, trace, hit)
 }
 
 /// The delay rule of the paper's GA.
-fn rule(cell: &PcbCell) -> DelayRule {
+pub fn rule(cell: &PcbCell) -> DelayRule {
     if cell.robots.len() == 2 && cell.collision_avoidance {
         DelayRule::Paper
     } else {

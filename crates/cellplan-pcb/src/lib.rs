@@ -18,6 +18,7 @@ pub mod bound;
 pub mod cell;
 pub mod document;
 pub mod ga;
+pub mod plan;
 pub mod rendezvous;
 pub mod search;
 pub mod sexpr;

@@ -19,6 +19,8 @@ pub struct SearchSettings {
     pub evaluations: usize,
     /// Seed.
     pub seed: u64,
+    /// Wall-clock safety net.
+    pub deadline: Option<std::time::Instant>,
 }
 
 impl Default for SearchSettings {
@@ -26,6 +28,7 @@ impl Default for SearchSettings {
         SearchSettings {
             evaluations: 200_000,
             seed: 0,
+            deadline: None,
         }
     }
 }
@@ -314,20 +317,20 @@ pub type Trace = Vec<(usize, f64)>;
 
 /// Runs our optimiser from `start` (or our own start); returns the best decision (with its
 /// rendezvous recorded), its assembly time under [`Given`] rendezvous, and the trace.
-pub fn run(cell: &PcbCell, settings: &SearchSettings, start: Option<&Decision>) -> (Decision, f64, Trace) {
+pub fn run(
+    cell: &PcbCell,
+    settings: &SearchSettings,
+    start: Option<&Decision>,
+) -> (Decision, f64, Trace, bool) {
     let start = start.cloned().unwrap_or_else(|| initial(cell));
     let half = settings.evaluations / 2;
-    let ((d0, v0, t0), (d1, v1, t1)) = rayon::join(
-        || chain(cell, &start, half, settings.seed.wrapping_mul(2).wrapping_add(1)),
-        || {
-            chain(
-                cell,
-                &start,
-                settings.evaluations - half,
-                settings.seed.wrapping_mul(2).wrapping_add(2),
-            )
-        },
+    let deadline = settings.deadline;
+    let seed = |k: u64| settings.seed.wrapping_mul(2).wrapping_add(k);
+    let ((d0, v0, t0, h0), (d1, v1, t1, h1)) = rayon::join(
+        || chain(cell, &start, half, seed(1), deadline),
+        || chain(cell, &start, settings.evaluations - half, seed(2), deadline),
     );
+    let hit = h0 || h1;
     // Merge the traces by simulations spent (both chains run at once).
     let mut trace: Trace = Vec::new();
     let mut all: Vec<(usize, f64)> = t0
@@ -342,9 +345,9 @@ pub fn run(cell: &PcbCell, settings: &SearchSettings, start: Option<&Decision>) 
         }
     }
     if v1 < v0 - 1e-12 {
-        (d1, v1, trace)
+        (d1, v1, trace, hit)
     } else {
-        (d0, v0, trace)
+        (d0, v0, trace, hit)
     }
 }
 
@@ -476,7 +479,14 @@ fn gauss(rng: &mut ChaCha8Rng) -> f64 {
     (-2.0 * u.ln()).sqrt() * (std::f64::consts::TAU * v).cos()
 }
 
-fn chain(cell: &PcbCell, start: &Decision, budget: usize, seed: u64) -> (Decision, f64, Trace) {
+fn chain(
+    cell: &PcbCell,
+    start: &Decision,
+    budget: usize,
+    seed: u64,
+    deadline: Option<std::time::Instant>,
+) -> (Decision, f64, Trace, bool) {
+    let mut hit = false;
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let mut cur = start.clone();
     let mut cur_v = evaluate(cell, &cur);
@@ -490,6 +500,10 @@ fn chain(cell: &PcbCell, start: &Decision, budget: usize, seed: u64) -> (Decisio
     // Keep a fifth of the budget for the rendezvous polish.
     let search_budget = budget - budget / 5;
     while evals < search_budget {
+        if evals % 64 == 0 && deadline.is_some_and(|d| std::time::Instant::now() > d) {
+            hit = true;
+            break;
+        }
         let Some(x) = neighbour(cell, &cur, &mut rng, &mut step) else {
             evals += 1;
             continue;
@@ -533,14 +547,14 @@ fn chain(cell: &PcbCell, start: &Decision, budget: usize, seed: u64) -> (Decisio
         }
     }
     record_rendezvous(cell, &mut best);
-    let polish_budget = budget.saturating_sub(evals);
+    let polish_budget = if hit { 0 } else { budget.saturating_sub(evals) };
     let (best, best_v, spent) = polish(cell, best, polish_budget);
     if let Some(last) = trace.last()
         && best_v < last.1 - 1e-12
     {
         trace.push((evals + spent, best_v));
     }
-    (best, best_v, trace)
+    (best, best_v, trace, hit)
 }
 
 /// Coordinate descent on the recorded rendezvous of moving devices, on the whole schedule

@@ -69,6 +69,7 @@ pub fn random_cell(
         drive: drive(2.0),
         home: [-0.2, 0.05],
         x: [-0.25, 0.35],
+        x_given: [-0.25, 0.35],
         y: [-0.1, 0.3],
     }];
     if robots == 2 {
@@ -78,6 +79,7 @@ pub fn random_cell(
             drive: drive(2.0),
             home: [0.33, 0.05],
             x: [feeders[0].x + gap, 0.35],
+            x_given: [-0.25, 0.35],
             y: [-0.1, 0.3],
         });
     }

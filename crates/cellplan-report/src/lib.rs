@@ -10,6 +10,7 @@ pub mod charts;
 pub mod csv;
 pub mod gltf;
 pub mod html;
+pub mod pcb;
 pub mod playback;
 pub mod scene;
 pub mod svg;

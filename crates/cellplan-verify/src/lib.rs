@@ -21,6 +21,7 @@
 //! large to check at the requested resolution is refused ([`workload`]).
 pub mod motion;
 mod paths;
+pub mod pcb;
 mod record;
 mod robots;
 mod tasks;

@@ -168,8 +168,13 @@ pub fn process_kind(path: &Path) -> Result<String, InputError> {
             .hint("give the path of a cell TOML file, e.g. examples/autobody-4r/cell.toml")
     })?;
     let head: Head = toml::from_str(&text).map_err(|e| {
-        InputError::at_span(path, &text, e.span().unwrap_or(0..0), format!("invalid cell file: {}", e.message().trim()))
-            .hint("docs/cell-format.md lists every key and its type")
+        InputError::at_span(
+            path,
+            &text,
+            e.span().unwrap_or(0..0),
+            format!("invalid cell file: {}", e.message().trim()),
+        )
+        .hint("docs/cell-format.md lists every key and its type")
     })?;
     let Some(process) = head.process else {
         return Err(InputError::new(path, "the cell file has no `[process]` table")

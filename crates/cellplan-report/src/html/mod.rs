@@ -55,7 +55,7 @@ pub fn long_axis(cell: &Cell) -> usize {
 }
 
 /// `<head>` of every page: the title and the report's style sheet.
-fn head(title: &str) -> Markup {
+pub(crate) fn head(title: &str) -> Markup {
     html! {
         head {
             meta charset="utf-8";

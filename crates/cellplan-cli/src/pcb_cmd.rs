@@ -1,0 +1,394 @@
+//! `plan`, `verify`, `report` and `compare` on PCB-assembly cells (paper 004): argument checks,
+//! output files and printing only; the work is in `cellplan-pcb`, the check in
+//! `cellplan-verify::pcb`, the page in `cellplan-report::pcb`.
+use crate::Failure;
+use crate::plan_cmd::PlanArgs;
+use cellplan_model::InputError;
+use cellplan_model::io::{check_writable, write_all_atomic};
+use cellplan_pcb::PcbCell;
+use cellplan_pcb::cell::{Configuration, KIND, MotionModel};
+use cellplan_pcb::document::PcbPlan;
+use cellplan_pcb::plan::{Optimizer, Outcome, Request};
+use cellplan_verify::pcb::{PcbReport, PcbVerifySettings, verify_pcb};
+use serde::Serialize;
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
+
+/// Whether the cell file is a PCB-assembly cell (read by its `[process] kind`).
+pub fn is_pcb(cell: &Path) -> Result<bool, Failure> {
+    Ok(cellplan_model::process_kind(cell)? == KIND)
+}
+
+/// Loads a PCB cell.
+pub fn load(path: &Path) -> Result<PcbCell, Failure> {
+    Ok(cellplan_pcb::load(path)?)
+}
+
+/// The optimiser names of `--optimizer`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum OptimizerArg {
+    /// Paper 004's GA.
+    Ga,
+    /// Ours.
+    Best,
+}
+
+impl From<OptimizerArg> for Optimizer {
+    fn from(o: OptimizerArg) -> Self {
+        match o {
+            OptimizerArg::Ga => Optimizer::Ga,
+            OptimizerArg::Best => Optimizer::Best,
+        }
+    }
+}
+
+/// `--configuration`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum ConfigurationArg {
+    /// Feeders and table fixed.
+    AllFixed,
+    /// Feeders move, table fixed.
+    MovingCds,
+    /// Table moves, feeders fixed.
+    MovingTable,
+    /// All move.
+    AllMoving,
+}
+
+impl From<ConfigurationArg> for Configuration {
+    fn from(c: ConfigurationArg) -> Self {
+        match c {
+            ConfigurationArg::AllFixed => Configuration::AllFixed,
+            ConfigurationArg::MovingCds => Configuration::MovingCds,
+            ConfigurationArg::MovingTable => Configuration::MovingTable,
+            ConfigurationArg::AllMoving => Configuration::AllMoving,
+        }
+    }
+}
+
+/// `--motion`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum MotionArg {
+    /// Full speed at once (the paper's assumption).
+    ConstantSpeed,
+    /// Acceleration-limited.
+    Trapezoid,
+}
+
+/// Most simulations a run may be given.
+pub const MAX_EVALUATIONS: usize = 100_000_000;
+
+/// The cell as the flags ask for it.
+fn variant(cell: &PcbCell, args: &PlanArgs) -> Result<PcbCell, Failure> {
+    let robots = args.robots.unwrap_or(cell.robots.len());
+    if !(1..=2).contains(&robots) {
+        return Err(Failure::Usage(format!("--robots must be 1 or 2, not {robots}")));
+    }
+    let configuration = args.configuration.map_or(cell.configuration, Into::into);
+    let motion = match args.motion {
+        None => cell.motion,
+        Some(MotionArg::ConstantSpeed) => MotionModel::ConstantSpeed,
+        Some(MotionArg::Trapezoid) => MotionModel::Trapezoid,
+    };
+    cell.variant(robots, configuration, motion).map_err(|e| {
+        Failure::Input(Box::new(
+            InputError::new(&cell.path, format!("cannot plan this cell so: {e}")).hint(
+                "a one-robot run of a two-robot cell needs robot 1 to reach both feeders and the whole board",
+            ),
+        ))
+    })
+}
+
+#[derive(Serialize)]
+struct Summary<'a> {
+    plan_file: String,
+    report_file: Option<String>,
+    program_file: String,
+    cycle_time_s: f64,
+    lower_bound_s: f64,
+    gap_to_lower_bound: f64,
+    components: usize,
+    robots: Vec<RobotSummary<'a>>,
+    configuration: &'static str,
+    optimizer: &'static str,
+    collision_avoidance: bool,
+    evaluations: usize,
+    time_limit_hit: bool,
+    verified: bool,
+    compute_s: f64,
+}
+
+#[derive(Serialize)]
+struct RobotSummary<'a> {
+    name: &'a str,
+    components: usize,
+    motion_s: f64,
+    waiting_s: f64,
+    total_s: f64,
+}
+
+/// Plans with the flags' optimiser and budget.
+pub fn run_plan(
+    cell: &PcbCell,
+    optimizer: Optimizer,
+    evaluations: usize,
+    seed: u64,
+    time_limit: Option<f64>,
+) -> Outcome {
+    cellplan_pcb::plan::run(
+        cell,
+        &Request {
+            optimizer,
+            evaluations,
+            seed,
+            deadline: time_limit.map(|t| Instant::now() + Duration::from_secs_f64(t)),
+        },
+    )
+}
+
+/// The verifier's verdict on a plan made with the cell's collision setting.
+pub fn check(cell: &PcbCell, plan: &PcbPlan) -> PcbReport {
+    verify_pcb(
+        cell,
+        plan,
+        &PcbVerifySettings {
+            robot_robot: plan.collision_avoidance || plan.robots.len() < 2,
+        },
+    )
+}
+
+/// `cellplan plan` on a PCB cell.
+pub fn plan(args: &PlanArgs) -> Result<(), Failure> {
+    let start = Instant::now();
+    if args.evaluations == 0 || args.evaluations > MAX_EVALUATIONS {
+        return Err(Failure::Usage(format!(
+            "--evaluations must be between 1 and {MAX_EVALUATIONS}"
+        )));
+    }
+    if args
+        .time_limit
+        .is_some_and(|t| !(t.is_finite() && t > 0.0 && t <= 1e6))
+    {
+        return Err(Failure::Usage(
+            "--time-limit must be a number of seconds above 0 and at most 1e6".into(),
+        ));
+    }
+    let loaded = load(&args.cell)?;
+    let cell = variant(&loaded, args)?;
+    let dir = match &args.output {
+        Some(d) => d.clone(),
+        None => output_dir(&cell)?,
+    };
+    check_writable(&dir).map_err(|e| {
+        Failure::Usage(format!(
+            "cannot write into the output folder {}: {e}; give a writable folder with -o",
+            dir.display()
+        ))
+    })?;
+    let show = !args.quiet && !args.json;
+    let pb = crate::spinner(show, &format!("planning {} components", cell.len()));
+    let optimizer: Optimizer = args.optimizer.into();
+    let out = run_plan(&cell, optimizer, args.evaluations, args.seed, args.time_limit);
+    pb.set_message("verifying the plan");
+    let verdict = check(&loaded, &out.plan);
+    if !verdict.ok && !args.no_verify {
+        pb.finish_and_clear();
+        for v in &verdict.violations {
+            eprintln!("{}", describe(v));
+        }
+        return Err(Failure::Other(format!(
+            "the plan failed verification ({} violation(s)) and was not written; --no-verify writes it anyway",
+            verdict.violations.len()
+        )));
+    }
+    let mut doc = out.plan.clone();
+    doc.compute_s = start.elapsed().as_secs_f64();
+    let file = dir.join("plan.json");
+    let program_file = dir.join("placement.csv");
+    let report_file = dir.join("report.html");
+    let text = serde_json::to_string_pretty(&doc).map_err(|e| Failure::Other(e.to_string()))?;
+    let program = cellplan_report::pcb::program_csv(&doc);
+    let page = (!args.no_report).then(|| cellplan_report::pcb::html(&doc, &cell, Some(&verdict)));
+    let mut files: Vec<(&Path, &[u8])> = vec![(&file, text.as_bytes()), (&program_file, program.as_bytes())];
+    if let Some(p) = &page {
+        files.push((&report_file, p.as_bytes()));
+    }
+    write_all_atomic(&files)
+        .map_err(|e| Failure::Other(format!("cannot write into {}: {e}", dir.display())))?;
+    pb.finish_and_clear();
+    if args.json {
+        let summary = Summary {
+            plan_file: file.display().to_string(),
+            report_file: page.is_some().then(|| report_file.display().to_string()),
+            program_file: program_file.display().to_string(),
+            cycle_time_s: doc.cycle_time_s,
+            lower_bound_s: doc.lower_bound_s,
+            gap_to_lower_bound: gap(doc.cycle_time_s, doc.lower_bound_s),
+            components: doc.placements.len(),
+            robots: doc
+                .robots
+                .iter()
+                .map(|r| RobotSummary {
+                    name: &r.name,
+                    components: r.components,
+                    motion_s: r.motion_s,
+                    waiting_s: r.waiting_s,
+                    total_s: r.total_s,
+                })
+                .collect(),
+            configuration: doc.configuration.name(),
+            optimizer: optimizer.name(),
+            collision_avoidance: doc.collision_avoidance,
+            evaluations: doc.evaluations,
+            time_limit_hit: out.time_limit_hit,
+            verified: verdict.ok,
+            compute_s: doc.compute_s,
+        };
+        crate::print_json(&summary)?;
+    } else if !args.quiet {
+        print!("{}", render(&doc, &verdict, out.time_limit_hit));
+        println!("plan written to {}", file.display());
+        println!("placement program written to {}", program_file.display());
+        if page.is_some() {
+            println!("report written to {}", report_file.display());
+        }
+    }
+    Ok(())
+}
+
+/// (cycle − bound) / bound.
+pub fn gap(cycle: f64, bound: f64) -> f64 {
+    if bound > 0.0 { cycle / bound - 1.0 } else { 0.0 }
+}
+
+fn output_dir(cell: &PcbCell) -> Result<PathBuf, Failure> {
+    let name = &cell.name;
+    let plain = !name.is_empty()
+        && name != "."
+        && name != ".."
+        && !name.contains(['/', '\\', '\0'])
+        && Path::new(name).components().count() == 1;
+    if !plain {
+        return Err(Failure::Usage(format!(
+            "the cell name `{name}` is not a plain folder name; give the output folder with -o"
+        )));
+    }
+    Ok(PathBuf::from("out").join(name))
+}
+
+fn render(doc: &PcbPlan, verdict: &PcbReport, hit: bool) -> String {
+    let mut s = format!(
+        "{} — {} components, {} robot(s), {}, optimiser {}, seed {}\n\n",
+        doc.cell,
+        doc.placements.len(),
+        doc.robots.len(),
+        doc.configuration.name(),
+        doc.optimizer,
+        doc.seed
+    );
+    s += &format!(
+        "{:<10} {:>10} {:>10} {:>10} {:>10} {:>9}\n",
+        "robot", "components", "motion s", "working s", "waiting s", "total s"
+    );
+    for r in &doc.robots {
+        s += &format!(
+            "{:<10} {:>10} {:>10.3} {:>10.3} {:>10.3} {:>9.3}\n",
+            r.name, r.components, r.motion_s, r.working_s, r.waiting_s, r.total_s
+        );
+    }
+    let delays: f64 = doc.placements.iter().map(|p| p.safety_delay_s).sum();
+    if doc.robots.len() == 2 {
+        s += &format!(
+            "\nsafety delays {:.3} s in {} placements (collision avoidance {})\n",
+            delays,
+            doc.placements.iter().filter(|p| p.safety_delay_s > 1e-9).count(),
+            if doc.collision_avoidance { "on" } else { "off" }
+        );
+    }
+    s += &format!(
+        "\nassembly time {:.3} s   lower bound {:.3} s (gap {:.1} %)   {} simulations, compute {:.2} s\n",
+        doc.cycle_time_s,
+        doc.lower_bound_s,
+        100.0 * gap(doc.cycle_time_s, doc.lower_bound_s),
+        doc.evaluations,
+        doc.compute_s
+    );
+    if hit {
+        s += "time limit reached: the search stopped before its work budget, so this plan depends on this machine's speed\n";
+    }
+    s += &if verdict.ok {
+        "verified: every device replayed on one clock — speeds, travel, every pick and placement a true meeting, each component once, the robots apart\n".to_string()
+    } else {
+        format!(
+            "NOT VERIFIED ({} violation(s); written with --no-verify)\n",
+            verdict.violations.len()
+        )
+    };
+    s
+}
+
+/// One violation on one line.
+pub fn describe(v: &cellplan_verify::pcb::PcbViolation) -> String {
+    let who = v.device.as_deref().unwrap_or("-");
+    let when = v.time_s.map_or(String::new(), |t| format!(" at {t:.3} s"));
+    let comp = v
+        .component
+        .as_ref()
+        .map_or(String::new(), |c| format!(" component {c}"));
+    format!("{:?} {who}{when}{comp}: {}", v.kind, v.detail)
+}
+
+/// `cellplan verify` on a PCB plan.
+pub fn verify(plan_path: &Path, cell_path: &Path, json: bool) -> Result<(), Failure> {
+    let cell = load(cell_path)?;
+    let plan = cellplan_pcb::document::read(plan_path).map_err(|e| {
+        Failure::Input(Box::new(
+            InputError::new(plan_path, e)
+                .hint("give a plan.json that `cellplan plan` wrote for this PCB cell"),
+        ))
+    })?;
+    let report = check(&cell, &plan);
+    if json {
+        crate::print_json(&report)?;
+    } else {
+        for v in &report.violations {
+            println!("{}", describe(v));
+        }
+        println!(
+            "{}: {} violation(s); assembly time {:.3} s (recomputed), lower bound {:.3} s{}",
+            if report.ok { "ok" } else { "NOT OK" },
+            report.violations.len(),
+            report.cycle_time_s,
+            report.lower_bound_s,
+            if report.crossings > 0 && report.ok {
+                format!(
+                    "; {} robot crossing(s) — collision avoidance was off",
+                    report.crossings
+                )
+            } else {
+                String::new()
+            }
+        );
+    }
+    if report.ok { Ok(()) } else { Err(Failure::Rejected) }
+}
+
+/// `cellplan report` on a PCB plan.
+pub fn report(plan_path: &Path, cell_path: &Path, out: &Path) -> Result<(), Failure> {
+    let cell = load(cell_path)?;
+    let plan = cellplan_pcb::document::read(plan_path).map_err(|e| {
+        Failure::Input(Box::new(
+            InputError::new(plan_path, e)
+                .hint("give a plan.json that `cellplan plan` wrote for this PCB cell"),
+        ))
+    })?;
+    let report = check(&cell, &plan);
+    let n_robots = plan.robots.len();
+    let cell = cell
+        .variant(n_robots, plan.configuration, plan.motion)
+        .map_err(|e| Failure::Other(e.to_string()))?;
+    let page = cellplan_report::pcb::html(&plan, &cell, Some(&report));
+    cellplan_model::io::write_atomic(out, page.as_bytes())
+        .map_err(|e| Failure::Other(format!("cannot write {}: {e}", out.display())))?;
+    Ok(())
+}
