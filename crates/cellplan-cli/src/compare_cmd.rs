@@ -20,10 +20,10 @@ use std::time::{Duration, Instant};
 #[derive(Args)]
 pub struct CompareArgs {
     /// The cell file (TOML).
-    cell: PathBuf,
+    pub cell: PathBuf,
     /// Seed of the planners (and of the random MP sets).
     #[arg(long, default_value_t = 0)]
-    seed: u64,
+    pub seed: u64,
     /// Instead of the cell's MPs, draw this many random MP sets on the part (as many MPs as
     /// the cell has, in the region and facing of the cell's MPs) and report mean and spread.
     #[arg(long, value_name = "K")]
@@ -31,13 +31,20 @@ pub struct CompareArgs {
     /// Print JSON (stable keys: strategies[].allocation, coordination, cycle_time_s,
     /// delta_t_s, conflicts_before, verified, compute_s).
     #[arg(long)]
-    json: bool,
+    pub json: bool,
     /// Also write the Markdown table and the JSON to this folder.
     #[arg(short, long, value_name = "DIR")]
-    output: Option<PathBuf>,
+    pub output: Option<PathBuf>,
     /// No progress output.
     #[arg(long, short)]
-    quiet: bool,
+    pub quiet: bool,
+    /// PCB assembly: simulations per optimiser run.
+    #[arg(long, value_name = "N", default_value_t = 200_000)]
+    pub evaluations: usize,
+    /// PCB assembly: simulations of the GA runs (default: as `--evaluations`); a GA
+    /// simulation is cheaper than one of ours, so equal compute time means more of them.
+    #[arg(long, value_name = "N")]
+    pub ga_evaluations: Option<usize>,
 }
 
 #[derive(Serialize, Clone)]
@@ -100,6 +107,9 @@ const ALLOCATIONS: [Allocation; 4] = [
 ];
 
 pub fn run(args: &CompareArgs) -> Result<(), Failure> {
+    if crate::pcb_cmd::is_pcb(&args.cell)? {
+        return crate::pcb_cmd::compare(args);
+    }
     let show = !args.quiet && !args.json;
     let opts = load_options(false, &None);
     let pb = spinner(show, "loading the cell");

@@ -392,3 +392,170 @@ pub fn report(plan_path: &Path, cell_path: &Path, out: &Path) -> Result<(), Fail
         .map_err(|e| Failure::Other(format!("cannot write {}: {e}", out.display())))?;
     Ok(())
 }
+
+/// One row of `compare` on a PCB cell.
+#[derive(Serialize, Clone)]
+struct CompareRow {
+    optimizer: &'static str,
+    configuration: &'static str,
+    robots: usize,
+    collision_avoidance: bool,
+    cycle_time_s: f64,
+    lower_bound_s: f64,
+    gap_to_lower_bound: f64,
+    safety_delays_s: f64,
+    crossings: usize,
+    verified: bool,
+    evaluations: usize,
+    compute_s: f64,
+    /// Simulations after which the run first reached its final assembly time within 0.1 %.
+    evaluations_to_final: usize,
+}
+
+#[derive(Serialize)]
+struct CompareOut {
+    cell: String,
+    components: usize,
+    seed: u64,
+    strategies: Vec<CompareRow>,
+}
+
+/// `cellplan compare` on a PCB cell: the one-robot configurations (with the cell's first robot)
+/// and, on a two-robot cell, two robots with and without collision avoidance; each with the
+/// paper's GA and ours, on the same budget of simulations unless `--ga-evaluations` says
+/// otherwise.
+pub fn compare(args: &crate::compare_cmd::CompareArgs) -> Result<(), Failure> {
+    let ga_evals = args.ga_evaluations.unwrap_or(args.evaluations);
+    for e in [args.evaluations, ga_evals] {
+        if e == 0 || e > MAX_EVALUATIONS {
+            return Err(Failure::Usage(format!(
+                "--evaluations and --ga-evaluations must be between 1 and {MAX_EVALUATIONS}"
+            )));
+        }
+    }
+    let base = load(&args.cell)?;
+    let show = !args.quiet && !args.json;
+    let mut cases: Vec<(usize, Configuration, bool)> = Vec::new();
+    if base.variant(1, Configuration::AllMoving, base.motion).is_ok() {
+        cases.extend(Configuration::ALL.iter().map(|&c| (1, c, false)));
+    }
+    if base.robots.len() == 2 {
+        cases.push((2, Configuration::AllMoving, true));
+        cases.push((2, Configuration::AllMoving, false));
+    }
+    let pb = crate::spinner(show, "comparing");
+    let mut rows = Vec::new();
+    for &(robots, configuration, avoid) in &cases {
+        let Ok(mut cell) = base.variant(robots, configuration, base.motion) else {
+            continue;
+        };
+        if robots == 2 {
+            cell.collision_avoidance = avoid;
+        }
+        for optimizer in [Optimizer::Ga, Optimizer::Best] {
+            pb.set_message(format!(
+                "{} robot(s), {}, {}{}",
+                robots,
+                configuration.name(),
+                optimizer.name(),
+                if robots == 2 && !avoid {
+                    ", no collision avoidance"
+                } else {
+                    ""
+                }
+            ));
+            let evals = if optimizer == Optimizer::Ga {
+                ga_evals
+            } else {
+                args.evaluations
+            };
+            let out = run_plan(&cell, optimizer, evals, args.seed, None);
+            let verdict = verify_pcb(
+                &base,
+                &out.plan,
+                &PcbVerifySettings {
+                    robot_robot: robots < 2 || avoid,
+                },
+            );
+            let last = out.plan.cycle_time_s;
+            let to_final = out
+                .trace
+                .iter()
+                .find(|(_, v)| *v <= last * 1.001)
+                .map_or(evals, |t| t.0);
+            rows.push(CompareRow {
+                optimizer: optimizer.name(),
+                configuration: configuration.name(),
+                robots,
+                collision_avoidance: robots == 2 && avoid,
+                cycle_time_s: out.plan.cycle_time_s,
+                lower_bound_s: out.plan.lower_bound_s,
+                gap_to_lower_bound: gap(out.plan.cycle_time_s, out.plan.lower_bound_s),
+                safety_delays_s: out.plan.placements.iter().map(|p| p.safety_delay_s).sum(),
+                crossings: verdict.crossings,
+                verified: verdict.ok,
+                evaluations: out.plan.evaluations,
+                compute_s: out.plan.compute_s,
+                evaluations_to_final: to_final,
+            });
+        }
+    }
+    pb.finish_and_clear();
+    let out = CompareOut {
+        cell: base.name.clone(),
+        components: base.len(),
+        seed: args.seed,
+        strategies: rows,
+    };
+    let text = serde_json::to_string_pretty(&out).map_err(|e| Failure::Other(e.to_string()))?;
+    let table = compare_table(&out);
+    if let Some(dir) = &args.output {
+        let md = dir.join("compare.md");
+        let js = dir.join("compare.json");
+        write_all_atomic(&[(&md, table.as_bytes()), (&js, text.as_bytes())])
+            .map_err(|e| Failure::Other(format!("cannot write into {}: {e}", dir.display())))?;
+    }
+    if args.json {
+        println!("{text}");
+    } else {
+        print!("{table}");
+    }
+    Ok(())
+}
+
+fn compare_table(out: &CompareOut) -> String {
+    let mut s = format!(
+        "{} — {} components, seed {}\n\n| robots | configuration | collision avoidance | optimiser | assembly s | bound s | gap | delays s | verified | simulations | compute s |\n|---|---|---|---|---|---|---|---|---|---|---|\n",
+        out.cell, out.components, out.seed
+    );
+    for r in &out.strategies {
+        let _ = std::fmt::Write::write_fmt(
+            &mut s,
+            format_args!(
+                "| {} | {} | {} | {} | {:.3} | {:.3} | {:.1} % | {:.3} | {} | {} | {:.2} |\n",
+                r.robots,
+                r.configuration,
+                if r.robots == 2 {
+                    if r.collision_avoidance { "yes" } else { "no" }
+                } else {
+                    "-"
+                },
+                r.optimizer,
+                r.cycle_time_s,
+                r.lower_bound_s,
+                100.0 * r.gap_to_lower_bound,
+                r.safety_delays_s,
+                if r.verified {
+                    "yes".to_string()
+                } else if r.crossings > 0 {
+                    format!("no ({} crossings)", r.crossings)
+                } else {
+                    "NO".to_string()
+                },
+                r.evaluations,
+                r.compute_s
+            ),
+        );
+    }
+    s
+}

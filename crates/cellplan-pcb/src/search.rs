@@ -322,7 +322,50 @@ pub fn run(
     settings: &SearchSettings,
     start: Option<&Decision>,
 ) -> (Decision, f64, Trace, bool) {
-    let start = start.cloned().unwrap_or_else(|| initial(cell));
+    // With moving feeders, most of the budget goes to the same cell with the feeders fixed
+    // (a simulation there is several times cheaper: no carriage to choose, and a fixed feeder
+    // is one of the moving feeder's options); its result starts the search on the real cell.
+    if cell.configuration.feeders_move() && settings.evaluations >= 1000 {
+        let relaxed_conf = if cell.configuration.table_moves() {
+            crate::cell::Configuration::MovingTable
+        } else {
+            crate::cell::Configuration::AllFixed
+        };
+        let mut relaxed = cell.clone();
+        relaxed.configuration = relaxed_conf;
+        let first = settings.evaluations * 3 / 5;
+        let (d, _, mut trace, hit) = search_chains(
+            &relaxed,
+            &SearchSettings {
+                evaluations: first,
+                ..*settings
+            },
+            start.cloned().unwrap_or_else(|| initial(&relaxed)),
+        );
+        if hit {
+            let v = evaluate(cell, &d);
+            let mut d = d;
+            record_rendezvous(cell, &mut d);
+            return (d, v, trace, hit);
+        }
+        let (d2, v2, t2, h2) = search_chains(
+            cell,
+            &SearchSettings {
+                evaluations: settings.evaluations - first,
+                ..*settings
+            },
+            d,
+        );
+        // The relaxed cell's times are not this cell's: its trace is left out.
+        trace.clear();
+        trace.extend(t2.into_iter().map(|(e, v)| (e + first, v)));
+        return (d2, v2, trace, h2);
+    }
+    search_chains(cell, settings, start.cloned().unwrap_or_else(|| initial(cell)))
+}
+
+/// Two chains from `start` on `cell`.
+fn search_chains(cell: &PcbCell, settings: &SearchSettings, start: Decision) -> (Decision, f64, Trace, bool) {
     let half = settings.evaluations / 2;
     let deadline = settings.deadline;
     let seed = |k: u64| settings.seed.wrapping_mul(2).wrapping_add(k);
@@ -425,7 +468,7 @@ fn neighbour(cell: &PcbCell, d: &Decision, rng: &mut ChaCha8Rng, step: &mut [f64
                 cell.pick_range(0, x.feeder[c], slot)?;
             }
         }
-    } else if roll < 0.9 && two {
+    } else if roll < 0.9 && two && !(fixed && roll >= 0.85) {
         let c = rng.random_range(0..n);
         let lookup = slot_lookup(cell, &x);
         let r = 1 - x.robot[c];
@@ -435,32 +478,35 @@ fn neighbour(cell: &PcbCell, d: &Decision, rng: &mut ChaCha8Rng, step: &mut [f64
         x.robot[c] = r;
         x.feeder[c] = r;
     } else if fixed {
-        // Nudge a fixed device.
+        // Move a fixed device: a small step, or anywhere in its travel (the time is far from
+        // unimodal in a fixed position while order and bins follow the old one).
         let which = rng.random_range(0..3);
+        let jump = rng.random::<bool>();
         let g = gauss(rng);
+        let h = gauss(rng);
+        let (u, w): (f64, f64) = (rng.random(), rng.random());
         if which < 2 && !cell.configuration.feeders_move() {
             let f = which;
-            let s = step[0];
+            let travel = cell.feeders[f].travel;
             for c in 0..n {
                 if x.feeder[c] == f {
-                    x.carriage[c] += g * s;
+                    x.carriage[c] = if jump {
+                        travel[0] + u * (travel[1] - travel[0])
+                    } else {
+                        x.carriage[c] + g * step[0]
+                    };
                 }
             }
-            let first = x.order.iter().find(|&&c| x.feeder[c] == f).copied();
-            let Some(first) = first else { return None };
-            let pos = x.carriage[first];
-            fix_devices(cell, &mut x, None)?;
-            if (x.carriage[first] - pos).abs() > 1e-12 {
-                step[0] *= 0.9;
-            }
         } else if !cell.configuration.table_moves() {
-            let s = step[1];
-            let h = gauss(rng);
+            let (tx, ty) = (cell.table.x, cell.table.y);
             for t in x.table.iter_mut() {
-                t[0] += g * s;
-                t[1] += h * s;
+                if jump {
+                    *t = [tx[0] + u * (tx[1] - tx[0]), ty[0] + w * (ty[1] - ty[0])];
+                } else {
+                    t[0] += g * step[1];
+                    t[1] += h * step[1];
+                }
             }
-            fix_devices(cell, &mut x, None)?;
         } else {
             return None;
         }
@@ -479,6 +525,127 @@ fn gauss(rng: &mut ChaCha8Rng) -> f64 {
     (-2.0 * u.ln()).sqrt() * (std::f64::consts::TAU * v).cos()
 }
 
+/// The decision with the contents of the two feeders exchanged bin for bin (one robot, bins
+/// free, equal bin counts, every bin still reachable).
+fn mirrored(cell: &PcbCell, d: &Decision) -> Option<Decision> {
+    if cell.robots.len() != 1 || !cell.given_bins.is_empty() || cell.feeders[0].bins != cell.feeders[1].bins {
+        return None;
+    }
+    let mut x = d.clone();
+    x.slots.swap(0, 1);
+    for c in 0..cell.len() {
+        x.feeder[c] = 1 - x.feeder[c];
+    }
+    let lookup = slot_lookup(cell, &x);
+    for c in 0..cell.len() {
+        let slot = lookup[x.feeder[c]][cell.type_of[c]]?;
+        let r = cell.pick_range(0, x.feeder[c], slot)?;
+        x.carriage[c] = 0.5 * (r[0] + r[1]);
+    }
+    fix_devices(cell, &mut x, Some([0.5; 4]))?;
+    Some(x)
+}
+
+/// Golden-section line searches on each coordinate of the fixed devices' positions (feeder
+/// carriages, table x and y) over the range that serves all their meetings; returns the
+/// decision, its time and the simulations spent.
+fn tune_fixed(cell: &PcbCell, mut d: Decision, rounds: usize) -> (Decision, f64, usize) {
+    let mut spent = 0;
+    let mut best = evaluate(cell, &d);
+    spent += 1;
+    if cell.configuration.feeders_move() && cell.configuration.table_moves() {
+        return (d, best, spent);
+    }
+    let lookup = slot_lookup(cell, &d);
+    for _ in 0..rounds {
+        for axis in 0..4 {
+            let range = if axis < 2 {
+                if cell.configuration.feeders_move() {
+                    continue;
+                }
+                let f = axis;
+                let mut r = cell.feeders[f].travel;
+                let mut any = false;
+                for c in 0..d.order.len() {
+                    if d.feeder[c] != f {
+                        continue;
+                    }
+                    any = true;
+                    let Some(slot) = lookup[f][cell.type_of[c]] else {
+                        continue;
+                    };
+                    let Some(pr) = cell.pick_range(d.robot[c], f, slot) else {
+                        continue;
+                    };
+                    r = [r[0].max(pr[0]), r[1].min(pr[1])];
+                }
+                if !any || r[0] > r[1] {
+                    continue;
+                }
+                r
+            } else {
+                if cell.configuration.table_moves() {
+                    continue;
+                }
+                let a = axis - 2;
+                let mut r = if a == 0 { cell.table.x } else { cell.table.y };
+                for c in 0..d.order.len() {
+                    let Some(bx) = cell.place_box(d.robot[c], c) else {
+                        continue;
+                    };
+                    r = [r[0].max(bx[a][0]), r[1].min(bx[a][1])];
+                }
+                if r[0] > r[1] {
+                    continue;
+                }
+                r
+            };
+            let set = |d: &mut Decision, v: f64| {
+                if axis < 2 {
+                    for c in 0..d.order.len() {
+                        if d.feeder[c] == axis {
+                            d.carriage[c] = v;
+                        }
+                    }
+                } else {
+                    for t in d.table.iter_mut() {
+                        t[axis - 2] = v;
+                    }
+                }
+            };
+            let mut trial = d.clone();
+            // A coarse scan first (the time is not unimodal in a fixed position once bins and
+            // order are fixed), then golden-section search around the best point of the scan.
+            let steps = 16;
+            let at = |k: usize| range[0] + (range[1] - range[0]) * k as f64 / steps as f64;
+            let mut scan_best = (f64::INFINITY, 0);
+            for k in 0..=steps {
+                set(&mut trial, at(k));
+                spent += 1;
+                let v = evaluate(cell, &trial);
+                if v < scan_best.0 {
+                    scan_best = (v, k);
+                }
+            }
+            let k = scan_best.1;
+            let (lo, hi) = (at(k.saturating_sub(1)), at((k + 1).min(steps)));
+            let x = crate::rendezvous::golden(lo, hi, 20, |v| {
+                set(&mut trial, v);
+                spent += 1;
+                evaluate(cell, &trial)
+            });
+            set(&mut trial, x);
+            let v = evaluate(cell, &trial);
+            spent += 1;
+            if v < best - 1e-12 {
+                best = v;
+                d = trial;
+            }
+        }
+    }
+    (d, best, spent)
+}
+
 fn chain(
     cell: &PcbCell,
     start: &Decision,
@@ -488,17 +655,46 @@ fn chain(
 ) -> (Decision, f64, Trace, bool) {
     let mut hit = false;
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    let mut cur = start.clone();
-    let mut cur_v = evaluate(cell, &cur);
+    let (mut cur, mut cur_v, mut evals) = tune_fixed(cell, start.clone(), 2);
+    // One robot: the start with the two feeders' contents exchanged too (where a fixed table
+    // sits nearer one feeder, the busy types belong in that one; the search rarely moves them
+    // all across one swap at a time).
+    if let Some(mirror) = mirrored(cell, start) {
+        let (d, v, spent) = tune_fixed(cell, mirror, 2);
+        evals += spent;
+        if v < cur_v - 1e-12 {
+            cur = d;
+            cur_v = v;
+        }
+    }
     let mut best = cur.clone();
     let mut best_v = cur_v;
-    let mut evals = 1;
     let mut trace: Trace = vec![(evals, best_v)];
-    let mut stale = 0usize;
-    let n = cell.len().max(1);
     let mut step = [0.01, 0.01];
     // Keep a fifth of the budget for the rendezvous polish.
     let search_budget = budget - budget / 5;
+    // Simulated annealing: the start temperature accepts a typical worsening move of the
+    // first sample with probability 0.3; geometric cooling by a factor 10⁴ over the budget.
+    let mut sample = Vec::new();
+    for _ in 0..50 {
+        if let Some(x) = neighbour(cell, &cur, &mut rng, &mut step) {
+            let v = evaluate(cell, &x);
+            evals += 1;
+            if v > cur_v {
+                sample.push(v - cur_v);
+            }
+        }
+    }
+    let typical = if sample.is_empty() {
+        1e-3 * cur_v.max(1e-9)
+    } else {
+        sample.iter().sum::<f64>() / sample.len() as f64
+    };
+    let t0 = typical / -(0.3f64.ln());
+    let start_evals = evals;
+    let span = (search_budget.saturating_sub(start_evals)).max(1) as f64;
+    let mut since_best = 0usize;
+    let n = cell.len().max(1);
     while evals < search_budget {
         if evals % 64 == 0 && deadline.is_some_and(|d| std::time::Instant::now() > d) {
             hit = true;
@@ -510,40 +706,32 @@ fn chain(
         };
         let v = evaluate(cell, &x);
         evals += 1;
-        if v <= cur_v + 1e-12 {
-            if v < cur_v - 1e-12 {
-                stale = 0;
-            } else {
-                stale += 1;
-            }
+        let progress = (evals - start_evals) as f64 / span;
+        let temp = t0 * (1e-4f64).powf(progress);
+        let accept = v <= cur_v + 1e-12 || rng.random::<f64>() < (-(v - cur_v) / temp).exp();
+        since_best += 1;
+        if accept {
             cur = x;
             cur_v = v;
             if v < best_v - 1e-12 {
                 best = cur.clone();
                 best_v = v;
+                since_best = 0;
                 trace.push((evals, best_v));
             }
-        } else {
-            stale += 1;
         }
-        if stale > 20 * n {
-            // Kick: a double bridge on the best order.
-            cur = best.clone();
-            let m = cur.order.len();
-            if m >= 8 {
-                let mut cuts = [
-                    rng.random_range(1..m),
-                    rng.random_range(1..m),
-                    rng.random_range(1..m),
-                ];
-                cuts.sort();
-                let [a, b, c] = cuts;
-                let o = &cur.order;
-                cur.order = [&o[..a], &o[b..c], &o[a..b], &o[c..]].concat();
+        if since_best > 200 * n {
+            // Long without a new best: back to it, with the fixed devices re-tuned.
+            let (d, v, spent) = tune_fixed(cell, best.clone(), 1);
+            evals += spent;
+            cur = d;
+            cur_v = v;
+            since_best = 0;
+            if cur_v < best_v - 1e-12 {
+                best = cur.clone();
+                best_v = cur_v;
+                trace.push((evals, best_v));
             }
-            cur_v = evaluate(cell, &cur);
-            evals += 1;
-            stale = 0;
         }
     }
     record_rendezvous(cell, &mut best);
@@ -558,7 +746,10 @@ fn chain(
 }
 
 /// Coordinate descent on the recorded rendezvous of moving devices, on the whole schedule
-/// (which sees what the greedy rule cannot: a meeting placed for the next cycle's sake).
+/// (which sees what the greedy rule cannot: a meeting placed for the next cycles' sake). Under
+/// the constant-speed model without safety delays the assembly time is a convex function of
+/// all meeting positions (sums and maxima of distances), so each coordinate's golden-section
+/// search is exact along that coordinate.
 pub fn polish(cell: &PcbCell, mut d: Decision, budget: usize) -> (Decision, f64, usize) {
     let eval = |d: &Decision| simulate(cell, d, &mut Given(d), rule(cell)).makespan;
     let mut best = eval(&d);
@@ -566,53 +757,86 @@ pub fn polish(cell: &PcbCell, mut d: Decision, budget: usize) -> (Decision, f64,
     let lookup = slot_lookup(cell, &d);
     let moving_feeders = cell.configuration.feeders_move();
     let moving_table = cell.configuration.table_moves();
-    let mut step = 0.004;
-    while spent < budget && step > 1e-5 {
-        let mut improved = false;
+    let mut round_gain = f64::INFINITY;
+    while spent < budget && round_gain > 1e-9 {
+        let before = best;
         for k in 0..d.order.len() {
             let c = d.order[k];
-            let r = d.robot[c];
-            let f = d.feeder[c];
-            let mut tries: Vec<(usize, f64)> = Vec::new();
-            if moving_feeders {
-                tries.extend([(0, step), (0, -step)]);
-            }
-            if moving_table {
-                tries.extend([(1, step), (1, -step), (2, step), (2, -step)]);
-            }
-            for (axis, delta) in tries {
+            let (r, f) = (d.robot[c], d.feeder[c]);
+            for axis in 0..3 {
                 if spent >= budget {
                     break;
                 }
-                let mut x = d.clone();
-                match axis {
-                    0 => {
+                let range = match axis {
+                    0 if moving_feeders => {
                         let Some(slot) = lookup[f][cell.type_of[c]] else {
                             continue;
                         };
                         let Some(rg) = cell.pick_range(r, f, slot) else {
                             continue;
                         };
-                        x.carriage[c] = (x.carriage[c] + delta).clamp(rg[0], rg[1]);
+                        rg
                     }
-                    a => {
+                    1 | 2 if moving_table => {
                         let Some(bx) = cell.place_box(r, c) else { continue };
-                        let i = a - 1;
-                        x.table[c][i] = (x.table[c][i] + delta).clamp(bx[i][0], bx[i][1]);
+                        bx[axis - 1]
                     }
-                }
-                let v = eval(&x);
+                    _ => continue,
+                };
+                let mut x = d.clone();
+                let set = |x: &mut Decision, v: f64| {
+                    if axis == 0 {
+                        x.carriage[c] = v;
+                    } else {
+                        x.table[c][axis - 1] = v;
+                    }
+                };
+                let v = crate::rendezvous::golden(range[0], range[1], 25, |v| {
+                    set(&mut x, v);
+                    spent += 1;
+                    eval(&x)
+                });
+                set(&mut x, v);
+                let value = eval(&x);
                 spent += 1;
-                if v < best - 1e-12 {
-                    best = v;
+                if value < best - 1e-12 {
+                    best = value;
                     d = x;
-                    improved = true;
                 }
             }
         }
-        if !improved {
-            step /= 2.0;
-        }
+        round_gain = before - best;
     }
     (d, best, spent)
+}
+
+#[cfg(test)]
+mod debug_tests {
+    use super::*;
+    #[test]
+    #[ignore]
+    fn debug_fixed() {
+        let cell = crate::cell::load(std::path::Path::new("../../examples/pcb-bitsy-1r/cell.toml")).unwrap();
+        let fixed = cell
+            .variant(1, crate::cell::Configuration::AllFixed, cell.motion)
+            .unwrap();
+        let mcds = cell
+            .variant(1, crate::cell::Configuration::MovingCds, cell.motion)
+            .unwrap();
+        let (d, v, _, _) = run(
+            &fixed,
+            &SearchSettings {
+                evaluations: 100_000,
+                seed: 0,
+                deadline: None,
+            },
+            None,
+        );
+        eprintln!("all-fixed {v}");
+        let given = simulate(&mcds, &d, &mut Given(&d), rule(&mcds)).makespan;
+        let greedy = evaluate(&mcds, &d);
+        eprintln!("as moving-cds: given {given}, greedy {greedy}");
+        let (_, p, _) = polish(&mcds, d.clone(), 20000);
+        eprintln!("polished {p}");
+    }
 }

@@ -33,7 +33,98 @@ fn plan_args(cell: String, dir: &Path) -> Vec<String> {
     ]
 }
 
+/// The six-component PCB example with `edit` applied to its cell text (and the board CSV as
+/// `board(...)` gives it), written into `dir`.
+fn pcb_with(dir: &Path, edit: impl Fn(String) -> String, board: impl Fn(String) -> String) -> String {
+    let ex = root().join("examples/pcb-paper-6");
+    let cell = std::fs::read_to_string(ex.join("cell.toml")).unwrap();
+    let csv = std::fs::read_to_string(ex.join("board.csv")).unwrap();
+    std::fs::write(dir.join("cell.toml"), edit(cell)).unwrap();
+    std::fs::write(dir.join("board.csv"), board(csv)).unwrap();
+    dir.join("cell.toml").display().to_string()
+}
+
+/// The single-robot version of the PCB example (its second robot's entry cut).
+fn one_robot(c: String) -> String {
+    let at = c.find("[[robots]]\nname = \"R2\"").unwrap();
+    let end = c[at..].find("[[feeders]]").unwrap() + at;
+    format!("{}{}", &c[..at], &c[end..])
+}
+
 const CASES: &[Case] = &[
+    Case {
+        name: "pcb: a board file that is not KiCad",
+        setup: |d| plan_args(pcb_with(d, |c| c, |_| "hello, world\n".into()), d),
+        says: &["board.csv:1", "not a KiCad board"],
+    },
+    Case {
+        name: "pcb: a footprint without position",
+        setup: |d| {
+            let cell = pcb_with(d, |c| c.replace("board.csv", "board.kicad_pcb"), |b| b);
+            std::fs::write(
+                d.join("board.kicad_pcb"),
+                "(kicad_pcb (version 20240108)\n  (footprint \"R_0805\" (layer \"F.Cu\")\n    (property \"Reference\" \"R1\") (attr smd)))\n",
+            )
+            .unwrap();
+            plan_args(cell, d)
+        },
+        says: &["board.kicad_pcb:2", "no position"],
+    },
+    Case {
+        name: "pcb: a component type with no bin",
+        setup: |d| {
+            plan_args(
+                pcb_with(
+                    d,
+                    |c| {
+                        c + "\n[[process.bins]]\nfeeder = \"CDS1\"\nbin = 0\nfootprint = \"R_0805\"\nvalue = \"10k\"\n"
+                    },
+                    |b| b,
+                ),
+                d,
+            )
+        },
+        says: &["board.csv:", "has no bin", "[[process.bins]]"],
+    },
+    Case {
+        name: "pcb: a board larger than the table's reach",
+        setup: |d| {
+            plan_args(
+                pcb_with(
+                    d,
+                    |c| {
+                        c.replace(
+                            "x = [-20, 60]           # the board",
+                            "x = [300, 320]           # the board",
+                        )
+                        .replace("home = [20, 0]", "home = [310, 0]")
+                    },
+                    |b| b,
+                ),
+                d,
+            )
+        },
+        says: &["cell.toml:", "larger than the table's reach"],
+    },
+    Case {
+        name: "pcb: a robot speed of zero",
+        setup: |d| {
+            plan_args(
+                pcb_with(
+                    d,
+                    |c| c.replace("name = \"R1\"", "name = \"R1\"\nspeed = 0"),
+                    |b| b,
+                ),
+                d,
+            )
+        },
+        says: &["cell.toml:", "speed 0 must be above 0"],
+    },
+    Case {
+        name: "pcb: one robot and a two-robot option",
+        setup: |d| plan_args(pcb_with(d, one_robot, |b| b), d),
+        says: &["cell.toml:", "`safety_gap` is a two-robot option"],
+    },
     Case {
         name: "absurd pose sampling",
         setup: |d| {
