@@ -14,6 +14,99 @@
 //! is larger.
 use crate::cell::PcbCell;
 
+/// The robot's travel with each type in one feeder: the leg from a pick to its placement is at
+/// least the X distance from that type's feeder line to the place point (`a`), the leg from a
+/// placement to the next pick at least the distance to the nearer line (`m`), and the types go
+/// to the feeders by the cheapest assignment the bin counts allow (exact for two feeders: the
+/// types that gain most from feeder 2 go there). With a fixed table, the table position is one
+/// for all placements: the bound is the least over its X (scanned at 0.1 mm, less the most the
+/// travel can fall between two scanned points).
+fn assigned_travel(cell: &PcbCell, h: f64) -> f64 {
+    let n = cell.len();
+    let nt = cell.types.len();
+    let xf = [cell.feeders[0].x, cell.feeders[1].x];
+    let dist_to = |lo: f64, hi: f64, x: f64| {
+        if x < lo {
+            lo - x
+        } else if x > hi {
+            x - hi
+        } else {
+            0.0
+        }
+    };
+    // For table X positions within [lo, hi] (per component), the travel bound.
+    let travel = |ranges: &dyn Fn(usize) -> Option<[f64; 2]>| -> Option<f64> {
+        let mut m_sum = 0.0;
+        let mut m_max = 0.0f64;
+        let mut cost = vec![[0.0f64; 2]; nt];
+        for c in 0..n {
+            let r = ranges(c)?;
+            let a = [dist_to(r[0], r[1], xf[0]), dist_to(r[0], r[1], xf[1])];
+            let m = a[0].min(a[1]);
+            m_sum += m;
+            m_max = m_max.max(m);
+            let t = cell.type_of[c];
+            cost[t][0] += a[0];
+            cost[t][1] += a[1];
+        }
+        // Capacitated assignment of the types to the two feeders.
+        let (cap0, cap1) = (cell.feeders[0].bins, cell.feeders[1].bins);
+        let mut gain: Vec<f64> = cost.iter().map(|c| c[1] - c[0]).collect();
+        gain.sort_by(f64::total_cmp);
+        let base: f64 = cost.iter().map(|c| c[0]).sum();
+        let least_in_1 = nt.saturating_sub(cap0);
+        let most_in_1 = cap1.min(nt);
+        let mut best = f64::INFINITY;
+        let mut acc = 0.0;
+        for k in 0..=most_in_1 {
+            if k > 0 {
+                acc += gain[k - 1];
+            }
+            if k >= least_in_1 {
+                best = best.min(base + acc);
+            }
+        }
+        Some(h + m_sum - m_max + best)
+    };
+    let robot = &cell.robots[0];
+    if cell.configuration.table_moves() {
+        travel(&|c| {
+            let bx = cell.place_box(0, c)?;
+            let b = cell.components[c].position[0];
+            Some([bx[0][0] + b, bx[0][1] + b])
+        })
+        .unwrap_or(0.0)
+    } else {
+        // One table X for all: scan it.
+        let mut lo = cell.table.x[0];
+        let mut hi = cell.table.x[1];
+        for c in 0..n {
+            let b = cell.components[c].position[0];
+            lo = lo.max(robot.x[0] - b);
+            hi = hi.min(robot.x[1] - b);
+        }
+        if lo > hi {
+            return 0.0;
+        }
+        let step = 1e-4;
+        let k = ((hi - lo) / step).ceil().max(1.0) as usize;
+        let k = k.min(200_000);
+        let step = (hi - lo) / k as f64;
+        let mut best = f64::INFINITY;
+        for i in 0..=k {
+            let tx = lo + step * i as f64;
+            if let Some(t) = travel(&|c| {
+                let x = tx + cell.components[c].position[0];
+                Some([x, x])
+            }) {
+                best = best.min(t);
+            }
+        }
+        // Each component's two legs change by at most the table's shift: 2·n·step/2.
+        (best - n as f64 * step).max(0.0)
+    }
+}
+
 /// Components above which the quadratic coupling bound is skipped.
 const COUPLING_LIMIT: usize = 3000;
 
@@ -64,6 +157,7 @@ pub fn lower_bound(cell: &PcbCell) -> f64 {
     if robots == 1 {
         let travel = h + 2.0 * sum_m - max_m;
         let lb1 = work + travel / v;
+        let lb1 = lb1.max(work + assigned_travel(cell, h) / v);
         if n > COUPLING_LIMIT || n < 2 {
             return lb1;
         }

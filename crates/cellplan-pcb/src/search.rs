@@ -322,56 +322,21 @@ pub fn run(
     settings: &SearchSettings,
     start: Option<&Decision>,
 ) -> (Decision, f64, Trace, bool) {
-    // With moving feeders, most of the budget goes to the same cell with the feeders fixed
-    // (a simulation there is several times cheaper: no carriage to choose, and a fixed feeder
-    // is one of the moving feeder's options); its result starts the search on the real cell.
-    if cell.configuration.feeders_move() && settings.evaluations >= 1000 {
-        let relaxed_conf = if cell.configuration.table_moves() {
-            crate::cell::Configuration::MovingTable
-        } else {
-            crate::cell::Configuration::AllFixed
-        };
-        let mut relaxed = cell.clone();
-        relaxed.configuration = relaxed_conf;
-        let first = settings.evaluations * 3 / 5;
-        let (d, _, mut trace, hit) = search_chains(
-            &relaxed,
-            &SearchSettings {
-                evaluations: first,
-                ..*settings
-            },
-            start.cloned().unwrap_or_else(|| initial(&relaxed)),
-        );
-        if hit {
-            let v = evaluate(cell, &d);
-            let mut d = d;
-            record_rendezvous(cell, &mut d);
-            return (d, v, trace, hit);
-        }
-        let (d2, v2, t2, h2) = search_chains(
-            cell,
-            &SearchSettings {
-                evaluations: settings.evaluations - first,
-                ..*settings
-            },
-            d,
-        );
-        // The relaxed cell's times are not this cell's: its trace is left out.
-        trace.clear();
-        trace.extend(t2.into_iter().map(|(e, v)| (e + first, v)));
-        return (d2, v2, trace, h2);
-    }
-    search_chains(cell, settings, start.cloned().unwrap_or_else(|| initial(cell)))
-}
-
-/// Two chains from `start` on `cell`.
-fn search_chains(cell: &PcbCell, settings: &SearchSettings, start: Decision) -> (Decision, f64, Trace, bool) {
+    let start = start.cloned().unwrap_or_else(|| initial(cell));
     let half = settings.evaluations / 2;
-    let deadline = settings.deadline;
-    let seed = |k: u64| settings.seed.wrapping_mul(2).wrapping_add(k);
+    let seed = |k: u64| settings.seed.wrapping_mul(4).wrapping_add(k);
     let ((d0, v0, t0, h0), (d1, v1, t1, h1)) = rayon::join(
-        || chain(cell, &start, half, seed(1), deadline),
-        || chain(cell, &start, settings.evaluations - half, seed(2), deadline),
+        || staged_chain(cell, &start, half, 0, seed(1), settings.deadline),
+        || {
+            staged_chain(
+                cell,
+                &start,
+                settings.evaluations - half,
+                1,
+                seed(2),
+                settings.deadline,
+            )
+        },
     );
     let hit = h0 || h1;
     // Merge the traces by simulations spent (both chains run at once).
@@ -392,6 +357,62 @@ fn search_chains(cell: &PcbCell, settings: &SearchSettings, start: Decision) -> 
     } else {
         (d0, v0, trace, hit)
     }
+}
+
+/// One of the two chains. Chain 1 starts from the mirrored start where there is one (the
+/// feeders' contents exchanged), so that the two explore the two sides a fixed table can take.
+/// With moving feeders, three fifths of the budget go to the same cell with the feeders fixed
+/// first (a simulation there is several times cheaper: no carriage to choose; and a fixed
+/// feeder is one of a moving feeder's options) — chain 1 of an all-moving cell fixes the table
+/// too — and its result starts the search on the real cell.
+fn staged_chain(
+    cell: &PcbCell,
+    start: &Decision,
+    budget: usize,
+    k: usize,
+    seed: u64,
+    deadline: Option<std::time::Instant>,
+) -> (Decision, f64, Trace, bool) {
+    use crate::cell::Configuration::*;
+    let start = if k == 1 {
+        mirrored(cell, start).unwrap_or_else(|| start.clone())
+    } else {
+        start.clone()
+    };
+    let relaxation = match (cell.configuration, k) {
+        (AllMoving, 0) => Some(MovingTable),
+        (AllMoving, _) | (MovingCds, _) => Some(AllFixed),
+        _ => None,
+    };
+    let Some(relaxed_conf) = relaxation.filter(|_| budget >= 1000) else {
+        return chain(cell, &start, budget, seed, deadline);
+    };
+    let mut relaxed = cell.clone();
+    relaxed.configuration = relaxed_conf;
+    let first = budget * 3 / 5;
+    let (d, _, _, hit) = chain(&relaxed, &start, first, seed, deadline);
+    let mut d = d;
+    if hit {
+        record_rendezvous(cell, &mut d);
+        let v = evaluate(cell, &d);
+        return (d, v, vec![(first, v)], hit);
+    }
+    let rest = budget - first;
+    let polish_share = rest / 5;
+    let (d2, v2, t2, h2) = chain(cell, &d, rest - polish_share, seed.wrapping_add(1000), deadline);
+    // The relaxed cell's times are not this cell's: its trace is left out.
+    let mut trace: Trace = t2.into_iter().map(|(e, v)| (e + first, v)).collect();
+    // The relaxed plan as it stands (the devices it fixed moving once from home to their
+    // spot) is a plan of this cell too; polished, it sometimes beats the search's.
+    let as_is = simulate(cell, &d, &mut Given(&d), rule(cell)).makespan;
+    if !h2 && as_is < v2 + 0.05 * v2 {
+        let (d3, v3, _) = polish(cell, d, polish_share);
+        if v3 < v2 - 1e-12 {
+            trace.push((budget, v3));
+            return (d3, v3, trace, h2);
+        }
+    }
+    (d2, v2, trace, h2)
 }
 
 /// Moves of the local search.
@@ -656,17 +677,7 @@ fn chain(
     let mut hit = false;
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let (mut cur, mut cur_v, mut evals) = tune_fixed(cell, start.clone(), 2);
-    // One robot: the start with the two feeders' contents exchanged too (where a fixed table
-    // sits nearer one feeder, the busy types belong in that one; the search rarely moves them
-    // all across one swap at a time).
-    if let Some(mirror) = mirrored(cell, start) {
-        let (d, v, spent) = tune_fixed(cell, mirror, 2);
-        evals += spent;
-        if v < cur_v - 1e-12 {
-            cur = d;
-            cur_v = v;
-        }
-    }
+
     let mut best = cur.clone();
     let mut best_v = cur_v;
     let mut trace: Trace = vec![(evals, best_v)];

@@ -142,6 +142,9 @@ pub(crate) fn dist(a: [f64; 2], b: [f64; 2]) -> f64 {
     ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2)).sqrt()
 }
 
+/// Tolerance of the X levels of the safety delay (m).
+const LEVEL_TOL: f64 = 1e-9;
+
 /// One straight move of a robot, as the X track sees it.
 #[derive(Clone, Copy, Debug)]
 struct Piece {
@@ -171,16 +174,19 @@ impl Track {
     ) -> Option<f64> {
         let start = self.pieces.partition_point(|p| p.t1 < from);
         let mut last: Option<f64> = None;
+        // Levels are computed as `x − gap + gap`, which rounding may leave a hair below `x`:
+        // positions up to LEVEL_TOL above the level count as at it (conservative).
+        let up = level + LEVEL_TOL;
         for p in &self.pieces[start..] {
             let t = if p.t1.is_infinite() {
                 // The last known stay, at the robot's own feeder or home: a conflict only if it
                 // is strictly inside the gap (which the cell's travel limits rule out).
-                (p.x1 < level - 1e-12).then_some(f64::INFINITY)
-            } else if p.x1 <= level {
+                (p.x1 < level - LEVEL_TOL).then_some(f64::INFINITY)
+            } else if p.x1 <= up {
                 Some(p.t1)
-            } else if p.x0 <= level {
+            } else if p.x0 <= up {
                 // Moving away (x1 > level ≥ x0): the crossing.
-                let frac = (level - p.x0) / (p.x1 - p.x0);
+                let frac = ((up - p.x0) / (p.x1 - p.x0)).clamp(0.0, 1.0);
                 Some(p.t0 + drive.time_at(model, p.len, frac * p.len))
             } else {
                 None
@@ -525,40 +531,9 @@ fn safety_delay(
 mod tests {
     use super::*;
     use crate::cell::Configuration;
-    use crate::search::{initial, robot_can};
     use crate::testing::random_cell;
-    use rand::{RngExt, SeedableRng};
-    use rand_chacha::ChaCha8Rng;
 
-    /// A random decision with random rendezvous inside the feasible ranges.
-    fn random_decision(cell: &PcbCell, seed: u64) -> Decision {
-        let mut rng = ChaCha8Rng::seed_from_u64(seed);
-        let mut d = initial(cell);
-        let n = cell.len();
-        for i in (1..n).rev() {
-            let j = rng.random_range(0..=i);
-            d.order.swap(i, j);
-        }
-        let lookup = slot_lookup(cell, &d);
-        for c in 0..n {
-            if cell.robots.len() == 2 {
-                let r = rng.random_range(0..2);
-                if robot_can(cell, &lookup, r, c) {
-                    d.robot[c] = r;
-                    d.feeder[c] = r;
-                }
-            }
-            let slot = lookup[d.feeder[c]][cell.type_of[c]].unwrap();
-            let rg = cell.pick_range(d.robot[c], d.feeder[c], slot).unwrap();
-            d.carriage[c] = rng.random_range(rg[0]..=rg[1]);
-            let bx = cell.place_box(d.robot[c], c).unwrap();
-            d.table[c] = [
-                rng.random_range(bx[0][0]..=bx[0][1]),
-                rng.random_range(bx[1][0]..=bx[1][1]),
-            ];
-        }
-        d
-    }
+    use crate::testing::random_decision;
 
     /// Paper 004 eq. 1–7 (one robot), literally: cycle by cycle, with the CDS off time of eq. 5
     /// and 6 and the table off time of eq. 4.

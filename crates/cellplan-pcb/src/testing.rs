@@ -112,3 +112,40 @@ pub fn random_cell(
         given_bins: Vec::new(),
     }
 }
+
+/// A random decision for `cell`: a shuffled order, random robots where allowed, and random
+/// rendezvous inside the feasible ranges.
+pub fn random_decision(cell: &PcbCell, seed: u64) -> crate::sim::Decision {
+    use crate::search::{initial, robot_can};
+    use crate::sim::slot_lookup;
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let mut d = initial(cell);
+    let n = cell.len();
+    for i in (1..n).rev() {
+        let j = rng.random_range(0..=i);
+        d.order.swap(i, j);
+    }
+    let lookup = slot_lookup(cell, &d);
+    for c in 0..n {
+        if cell.robots.len() == 2 {
+            let r = rng.random_range(0..2);
+            if robot_can(cell, &lookup, r, c) {
+                d.robot[c] = r;
+                d.feeder[c] = r;
+            }
+        }
+        let Some(slot) = lookup[d.feeder[c]][cell.type_of[c]] else {
+            continue;
+        };
+        if let Some(rg) = cell.pick_range(d.robot[c], d.feeder[c], slot) {
+            d.carriage[c] = rng.random_range(rg[0]..=rg[1]);
+        }
+        if let Some(bx) = cell.place_box(d.robot[c], c) {
+            d.table[c] = [
+                rng.random_range(bx[0][0]..=bx[0][1]),
+                rng.random_range(bx[1][0]..=bx[1][1]),
+            ];
+        }
+    }
+    d
+}
