@@ -241,6 +241,9 @@ fn load_options(no_cache: bool, cache_dir: &Option<PathBuf>) -> LoadOptions {
 }
 
 fn run_check(args: &CheckArgs) -> Result<(), Failure> {
+    if pcb_cmd::is_pcb(&args.cell)? {
+        return pcb_cmd::check_cell(&args.cell, args.json);
+    }
     let start = Instant::now();
     let show = !args.quiet && !args.json;
     let opts = load_options(args.no_cache, &args.cache_dir);

@@ -559,3 +559,84 @@ fn compare_table(out: &CompareOut) -> String {
     }
     s
 }
+
+#[derive(Serialize)]
+struct CheckOut {
+    cell: String,
+    board: String,
+    footprints: usize,
+    components: usize,
+    types: usize,
+    bins: [usize; 2],
+    robots: usize,
+    skipped: std::collections::BTreeMap<&'static str, usize>,
+    lower_bound_s: Vec<(String, f64)>,
+}
+
+/// `cellplan check` on a PCB cell: what is placed, what is skipped and why, the bounds.
+pub fn check_cell(path: &Path, json: bool) -> Result<(), Failure> {
+    let cell = load(path)?;
+    let mut skipped = std::collections::BTreeMap::new();
+    let side = cell
+        .components
+        .first()
+        .map_or(cellplan_pcb::board::Side::Front, |c| c.side);
+    let placed: std::collections::HashSet<&str> =
+        cell.components.iter().map(|c| c.reference.as_str()).collect();
+    for c in &cell.board.components {
+        if placed.contains(c.reference.as_str()) {
+            continue;
+        }
+        let why = if c.dnp {
+            "do not populate"
+        } else if c.excluded {
+            "excluded from position files"
+        } else if c.reference.contains('*') {
+            "not annotated"
+        } else if c.side != side {
+            "other side"
+        } else {
+            "mounting or `components` not placed here"
+        };
+        *skipped.entry(why).or_insert(0) += 1;
+    }
+    let mut bounds = Vec::new();
+    for robots in 1..=cell.robots.len() {
+        for conf in Configuration::ALL {
+            if robots == 2 && conf != Configuration::AllMoving {
+                continue;
+            }
+            if let Ok(v) = cell.variant(robots, conf, cell.motion) {
+                bounds.push((
+                    format!("{robots} robot(s), {}", conf.name()),
+                    cellplan_pcb::bound::lower_bound(&v),
+                ));
+            }
+        }
+    }
+    let out = CheckOut {
+        cell: cell.name.clone(),
+        board: cell.board.title.clone(),
+        footprints: cell.board.components.len(),
+        components: cell.len(),
+        types: cell.types.len(),
+        bins: [cell.feeders[0].bins, cell.feeders[1].bins],
+        robots: cell.robots.len(),
+        skipped,
+        lower_bound_s: bounds,
+    };
+    if json {
+        return crate::print_json(&out);
+    }
+    println!(
+        "{} — board {}: {} footprints, {} to place ({} types) with {} robot(s); feeders hold {} + {} bins",
+        out.cell, out.board, out.footprints, out.components, out.types, out.robots, out.bins[0], out.bins[1]
+    );
+    for (why, n) in &out.skipped {
+        println!("  not placed: {n} ({why})");
+    }
+    for (what, lb) in &out.lower_bound_s {
+        println!("  lower bound {lb:.3} s ({what})");
+    }
+    Ok(())
+}

@@ -158,7 +158,7 @@ pub fn lower_bound(cell: &PcbCell) -> f64 {
         let travel = h + 2.0 * sum_m - max_m;
         let lb1 = work + travel / v;
         let lb1 = lb1.max(work + assigned_travel(cell, h) / v);
-        if n > COUPLING_LIMIT || n < 2 {
+        if !(2..=COUPLING_LIMIT).contains(&n) {
             return lb1;
         }
         let vt = cell.table.drive.speed;

@@ -390,3 +390,41 @@ pub fn read(path: &std::path::Path) -> Result<PcbPlan, String> {
 pub fn is_pcb_plan(text: &str) -> bool {
     text.get(..4096).unwrap_or(text).contains(FORMAT)
 }
+
+/// The JSON Schema of the document, as `docs/pcb-plan.schema.json` holds it.
+pub fn schema() -> String {
+    let schema = schemars::schema_for!(PcbPlan);
+    let mut text = serde_json::to_string_pretty(&schema).unwrap_or_default();
+    text.push('\n');
+    text
+}
+
+#[cfg(test)]
+mod tests {
+    use std::path::Path;
+
+    /// `docs/pcb-plan.schema.json` is the schema of these types (regenerate it with
+    /// `CELLPLAN_UPDATE_SCHEMA=1 cargo test -p cellplan-pcb schema`).
+    #[test]
+    fn the_schema_in_docs_is_generated_from_the_types() {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../docs/pcb-plan.schema.json");
+        let generated = super::schema();
+        if std::env::var_os("CELLPLAN_UPDATE_SCHEMA").is_some() {
+            std::fs::write(&path, &generated).unwrap();
+        }
+        let on_disk = std::fs::read_to_string(&path).unwrap_or_default();
+        assert!(
+            on_disk == generated,
+            "docs/pcb-plan.schema.json is not the schema of the document's types; regenerate it with \
+             CELLPLAN_UPDATE_SCHEMA=1 cargo test -p cellplan-pcb schema"
+        );
+        let schema: serde_json::Value = serde_json::from_str(&on_disk).unwrap();
+        let required = schema["required"].as_array().unwrap();
+        for key in ["placements", "devices", "cycle_time_s", "lower_bound_s"] {
+            assert!(
+                required.iter().any(|k| k == key),
+                "{key} not required: {required:?}"
+            );
+        }
+    }
+}

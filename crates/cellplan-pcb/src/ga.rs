@@ -223,8 +223,8 @@ fn crossover(a: &Genome, b: &Genome, rng: &mut ChaCha8Rng) -> Genome {
             })
             .collect();
     let mut fixed = [0.0; 4];
-    for k in 0..4 {
-        fixed[k] = blend(a.fixed[k], b.fixed[k], rng);
+    for (k, slot) in fixed.iter_mut().enumerate() {
+        *slot = blend(a.fixed[k], b.fixed[k], rng);
     }
     Genome {
         order,

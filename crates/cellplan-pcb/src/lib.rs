@@ -13,6 +13,10 @@
 //! - [`search`]: our optimiser;
 //! - [`bound`]: a lower bound on the assembly time;
 //! - [`document`]: the plan document.
+// Input errors carry the file's text for their snippet; they are built once, on the cold path
+// of refusing input.
+#![allow(clippy::result_large_err)]
+
 pub mod board;
 pub mod bound;
 pub mod cell;

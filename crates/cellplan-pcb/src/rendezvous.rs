@@ -75,7 +75,7 @@ impl Rendezvous for Greedy {
         let (rpos, rfree) = now.robot;
         let (fpos, ffree) = now.feeder;
         let off = slot as f64 * feeder.pitch;
-        golden(range[0], range[1], 40, |s| {
+        golden(range[0], range[1], 28, |s| {
             let k = [feeder.x, s + off];
             let at = (rfree + robot.drive.time(model, dist(rpos, k)))
                 .max(ffree + feeder.drive.time(model, s - fpos));
@@ -111,7 +111,7 @@ impl Rendezvous for Greedy {
             (pick_end + robot.drive.time(model, dist(pick, p)))
                 .max(tfree + cell.table.drive.time(model, dist(tpos, t)))
         };
-        let l = golden(0.0, 1.0, 40, |l| cost(at(l)));
+        let l = golden(0.0, 1.0, 28, |l| cost(at(l)));
         at(l)
     }
 }

@@ -469,9 +469,7 @@ fn neighbour(cell: &PcbCell, d: &Decision, rng: &mut ChaCha8Rng, step: &mut [f64
         for c in 0..n {
             let t = cell.type_of[c];
             if two {
-                if lookup[x.robot[c]][t].is_none() {
-                    return None;
-                }
+                lookup[x.robot[c]][t]?;
             } else {
                 x.feeder[c] = if lookup[0][t].is_some() {
                     0
@@ -565,6 +563,29 @@ fn mirrored(cell: &PcbCell, d: &Decision) -> Option<Decision> {
     }
     fix_devices(cell, &mut x, Some([0.5; 4]))?;
     Some(x)
+}
+
+/// The first position of the order from which `b` may simulate differently from `a` (0 when
+/// a fixed device stands elsewhere, since that is part of the start).
+fn first_change(cell: &PcbCell, a: &Decision, b: &Decision) -> usize {
+    let n = a.order.len();
+    if (!cell.configuration.feeders_move() && a.carriage != b.carriage)
+        || (!cell.configuration.table_moves() && a.table != b.table)
+    {
+        return 0;
+    }
+    let (la, lb) = (slot_lookup(cell, a), slot_lookup(cell, b));
+    for k in 0..n {
+        let (ca, cb) = (a.order[k], b.order[k]);
+        if ca != cb || a.feeder[ca] != b.feeder[cb] || a.robot[ca] != b.robot[cb] {
+            return k;
+        }
+        let t = cell.type_of[ca];
+        if la[a.feeder[ca]][t] != lb[b.feeder[cb]][t] {
+            return k;
+        }
+    }
+    n
 }
 
 /// Golden-section line searches on each coordinate of the fixed devices' positions (feeder
@@ -706,6 +727,30 @@ fn chain(
     let span = (search_budget.saturating_sub(start_evals)).max(1) as f64;
     let mut since_best = 0usize;
     let n = cell.len().max(1);
+    // One robot: each candidate is simulated only from the first cycle it changes, from the
+    // state the current decision had there, and only as long as it can still be accepted.
+    let one = cell.robots.len() == 1;
+    let least = if one {
+        crate::sim::least_cycles(cell)
+    } else {
+        Vec::new()
+    };
+    let mut cur_states = vec![crate::sim::blank_state(); cell.len() + 1];
+    let mut scratch = cur_states.clone();
+    if one {
+        let slot_of = slot_lookup(cell, &cur);
+        cur_v = crate::sim::one_robot_from(
+            cell,
+            &cur,
+            &slot_of,
+            &mut Greedy,
+            &mut cur_states,
+            0,
+            f64::INFINITY,
+            &least,
+        )
+        .unwrap_or(cur_v);
+    }
     while evals < search_budget {
         if evals % 64 == 0 && deadline.is_some_and(|d| std::time::Instant::now() > d) {
             hit = true;
@@ -715,15 +760,36 @@ fn chain(
             evals += 1;
             continue;
         };
-        let v = evaluate(cell, &x);
-        evals += 1;
         let progress = (evals - start_evals) as f64 / span;
         let temp = t0 * (1e-4f64).powf(progress);
-        let accept = v <= cur_v + 1e-12 || rng.random::<f64>() < (-(v - cur_v) / temp).exp();
+        let u: f64 = rng.random::<f64>().max(1e-300);
+        // Accepted when v ≤ cur_v, or with probability exp(−(v − cur_v)/T).
+        let threshold = (cur_v - temp * u.ln()).max(cur_v + 1e-12);
+        evals += 1;
+        let value = if one {
+            let from = first_change(cell, &cur, &x);
+            scratch[..=from].copy_from_slice(&cur_states[..=from]);
+            let slot_of = slot_lookup(cell, &x);
+            crate::sim::one_robot_from(
+                cell,
+                &x,
+                &slot_of,
+                &mut Greedy,
+                &mut scratch,
+                from,
+                threshold,
+                &least,
+            )
+        } else {
+            Some(evaluate(cell, &x)).filter(|&v| v <= threshold)
+        };
         since_best += 1;
-        if accept {
+        if let Some(v) = value {
             cur = x;
             cur_v = v;
+            if one {
+                std::mem::swap(&mut cur_states, &mut scratch);
+            }
             if v < best_v - 1e-12 {
                 best = cur.clone();
                 best_v = v;
@@ -738,6 +804,20 @@ fn chain(
             cur = d;
             cur_v = v;
             since_best = 0;
+            if one {
+                let slot_of = slot_lookup(cell, &cur);
+                cur_v = crate::sim::one_robot_from(
+                    cell,
+                    &cur,
+                    &slot_of,
+                    &mut Greedy,
+                    &mut cur_states,
+                    0,
+                    f64::INFINITY,
+                    &least,
+                )
+                .unwrap_or(cur_v);
+            }
             if cur_v < best_v - 1e-12 {
                 best = cur.clone();
                 best_v = cur_v;

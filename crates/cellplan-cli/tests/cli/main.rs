@@ -3,6 +3,7 @@
 mod bench;
 mod check;
 mod gen_tasks;
+mod pcb;
 mod plan;
 mod refusals;
 
