@@ -188,7 +188,12 @@ pub fn plan(args: &PlanArgs) -> Result<(), Failure> {
     let show = !args.quiet && !args.json;
     let pb = crate::spinner(show, &format!("planning {} components", cell.len()));
     let optimizer: Optimizer = args.optimizer.into();
-    let out = run_plan(&cell, optimizer, args.evaluations, args.seed, args.time_limit);
+    let out = match &args.order {
+        Some(file) => {
+            cellplan_pcb::plan::run_given(&cell, &read_order(file, &cell)?, args.evaluations, args.seed)
+        }
+        None => run_plan(&cell, optimizer, args.evaluations, args.seed, args.time_limit),
+    };
     pb.set_message("verifying the plan");
     let verdict = check(&loaded, &out.plan);
     if !verdict.ok && !args.no_verify {
@@ -237,7 +242,11 @@ pub fn plan(args: &PlanArgs) -> Result<(), Failure> {
                 })
                 .collect(),
             configuration: doc.configuration.name(),
-            optimizer: optimizer.name(),
+            optimizer: if args.order.is_some() {
+                "given"
+            } else {
+                optimizer.name()
+            },
             collision_avoidance: doc.collision_avoidance,
             evaluations: doc.evaluations,
             time_limit_hit: out.time_limit_hit,
@@ -254,6 +263,54 @@ pub fn plan(args: &PlanArgs) -> Result<(), Failure> {
         }
     }
     Ok(())
+}
+
+/// Reads a placement order: one reference per line (blank lines and `#` comments skipped; a
+/// CSV's first column). Every component of the cell exactly once.
+fn read_order(path: &Path, cell: &PcbCell) -> Result<Vec<usize>, Failure> {
+    let text = cellplan_model::io::read_bounded(path, 16 << 20).map_err(|e| {
+        InputError::new(path, format!("cannot read the order: {e}"))
+            .hint("give a file of references, one per line")
+    })?;
+    let mut order = Vec::new();
+    let mut seen = vec![false; cell.len()];
+    for (i, line) in text.lines().enumerate() {
+        let r = line.split(',').next().unwrap_or("").trim().trim_matches('"');
+        if r.is_empty() || r.starts_with('#') || (i == 0 && r.eq_ignore_ascii_case("ref")) {
+            continue;
+        }
+        let Some(c) = cell.components.iter().position(|c| c.reference == r) else {
+            return Err(InputError::at_line(
+                path,
+                Some(i + 1),
+                format!("`{r}` is not a component this cell places"),
+            )
+            .hint("list the references `cellplan check` counts as placed, one per line")
+            .into());
+        };
+        if std::mem::replace(&mut seen[c], true) {
+            return Err(
+                InputError::at_line(path, Some(i + 1), format!("`{r}` is listed twice"))
+                    .hint("list every component once")
+                    .into(),
+            );
+        }
+        order.push(c);
+    }
+    if let Some(c) = seen.iter().position(|s| !s) {
+        return Err(InputError::new(
+            path,
+            format!(
+                "the order lists {} of {} components; `{}` (and maybe others) is missing",
+                order.len(),
+                cell.len(),
+                cell.components[c].reference
+            ),
+        )
+        .hint("list every placed component once")
+        .into());
+    }
+    Ok(order)
 }
 
 /// (cycle − bound) / bound.

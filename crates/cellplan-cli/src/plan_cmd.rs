@@ -78,6 +78,10 @@ pub struct PlanArgs {
     /// PCB assembly: motion model (default: the cell's `motion`).
     #[arg(long, value_enum)]
     pub motion: Option<crate::pcb_cmd::MotionArg>,
+    /// PCB assembly: place in this order (a file of references, one per line, e.g. another
+    /// tool's program) and optimise only the rest; the plan's optimiser is then `given`.
+    #[arg(long, value_name = "FILE")]
+    pub order: Option<PathBuf>,
     /// PCB assembly: simulations the optimiser may spend (the work budget).
     #[arg(long, value_name = "N", default_value_t = 200_000)]
     pub evaluations: usize,

@@ -361,10 +361,13 @@ pub fn run(
 
 /// One of the two chains. Chain 1 starts from the mirrored start where there is one (the
 /// feeders' contents exchanged), so that the two explore the two sides a fixed table can take.
-/// With moving feeders, three fifths of the budget go to the same cell with the feeders fixed
-/// first (a simulation there is several times cheaper: no carriage to choose; and a fixed
-/// feeder is one of a moving feeder's options) — chain 1 of an all-moving cell fixes the table
-/// too — and its result starts the search on the real cell.
+/// With moving feeders the chain goes through stages, each a cell with fewer devices moving
+/// (cheaper to simulate — no carriage to choose — and a fixed device is one of a moving one's
+/// options), each stage starting from the last one's result: chain 0 of an all-moving cell
+/// runs moving-table then all-moving, chain 1 all-fixed, moving-feeders, all-moving; a
+/// moving-feeders cell runs all-fixed then moving-feeders. At the end, the previous stage's
+/// plan as it stands (the devices it fixed moving once from home to their spot), polished, is
+/// a candidate too.
 fn staged_chain(
     cell: &PcbCell,
     start: &Decision,
@@ -379,40 +382,58 @@ fn staged_chain(
     } else {
         start.clone()
     };
-    let relaxation = match (cell.configuration, k) {
-        (AllMoving, 0) => Some(MovingTable),
-        (AllMoving, _) | (MovingCds, _) => Some(AllFixed),
-        _ => None,
+    let stages: &[(crate::cell::Configuration, usize)] = match (cell.configuration, k) {
+        (AllMoving, 0) => &[(MovingTable, 60), (AllMoving, 40)],
+        (AllMoving, _) => &[(AllFixed, 40), (MovingCds, 30), (AllMoving, 30)],
+        (MovingCds, _) => &[(AllFixed, 60), (MovingCds, 40)],
+        _ => &[],
     };
-    let Some(relaxed_conf) = relaxation.filter(|_| budget >= 1000) else {
+    if stages.is_empty() || budget < 1000 {
         return chain(cell, &start, budget, seed, deadline);
-    };
-    let mut relaxed = cell.clone();
-    relaxed.configuration = relaxed_conf;
-    let first = budget * 3 / 5;
-    let (d, _, _, hit) = chain(&relaxed, &start, first, seed, deadline);
-    let mut d = d;
-    if hit {
-        record_rendezvous(cell, &mut d);
-        let v = evaluate(cell, &d);
-        return (d, v, vec![(first, v)], hit);
     }
-    let rest = budget - first;
-    let polish_share = rest / 5;
-    let (d2, v2, t2, h2) = chain(cell, &d, rest - polish_share, seed.wrapping_add(1000), deadline);
-    // The relaxed cell's times are not this cell's: its trace is left out.
-    let mut trace: Trace = t2.into_iter().map(|(e, v)| (e + first, v)).collect();
-    // The relaxed plan as it stands (the devices it fixed moving once from home to their
-    // spot) is a plan of this cell too; polished, it sometimes beats the search's.
-    let as_is = simulate(cell, &d, &mut Given(&d), rule(cell)).makespan;
-    if !h2 && as_is < v2 + 0.05 * v2 {
-        let (d3, v3, _) = polish(cell, d, polish_share);
-        if v3 < v2 - 1e-12 {
-            trace.push((budget, v3));
-            return (d3, v3, trace, h2);
+    let mut d = start;
+    let mut spent = 0;
+    let mut trace: Trace = Vec::new();
+    let mut last = (0.0, false);
+    for (i, &(conf, share)) in stages.iter().enumerate() {
+        let mut stage = cell.clone();
+        stage.configuration = conf;
+        let real = i + 1 == stages.len();
+        let mut part = if real {
+            budget - spent
+        } else {
+            budget * share / 100
+        };
+        let polish_share = if real { part / 5 } else { 0 };
+        part -= polish_share;
+        let (d2, v2, t2, hit) = chain(&stage, &d, part, seed.wrapping_add(1000 * i as u64), deadline);
+        if real {
+            // The relaxed stages' times are not this cell's: only this stage's trace is kept.
+            trace = t2.into_iter().map(|(e, v)| (e + spent, v)).collect();
+        }
+        spent += part;
+        if hit {
+            let mut d2 = d2;
+            if !real {
+                record_rendezvous(cell, &mut d2);
+            }
+            let v = evaluate(cell, &d2);
+            return (d2, v, vec![(spent, v)], true);
+        }
+        let prev = std::mem::replace(&mut d, d2);
+        last = (v2, false);
+        if real {
+            let as_is = simulate(cell, &prev, &mut Given(&prev), rule(cell)).makespan;
+            if as_is < v2 * 1.05 {
+                let (d3, v3, _) = polish(cell, prev, polish_share);
+                if v3 < v2 - 1e-12 {
+                    trace.push((budget, v3));
+                    return (d3, v3, trace, false);
+                }
+            }
         }
     }
-    (d2, v2, trace, h2)
+    (d, last.0, trace, last.1)
 }
 
 /// Moves of the local search.
@@ -901,33 +922,15 @@ pub fn polish(cell: &PcbCell, mut d: Decision, budget: usize) -> (Decision, f64,
     (d, best, spent)
 }
 
-#[cfg(test)]
-mod debug_tests {
-    use super::*;
-    #[test]
-    #[ignore]
-    fn debug_fixed() {
-        let cell = crate::cell::load(std::path::Path::new("../../examples/pcb-bitsy-1r/cell.toml")).unwrap();
-        let fixed = cell
-            .variant(1, crate::cell::Configuration::AllFixed, cell.motion)
-            .unwrap();
-        let mcds = cell
-            .variant(1, crate::cell::Configuration::MovingCds, cell.motion)
-            .unwrap();
-        let (d, v, _, _) = run(
-            &fixed,
-            &SearchSettings {
-                evaluations: 100_000,
-                seed: 0,
-                deadline: None,
-            },
-            None,
-        );
-        eprintln!("all-fixed {v}");
-        let given = simulate(&mcds, &d, &mut Given(&d), rule(&mcds)).makespan;
-        let greedy = evaluate(&mcds, &d);
-        eprintln!("as moving-cds: given {given}, greedy {greedy}");
-        let (_, p, _) = polish(&mcds, d.clone(), 20000);
-        eprintln!("polished {p}");
-    }
+/// A decision with the order given and everything else ours (bins, robots by board side, fixed
+/// positions tuned, meetings by our rule then polished within `budget` simulations): what
+/// `cellplan plan --order` evaluates, e.g. a placement order from another tool.
+pub fn settle_order(cell: &PcbCell, order: &[usize], budget: usize) -> (Decision, f64) {
+    let mut d = initial(cell);
+    d.order = order.to_vec();
+    let _ = fix_devices(cell, &mut d, None);
+    let (mut d, _, spent) = tune_fixed(cell, d, 2);
+    record_rendezvous(cell, &mut d);
+    let (d, v, _) = polish(cell, d, budget.saturating_sub(spent));
+    (d, v)
 }
