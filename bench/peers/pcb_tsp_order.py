@@ -48,6 +48,8 @@ def main():
             for j in range(n):
                 m[i][j] = int(round(1e6 * math.dist(pos[i], pos[j])))
         tour = elkai.DistanceMatrix(m).solve_tsp()
+        if len(tour) > 1 and tour[0] == tour[-1]:
+            tour = tour[:-1]  # elkai closes the tour
         k = tour.index(n)
         path = [t for t in tour[k + 1:] + tour[:k] if t != n]
         order_file = os.path.join(tmp, "order.txt")
