@@ -88,9 +88,10 @@ fn assigned_travel(cell: &PcbCell, h: f64) -> f64 {
         if lo > hi {
             return 0.0;
         }
+        // 0.1 mm steps, but no more than about 2·10⁷ component visits in all.
         let step = 1e-4;
         let k = ((hi - lo) / step).ceil().max(1.0) as usize;
-        let k = k.min(200_000);
+        let k = k.min(20_000_000 / n.max(1)).clamp(1, 200_000);
         let step = (hi - lo) / k as f64;
         let mut best = f64::INFINITY;
         for i in 0..=k {
@@ -197,6 +198,66 @@ pub fn lower_bound(cell: &PcbCell) -> f64 {
         let busy = (work + (2.0 * sum_m - 2.0 * max_m + h).max(0.0) / v) / 2.0;
         let first = pk + pl + (h + m.iter().copied().fold(f64::INFINITY, f64::min)) / v;
         let serial = first + (n as f64 - 1.0) * pl;
-        busy.max(serial)
+        busy.max(serial).max(two_robot_split(cell))
     }
+}
+
+/// Two robots: the longer robot's busy time under the best fractional split of the components.
+/// Robot `r` spends at least `pick + place + 2·a_jr/v_r` on component `j` (both its legs run
+/// between its own feeder's line and the place point, at least `a_jr` apart in X), less its
+/// longest such leg once (its last placement needs no return); the LP relaxation of "assign
+/// each component to one robot, minimise the larger busy time" is a fractional knapsack,
+/// solved exactly by taking components in order of `c_j0 / c_j1`.
+fn two_robot_split(cell: &PcbCell) -> f64 {
+    let n = cell.len();
+    let (pk, pl) = (cell.pick_time, cell.place_time);
+    let cost = |r: usize, c: usize| -> Option<(f64, f64)> {
+        let bx = cell.place_box(r, c)?;
+        let b = cell.components[c].position[0];
+        let (lo, hi) = (bx[0][0] + b, bx[0][1] + b);
+        let x = cell.feeders[r].x;
+        let a = if x < lo { lo - x } else if x > hi { x - hi } else { 0.0 };
+        let v = cell.robots[r].drive.speed;
+        Some((pk + pl + 2.0 * a / v, a / v))
+    };
+    let mut items: Vec<(f64, f64)> = Vec::with_capacity(n);
+    let (mut fixed0, mut fixed1) = (0.0, 0.0);
+    let mut longest = [0.0f64; 2];
+    for c in 0..n {
+        match (cost(0, c), cost(1, c)) {
+            (Some(a), Some(b)) => {
+                items.push((a.0, b.0));
+                longest[0] = longest[0].max(a.1);
+                longest[1] = longest[1].max(b.1);
+            }
+            (Some(a), None) => {
+                fixed0 += a.0;
+                longest[0] = longest[0].max(a.1);
+            }
+            (None, Some(b)) => {
+                fixed1 += b.0;
+                longest[1] = longest[1].max(b.1);
+            }
+            (None, None) => {}
+        }
+    }
+    items.sort_by(|x, y| (x.0 / x.1).total_cmp(&(y.0 / y.1)));
+    // Robot 0 takes a prefix (the last item in part); find where the two busy times meet.
+    let total1: f64 = items.iter().map(|i| i.1).sum();
+    let (m0, m1) = (longest[0], longest[1]);
+    let mut a = fixed0 - m0;
+    let mut b = fixed1 + total1 - m1;
+    if a >= b {
+        return a.max(0.0);
+    }
+    for &(c0, c1) in &items {
+        if a + c0 >= b - c1 {
+            // Split this item: a + f·c0 = b − f·c1.
+            let f = (b - a) / (c0 + c1);
+            return (a + f * c0).max(0.0);
+        }
+        a += c0;
+        b -= c1;
+    }
+    a.max(b).max(0.0)
 }
