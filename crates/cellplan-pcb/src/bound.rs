@@ -216,7 +216,13 @@ fn two_robot_split(cell: &PcbCell) -> f64 {
         let b = cell.components[c].position[0];
         let (lo, hi) = (bx[0][0] + b, bx[0][1] + b);
         let x = cell.feeders[r].x;
-        let a = if x < lo { lo - x } else if x > hi { x - hi } else { 0.0 };
+        let a = if x < lo {
+            lo - x
+        } else if x > hi {
+            x - hi
+        } else {
+            0.0
+        };
         let v = cell.robots[r].drive.speed;
         Some((pk + pl + 2.0 * a / v, a / v))
     };
