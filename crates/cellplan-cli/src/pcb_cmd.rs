@@ -146,15 +146,9 @@ pub fn run_plan(
     )
 }
 
-/// The verifier's verdict on a plan made with the cell's collision setting.
+/// The verifier's verdict on a plan, robot–robot gap included.
 pub fn check(cell: &PcbCell, plan: &PcbPlan) -> PcbReport {
-    verify_pcb(
-        cell,
-        plan,
-        &PcbVerifySettings {
-            robot_robot: plan.collision_avoidance || plan.robots.len() < 2,
-        },
-    )
+    verify_pcb(cell, plan, &PcbVerifySettings::default())
 }
 
 /// `cellplan plan` on a PCB cell.
@@ -396,7 +390,8 @@ pub fn describe(v: &cellplan_verify::pcb::PcbViolation) -> String {
 }
 
 /// `cellplan verify` on a PCB plan.
-pub fn verify(plan_path: &Path, cell_path: &Path, json: bool) -> Result<(), Failure> {
+/// (`robot_robot` false: crossings are counted, not refused.)
+pub fn verify(plan_path: &Path, cell_path: &Path, json: bool, robot_robot: bool) -> Result<(), Failure> {
     let cell = load(cell_path)?;
     let plan = cellplan_pcb::document::read(plan_path).map_err(|e| {
         Failure::Input(Box::new(
@@ -404,7 +399,7 @@ pub fn verify(plan_path: &Path, cell_path: &Path, json: bool) -> Result<(), Fail
                 .hint("give a plan.json that `cellplan plan` wrote for this PCB cell"),
         ))
     })?;
-    let report = check(&cell, &plan);
+    let report = verify_pcb(&cell, &plan, &PcbVerifySettings { robot_robot });
     if json {
         crate::print_json(&report)?;
     } else {
@@ -419,7 +414,7 @@ pub fn verify(plan_path: &Path, cell_path: &Path, json: bool) -> Result<(), Fail
             report.lower_bound_s,
             if report.crossings > 0 && report.ok {
                 format!(
-                    "; {} robot crossing(s) — collision avoidance was off",
+                    "; {} robot crossing(s), not checked (--no-robot-robot)",
                     report.crossings
                 )
             } else {
@@ -527,8 +522,10 @@ pub fn compare(args: &crate::compare_cmd::CompareArgs) -> Result<(), Failure> {
                 args.evaluations
             };
             let out = run_plan(&cell, optimizer, evals, args.seed, None);
+            // The no-avoidance runs are checked against their own cell (avoidance off), with
+            // crossings counted rather than refused.
             let verdict = verify_pcb(
-                &base,
+                &cell,
                 &out.plan,
                 &PcbVerifySettings {
                     robot_robot: robots < 2 || avoid,

@@ -24,7 +24,7 @@ pub struct VerifyArgs {
 
 pub fn run(args: &VerifyArgs) -> Result<(), Failure> {
     if crate::pcb_cmd::is_pcb(&args.cell)? {
-        return crate::pcb_cmd::verify(&args.plan, &args.cell, args.json);
+        return crate::pcb_cmd::verify(&args.plan, &args.cell, args.json, !args.no_robot_robot);
     }
     if !(args.time_step.is_finite() && (1e-4..=1.0).contains(&args.time_step)) {
         return Err(Failure::Usage(format!(

@@ -14,11 +14,12 @@
 //! is larger.
 use crate::cell::PcbCell;
 
-/// The robot's travel with each type in one feeder: the leg from a pick to its placement is at
-/// least the X distance from that type's feeder line to the place point (`a`), the leg from a
-/// placement to the next pick at least the distance to the nearer line (`m`), and the types go
-/// to the feeders by the cheapest assignment the bin counts allow (exact for two feeders: the
-/// types that gain most from feeder 2 go there). With a fixed table, the table position is one
+/// The robot's travel with the types in the feeders: the leg from a pick to its placement is at
+/// least the X distance from the feeder line it picks at to the place point (`a`), the leg from a
+/// placement to the next pick at least the distance to the nearer line (`m`). With the bins the
+/// cell gives, each type's feeders are known; otherwise the types go to the feeders by the
+/// cheapest assignment the bin counts allow (exact for two feeders: the types that gain most
+/// from feeder 2 go there), less what spare bins could save by holding a type in both feeders. With a fixed table, the table position is one
 /// for all placements: the bound is the least over its X (scanned at 0.1 mm, less the most the
 /// travel can fall between two scanned points).
 fn assigned_travel(cell: &PcbCell, h: f64) -> f64 {
@@ -39,6 +40,8 @@ fn assigned_travel(cell: &PcbCell, h: f64) -> f64 {
         let mut m_sum = 0.0;
         let mut m_max = 0.0f64;
         let mut cost = vec![[0.0f64; 2]; nt];
+        // A type in both feeders lets each of its components use the nearer one.
+        let mut both = vec![0.0f64; nt];
         for c in 0..n {
             let r = ranges(c)?;
             let a = [dist_to(r[0], r[1], xf[0]), dist_to(r[0], r[1], xf[1])];
@@ -48,24 +51,52 @@ fn assigned_travel(cell: &PcbCell, h: f64) -> f64 {
             let t = cell.type_of[c];
             cost[t][0] += a[0];
             cost[t][1] += a[1];
+            both[t] += m;
         }
-        // Capacitated assignment of the types to the two feeders.
-        let (cap0, cap1) = (cell.feeders[0].bins, cell.feeders[1].bins);
-        let mut gain: Vec<f64> = cost.iter().map(|c| c[1] - c[0]).collect();
-        gain.sort_by(f64::total_cmp);
-        let base: f64 = cost.iter().map(|c| c[0]).sum();
-        let least_in_1 = nt.saturating_sub(cap0);
-        let most_in_1 = cap1.min(nt);
-        let mut best = f64::INFINITY;
-        let mut acc = 0.0;
-        for k in 0..=most_in_1 {
-            if k > 0 {
-                acc += gain[k - 1];
+        let best = if !cell.given_bins.is_empty() {
+            // The cell fixes the bins: each type's feeders are known.
+            let mut in_feeder = vec![[false; 2]; nt];
+            for b in &cell.given_bins {
+                in_feeder[b.kind][b.feeder] = true;
             }
-            if k >= least_in_1 {
-                best = best.min(base + acc);
+            (0..nt)
+                .map(|t| match in_feeder[t] {
+                    [true, true] => both[t],
+                    [true, false] => cost[t][0],
+                    [false, true] => cost[t][1],
+                    [false, false] => 0.0,
+                })
+                .sum()
+        } else {
+            // Capacitated assignment of the types to the two feeders, one bin each.
+            let (cap0, cap1) = (cell.feeders[0].bins, cell.feeders[1].bins);
+            let mut gain: Vec<f64> = cost.iter().map(|c| c[1] - c[0]).collect();
+            gain.sort_by(f64::total_cmp);
+            let base: f64 = cost.iter().map(|c| c[0]).sum();
+            let least_in_1 = nt.saturating_sub(cap0);
+            let most_in_1 = cap1.min(nt);
+            let mut single = f64::INFINITY;
+            let mut acc = 0.0;
+            for k in 0..=most_in_1 {
+                if k > 0 {
+                    acc += gain[k - 1];
+                }
+                if k >= least_in_1 {
+                    single = single.min(base + acc);
+                }
             }
-        }
+            // Spare bins may hold a type twice, once in each feeder: a plan with doubled types
+            // D becomes one with single types by keeping each doubled type in its cheaper feeder
+            // (no feeder gets fuller), at an extra cost of that type's gain from doubling. So
+            // no plan beats the single assignment by more than the `spare` largest gains.
+            let spare = (cap0 + cap1).saturating_sub(nt);
+            let mut gains: Vec<f64> = (0..nt)
+                .map(|t| (cost[t][0].min(cost[t][1]) - both[t]).max(0.0))
+                .collect();
+            gains.sort_by(|a, b| b.total_cmp(a));
+            let saved: f64 = gains.iter().take(spare).sum();
+            (single - saved).max(0.0)
+        };
         Some(h + m_sum - m_max + best)
     };
     let robot = &cell.robots[0];

@@ -2,7 +2,8 @@
 //! for one robot a sequencing sub-genome, two CDS-allocation sub-genomes (here one permutation
 //! of the types and empty bins over the bins of both feeders, cut in two) and a rendezvous
 //! sub-genome; for two robots a sequencing sub-genome, the robot assignment and the rendezvous
-//! sub-genome (bins as the cell gives them, or every type in both feeders) — scored by the
+//! sub-genome (bins as the cell gives them; else every type in both feeders where they have the
+//! bins, or the types split by board side) — scored by the
 //! assembly time of the cycle-time model, with the safety delays of the paper's collision rule
 //! inside the fitness.
 //!
@@ -80,7 +81,7 @@ pub fn run(cell: &PcbCell, settings: &GaSettings) -> (Decision, f64, Trace, bool
         if evolve_bins {
             shuffle(&mut alloc, rng);
         }
-        let robot = (0..n).map(|_| rng.random_range(0..cell.robots.len())).collect();
+        let robot = (0..n).map(|_| rng.random_range(0..2)).collect();
         let rv = (0..n)
             .map(|_| [rng.random(), rng.random(), rng.random()])
             .collect();
@@ -129,13 +130,7 @@ pub fn run(cell: &PcbCell, settings: &GaSettings) -> (Decision, f64, Trace, bool
             } else {
                 pa.clone()
             };
-            mutate(
-                &mut child,
-                settings.mutation,
-                evolve_bins,
-                cell.robots.len(),
-                &mut rng,
-            );
+            mutate(&mut child, settings.mutation, evolve_bins, &mut rng);
             next.push(child);
         }
         let new_fit: Vec<f64> = next[2..].par_iter().map(fitness).collect();
@@ -235,7 +230,7 @@ fn crossover(a: &Genome, b: &Genome, rng: &mut ChaCha8Rng) -> Genome {
     }
 }
 
-fn mutate(g: &mut Genome, p: f64, evolve_bins: bool, robots: usize, rng: &mut ChaCha8Rng) {
+fn mutate(g: &mut Genome, p: f64, evolve_bins: bool, rng: &mut ChaCha8Rng) {
     let n = g.order.len();
     if n >= 2 && rng.random::<f64>() < p {
         let i = rng.random_range(0..n);
@@ -251,7 +246,7 @@ fn mutate(g: &mut Genome, p: f64, evolve_bins: bool, robots: usize, rng: &mut Ch
         let j = rng.random_range(0..g.alloc.len());
         g.alloc.swap(i, j);
     }
-    if robots == 2 && n > 0 && rng.random::<f64>() < p {
+    if n > 0 && rng.random::<f64>() < p {
         let i = rng.random_range(0..n);
         g.robot[i] = 1 - g.robot[i];
     }
@@ -307,7 +302,13 @@ fn decode(cell: &PcbCell, g: &Genome, evolve_bins: bool, base: &[Vec<Option<usiz
     for c in 0..n {
         let t = cell.type_of[c];
         let (r, f) = if cell.robots.len() == 1 {
-            (0, if lookup[0][t].is_some() { 0 } else { 1 })
+            // The robot gene chooses the feeder where both hold the type.
+            let f = match (lookup[0][t].is_some(), lookup[1][t].is_some()) {
+                (true, true) => g.robot[c],
+                (false, true) => 1,
+                _ => 0,
+            };
+            (0, f)
         } else {
             // The robot gene, repaired where that robot cannot do it.
             let want = g.robot[c];

@@ -226,6 +226,28 @@ fn board_tour(cell: &PcbCell, members: &[usize]) -> Vec<usize> {
     tour
 }
 
+/// One robot: the feeder to pick component `c` from — the one holding its type, or of the two
+/// that both do, the one whose pick line is nearer to where it can be placed.
+pub fn nearer_feeder(cell: &PcbCell, lookup: &[Vec<Option<usize>>; 2], c: usize) -> usize {
+    let t = cell.type_of[c];
+    match (lookup[0][t].is_some(), lookup[1][t].is_some()) {
+        (true, true) => nearer_feeder_of_two(cell, c),
+        (false, true) => 1,
+        _ => 0,
+    }
+}
+
+/// The feeder whose pick line is nearer to the middle of where component `c` can be placed.
+fn nearer_feeder_of_two(cell: &PcbCell, c: usize) -> usize {
+    let b = cell.components[c].position[0];
+    let x = 0.5 * (cell.table.x[0] + cell.table.x[1]) + b;
+    if (cell.feeders[0].x - x).abs() <= (cell.feeders[1].x - x).abs() {
+        0
+    } else {
+        1
+    }
+}
+
 /// Our starting decision.
 pub fn initial(cell: &PcbCell) -> Decision {
     let n = cell.len();
@@ -241,11 +263,7 @@ pub fn initial(cell: &PcbCell) -> Decision {
     let lookup = slot_lookup(cell, &d);
     if cell.robots.len() == 1 {
         for c in 0..n {
-            d.feeder[c] = if lookup[0][cell.type_of[c]].is_some() {
-                0
-            } else {
-                1
-            };
+            d.feeder[c] = nearer_feeder(cell, &lookup, c);
         }
         d.order = board_tour(cell, &(0..n).collect::<Vec<_>>());
     } else {
@@ -257,7 +275,14 @@ pub fn initial(cell: &PcbCell) -> Decision {
                 .then(a.cmp(&b))
         });
         for (k, &c) in by_x.iter().enumerate() {
-            let want = if k < n / 2 { 0 } else { 1 };
+            // (One component: the robot whose feeder is nearer.)
+            let want = if n == 1 {
+                nearer_feeder_of_two(cell, c)
+            } else if k < n / 2 {
+                0
+            } else {
+                1
+            };
             let r = if robot_can(cell, &lookup, want, c) {
                 want
             } else {
@@ -453,9 +478,11 @@ fn neighbour(cell: &PcbCell, d: &Decision, rng: &mut ChaCha8Rng, step: &mut [f64
             rng.random_range(0..n)
         }
     };
-    if n < 2 {
+    if n == 0 || (n < 2 && !two) {
         return None;
     }
+    // One component of two robots: only a change of robot is a move.
+    let roll = if n < 2 { 0.86 } else { roll };
     if roll < 0.35 {
         let i = rng.random_range(0..n);
         let j = near(rng, i);
@@ -508,7 +535,7 @@ fn neighbour(cell: &PcbCell, d: &Decision, rng: &mut ChaCha8Rng, step: &mut [f64
                 cell.pick_range(0, x.feeder[c], slot)?;
             }
         }
-    } else if roll < 0.9 && two && !(fixed && roll >= 0.85) {
+    } else if roll < 0.9 && two && !(fixed && roll >= 0.85 && n >= 2) {
         let c = rng.random_range(0..n);
         let lookup = slot_lookup(cell, &x);
         let r = 1 - x.robot[c];
@@ -517,6 +544,14 @@ fn neighbour(cell: &PcbCell, d: &Decision, rng: &mut ChaCha8Rng, step: &mut [f64
         }
         x.robot[c] = r;
         x.feeder[c] = r;
+    } else if roll < 0.9 && !two && !(fixed && roll >= 0.85) {
+        // One robot: a component whose type both feeders hold picks from the other one.
+        let c = rng.random_range(0..n);
+        let lookup = slot_lookup(cell, &x);
+        let f = 1 - x.feeder[c];
+        let slot = lookup[f][cell.type_of[c]]?;
+        cell.pick_range(0, f, slot)?;
+        x.feeder[c] = f;
     } else if fixed {
         // Move a fixed device: a small step, or anywhere in its travel (the time is far from
         // unimodal in a fixed position while order and bins follow the old one).

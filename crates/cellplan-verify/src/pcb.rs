@@ -217,6 +217,19 @@ pub fn verify_pcb(cell: &PcbCell, plan: &PcbPlan, settings: &PcbVerifySettings) 
             format!("process `{}` is not `pcb-assembly`", plan.process),
         ));
     }
+    if cell.robots.len() == 2 && plan.collision_avoidance != cell.collision_avoidance {
+        out.push(v(
+            PcbViolationKind::Format,
+            None,
+            None,
+            None,
+            format!(
+                "the plan says collision avoidance {}, the cell {}",
+                if plan.collision_avoidance { "on" } else { "off" },
+                if cell.collision_avoidance { "on" } else { "off" }
+            ),
+        ));
+    }
     if plan.cell != cell.name {
         out.push(v(
             PcbViolationKind::Format,
@@ -345,6 +358,28 @@ pub fn verify_pcb(cell: &PcbCell, plan: &PcbPlan, settings: &PcbVerifySettings) 
             ));
         }
     }
+    if !cell.given_bins.is_empty() {
+        let given: std::collections::HashSet<(usize, usize, usize)> = cell
+            .given_bins
+            .iter()
+            .map(|g| (g.feeder, g.slot, g.kind))
+            .collect();
+        let stated: std::collections::HashSet<(usize, usize, usize)> =
+            bin_type.iter().map(|(&(f, b), &t)| (f, b, t)).collect();
+        if given != stated {
+            out.push(v(
+                PcbViolationKind::Bin,
+                None,
+                None,
+                None,
+                format!(
+                    "the plan's bins ({}) are not the {} the cell gives",
+                    stated.len(),
+                    given.len()
+                ),
+            ));
+        }
+    }
     // Placements.
     let mut placed: HashMap<&str, usize> = HashMap::new();
     let mut events: HashMap<&str, Vec<(f64, f64, bool, &str)>> = HashMap::new();
@@ -404,6 +439,15 @@ pub fn verify_pcb(cell: &PcbCell, plan: &PcbPlan, settings: &PcbVerifySettings) 
         let feeder = &replays[p.feeder.as_str()];
         let table = &replays["table"];
         let fd = &cell.feeders[f];
+        if p.pick.t[0] < -TIME_TOL || p.place.t[0] < -TIME_TOL {
+            out.push(v(
+                PcbViolationKind::Sequence,
+                Some(&p.robot),
+                who,
+                Some(p.pick.t[0].min(p.place.t[0])),
+                "an event before time 0".into(),
+            ));
+        }
         // The pick.
         if p.pick.t[1] - p.pick.t[0] < cell.pick_time - TIME_TOL || !p.pick.t.iter().all(|t| t.is_finite()) {
             out.push(v(
@@ -554,6 +598,29 @@ pub fn verify_pcb(cell: &PcbCell, plan: &PcbPlan, settings: &PcbVerifySettings) 
                 None,
                 format!("placed {k} times"),
             )),
+        }
+    }
+    // One placement at a time (paper 004 §2.1.2: the components are placed one after the other,
+    // on the one table).
+    let mut places: Vec<(f64, f64, &str)> = plan
+        .placements
+        .iter()
+        .map(|p| (p.place.t[0], p.place.t[1], p.component.as_str()))
+        .collect();
+    places.sort_by(|a, b| a.0.total_cmp(&b.0));
+    for w in places.windows(2) {
+        if w[1].0 < w[0].1 - TIME_TOL {
+            out.push(v(
+                PcbViolationKind::Place,
+                None,
+                Some(w[1].2),
+                Some(w[1].0),
+                format!(
+                    "placed while {} is still being placed (one placement at a time)",
+                    w[0].2
+                ),
+            ));
+            break;
         }
     }
     // One nozzle: each robot's events alternate pick, place of the same component.
@@ -749,6 +816,16 @@ fn check_device(cell: &PcbCell, dev: &DeviceOut, drive: Drive, out: &mut Vec<Pcb
     let mut free = 0.0f64;
     for m in &dev.moves {
         let t0 = m.t[0];
+        if t0 < -TIME_TOL {
+            out.push(v(
+                PcbViolationKind::Motion,
+                name,
+                None,
+                Some(t0),
+                "a move before time 0".into(),
+            ));
+            return;
+        }
         if !(m.t[0].is_finite() && m.t[1].is_finite()) || t0 < free - TIME_TOL {
             out.push(v(
                 PcbViolationKind::Motion,

@@ -166,6 +166,61 @@ fn faults_injected_into_a_plan_are_caught() {
             "{name}: expected {kind:?}, found {found:?}"
         );
     }
+    // Every time shifted before 0.
+    let mut p = good.clone();
+    for d in &mut p.devices {
+        for m in &mut d.moves {
+            m.t = [m.t[0] - 0.05, m.t[1] - 0.05];
+        }
+    }
+    for pl in &mut p.placements {
+        pl.pick.t = [pl.pick.t[0] - 0.05, pl.pick.t[1] - 0.05];
+        pl.place.t = [pl.place.t[0] - 0.05, pl.place.t[1] - 0.05];
+    }
+    let found = verify_pcb(&base, &p, &PcbVerifySettings::default()).violations;
+    assert!(
+        found.iter().any(|v| v.detail.contains("before time 0")),
+        "{found:?}"
+    );
+    // A plan claiming collision avoidance off on a cell that has it on.
+    let mut p = good.clone();
+    p.collision_avoidance = false;
+    assert!(kinds(&base, &p).contains(&PcbViolationKind::Format));
+    // Two placements at once (the paper places one after the other, on the one table).
+    let mut p = good.clone();
+    let k = (1..p.placements.len())
+        .find(|&k| p.placements[k].robot != p.placements[k - 1].robot)
+        .unwrap();
+    p.placements[k].place.t = p.placements[k - 1].place.t;
+    let found = verify_pcb(&base, &p, &PcbVerifySettings::default()).violations;
+    assert!(
+        found.iter().any(|v| v.detail.contains("one placement at a time")),
+        "{found:?}"
+    );
+    // Bins the cell fixes: a plan may not stock others.
+    let mut given = base.clone();
+    for b in &good.bins {
+        let feeder = given.feeders.iter().position(|f| f.name == b.feeder).unwrap();
+        let kind = given
+            .types
+            .iter()
+            .position(|t| t.footprint == b.footprint && t.value == b.value)
+            .unwrap();
+        given.given_bins.push(cellplan_pcb::cell::GivenBin {
+            feeder,
+            slot: b.bin,
+            kind,
+        });
+    }
+    let mut p = good.clone();
+    p.lower_bound_s = cellplan_pcb::bound::lower_bound(&given);
+    assert!(kinds(&given, &p).is_empty(), "{:?}", kinds(&given, &p));
+    let mut extra = p.bins[0].clone();
+    extra.bin = (0..4)
+        .find(|b| !p.bins.iter().any(|x| x.feeder == extra.feeder && x.bin == *b))
+        .unwrap();
+    p.bins.push(extra);
+    assert!(kinds(&given, &p).contains(&PcbViolationKind::Bin));
     // A fixed table that moves.
     let fixed = base.variant(1, Configuration::AllFixed, base.motion).unwrap();
     let mut p = plan(&fixed, Optimizer::Best, 2000, 0);
@@ -256,6 +311,29 @@ fn safety_delays_of_both_rules_keep_the_gap_exactly_on_random_schedules() {
             let doc = build(&cell, &d, &s, &info);
             let r = verify_pcb(&cell, &doc, &PcbVerifySettings::default());
             assert!(r.ok, "seed {seed} {rule:?}: {:?}", r.violations);
+        }
+    }
+}
+
+#[test]
+fn the_bound_holds_when_a_type_is_in_both_feeders() {
+    // One robot, a fixed table: two types stocked in both feeders, components near each
+    // feeder; picking each component from the nearer feeder beats any one-feeder-per-type plan.
+    for seed in 0..8 {
+        let mut cell = cellplan_pcb::testing::random_cell(12, 2, 1, Configuration::AllFixed, seed);
+        for (feeder, slot, kind) in [(0, 3, 0), (0, 5, 1), (1, 3, 0), (1, 5, 1)] {
+            cell.given_bins
+                .push(cellplan_pcb::cell::GivenBin { feeder, slot, kind });
+        }
+        for optimizer in [Optimizer::Ga, Optimizer::Best] {
+            let p = plan(&cell, optimizer, 4000, seed);
+            let r = verify_pcb(&cell, &p, &PcbVerifySettings::default());
+            assert!(r.ok, "seed {seed} {optimizer:?}: {:?}", r.violations);
+            assert!(r.lower_bound_s <= p.cycle_time_s + 1e-9);
+            // Both feeders are used for one type somewhere (the nearer one per component).
+            let used: std::collections::HashSet<&str> =
+                p.placements.iter().map(|x| x.feeder.as_str()).collect();
+            assert_eq!(used.len(), 2, "seed {seed} {optimizer:?}");
         }
     }
 }
