@@ -171,14 +171,14 @@ fn x_time_svg(plan: &PcbPlan, cell: &PcbCell) -> String {
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), (_, r)| {
             (a.min(r.x_given[0]), b.max(r.x_given[1]))
         });
-    let (w, h, l, top) = (900.0, 320.0, 60.0, 20.0);
+    let (w, h, l, top) = (900.0, 330.0, 60.0, 30.0);
     let tx = |t: f64| l + t / t_end * (w - l - 20.0);
     let xy = |x: f64| top + (1.0 - (x - xmin) / (xmax - xmin).max(1e-9)) * (h - top - 40.0);
     let mut s = format!(
         "<svg xmlns=\"http://www.w3.org/2000/svg\" id=\"x-time\" viewBox=\"0 0 {w} {h}\" width=\"{w}\" height=\"{h}\">\
          <line x1=\"{l}\" y1=\"{:.1}\" x2=\"{:.1}\" y2=\"{:.1}\" stroke=\"#888\"/>\
          <text x=\"{:.1}\" y=\"{:.1}\" font-size=\"11\">time (s), assembly ends at {:.3} s</text>\
-         <text x=\"4\" y=\"{top}\" font-size=\"11\">X (mm)</text>",
+         <text x=\"4\" y=\"12\" font-size=\"11\">X (mm)</text>",
         h - 40.0,
         w - 20.0,
         h - 40.0,
