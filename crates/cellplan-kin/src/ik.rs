@@ -36,8 +36,9 @@ pub fn limit_variants(q: &[f64], chain: &Chain, out: &mut Vec<Vec<f64>>) {
     if q.len() != n {
         return;
     }
-    // Per joint: the smallest admissible value and how many turns fit above it.
-    let mut ranges: Vec<(f64, usize)> = Vec::with_capacity(n);
+    // Per joint: the value, the first admissible number of turns and how many fit. A variant is
+    // `v + k·2π` in one step, so that k = 0 gives `v` itself, bit for bit.
+    let mut ranges: Vec<(f64, f64, usize)> = Vec::with_capacity(n);
     for (joint, &v) in chain.joints.iter().zip(q) {
         if !v.is_finite() {
             return;
@@ -53,12 +54,12 @@ pub fn limit_variants(q: &[f64], chain: &Chain, out: &mut Vec<Vec<f64>>) {
                 return;
             }
             // Both are small integers (|k| ≤ MAX_TURNS + 1).
-            ranges.push((v + k_lo * TAU, (k_hi - k_lo) as usize + 1));
+            ranges.push((v, k_lo, (k_hi - k_lo) as usize + 1));
         } else {
             if !(v >= lo && v <= hi) {
                 return;
             }
-            ranges.push((v, 1));
+            ranges.push((v, 0.0, 1));
         }
     }
     let mut idx = vec![0usize; n];
@@ -68,7 +69,9 @@ pub fn limit_variants(q: &[f64], chain: &Chain, out: &mut Vec<Vec<f64>>) {
             .iter()
             .zip(&ranges)
             .zip(&idx)
-            .map(|((joint, &(first, _)), &i)| (first + i as f64 * TAU).min(joint.upper).max(joint.lower))
+            .map(|((joint, &(v, k_lo, _)), &i)| {
+                (v + (k_lo + i as f64) * TAU).min(joint.upper).max(joint.lower)
+            })
             .collect();
         out.push(variant);
         // Odometer increment, last joint fastest.
@@ -79,7 +82,7 @@ pub fn limit_variants(q: &[f64], chain: &Chain, out: &mut Vec<Vec<f64>>) {
             }
             j -= 1;
             idx[j] += 1;
-            if idx[j] < ranges[j].1 {
+            if idx[j] < ranges[j].2 {
                 break;
             }
             idx[j] = 0;

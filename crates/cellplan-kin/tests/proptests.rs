@@ -112,3 +112,15 @@ proptest! {
         }
     }
 }
+
+/// The case proptest found: a configuration within the limits must come back bit for bit among
+/// its variants (it did not when a variant was built as `(v − 2π) + 2π`).
+#[test]
+fn a_configuration_within_the_limits_is_its_own_variant() {
+    let chain = &fanuc().0.chain;
+    let q = [0.0, 0.0, 0.0, 0.10204323909409894, 0.0, 0.0];
+    assert!(chain.within_limits(&q, 0.0));
+    let mut out = Vec::new();
+    limit_variants(&q, chain, &mut out);
+    assert!(out.iter().any(|v| v.as_slice() == q.as_slice()), "{out:?}");
+}
