@@ -6,6 +6,8 @@
 //! - [`srdf`]: the `disable_collisions` rules of an SRDF.
 //! - [`chain`]: the serial [`Chain`], its [`Joint`]s and forward kinematics.
 //! - [`opw`]: [`OpwParameters`] and the closed-form solution with all eight branches.
+//! - [`cmm`]: a five-axis CMM head and probe (paper 003): closed-form inverse from ball centre and
+//!   probe direction, the move-or-rotate motion model.
 //! - [`ik`]: the [`IkSolver`] trait, [`OpwIk`] (OPW on a URDF chain), [`DlsIk`] (numeric),
 //!   and joint-limit filtering with ±2π variants.
 //!
@@ -13,6 +15,7 @@
 #![warn(missing_docs)]
 
 pub mod chain;
+pub mod cmm;
 pub mod error;
 pub mod ik;
 pub mod opw;
