@@ -14,7 +14,7 @@ mod verify_cmd;
 
 use cellplan_core::{candidates, check};
 use cellplan_geom::{DVec3, load_mesh};
-use cellplan_model::io::write_atomic;
+use cellplan_model::io::{write_all_atomic, write_atomic};
 use cellplan_model::taskgen::{GenOptions, sample_tasks};
 use cellplan_model::{Cell, InputError, LoadOptions, Registry};
 use cellplan_report::svg;
@@ -89,6 +89,19 @@ enum GenCommand {
     /// Sample measurement points on a mesh surface: area-weighted, spread apart, with outward
     /// normals. Writes a task CSV in the mesh's own units and frame.
     Tasks(GenTasksArgs),
+    /// Write paper 003's kind of test part: a cylinder-block-like machined block (mesh, mm) and
+    /// its 39 measuring points with cone half-angles (task CSV), as `block.obj` and `tasks.csv`.
+    Block(GenBlockArgs),
+}
+
+#[derive(Args)]
+struct GenBlockArgs {
+    /// Output folder.
+    #[arg(short, long, value_name = "DIR")]
+    out: PathBuf,
+    /// Segments of a full circle (bores, holes, bosses).
+    #[arg(long, default_value_t = 48)]
+    segments: usize,
 }
 
 #[derive(Args)]
@@ -323,6 +336,39 @@ fn run_gen_tasks(args: &GenTasksArgs) -> Result<(), Failure> {
     Ok(())
 }
 
+fn run_gen_block(args: &GenBlockArgs) -> Result<(), Failure> {
+    if !(8..=720).contains(&args.segments) {
+        return Err(Failure::Usage(format!(
+            "--segments must be between 8 and 720, not {}",
+            args.segments
+        )));
+    }
+    let spec = cellplan_cmm::part::BlockSpec {
+        segments: args.segments,
+        ..Default::default()
+    };
+    let (mesh, mps) = cellplan_cmm::part::cylinder_block(&spec);
+    let obj = cellplan_cmm::part::to_obj(
+        &mesh,
+        &format!(
+            "cellplan gen block --segments {}: paper 003's kind of cylinder block, mm (crates/cellplan-cmm/src/part.rs documents it)",
+            args.segments
+        ),
+    );
+    let csv = cellplan_cmm::part::to_csv(&mps);
+    let (a, b) = (args.out.join("block.obj"), args.out.join("tasks.csv"));
+    write_all_atomic(&[(&a, obj.as_bytes()), (&b, csv.as_bytes())])
+        .map_err(|e| Failure::Other(format!("cannot write into {}: {e}", args.out.display())))?;
+    eprintln!(
+        "{}: {} triangles; {}: {} measuring points",
+        a.display(),
+        mesh.triangles.len(),
+        b.display(),
+        mps.len()
+    );
+    Ok(())
+}
+
 fn run_bench(args: &bench::BenchArgs) -> Result<(), Failure> {
     if args.kind == bench::Kind::Motion {
         return run_bench_motion(args);
@@ -435,6 +481,7 @@ fn main() -> ExitCode {
         Command::Report(a) => report_cmd::run_report(a),
         Command::Export(a) => report_cmd::run_export(a),
         Command::Gen(GenCommand::Tasks(a)) => run_gen_tasks(a),
+        Command::Gen(GenCommand::Block(a)) => run_gen_block(a),
         Command::Bench(a) => run_bench(a),
     };
     match result {

@@ -1,0 +1,10 @@
+//! Paper 003 (Zhao, Wang, Liu: path planning for 5-axis CMM inspection considering path reuse)
+//! as a cellplan process — in progress. Built so far:
+//!
+//! - [`part`]: the cylinder-block-like test part, generated as a mesh with its 39 measuring
+//!   points (the paper's case has 39 MPs on a cylinder block; its geometry is not published).
+//!
+//! The machine's kinematics and motion model are `cellplan_kin::cmm`.
+#![warn(missing_docs)]
+
+pub mod part;

@@ -1,0 +1,693 @@
+//! The test part of paper 003's kind: a machined block like an inline-four cylinder block, built
+//! as a triangle mesh by this code, with its measuring points (MPs).
+//!
+//! Dimensions ([`BlockSpec::default`], mm; the block's corner at the origin, on a fixture plate
+//! whose top is z = 0):
+//! - the block: 400 (X) × 240 (Y) × 300 (Z), the two top long edges chamfered 30 mm at 45°;
+//! - the deck face (z = 300) with four cylinder bores Ø80 at x = 65, 155, 245, 335, y = 120,
+//!   150 deep;
+//! - the side y = 0 with three holes Ø20, 40 deep, at x = 100, 200, 300, z = 150;
+//! - the side y = 240 with two bosses Ø40 standing 15 out, at x = 130, 270, z = 120;
+//! - the end x = 0 with a hole Ø30, 50 deep, at y = 120, z = 80; the end x = 400 with a boss Ø50
+//!   standing 20 out at the same place.
+//!
+//! The 39 MPs: nine on the deck, two on each bore wall (12 mm below the deck, facing the bore's
+//! axis), two on each chamfer, on the side y = 0 the rim of each hole and four plane points, on
+//! the side y = 240 the face of each boss and two plane points, on the end x = 0 two points on the
+//! hole's rim and two plane points, on the end x = 400 the boss's face and two plane points.
+//! Each has a cone half-angle θ: 20° for plane points, 30° for rims and boss faces, 60° for bore
+//! walls (the probe reaches them tilted, from above).
+use cellplan_geom::Mesh;
+use glam::DVec3;
+
+/// The block's dimensions (mm) and the circle resolution.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BlockSpec {
+    /// Length along X.
+    pub length: f64,
+    /// Width along Y.
+    pub width: f64,
+    /// Height along Z.
+    pub height: f64,
+    /// The chamfer of the top long edges (45°).
+    pub chamfer: f64,
+    /// Bore diameter, depth, and the X of each bore.
+    pub bore: (f64, f64, [f64; 4]),
+    /// Segments of a full circle.
+    pub segments: usize,
+}
+
+impl Default for BlockSpec {
+    fn default() -> Self {
+        BlockSpec {
+            length: 400.0,
+            width: 240.0,
+            height: 300.0,
+            chamfer: 30.0,
+            bore: (80.0, 150.0, [65.0, 155.0, 245.0, 335.0]),
+            segments: 48,
+        }
+    }
+}
+
+/// What a measuring point measures.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MpFeature {
+    /// A point of a plane.
+    Plane,
+    /// A point of a bore wall.
+    BoreWall,
+    /// A point on a hole's rim.
+    HoleEdge,
+    /// A point on a boss's face.
+    Boss,
+}
+
+impl MpFeature {
+    /// The name in the task file's `feature` column.
+    pub fn column(self) -> &'static str {
+        match self {
+            MpFeature::Plane => "surface",
+            MpFeature::BoreWall => "hole",
+            MpFeature::HoleEdge => "edge",
+            MpFeature::Boss => "stud",
+        }
+    }
+}
+
+/// A measuring point (mm).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Mp {
+    /// Name (`D1`, `B3`, …).
+    pub name: String,
+    /// Position.
+    pub position: DVec3,
+    /// Outward unit normal of the surface.
+    pub normal: DVec3,
+    /// What it measures.
+    pub feature: MpFeature,
+    /// Cone half-angle θ (deg).
+    pub theta_deg: f64,
+    /// Index of the face it lies on (points on the same plane share it; a bore wall counts as
+    /// its own face).
+    pub face: usize,
+}
+
+/// A planar frame: a point and two unit axes; the face's outward normal is `u × v`.
+#[derive(Clone, Copy, Debug)]
+struct Frame {
+    origin: DVec3,
+    u: DVec3,
+    v: DVec3,
+}
+
+impl Frame {
+    fn at(&self, s: f64, t: f64) -> DVec3 {
+        self.origin + s * self.u + t * self.v
+    }
+    fn normal(&self) -> DVec3 {
+        self.u.cross(self.v).normalize()
+    }
+}
+
+/// A circle cut into (or standing on) a face: centre in the face's (s, t), radius, and how far
+/// it goes: negative into the part (a bore or hole), positive out of it (a boss).
+#[derive(Clone, Copy, Debug)]
+struct Circle {
+    s: f64,
+    t: f64,
+    r: f64,
+    depth: f64,
+}
+
+#[derive(Default)]
+struct Builder {
+    mesh: Mesh,
+}
+
+impl Builder {
+    fn vertex(&mut self, p: DVec3) -> u32 {
+        self.mesh.vertices.push(p);
+        (self.mesh.vertices.len() - 1) as u32
+    }
+
+    /// A triangle wound so that its normal points along `facing`.
+    fn tri(&mut self, a: u32, b: u32, c: u32, facing: DVec3) {
+        let v = &self.mesh.vertices;
+        let n = (v[b as usize] - v[a as usize]).cross(v[c as usize] - v[a as usize]);
+        if n.dot(facing) >= 0.0 {
+            self.mesh.triangles.push([a, b, c]);
+        } else {
+            self.mesh.triangles.push([a, c, b]);
+        }
+    }
+
+    /// A rectangle [s0, s1] × [t0, t1] of a face, with circular openings (`depth < 0`) cut
+    /// into it: cut into cells along s, one per opening, each triangulated between the circle
+    /// and the cell's border by angle.
+    fn rect_face(&mut self, f: &Frame, s: [f64; 2], t: [f64; 2], holes: &[Circle], segments: usize) {
+        let n = f.normal();
+        let mut holes: Vec<Circle> = holes.iter().copied().filter(|h| h.depth < 0.0).collect();
+        holes.sort_by(|a, b| a.s.total_cmp(&b.s));
+        let mut edges = vec![s[0]];
+        for w in holes.windows(2) {
+            edges.push(0.5 * (w[0].s + w[1].s));
+        }
+        edges.push(s[1]);
+        if holes.is_empty() {
+            let q = [
+                f.at(s[0], t[0]),
+                f.at(s[1], t[0]),
+                f.at(s[1], t[1]),
+                f.at(s[0], t[1]),
+            ]
+            .map(|p| self.vertex(p));
+            self.tri(q[0], q[1], q[2], n);
+            self.tri(q[0], q[2], q[3], n);
+            return;
+        }
+        for (k, h) in holes.iter().enumerate() {
+            let (a, b) = (edges[k], edges[k + 1]);
+            self.cell_with_opening(f, [a, b], t, h, segments);
+        }
+    }
+
+    /// One cell [a, b] × [t0, t1] around an opening, the opening's wall and bottom.
+    fn cell_with_opening(&mut self, f: &Frame, sr: [f64; 2], tr: [f64; 2], h: &Circle, segments: usize) {
+        let n = f.normal();
+        let tau = std::f64::consts::TAU;
+        // The circle's points, counter-clockwise in (s, t).
+        let ring: Vec<(f64, DVec3)> = (0..segments)
+            .map(|j| {
+                let phi = tau * j as f64 / segments as f64;
+                (phi, f.at(h.s + h.r * phi.cos(), h.t + h.r * phi.sin()))
+            })
+            .collect();
+        // The border: the ray from the centre at each circle angle, and the four corners.
+        let mut border: Vec<(f64, DVec3)> = ring
+            .iter()
+            .map(|&(phi, _)| {
+                let (c, s) = (phi.cos(), phi.sin());
+                let mut best = f64::INFINITY;
+                for (lim, dir) in [(sr[0], c), (sr[1], c)] {
+                    if dir.abs() > 1e-12 {
+                        let l = (lim - h.s) / dir;
+                        if l > 0.0 {
+                            best = best.min(l);
+                        }
+                    }
+                }
+                for (lim, dir) in [(tr[0], s), (tr[1], s)] {
+                    if dir.abs() > 1e-12 {
+                        let l = (lim - h.t) / dir;
+                        if l > 0.0 {
+                            best = best.min(l);
+                        }
+                    }
+                }
+                (phi, f.at(h.s + best * c, h.t + best * s))
+            })
+            .collect();
+        for (cs, ct) in [(sr[0], tr[0]), (sr[1], tr[0]), (sr[1], tr[1]), (sr[0], tr[1])] {
+            let ang = (ct - h.t).atan2(cs - h.s).rem_euclid(tau);
+            border.push((ang, f.at(cs, ct)));
+        }
+        border.sort_by(|x, y| x.0.total_cmp(&y.0));
+        let ring_ids: Vec<u32> = ring.iter().map(|&(_, p)| self.vertex(p)).collect();
+        let border_ids: Vec<u32> = border.iter().map(|&(_, p)| self.vertex(p)).collect();
+        // Zip the two loops by angle.
+        let (ni, no) = (ring.len(), border.len());
+        let (mut i, mut o) = (0usize, 0usize);
+        while i < ni || o < no {
+            let next_i = if i < ni {
+                ring[(i + 1) % ni].0 + if i + 1 == ni { tau } else { 0.0 }
+            } else {
+                f64::INFINITY
+            };
+            let next_o = if o < no {
+                border[(o + 1) % no].0 + if o + 1 == no { tau } else { 0.0 }
+            } else {
+                f64::INFINITY
+            };
+            if next_o <= next_i {
+                self.tri(ring_ids[i % ni], border_ids[o % no], border_ids[(o + 1) % no], n);
+                o += 1;
+            } else {
+                self.tri(ring_ids[i % ni], border_ids[o % no], ring_ids[(i + 1) % ni], n);
+                i += 1;
+            }
+        }
+        // The wall down to the bottom, and the bottom.
+        self.cylinder(f, h, &ring_ids, segments);
+    }
+
+    /// The wall of a circle from its ring on the face to `depth` along the face normal, and its
+    /// end cap. Into the part (`depth < 0`) the wall faces the axis and the cap faces out of
+    /// the opening; out of it (a boss) the wall faces away from the axis and the cap outward.
+    fn cylinder(&mut self, f: &Frame, h: &Circle, ring: &[u32], segments: usize) {
+        let n = f.normal();
+        let tau = std::f64::consts::TAU;
+        let end: Vec<u32> = (0..segments)
+            .map(|j| {
+                let p = self.mesh.vertices[ring[j] as usize];
+                self.vertex(p + h.depth * n)
+            })
+            .collect();
+        let centre = f.at(h.s, h.t);
+        let sign = if h.depth < 0.0 { -1.0 } else { 1.0 };
+        for j in 0..segments {
+            let k = (j + 1) % segments;
+            let mid = tau * (j as f64 + 0.5) / segments as f64;
+            let radial = (mid.cos() * f.u + mid.sin() * f.v).normalize();
+            self.tri(ring[j], ring[k], end[k], sign * radial);
+            self.tri(ring[j], end[k], end[j], sign * radial);
+        }
+        let c = self.vertex(centre + h.depth * n);
+        for j in 0..segments {
+            self.tri(c, end[j], end[(j + 1) % segments], n);
+        }
+    }
+
+    /// A boss standing on a face (its base lies on the face, which is left whole).
+    fn boss(&mut self, f: &Frame, h: &Circle, segments: usize) {
+        let tau = std::f64::consts::TAU;
+        let ring: Vec<u32> = (0..segments)
+            .map(|j| {
+                let phi = tau * j as f64 / segments as f64;
+                self.vertex(f.at(h.s + h.r * phi.cos(), h.t + h.r * phi.sin()))
+            })
+            .collect();
+        self.cylinder(f, h, &ring, segments);
+    }
+}
+
+/// The block's mesh and its MPs (mm).
+pub fn cylinder_block(spec: &BlockSpec) -> (Mesh, Vec<Mp>) {
+    let (l, w, h, c) = (spec.length, spec.width, spec.height, spec.chamfer);
+    let seg = spec.segments.max(8);
+    let mut b = Builder::default();
+    let (x, y, z) = (DVec3::X, DVec3::Y, DVec3::Z);
+    let r2 = std::f64::consts::SQRT_2;
+    // Faces and their frames.
+    let bottom = Frame {
+        origin: DVec3::ZERO,
+        u: y,
+        v: x,
+    };
+    let deck = Frame {
+        origin: DVec3::ZERO + h * z,
+        u: x,
+        v: y,
+    };
+    let side0 = Frame {
+        origin: DVec3::ZERO,
+        u: x,
+        v: z,
+    };
+    let side1 = Frame {
+        origin: DVec3::new(0.0, w, 0.0),
+        u: z,
+        v: x,
+    };
+    let chamfer0 = Frame {
+        origin: DVec3::new(0.0, 0.0, h - c),
+        u: x,
+        v: (y + z) / r2,
+    };
+    let chamfer1 = Frame {
+        origin: DVec3::new(l, w, h - c),
+        u: -x,
+        v: (z - y) / r2,
+    };
+    let end0 = Frame {
+        origin: DVec3::ZERO,
+        u: z,
+        v: y,
+    };
+    let end1 = Frame {
+        origin: DVec3::new(l, 0.0, 0.0),
+        u: y,
+        v: z,
+    };
+    let (bore_d, bore_depth, bore_x) = spec.bore;
+    let bores: Vec<Circle> = bore_x
+        .iter()
+        .map(|&bx| Circle {
+            s: bx,
+            t: w / 2.0,
+            r: bore_d / 2.0,
+            depth: -bore_depth,
+        })
+        .collect();
+    let side_holes: Vec<Circle> = [100.0, 200.0, 300.0]
+        .iter()
+        .map(|&hx| Circle {
+            s: hx,
+            t: 150.0,
+            r: 10.0,
+            depth: -40.0,
+        })
+        .collect();
+    let side_bosses: Vec<Circle> = [130.0, 270.0]
+        .iter()
+        .map(|&bx| Circle {
+            s: 120.0,
+            t: bx,
+            r: 20.0,
+            depth: 15.0,
+        })
+        .collect();
+    let end_hole = Circle {
+        s: 80.0,
+        t: w / 2.0,
+        r: 15.0,
+        depth: -50.0,
+    };
+    let end_boss = Circle {
+        s: w / 2.0,
+        t: 80.0,
+        r: 25.0,
+        depth: 20.0,
+    };
+
+    b.rect_face(&bottom, [0.0, w], [0.0, l], &[], seg);
+    b.rect_face(&deck, [0.0, l], [c, w - c], &bores, seg);
+    b.rect_face(&side0, [0.0, l], [0.0, h - c], &side_holes, seg);
+    b.rect_face(&side1, [0.0, h - c], [0.0, l], &[], seg);
+    for sb in &side_bosses {
+        b.boss(&side1, sb, seg);
+    }
+    b.rect_face(&chamfer0, [0.0, l], [0.0, c * r2], &[], seg);
+    b.rect_face(&chamfer1, [0.0, l], [0.0, c * r2], &[], seg);
+    // The ends: the rectangle below the chamfers (with the hole or the boss), and the trapezoid.
+    b.rect_face(&end0, [0.0, h - c], [0.0, w], &[end_hole], seg);
+    b.rect_face(&end1, [0.0, w], [0.0, h - c], &[], seg);
+    b.boss(&end1, &end_boss, seg);
+    for (xe, normal) in [(0.0, -x), (l, x)] {
+        let q = [
+            DVec3::new(xe, 0.0, h - c),
+            DVec3::new(xe, w, h - c),
+            DVec3::new(xe, w - c, h),
+            DVec3::new(xe, c, h),
+        ]
+        .map(|p| b.vertex(p));
+        b.tri(q[0], q[1], q[2], normal);
+        b.tri(q[0], q[2], q[3], normal);
+    }
+
+    // The MPs.
+    let mut mps = Vec::new();
+    let mut add = |name: String, p: DVec3, n: DVec3, feature: MpFeature, theta: f64, face: usize| {
+        mps.push(Mp {
+            name,
+            position: p,
+            normal: n.normalize(),
+            feature,
+            theta_deg: theta,
+            face,
+        });
+    };
+    // Deck: between and beside the bores.
+    let deck_pts = [
+        (20.0, 60.0),
+        (110.0, 60.0),
+        (200.0, 60.0),
+        (290.0, 60.0),
+        (380.0, 60.0),
+        (20.0, 180.0),
+        (110.0, 180.0),
+        (290.0, 180.0),
+        (380.0, 180.0),
+    ];
+    for (k, &(px, py)) in deck_pts.iter().enumerate() {
+        add(
+            format!("D{}", k + 1),
+            DVec3::new(px, py, h),
+            z,
+            MpFeature::Plane,
+            20.0,
+            0,
+        );
+    }
+    // Bore walls, 12 mm below the deck, at ring vertices (so on the mesh), facing the axis.
+    for (k, bore) in bores.iter().enumerate() {
+        for (m, j) in [seg / 4, 3 * seg / 4].into_iter().enumerate() {
+            let phi = std::f64::consts::TAU * j as f64 / seg as f64;
+            let radial = phi.cos() * x + phi.sin() * y;
+            let p = DVec3::new(bore.s, bore.t, h - 12.0) + bore.r * radial;
+            add(
+                format!("B{}", 2 * k + m + 1),
+                p,
+                -radial,
+                MpFeature::BoreWall,
+                60.0,
+                1 + k,
+            );
+        }
+    }
+    // Chamfers.
+    for (k, &px) in [120.0, 280.0].iter().enumerate() {
+        add(
+            format!("C{}", k + 1),
+            chamfer0.at(px, c * r2 / 2.0),
+            chamfer0.normal(),
+            MpFeature::Plane,
+            20.0,
+            5,
+        );
+        add(
+            format!("C{}", k + 3),
+            chamfer1.at(l - px, c * r2 / 2.0),
+            chamfer1.normal(),
+            MpFeature::Plane,
+            20.0,
+            6,
+        );
+    }
+    // Side y = 0: the rim of each hole (2 mm outside it, on the face) and plane points.
+    for (k, hole) in side_holes.iter().enumerate() {
+        add(
+            format!("S{}", k + 1),
+            side0.at(hole.s, hole.t + hole.r + 2.0),
+            -y,
+            MpFeature::HoleEdge,
+            30.0,
+            7,
+        );
+    }
+    for (k, &(px, pz)) in [(40.0, 60.0), (160.0, 60.0), (240.0, 60.0), (360.0, 60.0)]
+        .iter()
+        .enumerate()
+    {
+        add(
+            format!("S{}", k + 4),
+            DVec3::new(px, 0.0, pz),
+            -y,
+            MpFeature::Plane,
+            20.0,
+            7,
+        );
+    }
+    // Side y = 240: the face of each boss and two plane points.
+    for (k, boss) in side_bosses.iter().enumerate() {
+        add(
+            format!("T{}", k + 1),
+            side1.at(boss.s, boss.t) + boss.depth * y,
+            y,
+            MpFeature::Boss,
+            30.0,
+            8 + k,
+        );
+    }
+    for (k, &px) in [60.0, 340.0].iter().enumerate() {
+        add(
+            format!("T{}", k + 3),
+            DVec3::new(px, w, 200.0),
+            y,
+            MpFeature::Plane,
+            20.0,
+            10,
+        );
+    }
+    // End x = 0: two rim points of the hole and two plane points.
+    for (k, dy) in [-1.0, 1.0].iter().enumerate() {
+        add(
+            format!("E{}", k + 1),
+            DVec3::new(0.0, w / 2.0 + dy * (end_hole.r + 2.0), end_hole.s),
+            -x,
+            MpFeature::HoleEdge,
+            30.0,
+            11,
+        );
+    }
+    for (k, &(py, pz)) in [(40.0, 200.0), (200.0, 200.0)].iter().enumerate() {
+        add(
+            format!("E{}", k + 3),
+            DVec3::new(0.0, py, pz),
+            -x,
+            MpFeature::Plane,
+            20.0,
+            11,
+        );
+    }
+    // End x = 400: the boss's face and two plane points.
+    add(
+        "F1".into(),
+        DVec3::new(l + end_boss.depth, w / 2.0, end_boss.t),
+        x,
+        MpFeature::Boss,
+        30.0,
+        12,
+    );
+    for (k, &(py, pz)) in [(40.0, 200.0), (200.0, 200.0)].iter().enumerate() {
+        add(
+            format!("F{}", k + 2),
+            DVec3::new(l, py, pz),
+            x,
+            MpFeature::Plane,
+            20.0,
+            13,
+        );
+    }
+    (b.mesh, mps)
+}
+
+/// The mesh as Wavefront OBJ text.
+pub fn to_obj(mesh: &Mesh, comment: &str) -> String {
+    use std::fmt::Write;
+    let mut s = String::new();
+    for line in comment.lines() {
+        let _ = writeln!(s, "# {line}");
+    }
+    for v in &mesh.vertices {
+        let _ = writeln!(s, "v {:.6} {:.6} {:.6}", v.x, v.y, v.z);
+    }
+    for t in &mesh.triangles {
+        let _ = writeln!(s, "f {} {} {}", t[0] + 1, t[1] + 1, t[2] + 1);
+    }
+    s
+}
+
+/// The MPs as a task CSV (`id,x,y,z,nx,ny,nz,feature,theta`; mm and degrees).
+pub fn to_csv(mps: &[Mp]) -> String {
+    use std::fmt::Write;
+    let mut s = String::from("id,x,y,z,nx,ny,nz,feature,theta\n");
+    for m in mps {
+        let _ = writeln!(
+            s,
+            "{},{:.4},{:.4},{:.4},{:.6},{:.6},{:.6},{},{}",
+            m.name,
+            m.position.x,
+            m.position.y,
+            m.position.z,
+            m.normal.x,
+            m.normal.y,
+            m.normal.z,
+            m.feature.column(),
+            m.theta_deg
+        );
+    }
+    s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn closest(mesh: &Mesh, p: DVec3) -> (f64, DVec3) {
+        let mut best = (f64::INFINITY, DVec3::ZERO);
+        for (i, _) in mesh.triangles.iter().enumerate() {
+            let [a, b, c] = mesh.corners(i);
+            let q = closest_on_triangle(p, a, b, c);
+            let d = (q - p).length();
+            if d < best.0 - 1e-9
+                || (d < best.0 + 1e-9 && mesh.triangle_area(i) > 0.0 && best.1 == DVec3::ZERO)
+            {
+                best = (d, mesh.triangle_normal(i));
+            }
+        }
+        best
+    }
+
+    /// Closest point on a triangle (Ericson, Real-Time Collision Detection, 5.1.5).
+    fn closest_on_triangle(p: DVec3, a: DVec3, b: DVec3, c: DVec3) -> DVec3 {
+        let (ab, ac, ap) = (b - a, c - a, p - a);
+        let (d1, d2) = (ab.dot(ap), ac.dot(ap));
+        if d1 <= 0.0 && d2 <= 0.0 {
+            return a;
+        }
+        let bp = p - b;
+        let (d3, d4) = (ab.dot(bp), ac.dot(bp));
+        if d3 >= 0.0 && d4 <= d3 {
+            return b;
+        }
+        let vc = d1 * d4 - d3 * d2;
+        if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
+            return a + ab * (d1 / (d1 - d3));
+        }
+        let cp = p - c;
+        let (d5, d6) = (ab.dot(cp), ac.dot(cp));
+        if d6 >= 0.0 && d5 <= d6 {
+            return c;
+        }
+        let vb = d5 * d2 - d1 * d6;
+        if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
+            return a + ac * (d2 / (d2 - d6));
+        }
+        let va = d3 * d6 - d5 * d4;
+        if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
+            return b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)));
+        }
+        let denom = 1.0 / (va + vb + vc);
+        a + ab * (vb * denom) + ac * (vc * denom)
+    }
+
+    #[test]
+    fn the_block_has_39_mps_on_its_surface_facing_out() {
+        let spec = BlockSpec::default();
+        let (mesh, mps) = cylinder_block(&spec);
+        assert_eq!(mps.len(), 39);
+        let names: std::collections::HashSet<&str> = mps.iter().map(|m| m.name.as_str()).collect();
+        assert_eq!(names.len(), 39, "names are unique");
+        let half_step = std::f64::consts::PI / spec.segments as f64;
+        for m in &mps {
+            let (d, n) = closest(&mesh, m.position);
+            assert!(d < 1e-6, "{} is {d} mm off the surface", m.name);
+            assert!(
+                n.dot(m.normal) > half_step.cos() - 1e-9,
+                "{}: mesh normal {n} against {}",
+                m.name,
+                m.normal
+            );
+        }
+        // Every triangle has area; the outward normals of a closed block sum to zero, here plus
+        // the caps of the three bosses (their bases lie on the faces they stand on).
+        let mut sum = DVec3::ZERO;
+        for i in 0..mesh.triangles.len() {
+            assert!(mesh.triangle_area(i) > 1e-9, "triangle {i} is degenerate");
+            sum += mesh.triangle_area(i) * mesh.triangle_normal(i);
+        }
+        let ring_area = |r: f64| {
+            0.5 * spec.segments as f64 * r * r * (std::f64::consts::TAU / spec.segments as f64).sin()
+        };
+        let expected = 2.0 * ring_area(20.0) * DVec3::Y + ring_area(25.0) * DVec3::X;
+        assert!(
+            (sum - expected).length() < 1e-6 * expected.length().max(1.0),
+            "{sum} vs {expected}"
+        );
+        let (lo, hi) = mesh.aabb().unwrap();
+        assert!((lo - DVec3::ZERO).length() < 1e-9);
+        assert!((hi - DVec3::new(420.0, 255.0, 300.0)).length() < 1e-9, "{hi}");
+    }
+
+    #[test]
+    fn files_are_written_in_the_usual_formats() {
+        let (mesh, mps) = cylinder_block(&BlockSpec::default());
+        let obj = to_obj(&mesh, "test");
+        let back = cellplan_geom::mesh::parse_obj(obj.as_bytes(), std::path::Path::new("block.obj")).unwrap();
+        assert_eq!(back.triangles.len(), mesh.triangles.len());
+        let csv = to_csv(&mps);
+        assert_eq!(csv.lines().count(), 40);
+        assert!(csv.starts_with("id,x,y,z,nx,ny,nz,feature,theta"));
+    }
+}
