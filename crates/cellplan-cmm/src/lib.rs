@@ -3,8 +3,11 @@
 //!
 //! - [`part`]: the cylinder-block-like test part, generated as a mesh with its 39 measuring
 //!   points (the paper's case has 39 MPs on a cylinder block; its geometry is not published).
+//! - [`classify`]: §3.1, the MPs grouped by probe orientation (eq. 3) as a set cover, greedy
+//!   (the paper's) or exact.
 //!
 //! The machine's kinematics and motion model are `cellplan_kin::cmm`.
 #![warn(missing_docs)]
 
+pub mod classify;
 pub mod part;

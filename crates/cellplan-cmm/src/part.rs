@@ -11,12 +11,13 @@
 //! - the end x = 0 with a hole Ø30, 50 deep, at y = 120, z = 80; the end x = 400 with a boss Ø50
 //!   standing 20 out at the same place.
 //!
-//! The 39 MPs: nine on the deck, two on each bore wall (12 mm below the deck, facing the bore's
-//! axis), two on each chamfer, on the side y = 0 the rim of each hole and four plane points, on
-//! the side y = 240 the face of each boss and two plane points, on the end x = 0 two points on the
-//! hole's rim and two plane points, on the end x = 400 the boss's face and two plane points.
-//! Each has a cone half-angle θ: 20° for plane points, 30° for rims and boss faces, 60° for bore
-//! walls (the probe reaches them tilted, from above).
+//! The 39 MPs: eleven on the deck, one on each bore wall (12 mm below the deck, on the bore's
+//! +X side, facing its axis), two on each chamfer, on the side y = 0 the rim of each hole and
+//! four plane points, six plane points on the side y = 240 around its bosses, on the end x = 0
+//! two points on the hole's rim and two plane points, on the end x = 400 the boss's face and two
+//! plane points. Each has a cone half-angle θ: 20° for plane points, 30° for rims, the boss
+//! face and the chamfers, 80° for bore walls (the probe reaches them tilted, from above). Faces are numbered for
+//! the classification ([`block_adjacent`]); the four bore walls count as one face.
 use cellplan_geom::Mesh;
 use glam::DVec3;
 
@@ -416,8 +417,10 @@ pub fn cylinder_block(spec: &BlockSpec) -> (Mesh, Vec<Mp>) {
         (380.0, 60.0),
         (20.0, 180.0),
         (110.0, 180.0),
+        (200.0, 180.0),
         (290.0, 180.0),
         (380.0, 180.0),
+        (200.0, 120.0),
     ];
     for (k, &(px, py)) in deck_pts.iter().enumerate() {
         add(
@@ -429,21 +432,11 @@ pub fn cylinder_block(spec: &BlockSpec) -> (Mesh, Vec<Mp>) {
             0,
         );
     }
-    // Bore walls, 12 mm below the deck, at ring vertices (so on the mesh), facing the axis.
+    // Bore walls, 12 mm below the deck on each bore's +X side (a ring vertex, so on the mesh),
+    // facing the axis; reached with the probe tilted from above.
     for (k, bore) in bores.iter().enumerate() {
-        for (m, j) in [seg / 4, 3 * seg / 4].into_iter().enumerate() {
-            let phi = std::f64::consts::TAU * j as f64 / seg as f64;
-            let radial = phi.cos() * x + phi.sin() * y;
-            let p = DVec3::new(bore.s, bore.t, h - 12.0) + bore.r * radial;
-            add(
-                format!("B{}", 2 * k + m + 1),
-                p,
-                -radial,
-                MpFeature::BoreWall,
-                60.0,
-                1 + k,
-            );
-        }
+        let p = DVec3::new(bore.s + bore.r, bore.t, h - 12.0);
+        add(format!("B{}", k + 1), p, -x, MpFeature::BoreWall, 80.0, 1);
     }
     // Chamfers.
     for (k, &px) in [120.0, 280.0].iter().enumerate() {
@@ -452,7 +445,7 @@ pub fn cylinder_block(spec: &BlockSpec) -> (Mesh, Vec<Mp>) {
             chamfer0.at(px, c * r2 / 2.0),
             chamfer0.normal(),
             MpFeature::Plane,
-            20.0,
+            30.0,
             5,
         );
         add(
@@ -460,7 +453,7 @@ pub fn cylinder_block(spec: &BlockSpec) -> (Mesh, Vec<Mp>) {
             chamfer1.at(l - px, c * r2 / 2.0),
             chamfer1.normal(),
             MpFeature::Plane,
-            20.0,
+            30.0,
             6,
         );
     }
@@ -488,21 +481,21 @@ pub fn cylinder_block(spec: &BlockSpec) -> (Mesh, Vec<Mp>) {
             7,
         );
     }
-    // Side y = 240: the face of each boss and two plane points.
-    for (k, boss) in side_bosses.iter().enumerate() {
+    // Side y = 240: plane points around the bosses.
+    for (k, &(px, pz)) in [
+        (60.0, 200.0),
+        (200.0, 200.0),
+        (340.0, 200.0),
+        (60.0, 60.0),
+        (200.0, 60.0),
+        (340.0, 60.0),
+    ]
+    .iter()
+    .enumerate()
+    {
         add(
             format!("T{}", k + 1),
-            side1.at(boss.s, boss.t) + boss.depth * y,
-            y,
-            MpFeature::Boss,
-            30.0,
-            8 + k,
-        );
-    }
-    for (k, &px) in [60.0, 340.0].iter().enumerate() {
-        add(
-            format!("T{}", k + 3),
-            DVec3::new(px, w, 200.0),
+            DVec3::new(px, w, pz),
             y,
             MpFeature::Plane,
             20.0,
@@ -550,6 +543,37 @@ pub fn cylinder_block(spec: &BlockSpec) -> (Mesh, Vec<Mp>) {
         );
     }
     (b.mesh, mps)
+}
+
+/// Whether two faces of [`cylinder_block`]'s MPs share an edge: 0 deck, 1 the bore walls, 5 and
+/// 6 the chamfers at y = 0 and y = 240, 7 the side y = 0, 8 and 9 the bosses on the side y = 240
+/// (10), 11 the end x = 0, 12 the boss on the end x = 400 (13).
+pub fn block_adjacent(f: usize, g: usize) -> bool {
+    const PAIRS: [(usize, usize); 20] = [
+        (0, 1),
+        (0, 2),
+        (0, 3),
+        (0, 4),
+        (0, 5),
+        (0, 6),
+        (0, 11),
+        (0, 13),
+        (5, 7),
+        (5, 11),
+        (5, 13),
+        (6, 10),
+        (6, 11),
+        (6, 13),
+        (7, 11),
+        (7, 13),
+        (8, 10),
+        (9, 10),
+        (10, 11),
+        (10, 13),
+    ];
+    f != g && PAIRS.iter().any(|&(a, b)| (a, b) == (f, g) || (b, a) == (f, g))
+        || (f, g) == (12, 13)
+        || (f, g) == (13, 12)
 }
 
 /// The mesh as Wavefront OBJ text.
