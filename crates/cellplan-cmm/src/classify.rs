@@ -7,7 +7,7 @@
 //! it covers the MPs on those faces that the orientation measures. The paper solves it with
 //! the greedy rule (its ref. [29]); [`Method::Exact`] is `cellplan-solve`'s branch and bound.
 use cellplan_geom::{CollisionWorld, DQuat, DVec3, GroupBody, GroupId, Pose, ShapeSpec};
-use cellplan_kin::cmm::CmmHead;
+use cellplan_kin::cmm::{CmmHead, CmmQ};
 use cellplan_solve::SetCover;
 use cellplan_solve::setcover::{self, ExactLimits};
 
@@ -78,6 +78,7 @@ pub struct Classification {
 pub struct Probe {
     world: CollisionWorld,
     group: GroupId,
+    moving: GroupId,
     head: CmmHead,
     bodies: ProbeBodies,
 }
@@ -138,12 +139,100 @@ impl Probe {
                 },
             ],
         );
+        let moving = world.add_group(
+            "probe-moving",
+            vec![
+                GroupBody {
+                    name: "ball".into(),
+                    shapes: vec![(
+                        ShapeSpec::Sphere {
+                            radius: head.ball_diameter / 2.0,
+                        },
+                        Pose::IDENTITY,
+                    )],
+                },
+                GroupBody {
+                    name: "stem".into(),
+                    shapes: vec![(
+                        ShapeSpec::Cylinder {
+                            radius: bodies.stem_diameter / 2.0,
+                            half_height: head.l2 / 2.0,
+                        },
+                        Pose::IDENTITY,
+                    )],
+                },
+                GroupBody {
+                    name: "extension".into(),
+                    shapes: vec![(
+                        ShapeSpec::Cylinder {
+                            radius: bodies.extension_diameter / 2.0,
+                            half_height: head.l1 / 2.0,
+                        },
+                        Pose::IDENTITY,
+                    )],
+                },
+                GroupBody {
+                    name: "head".into(),
+                    shapes: vec![(
+                        ShapeSpec::Cylinder {
+                            radius: bodies.head.0 / 2.0,
+                            half_height: bodies.head.1 / 2.0,
+                        },
+                        Pose::IDENTITY,
+                    )],
+                },
+                GroupBody {
+                    name: "ram".into(),
+                    shapes: vec![(
+                        ShapeSpec::Box {
+                            half_extents: DVec3::new(
+                                bodies.ram.0 / 2.0,
+                                bodies.ram.0 / 2.0,
+                                bodies.ram.1 / 2.0,
+                            ),
+                        },
+                        Pose::IDENTITY,
+                    )],
+                },
+            ],
+        );
         Probe {
             world,
             group,
+            moving,
             head,
             bodies,
         }
+    }
+
+    /// The head and probe.
+    pub fn head(&self) -> &CmmHead {
+        &self.head
+    }
+
+    /// The poses of the moving probe's bodies (ball, stem, extension, head, ram) at `q`.
+    pub fn moving_poses(&self, q: &CmmQ) -> [Pose; 5] {
+        let centre = DVec3::new(q[0], q[1], q[2]);
+        let d = CmmHead::direction(q[3], q[4]);
+        let turn = DQuat::from_rotation_arc(DVec3::Z, d);
+        let along = |from: f64, to: f64| Pose::from_parts(centre + d * (0.5 * (from + to)), turn);
+        let reach = self.head.reach();
+        [
+            Pose::from_parts(centre + d * reach, DQuat::IDENTITY),
+            along(self.head.l1, reach),
+            along(0.0, self.head.l1),
+            Pose::from_parts(centre + DVec3::Z * (self.bodies.head.1 / 2.0), DQuat::IDENTITY),
+            Pose::from_parts(
+                centre + DVec3::Z * (self.bodies.head.1 + self.bodies.ram.1 / 2.0),
+                DQuat::IDENTITY,
+            ),
+        ]
+    }
+
+    /// The distance of the whole probe at `q` to the statics, capped at `cap` (m).
+    pub fn distance(&self, q: &CmmQ, cap: f64) -> f64 {
+        self.world
+            .group_static_distance(self.moving, &self.moving_poses(q), cap)
     }
 
     /// Body poses for the A-axis centre at `centre` and probe direction `d`.

@@ -5,9 +5,12 @@
 //!   points (the paper's case has 39 MPs on a cylinder block; its geometry is not published).
 //! - [`classify`]: §3.1, the MPs grouped by probe orientation (eq. 3) as a set cover, greedy
 //!   (the paper's) or exact.
+//! - [`motion`]: the CMM's configuration space and the probe's clearance for the shared motion
+//!   planners.
 //!
 //! The machine's kinematics and motion model are `cellplan_kin::cmm`.
 #![warn(missing_docs)]
 
 pub mod classify;
+pub mod motion;
 pub mod part;
