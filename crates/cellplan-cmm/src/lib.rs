@@ -7,10 +7,13 @@
 //!   (the paper's) or exact.
 //! - [`motion`]: the CMM's configuration space and the probe's clearance for the shared motion
 //!   planners.
+//! - [`mrnc`]: §3.2, RRT-MRNC (Algorithms 1–4) for one orientation group, and reuse of its
+//!   stored paths for any subset of the group's MPs.
 //!
 //! The machine's kinematics and motion model are `cellplan_kin::cmm`.
 #![warn(missing_docs)]
 
 pub mod classify;
 pub mod motion;
+pub mod mrnc;
 pub mod part;
