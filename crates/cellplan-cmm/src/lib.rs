@@ -7,6 +7,8 @@
 //!   (the paper's) or exact.
 //! - [`motion`]: the CMM's configuration space and the probe's clearance for the shared motion
 //!   planners.
+//! - [`job`]: a whole job — groups, their paths, the orders (the paper's enhanced GA or ours) and
+//!   Table 3's times.
 //! - [`mrnc`]: §3.2, RRT-MRNC (Algorithms 1–4) for one orientation group, and reuse of its
 //!   stored paths for any subset of the group's MPs.
 //!
@@ -14,6 +16,7 @@
 #![warn(missing_docs)]
 
 pub mod classify;
+pub mod job;
 pub mod motion;
 pub mod mrnc;
 pub mod part;

@@ -1,0 +1,363 @@
+//! A whole inspection job (paper 003 §3): the groups (§3.1), each group's stored paths
+//! (§3.2, RRT-MRNC), the order of the groups and of the MPs inside each (§3.3), and the
+//! times of Table 3 — movement, rotation, inspection, motion.
+//!
+//! Within a group every path runs start → root → approach, root → root, approach → root →
+//! start, so a group's order is a travelling-salesperson tour from its start over the MPs, the
+//! cost of a step the movement time through the two roots. Between groups the head goes up
+//! to a safe height above the next group's start, turns there (paper 003 assumption 1: it
+//! moves or it turns, never both), and comes down. The group order is a tour from the home
+//! position over the group starts. Both are solved by `cellplan-solve`: the paper's enhanced
+//! GA ([`GtspMethod::Ga`]) or ours (iterated local search, [`GtspMethod::Ils`]).
+use crate::classify::Group;
+use crate::classify::Probe;
+use crate::mrnc::{GroupPaths, MrncError, MrncSettings, group_start, plan_group};
+use crate::part::Mp;
+use cellplan_kin::cmm::{CmmQ, CmmSpeeds};
+use cellplan_motion::plan::{JointSpace, StateValidity, check_segment};
+use cellplan_solve::{CostMatrix, Gtsp, GtspMethod, GtspParams, solve_gtsp};
+use std::time::{Duration, Instant};
+
+/// The job's settings.
+#[derive(Clone, Copy, Debug)]
+pub struct JobSettings {
+    /// RRT-MRNC.
+    pub mrnc: MrncSettings,
+    /// Speeds and the time per MP.
+    pub speeds: CmmSpeeds,
+    /// Time to inspect one MP (s); paper 003: 1 s.
+    pub inspection_s: f64,
+    /// The orderings' method.
+    pub order: GtspMethod,
+    /// Iterations of the ordering heuristics (so that the result depends on the seed only).
+    pub order_iterations: usize,
+    /// Height the head goes up to before it turns (m).
+    pub turn_height: f64,
+    /// Lowest height of a group's start (m).
+    pub start_height: f64,
+}
+
+impl Default for JobSettings {
+    fn default() -> Self {
+        JobSettings {
+            mrnc: MrncSettings::default(),
+            speeds: CmmSpeeds::paper(),
+            inspection_s: 1.0,
+            order: GtspMethod::Ils,
+            order_iterations: 2000,
+            turn_height: 0.75,
+            start_height: 0.55,
+        }
+    }
+}
+
+/// A planned job.
+#[derive(Clone, Debug)]
+pub struct Job {
+    /// Per group (in the classification's order): its paths and its MPs' visiting order
+    /// (indices into the group's members).
+    pub groups: Vec<(GroupPaths, Vec<usize>, Vec<usize>)>,
+    /// The order of the groups.
+    pub group_order: Vec<usize>,
+    /// The whole path, configuration by configuration, from home back to home.
+    pub path: Vec<Vec<f64>>,
+    /// Movement time (s).
+    pub movement_s: f64,
+    /// Rotation time (s).
+    pub rotation_s: f64,
+    /// Inspection time (s).
+    pub inspection_s: f64,
+    /// Computation time (s).
+    pub compute_s: f64,
+}
+
+impl Job {
+    /// Movement + rotation + inspection (s), Table 3's motion time.
+    pub fn motion_s(&self) -> f64 {
+        self.movement_s + self.rotation_s + self.inspection_s
+    }
+}
+
+/// Why a job could not be planned.
+#[derive(Clone, Debug, PartialEq)]
+pub enum JobError {
+    /// A group has no clear start.
+    Start(usize),
+    /// RRT-MRNC failed in a group.
+    Group(usize, MrncError),
+    /// The turn between two groups is not clear.
+    Turn(usize, usize),
+}
+
+fn q5(q: &[f64]) -> CmmQ {
+    [q[0], q[1], q[2], q[3], q[4]]
+}
+
+/// Plans a job from the groups of a classification.
+#[allow(clippy::too_many_arguments)]
+pub fn plan_job(
+    probe: &Probe,
+    validity: &dyn StateValidity,
+    space: &JointSpace,
+    mps: &[Mp],
+    groups: &[Group],
+    home: &[f64],
+    s: &JobSettings,
+) -> Result<Job, JobError> {
+    let started = Instant::now();
+    let move_time = |a: &[f64], b: &[f64]| s.speeds.move_time(&q5(a), &q5(b));
+    let path_time = |p: &[Vec<f64>]| p.windows(2).map(|w| move_time(&w[0], &w[1])).sum::<f64>();
+    // Each group's paths.
+    let mut planned: Vec<(GroupPaths, Vec<usize>)> = Vec::with_capacity(groups.len());
+    for (g, group) in groups.iter().enumerate() {
+        let start = group_start(
+            probe,
+            validity,
+            space,
+            mps,
+            &group.members,
+            group.angles,
+            s.start_height,
+        )
+        .ok_or(JobError::Start(g))?;
+        let settings = MrncSettings {
+            seed: s.mrnc.seed.wrapping_add(g as u64),
+            ..s.mrnc
+        };
+        let paths = plan_group(
+            probe,
+            validity,
+            space,
+            mps,
+            &group.members,
+            group.angles,
+            &start,
+            &settings,
+        )
+        .map_err(|e| JobError::Group(g, e))?;
+        // The group's tour: node 0 its start, node k + 1 its k-th MP.
+        let n = group.members.len();
+        let leg = |a: usize, b: usize| -> f64 {
+            // From node a to node b through the roots (a local path runs root → approach).
+            let out = if a == 0 {
+                0.0
+            } else {
+                path_time(&paths.local[a - 1])
+            };
+            let into = if b == 0 {
+                0.0
+            } else {
+                path_time(&paths.local[b - 1])
+            };
+            let from = if a == 0 { &paths.start } else { &paths.roots[a - 1] };
+            let to = if b == 0 { &paths.start } else { &paths.roots[b - 1] };
+            out + move_time(from, to) + into
+        };
+        let costs = CostMatrix::from_fn(n + 1, |a, b| if a == b { 0.0 } else { leg(a, b) });
+        let clusters: Vec<Vec<usize>> = (1..=n).map(|k| vec![k]).collect();
+        let order: Vec<usize> = if n <= 1 {
+            (0..n).collect()
+        } else {
+            let tsp = Gtsp::new(costs, clusters)
+                .and_then(|p| p.with_depots(Some(0), None))
+                .map_err(|_| JobError::Start(g))?;
+            let sol = solve_gtsp(
+                &tsp,
+                &GtspParams {
+                    method: s.order,
+                    seed: s.mrnc.seed,
+                    max_iterations: Some(s.order_iterations),
+                    time_limit: Duration::from_secs(3600),
+                },
+            );
+            sol.tour.nodes.iter().map(|&v| v - 1).collect()
+        };
+        planned.push((paths, order));
+    }
+    // The turns between groups: up above the next start, turn, down.
+    let lift = |q: &[f64]| vec![q[0], q[1], s.turn_height.max(q[2]), q[3], q[4]];
+    let transition = |from: &[f64], to: &[f64]| -> Vec<Vec<f64>> {
+        let up = lift(from);
+        let mut above = lift(to);
+        above[3] = from[3];
+        above[4] = from[4];
+        let turned = lift(to);
+        let mut p = vec![from.to_vec(), up, above, turned, to.to_vec()];
+        p.dedup();
+        p
+    };
+    let m = groups.len();
+    // The group order: node 0 home, node g + 1 group g's start.
+    let starts: Vec<&Vec<f64>> = planned.iter().map(|(p, _)| &p.start).collect();
+    let node = |k: usize| -> &[f64] { if k == 0 { home } else { starts[k - 1] } };
+    let gcosts = CostMatrix::from_fn(m + 1, |a, b| {
+        if a == b {
+            0.0
+        } else {
+            path_time(&transition(node(a), node(b)))
+        }
+    });
+    let group_order: Vec<usize> = if m <= 1 {
+        (0..m).collect()
+    } else {
+        let tsp = Gtsp::new(gcosts, (1..=m).map(|k| vec![k]).collect())
+            .and_then(|p| p.with_depots(Some(0), None))
+            .map_err(|_| JobError::Start(0))?;
+        let sol = solve_gtsp(
+            &tsp,
+            &GtspParams {
+                method: s.order,
+                seed: s.mrnc.seed,
+                max_iterations: Some(s.order_iterations),
+                time_limit: Duration::from_secs(3600),
+            },
+        );
+        sol.tour.nodes.iter().map(|&v| v - 1).collect()
+    };
+    // The whole path and its times.
+    let mut path: Vec<Vec<f64>> = vec![home.to_vec()];
+    let mut at: Vec<f64> = home.to_vec();
+    let mut inspections = 0usize;
+    for &g in &group_order {
+        let (paths, order) = &planned[g];
+        let t = transition(&at, &paths.start);
+        for w in t.windows(2) {
+            if !check_segment(space, validity, &w[0], &w[1], s.mrnc.min_clearance).valid {
+                return Err(JobError::Turn(path.len(), g));
+            }
+        }
+        path.extend(t.into_iter().skip(1));
+        path.extend(paths.reuse(order).into_iter().skip(1));
+        inspections += order.len();
+        at = paths.start.clone();
+    }
+    let back = transition(&at, home);
+    path.extend(back.into_iter().skip(1));
+    path.dedup();
+    let movement_s: f64 = path
+        .windows(2)
+        .map(|w| s.speeds.movement_time(&q5(&w[0]), &q5(&w[1])))
+        .sum();
+    let rotation_s: f64 = path
+        .windows(2)
+        .map(|w| s.speeds.rotation_time(&q5(&w[0]), &q5(&w[1])))
+        .sum();
+    Ok(Job {
+        groups: planned
+            .into_iter()
+            .zip(groups)
+            .map(|((p, o), g)| (p, o, g.members.clone()))
+            .collect(),
+        group_order,
+        path,
+        movement_s,
+        rotation_s,
+        inspection_s: inspections as f64 * s.inspection_s,
+        compute_s: started.elapsed().as_secs_f64(),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::classify::{Method, ProbeBodies, classify};
+    use crate::motion::{CmmValidity, Travel, space};
+    use crate::part::{BlockSpec, block_adjacent, cylinder_block};
+    use cellplan_geom::{DQuat, DVec3, Pose, ShapeSpec};
+    use cellplan_kin::cmm::CmmHead;
+    use std::sync::Arc;
+
+    #[test]
+    fn the_block_is_planned_whole_every_segment_clear_every_mp_once() {
+        let started = Instant::now();
+        let (mesh, mps) = cylinder_block(&BlockSpec::default());
+        let mps: Vec<Mp> = mps
+            .into_iter()
+            .map(|m| Mp {
+                position: m.position * 1e-3,
+                ..m
+            })
+            .collect();
+        let statics = vec![
+            (
+                "block".to_string(),
+                ShapeSpec::Mesh(Arc::new(mesh.scaled(1e-3))),
+                Pose::IDENTITY,
+            ),
+            (
+                "plate".to_string(),
+                ShapeSpec::Box {
+                    half_extents: DVec3::new(0.35, 0.25, 0.01),
+                },
+                Pose::from_parts(DVec3::new(0.2, 0.12, -0.011), DQuat::IDENTITY),
+            ),
+        ];
+        let probe = Probe::new(statics, CmmHead::paper(), ProbeBodies::paper());
+        let orientations = CmmHead {
+            index_step: Some(7.5f64.to_radians()),
+            ..CmmHead::paper()
+        }
+        .indexed_orientations();
+        let groups = classify(&mps, &block_adjacent, &probe, &orientations, 0.001, Method::Exact).groups;
+        let travel = Travel {
+            x: [-0.4, 0.8],
+            y: [-0.5, 0.7],
+            z: [0.0, 1.0],
+        };
+        let space = space(&probe, &travel);
+        let validity = CmmValidity {
+            probe: &probe,
+            margin: 0.002,
+        };
+        let home = vec![0.2, 0.12, 0.9, 0.0, 0.0];
+        let mut results = Vec::new();
+        for order in [GtspMethod::Ga, GtspMethod::Ils] {
+            let job = plan_job(
+                &probe,
+                &validity,
+                &space,
+                &mps,
+                &groups,
+                &home,
+                &JobSettings {
+                    order,
+                    ..JobSettings::default()
+                },
+            )
+            .unwrap_or_else(|e| panic!("{order:?}: {e:?}"));
+            // Every segment of the whole path is clear; every MP's approach is visited.
+            for w in job.path.windows(2) {
+                assert!(check_segment(&space, &validity, &w[0], &w[1], 1e-4).valid);
+            }
+            let mut visited = 0;
+            for (paths, order, members) in &job.groups {
+                assert_eq!(order.len(), members.len());
+                for &k in order {
+                    assert!(job.path.contains(&paths.approaches[k]));
+                    visited += 1;
+                }
+            }
+            assert_eq!(visited, 39);
+            assert_eq!(job.path.first(), Some(&home));
+            assert_eq!(job.path.last(), Some(&home));
+            assert!((job.inspection_s - 39.0).abs() < 1e-9);
+            eprintln!(
+                "{order:?}: {} groups, movement {:.1} s, rotation {:.1} s, inspection {:.1} s, motion {:.1} s, computed in {:.2} s",
+                job.groups.len(),
+                job.movement_s,
+                job.rotation_s,
+                job.inspection_s,
+                job.motion_s(),
+                job.compute_s
+            );
+            results.push(job.motion_s());
+        }
+        assert!(
+            results[1] <= results[0] * 1.05,
+            "ours {} against the GA {}",
+            results[1],
+            results[0]
+        );
+        eprintln!("whole test {:.2} s", started.elapsed().as_secs_f64());
+    }
+}
