@@ -76,6 +76,103 @@ impl Job {
     pub fn motion_s(&self) -> f64 {
         self.movement_s + self.rotation_s + self.inspection_s
     }
+
+    /// Paper 003's path reuse: the path for the MPs `subset` (indices into the job's MP list)
+    /// from the stored paths alone — the job's group order and each group's MP order, groups
+    /// without a wanted MP skipped, each wanted MP reached through its root — with no sampling
+    /// and no collision query. MPs the job does not hold are returned as the error.
+    pub fn reuse(&self, subset: &[usize], home: &[f64], s: &JobSettings) -> Result<Reused, Vec<usize>> {
+        let started = Instant::now();
+        let unknown: Vec<usize> = subset
+            .iter()
+            .copied()
+            .filter(|i| !self.groups.iter().any(|(_, _, members)| members.contains(i)))
+            .collect();
+        if !unknown.is_empty() {
+            return Err(unknown);
+        }
+        let mut path: Vec<Vec<f64>> = vec![home.to_vec()];
+        let mut at = home.to_vec();
+        let mut count = 0;
+        for &g in &self.group_order {
+            let (paths, order, members) = &self.groups[g];
+            let wanted: Vec<usize> = order
+                .iter()
+                .copied()
+                .filter(|&k| subset.contains(&members[k]))
+                .collect();
+            if wanted.is_empty() {
+                continue;
+            }
+            path.extend(transition(s, &at, &paths.start).into_iter().skip(1));
+            path.extend(paths.reuse(&wanted).into_iter().skip(1));
+            count += wanted.len();
+            at = paths.start.clone();
+        }
+        path.extend(transition(s, &at, home).into_iter().skip(1));
+        path.dedup();
+        let compute_s = started.elapsed().as_secs_f64();
+        Ok(Reused::new(path, count, s, compute_s))
+    }
+
+    /// The paper's "reuse of the initial path": the whole stored path walked again, touching
+    /// only the MPs of `subset`.
+    pub fn reuse_initial_path(&self, subset: &[usize], s: &JobSettings) -> Reused {
+        Reused::new(self.path.clone(), subset.len(), s, 0.0)
+    }
+}
+
+/// A path for a subset of MPs, with its times.
+#[derive(Clone, Debug)]
+pub struct Reused {
+    /// The path.
+    pub path: Vec<Vec<f64>>,
+    /// Movement time (s).
+    pub movement_s: f64,
+    /// Rotation time (s).
+    pub rotation_s: f64,
+    /// Inspection time (s).
+    pub inspection_s: f64,
+    /// Time to make it (s).
+    pub compute_s: f64,
+}
+
+impl Reused {
+    fn new(path: Vec<Vec<f64>>, inspections: usize, s: &JobSettings, compute_s: f64) -> Self {
+        let movement_s: f64 = path
+            .windows(2)
+            .map(|w| s.speeds.movement_time(&q5(&w[0]), &q5(&w[1])))
+            .sum();
+        let rotation_s: f64 = path
+            .windows(2)
+            .map(|w| s.speeds.rotation_time(&q5(&w[0]), &q5(&w[1])))
+            .sum();
+        Reused {
+            path,
+            movement_s,
+            rotation_s,
+            inspection_s: inspections as f64 * s.inspection_s,
+            compute_s,
+        }
+    }
+
+    /// Movement + rotation + inspection (s).
+    pub fn motion_s(&self) -> f64 {
+        self.movement_s + self.rotation_s + self.inspection_s
+    }
+}
+
+/// From one group's start to another's (or home): up to the turn height, turn, down.
+fn transition(s: &JobSettings, from: &[f64], to: &[f64]) -> Vec<Vec<f64>> {
+    let lift = |q: &[f64]| vec![q[0], q[1], s.turn_height.max(q[2]), q[3], q[4]];
+    let up = lift(from);
+    let mut above = lift(to);
+    above[3] = from[3];
+    above[4] = from[4];
+    let turned = lift(to);
+    let mut p = vec![from.to_vec(), up, above, turned, to.to_vec()];
+    p.dedup();
+    p
 }
 
 /// Why a job could not be planned.
@@ -175,17 +272,7 @@ pub fn plan_job(
         planned.push((paths, order));
     }
     // The turns between groups: up above the next start, turn, down.
-    let lift = |q: &[f64]| vec![q[0], q[1], s.turn_height.max(q[2]), q[3], q[4]];
-    let transition = |from: &[f64], to: &[f64]| -> Vec<Vec<f64>> {
-        let up = lift(from);
-        let mut above = lift(to);
-        above[3] = from[3];
-        above[4] = from[4];
-        let turned = lift(to);
-        let mut p = vec![from.to_vec(), up, above, turned, to.to_vec()];
-        p.dedup();
-        p
-    };
+    let transition = |from: &[f64], to: &[f64]| transition(s, from, to);
     let m = groups.len();
     // The group order: node 0 home, node g + 1 group g's start.
     let starts: Vec<&Vec<f64>> = planned.iter().map(|(p, _)| &p.start).collect();
@@ -358,6 +445,60 @@ mod tests {
             results[1],
             results[0]
         );
+        // Reuse on 20 random subsets of 3–20 MPs, against walking the initial path and against
+        // planning the subset from scratch.
+        use rand::{RngExt, SeedableRng};
+        let settings = JobSettings::default();
+        let job = plan_job(&probe, &validity, &space, &mps, &groups, &home, &settings).unwrap();
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(7);
+        let (mut t_reuse, mut r_replan, mut r_initial, mut worst_replan) = (0.0, 0.0, 0.0, 0.0f64);
+        for _ in 0..20 {
+            let size = rng.random_range(3..=20);
+            let mut subset: Vec<usize> = (0..mps.len()).collect();
+            for i in (1..subset.len()).rev() {
+                let j = rng.random_range(0..=i);
+                subset.swap(i, j);
+            }
+            subset.truncate(size);
+            let reused = job.reuse(&subset, &home, &settings).unwrap();
+            for w in reused.path.windows(2) {
+                assert!(
+                    check_segment(&space, &validity, &w[0], &w[1], 1e-4).valid,
+                    "a reused segment collides"
+                );
+            }
+            for &i in &subset {
+                let (paths, _, members) = job.groups.iter().find(|(_, _, m)| m.contains(&i)).unwrap();
+                let k = members.iter().position(|&x| x == i).unwrap();
+                assert!(reused.path.contains(&paths.approaches[k]));
+            }
+            let initial = job.reuse_initial_path(&subset, &settings);
+            assert!(reused.motion_s() <= initial.motion_s() + 1e-9);
+            let sub_mps: Vec<Mp> = subset.iter().map(|&i| mps[i].clone()).collect();
+            let sub_groups = classify(
+                &sub_mps,
+                &block_adjacent,
+                &probe,
+                &orientations,
+                0.001,
+                Method::Exact,
+            )
+            .groups;
+            let replan =
+                plan_job(&probe, &validity, &space, &sub_mps, &sub_groups, &home, &settings).unwrap();
+            t_reuse += reused.compute_s;
+            r_replan += reused.motion_s() / replan.motion_s();
+            worst_replan = worst_replan.max(reused.motion_s() / replan.motion_s());
+            r_initial += reused.motion_s() / initial.motion_s();
+        }
+        eprintln!(
+            "reuse over 20 subsets: {:.1} µs per query; motion {:.3}× re-planning (worst {:.3}×), {:.3}× the initial path",
+            t_reuse / 20.0 * 1e6,
+            r_replan / 20.0,
+            worst_replan,
+            r_initial / 20.0
+        );
+        assert!(r_initial / 20.0 < 1.0);
         eprintln!("whole test {:.2} s", started.elapsed().as_secs_f64());
     }
 }
