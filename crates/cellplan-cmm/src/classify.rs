@@ -205,6 +205,14 @@ impl Probe {
         }
     }
 
+    /// The highest point of the static objects (m).
+    pub fn statics_top(&self) -> f64 {
+        (0..self.world.static_count())
+            .filter_map(|i| self.world.static_aabb(cellplan_geom::StaticId(i as u32)))
+            .map(|(_, hi)| hi.z)
+            .fold(f64::NEG_INFINITY, f64::max)
+    }
+
     /// The head and probe.
     pub fn head(&self) -> &CmmHead {
         &self.head

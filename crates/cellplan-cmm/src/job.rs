@@ -69,6 +69,9 @@ pub struct Job {
     pub inspection_s: f64,
     /// Computation time (s).
     pub compute_s: f64,
+    /// The height the head turns at: high enough that every configuration there keeps the
+    /// whole probe above every static object, so moves and turns at it need no check.
+    pub turn_height: f64,
 }
 
 impl Job {
@@ -80,9 +83,16 @@ impl Job {
     /// Paper 003's path reuse: the path for the MPs `subset` (indices into the job's MP list)
     /// from the stored paths alone — the job's group order and each group's MP order, groups
     /// without a wanted MP skipped, each wanted MP reached through its root — with no sampling
-    /// and no collision query. MPs the job does not hold are returned as the error.
+    /// and no collision query. Every segment is one planning checked: a group's stored paths,
+    /// the vertical move between a group's start and the turn height (the same whichever
+    /// group comes before or after), and moves and turns at the turn height, which are clear
+    /// by construction ([`Job::turn_height`]). MPs the job does not hold are returned as the error.
     pub fn reuse(&self, subset: &[usize], home: &[f64], s: &JobSettings) -> Result<Reused, Vec<usize>> {
         let started = Instant::now();
+        let s = &JobSettings {
+            turn_height: self.turn_height,
+            ..*s
+        };
         let unknown: Vec<usize> = subset
             .iter()
             .copied()
@@ -202,6 +212,12 @@ pub fn plan_job(
     s: &JobSettings,
 ) -> Result<Job, JobError> {
     let started = Instant::now();
+    // The turn height: above every static object by the probe's whole reach and a margin, so
+    // that at it any position and any orientation is clear.
+    let head = probe.head();
+    let top = probe.statics_top();
+    let turn_height = s.turn_height.max(top + head.reach() + head.ball_diameter + 0.05);
+    let s = &JobSettings { turn_height, ..*s };
     let move_time = |a: &[f64], b: &[f64]| s.speeds.move_time(&q5(a), &q5(b));
     let path_time = |p: &[Vec<f64>]| p.windows(2).map(|w| move_time(&w[0], &w[1])).sum::<f64>();
     // Each group's paths.
@@ -341,6 +357,7 @@ pub fn plan_job(
         rotation_s,
         inspection_s: inspections as f64 * s.inspection_s,
         compute_s: started.elapsed().as_secs_f64(),
+        turn_height,
     })
 }
 
