@@ -72,6 +72,8 @@ pub struct Job {
     /// The height the head turns at: high enough that every configuration there keeps the
     /// whole probe above every static object, so moves and turns at it need no check.
     pub turn_height: f64,
+    /// Where the job starts and ends.
+    pub home: Vec<f64>,
 }
 
 impl Job {
@@ -85,9 +87,10 @@ impl Job {
     /// without a wanted MP skipped, each wanted MP reached through its root — with no sampling
     /// and no collision query. Every segment is one planning checked: a group's stored paths,
     /// the vertical move between a group's start and the turn height (the same whichever
-    /// group comes before or after), and moves and turns at the turn height, which are clear
-    /// by construction ([`Job::turn_height`]). MPs the job does not hold are returned as the error.
-    pub fn reuse(&self, subset: &[usize], home: &[f64], s: &JobSettings) -> Result<Reused, Vec<usize>> {
+    /// group comes before or after), the way from and to home, and moves and turns at the turn
+    /// height, which are clear by construction ([`Job::turn_height`]). MPs the job does not hold are returned as the error.
+    pub fn reuse(&self, subset: &[usize], s: &JobSettings) -> Result<Reused, Vec<usize>> {
+        let home = &self.home;
         let started = Instant::now();
         let s = &JobSettings {
             turn_height: self.turn_height,
@@ -192,8 +195,11 @@ pub enum JobError {
     Start(usize),
     /// RRT-MRNC failed in a group.
     Group(usize, MrncError),
-    /// The turn between two groups is not clear.
-    Turn(usize, usize),
+    /// A move between groups (or to or from home) is not clear: the group (or `None` for the
+    /// way home).
+    Turn(Option<usize>),
+    /// The turn height (above every static object by the probe's reach) is beyond the Z travel.
+    TurnHeight(f64),
 }
 
 fn q5(q: &[f64]) -> CmmQ {
@@ -217,6 +223,9 @@ pub fn plan_job(
     let head = probe.head();
     let top = probe.statics_top();
     let turn_height = s.turn_height.max(top + head.reach() + head.ball_diameter + 0.05);
+    if turn_height > space.upper[2] {
+        return Err(JobError::TurnHeight(turn_height));
+    }
     let s = &JobSettings { turn_height, ..*s };
     let move_time = |a: &[f64], b: &[f64]| s.speeds.move_time(&q5(a), &q5(b));
     let path_time = |p: &[Vec<f64>]| p.windows(2).map(|w| move_time(&w[0], &w[1])).sum::<f64>();
@@ -326,7 +335,7 @@ pub fn plan_job(
         let t = transition(&at, &paths.start);
         for w in t.windows(2) {
             if !check_segment(space, validity, &w[0], &w[1], s.mrnc.min_clearance).valid {
-                return Err(JobError::Turn(path.len(), g));
+                return Err(JobError::Turn(Some(g)));
             }
         }
         path.extend(t.into_iter().skip(1));
@@ -335,6 +344,11 @@ pub fn plan_job(
         at = paths.start.clone();
     }
     let back = transition(&at, home);
+    for w in back.windows(2) {
+        if !check_segment(space, validity, &w[0], &w[1], s.mrnc.min_clearance).valid {
+            return Err(JobError::Turn(None));
+        }
+    }
     path.extend(back.into_iter().skip(1));
     path.dedup();
     let movement_s: f64 = path
@@ -358,6 +372,7 @@ pub fn plan_job(
         inspection_s: inspections as f64 * s.inspection_s,
         compute_s: started.elapsed().as_secs_f64(),
         turn_height,
+        home: home.to_vec(),
     })
 }
 
@@ -477,7 +492,7 @@ mod tests {
                 subset.swap(i, j);
             }
             subset.truncate(size);
-            let reused = job.reuse(&subset, &home, &settings).unwrap();
+            let reused = job.reuse(&subset, &settings).unwrap();
             for w in reused.path.windows(2) {
                 assert!(
                     check_segment(&space, &validity, &w[0], &w[1], 1e-4).valid,

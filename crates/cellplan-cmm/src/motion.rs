@@ -50,8 +50,9 @@ pub struct CmmValidity<'a> {
     pub margin: f64,
 }
 
-/// Distances beyond this are not measured exactly (m).
-const CAP: f64 = 0.05;
+/// Distances beyond this are not measured exactly (m): every clearance threshold compared with
+/// [`StateValidity::clearance`] (the group start's 5 cm, RRT-MRNC's safety) must stay below it.
+pub const CAP: f64 = 0.1;
 
 impl StateValidity for CmmValidity<'_> {
     fn clearance(&self, q: &[f64]) -> f64 {

@@ -171,9 +171,17 @@ pub fn plan_group(
         }
     }
     library.push(-d);
-    library.dedup_by(|a, b| (*a - *b).length() < 1e-9);
+    let mut unique: Vec<DVec3> = Vec::with_capacity(library.len());
+    for v in library {
+        if !unique.iter().any(|u| (*u - v).length() < 1e-9) {
+            unique.push(v);
+        }
+    }
+    let library = unique;
     let config = |p: DVec3| vec![p.x, p.y, p.z, angles.0, angles.1];
-    let safe = |q: &[f64]| space.contains(q) && validity.clearance(q) >= s.safety;
+    // (The clearance is capped at `motion::CAP`; a safety at or above it could never be met.)
+    let safety = s.safety.min(0.9 * crate::motion::CAP);
+    let safe = |q: &[f64]| space.contains(q) && validity.clearance(q) >= safety;
     let clear = |a: &[f64], b: &[f64]| check_segment(&space, validity, a, b, s.min_clearance).valid;
     // Algorithm 3.
     let search = |rng: &mut ChaCha8Rng, k: usize| -> Option<Vec<f64>> {

@@ -17,7 +17,11 @@
 //! two points on the hole's rim and two plane points, on the end x = 400 the boss's face and two
 //! plane points. Each has a cone half-angle θ: 20° for plane points, 30° for rims, the boss
 //! face and the chamfers, 80° for bore walls (the probe reaches them tilted, from above). Faces are numbered for
-//! the classification ([`block_adjacent`]); the four bore walls count as one face.
+//! the classification ([`block_adjacent`]); the four bore walls count as one face — a liberty
+//! with eq. 3's "at most two planes" (the walls are four cylinders, all adjacent to the deck and
+//! reached from above along one probe direction), which lets the deck and the bores form one
+//! group as a real cylinder block's deck program does. The mesh is a set of faces meeting with
+//! T-junctions along shared cell edges: exact for distances, not for inside/outside tests.
 use cellplan_geom::Mesh;
 use glam::DVec3;
 

@@ -106,12 +106,23 @@ impl CmmHead {
         let a = (-d.z).clamp(-1.0, 1.0).acos();
         let mut candidates: Vec<(f64, f64)> = Vec::new();
         if a.sin().abs() < 1e-9 {
-            // Along the B axis: any B. Prefer the hint, clamped into range (and onto the grid).
-            let mut b = b_hint.clamp(self.b_range[0], self.b_range[1]);
+            // Along the B axis: any B. Prefer the hint, clamped into range (and onto the grid,
+            // within range); straight up, the tilt may also be −π.
+            let (lo, hi) = match self.index_step {
+                Some(s) => (
+                    (self.b_range[0] / s - 1e-9).ceil() * s,
+                    (self.b_range[1] / s + 1e-9).floor() * s,
+                ),
+                None => (self.b_range[0], self.b_range[1]),
+            };
+            let mut b = b_hint.clamp(lo, hi);
             if let Some(s) = self.index_step {
-                b = (b / s).round() * s;
+                b = ((b / s).round() * s).clamp(lo, hi);
             }
             candidates.push((a, b));
+            if a > 1.0 {
+                candidates.push((-a, b));
+            }
         } else {
             let b = d.y.atan2(d.x);
             for (aa, bb) in [(a, b), (-a, b + std::f64::consts::PI)] {
