@@ -84,118 +84,16 @@ pub struct Probe {
 }
 
 impl Probe {
-    /// The part (and fixture) `statics` as static objects, the probe as a group of bodies.
+    /// The part (and fixture) `statics` as static objects, the probe as two groups of bodies:
+    /// for touching (the ball and the stem's last `stem_start` left out — they touch by design)
+    /// and for moving (the whole probe).
     pub fn new(statics: Vec<(String, ShapeSpec, Pose)>, head: CmmHead, bodies: ProbeBodies) -> Self {
         let mut world = CollisionWorld::new();
         for (name, shape, pose) in statics {
             world.add_static(&name, &shape, pose);
         }
-        let stem_len = head.reach() - head.l1 - bodies.stem_start;
-        let group = world.add_group(
-            "probe",
-            vec![
-                GroupBody {
-                    name: "stem".into(),
-                    shapes: vec![(
-                        ShapeSpec::Cylinder {
-                            radius: bodies.stem_diameter / 2.0,
-                            half_height: stem_len / 2.0,
-                        },
-                        Pose::IDENTITY,
-                    )],
-                },
-                GroupBody {
-                    name: "extension".into(),
-                    shapes: vec![(
-                        ShapeSpec::Cylinder {
-                            radius: bodies.extension_diameter / 2.0,
-                            half_height: head.l1 / 2.0,
-                        },
-                        Pose::IDENTITY,
-                    )],
-                },
-                GroupBody {
-                    name: "head".into(),
-                    shapes: vec![(
-                        ShapeSpec::Cylinder {
-                            radius: bodies.head.0 / 2.0,
-                            half_height: bodies.head.1 / 2.0,
-                        },
-                        Pose::IDENTITY,
-                    )],
-                },
-                GroupBody {
-                    name: "ram".into(),
-                    shapes: vec![(
-                        ShapeSpec::Box {
-                            half_extents: DVec3::new(
-                                bodies.ram.0 / 2.0,
-                                bodies.ram.0 / 2.0,
-                                bodies.ram.1 / 2.0,
-                            ),
-                        },
-                        Pose::IDENTITY,
-                    )],
-                },
-            ],
-        );
-        let moving = world.add_group(
-            "probe-moving",
-            vec![
-                GroupBody {
-                    name: "ball".into(),
-                    shapes: vec![(
-                        ShapeSpec::Sphere {
-                            radius: head.ball_diameter / 2.0,
-                        },
-                        Pose::IDENTITY,
-                    )],
-                },
-                GroupBody {
-                    name: "stem".into(),
-                    shapes: vec![(
-                        ShapeSpec::Cylinder {
-                            radius: bodies.stem_diameter / 2.0,
-                            half_height: head.l2 / 2.0,
-                        },
-                        Pose::IDENTITY,
-                    )],
-                },
-                GroupBody {
-                    name: "extension".into(),
-                    shapes: vec![(
-                        ShapeSpec::Cylinder {
-                            radius: bodies.extension_diameter / 2.0,
-                            half_height: head.l1 / 2.0,
-                        },
-                        Pose::IDENTITY,
-                    )],
-                },
-                GroupBody {
-                    name: "head".into(),
-                    shapes: vec![(
-                        ShapeSpec::Cylinder {
-                            radius: bodies.head.0 / 2.0,
-                            half_height: bodies.head.1 / 2.0,
-                        },
-                        Pose::IDENTITY,
-                    )],
-                },
-                GroupBody {
-                    name: "ram".into(),
-                    shapes: vec![(
-                        ShapeSpec::Box {
-                            half_extents: DVec3::new(
-                                bodies.ram.0 / 2.0,
-                                bodies.ram.0 / 2.0,
-                                bodies.ram.1 / 2.0,
-                            ),
-                        },
-                        Pose::IDENTITY,
-                    )],
-                },
-            ],
-        );
+        let group = world.add_group("probe", probe_bodies(&head, &bodies, false));
+        let moving = world.add_group("probe-moving", probe_bodies(&head, &bodies, true));
         Probe {
             world,
             group,
@@ -218,45 +116,38 @@ impl Probe {
         &self.head
     }
 
-    /// The poses of the moving probe's bodies (ball, stem, extension, head, ram) at `q`.
-    pub fn moving_poses(&self, q: &CmmQ) -> [Pose; 5] {
-        let centre = DVec3::new(q[0], q[1], q[2]);
-        let d = CmmHead::direction(q[3], q[4]);
+    /// Poses of the bodies [`probe_bodies`] makes, for the A-axis centre at `centre` and probe
+    /// direction `d`: the ball (`whole`), the stem, the extension, the head, the ram.
+    fn body_poses(&self, centre: DVec3, d: DVec3, whole: bool) -> Vec<Pose> {
         let turn = DQuat::from_rotation_arc(DVec3::Z, d);
         let along = |from: f64, to: f64| Pose::from_parts(centre + d * (0.5 * (from + to)), turn);
         let reach = self.head.reach();
-        [
-            Pose::from_parts(centre + d * reach, DQuat::IDENTITY),
-            along(self.head.l1, reach),
-            along(0.0, self.head.l1),
-            Pose::from_parts(centre + DVec3::Z * (self.bodies.head.1 / 2.0), DQuat::IDENTITY),
-            Pose::from_parts(
-                centre + DVec3::Z * (self.bodies.head.1 + self.bodies.ram.1 / 2.0),
-                DQuat::IDENTITY,
-            ),
-        ]
+        let mut poses = Vec::with_capacity(5);
+        if whole {
+            poses.push(Pose::from_parts(centre + d * reach, DQuat::IDENTITY));
+        }
+        let stem_end = if whole {
+            reach
+        } else {
+            reach - self.bodies.stem_start
+        };
+        poses.push(along(self.head.l1, stem_end));
+        poses.push(along(0.0, self.head.l1));
+        poses.push(Pose::from_parts(
+            centre + DVec3::Z * (self.bodies.head.1 / 2.0),
+            DQuat::IDENTITY,
+        ));
+        poses.push(Pose::from_parts(
+            centre + DVec3::Z * (self.bodies.head.1 + self.bodies.ram.1 / 2.0),
+            DQuat::IDENTITY,
+        ));
+        poses
     }
 
     /// The distance of the whole probe at `q` to the statics, capped at `cap` (m).
     pub fn distance(&self, q: &CmmQ, cap: f64) -> f64 {
-        self.world
-            .group_static_distance(self.moving, &self.moving_poses(q), cap)
-    }
-
-    /// Body poses for the A-axis centre at `centre` and probe direction `d`.
-    pub fn poses(&self, centre: DVec3, d: DVec3) -> [Pose; 4] {
-        let turn = DQuat::from_rotation_arc(DVec3::Z, d);
-        let along = |from: f64, to: f64| Pose::from_parts(centre + d * (0.5 * (from + to)), turn);
-        let reach = self.head.reach();
-        [
-            along(self.head.l1, reach - self.bodies.stem_start),
-            along(0.0, self.head.l1),
-            Pose::from_parts(centre + DVec3::Z * (self.bodies.head.1 / 2.0), DQuat::IDENTITY),
-            Pose::from_parts(
-                centre + DVec3::Z * (self.bodies.head.1 + self.bodies.ram.1 / 2.0),
-                DQuat::IDENTITY,
-            ),
-        ]
+        let poses = self.body_poses(DVec3::new(q[0], q[1], q[2]), CmmHead::direction(q[3], q[4]), true);
+        self.world.group_static_distance(self.moving, &poses, cap)
     }
 
     /// Whether the probe touching `mp` (m, normal) along direction `d` stays `clearance` clear of
@@ -265,9 +156,46 @@ impl Probe {
         let ball = position + normal * (self.head.ball_diameter / 2.0);
         let centre = ball - d * self.head.reach();
         self.world
-            .group_vs_static(self.group, &self.poses(centre, d), clearance)
+            .group_vs_static(self.group, &self.body_poses(centre, d, false), clearance)
             .is_none()
     }
+}
+
+/// The probe's bodies: the ball (`whole` only), the stem (all of L2 when `whole`, else from
+/// the extension to `stem_start` above the ball's centre), the extension, the head, the ram.
+fn probe_bodies(head: &CmmHead, b: &ProbeBodies, whole: bool) -> Vec<GroupBody> {
+    let body = |name: &str, shape: ShapeSpec| GroupBody {
+        name: name.into(),
+        shapes: vec![(shape, Pose::IDENTITY)],
+    };
+    let cylinder = |diameter: f64, length: f64| ShapeSpec::Cylinder {
+        radius: diameter / 2.0,
+        half_height: length / 2.0,
+    };
+    let stem = if whole {
+        head.l2
+    } else {
+        head.reach() - head.l1 - b.stem_start
+    };
+    let mut out = Vec::with_capacity(5);
+    if whole {
+        out.push(body(
+            "ball",
+            ShapeSpec::Sphere {
+                radius: head.ball_diameter / 2.0,
+            },
+        ));
+    }
+    out.push(body("stem", cylinder(b.stem_diameter, stem)));
+    out.push(body("extension", cylinder(b.extension_diameter, head.l1)));
+    out.push(body("head", cylinder(b.head.0, b.head.1)));
+    out.push(body(
+        "ram",
+        ShapeSpec::Box {
+            half_extents: DVec3::new(b.ram.0 / 2.0, b.ram.0 / 2.0, b.ram.1 / 2.0),
+        },
+    ));
+    out
 }
 
 /// Classifies `mps` (positions in m) over the candidate head `orientations`, with the faces'
@@ -385,44 +313,8 @@ pub fn classify(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::part::{BlockSpec, block_adjacent, cylinder_block};
-    use std::sync::Arc;
-
-    /// The block in metres with a fixture plate under it.
-    fn setup() -> (Vec<Mp>, Probe) {
-        let (mesh, mps) = cylinder_block(&BlockSpec::default());
-        let mesh = mesh.scaled(1e-3);
-        let mps: Vec<Mp> = mps
-            .into_iter()
-            .map(|m| Mp {
-                position: m.position * 1e-3,
-                ..m
-            })
-            .collect();
-        let statics = vec![
-            (
-                "block".to_string(),
-                ShapeSpec::Mesh(Arc::new(mesh)),
-                Pose::IDENTITY,
-            ),
-            (
-                "plate".to_string(),
-                ShapeSpec::Box {
-                    half_extents: DVec3::new(0.35, 0.25, 0.01),
-                },
-                Pose::from_parts(DVec3::new(0.2, 0.12, -0.011), DQuat::IDENTITY),
-            ),
-        ];
-        (mps, Probe::new(statics, CmmHead::paper(), ProbeBodies::paper()))
-    }
-
-    fn grid() -> Vec<(f64, f64)> {
-        let head = CmmHead {
-            index_step: Some(7.5f64.to_radians()),
-            ..CmmHead::paper()
-        };
-        head.indexed_orientations()
-    }
+    use crate::part::block_adjacent;
+    use crate::scene::{block as setup, grid};
 
     #[test]
     fn every_mp_of_the_block_is_grouped_within_its_cone_on_adjacent_faces() {

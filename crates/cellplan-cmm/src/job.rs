@@ -175,6 +175,34 @@ impl Reused {
     }
 }
 
+/// A tour from node 0 of `costs` over all the others, by the settings' method, as the indices
+/// (0-based) of the other nodes in visiting order. (Single-node clusters and a depot outside
+/// them always make a valid GTSP, so the fallback to the given order is never taken.)
+fn tour_from_depot(costs: CostMatrix, s: &JobSettings) -> Vec<usize> {
+    let n = costs.n() - 1;
+    let given: Vec<usize> = (0..n).collect();
+    if n <= 1 {
+        return given;
+    }
+    let Ok(tsp) =
+        Gtsp::new(costs, (1..=n).map(|k| vec![k]).collect()).and_then(|p| p.with_depots(Some(0), None))
+    else {
+        return given;
+    };
+    let params = GtspParams {
+        method: s.order,
+        seed: s.mrnc.seed,
+        max_iterations: Some(s.order_iterations),
+        time_limit: Duration::from_secs(3600),
+    };
+    solve_gtsp(&tsp, &params)
+        .tour
+        .nodes
+        .iter()
+        .map(|&v| v - 1)
+        .collect()
+}
+
 /// From one group's start to another's (or home): up to the turn height, turn, down.
 fn transition(s: &JobSettings, from: &[f64], to: &[f64]) -> Vec<Vec<f64>> {
     let lift = |q: &[f64]| vec![q[0], q[1], s.turn_height.max(q[2]), q[3], q[4]];
@@ -276,24 +304,7 @@ pub fn plan_job(
             out + move_time(from, to) + into
         };
         let costs = CostMatrix::from_fn(n + 1, |a, b| if a == b { 0.0 } else { leg(a, b) });
-        let clusters: Vec<Vec<usize>> = (1..=n).map(|k| vec![k]).collect();
-        let order: Vec<usize> = if n <= 1 {
-            (0..n).collect()
-        } else {
-            let tsp = Gtsp::new(costs, clusters)
-                .and_then(|p| p.with_depots(Some(0), None))
-                .map_err(|_| JobError::Start(g))?;
-            let sol = solve_gtsp(
-                &tsp,
-                &GtspParams {
-                    method: s.order,
-                    seed: s.mrnc.seed,
-                    max_iterations: Some(s.order_iterations),
-                    time_limit: Duration::from_secs(3600),
-                },
-            );
-            sol.tour.nodes.iter().map(|&v| v - 1).collect()
-        };
+        let order = tour_from_depot(costs, s);
         planned.push((paths, order));
     }
     // The turns between groups: up above the next start, turn, down.
@@ -309,23 +320,7 @@ pub fn plan_job(
             path_time(&transition(node(a), node(b)))
         }
     });
-    let group_order: Vec<usize> = if m <= 1 {
-        (0..m).collect()
-    } else {
-        let tsp = Gtsp::new(gcosts, (1..=m).map(|k| vec![k]).collect())
-            .and_then(|p| p.with_depots(Some(0), None))
-            .map_err(|_| JobError::Start(0))?;
-        let sol = solve_gtsp(
-            &tsp,
-            &GtspParams {
-                method: s.order,
-                seed: s.mrnc.seed,
-                max_iterations: Some(s.order_iterations),
-                time_limit: Duration::from_secs(3600),
-            },
-        );
-        sol.tour.nodes.iter().map(|&v| v - 1).collect()
-    };
+    let group_order = tour_from_depot(gcosts, s);
     // The whole path and its times.
     let mut path: Vec<Vec<f64>> = vec![home.to_vec()];
     let mut at: Vec<f64> = home.to_vec();
@@ -379,50 +374,17 @@ pub fn plan_job(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::classify::{Method, ProbeBodies, classify};
-    use crate::motion::{CmmValidity, Travel, space};
-    use crate::part::{BlockSpec, block_adjacent, cylinder_block};
-    use cellplan_geom::{DQuat, DVec3, Pose, ShapeSpec};
-    use cellplan_kin::cmm::CmmHead;
-    use std::sync::Arc;
+    use crate::classify::{Method, classify};
+    use crate::motion::{CmmValidity, space};
+    use crate::part::block_adjacent;
 
     #[test]
     fn the_block_is_planned_whole_every_segment_clear_every_mp_once() {
         let started = Instant::now();
-        let (mesh, mps) = cylinder_block(&BlockSpec::default());
-        let mps: Vec<Mp> = mps
-            .into_iter()
-            .map(|m| Mp {
-                position: m.position * 1e-3,
-                ..m
-            })
-            .collect();
-        let statics = vec![
-            (
-                "block".to_string(),
-                ShapeSpec::Mesh(Arc::new(mesh.scaled(1e-3))),
-                Pose::IDENTITY,
-            ),
-            (
-                "plate".to_string(),
-                ShapeSpec::Box {
-                    half_extents: DVec3::new(0.35, 0.25, 0.01),
-                },
-                Pose::from_parts(DVec3::new(0.2, 0.12, -0.011), DQuat::IDENTITY),
-            ),
-        ];
-        let probe = Probe::new(statics, CmmHead::paper(), ProbeBodies::paper());
-        let orientations = CmmHead {
-            index_step: Some(7.5f64.to_radians()),
-            ..CmmHead::paper()
-        }
-        .indexed_orientations();
+        let (mps, probe) = crate::scene::block();
+        let orientations = crate::scene::grid();
         let groups = classify(&mps, &block_adjacent, &probe, &orientations, 0.001, Method::Exact).groups;
-        let travel = Travel {
-            x: [-0.4, 0.8],
-            y: [-0.5, 0.7],
-            z: [0.0, 1.0],
-        };
+        let travel = crate::scene::TRAVEL;
         let space = space(&probe, &travel);
         let validity = CmmValidity {
             probe: &probe,

@@ -20,3 +20,5 @@ pub mod job;
 pub mod motion;
 pub mod mrnc;
 pub mod part;
+#[cfg(test)]
+mod scene;

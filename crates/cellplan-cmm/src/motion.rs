@@ -66,38 +66,12 @@ impl StateValidity for CmmValidity<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::classify::ProbeBodies;
-    use crate::part::{BlockSpec, Mp, cylinder_block};
-    use cellplan_geom::{DQuat, DVec3, Pose, ShapeSpec};
+
+    use crate::part::Mp;
+    use crate::scene::block as setup;
+    use cellplan_geom::DVec3;
     use cellplan_kin::cmm::CmmHead;
     use cellplan_motion::plan::{PlanSettings, plan_leg};
-    use std::sync::Arc;
-
-    fn setup() -> (Vec<Mp>, Probe) {
-        let (mesh, mps) = cylinder_block(&BlockSpec::default());
-        let mps: Vec<Mp> = mps
-            .into_iter()
-            .map(|m| Mp {
-                position: m.position * 1e-3,
-                ..m
-            })
-            .collect();
-        let statics = vec![
-            (
-                "block".to_string(),
-                ShapeSpec::Mesh(Arc::new(mesh.scaled(1e-3))),
-                Pose::IDENTITY,
-            ),
-            (
-                "plate".to_string(),
-                ShapeSpec::Box {
-                    half_extents: DVec3::new(0.35, 0.25, 0.01),
-                },
-                Pose::from_parts(DVec3::new(0.2, 0.12, -0.011), DQuat::IDENTITY),
-            ),
-        ];
-        (mps, Probe::new(statics, CmmHead::paper(), ProbeBodies::paper()))
-    }
 
     /// The configuration 5 mm off `mp` along its normal, the probe along `d`.
     fn approach(probe: &Probe, mp: &Mp, d: DVec3) -> CmmQ {

@@ -331,48 +331,16 @@ impl GroupPaths {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::classify::{Method, ProbeBodies, classify};
-    use crate::motion::{CmmValidity, Travel, space};
-    use crate::part::{BlockSpec, block_adjacent, cylinder_block};
-    use cellplan_geom::{DQuat, Pose, ShapeSpec};
-    use std::sync::Arc;
+    use crate::classify::{Method, classify};
+    use crate::motion::{CmmValidity, space};
+    use crate::part::block_adjacent;
 
     #[test]
     fn every_group_of_the_block_gets_roots_and_paths_and_any_subset_is_a_clear_path() {
-        let (mesh, mps) = cylinder_block(&BlockSpec::default());
-        let mps: Vec<Mp> = mps
-            .into_iter()
-            .map(|m| Mp {
-                position: m.position * 1e-3,
-                ..m
-            })
-            .collect();
-        let statics = vec![
-            (
-                "block".to_string(),
-                ShapeSpec::Mesh(Arc::new(mesh.scaled(1e-3))),
-                Pose::IDENTITY,
-            ),
-            (
-                "plate".to_string(),
-                ShapeSpec::Box {
-                    half_extents: DVec3::new(0.35, 0.25, 0.01),
-                },
-                Pose::from_parts(DVec3::new(0.2, 0.12, -0.011), DQuat::IDENTITY),
-            ),
-        ];
-        let probe = Probe::new(statics, CmmHead::paper(), ProbeBodies::paper());
-        let orientations = CmmHead {
-            index_step: Some(7.5f64.to_radians()),
-            ..CmmHead::paper()
-        }
-        .indexed_orientations();
+        let (mps, probe) = crate::scene::block();
+        let orientations = crate::scene::grid();
         let groups = classify(&mps, &block_adjacent, &probe, &orientations, 0.001, Method::Exact).groups;
-        let travel = Travel {
-            x: [-0.4, 0.8],
-            y: [-0.5, 0.7],
-            z: [0.0, 1.0],
-        };
+        let travel = crate::scene::TRAVEL;
         let space = space(&probe, &travel);
         let validity = CmmValidity {
             probe: &probe,
