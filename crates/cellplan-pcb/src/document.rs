@@ -50,7 +50,7 @@ pub struct PcbPlan {
     pub lower_bound_s: f64,
     /// Wall-clock time of the planning (s; the only number not re-derived).
     pub compute_s: f64,
-    /// Simulations the optimiser spent.
+    /// The simulations the optimiser was given (its work budget; a binding time limit stops it sooner).
     pub evaluations: usize,
 }
 
@@ -169,7 +169,7 @@ pub struct RunInfo {
     pub seed: u64,
     /// Wall clock (s).
     pub compute_s: f64,
-    /// Simulations spent.
+    /// The simulation budget.
     pub evaluations: usize,
     /// The lower bound (s).
     pub lower_bound_s: f64,
@@ -384,11 +384,6 @@ pub fn read(path: &std::path::Path) -> Result<PcbPlan, String> {
         ));
     }
     Ok(plan)
-}
-
-/// Whether a JSON text is a PCB plan (by its `format`).
-pub fn is_pcb_plan(text: &str) -> bool {
-    text.get(..4096).unwrap_or(text).contains(FORMAT)
 }
 
 /// The JSON Schema of the document, as `docs/pcb-plan.schema.json` holds it.

@@ -84,7 +84,6 @@ pub fn run(cell: &PcbCell, req: &Request) -> Outcome {
         }
     };
     let schedule = simulate(cell, &decision, &mut Given(&decision), rule(cell, req.optimizer));
-    let evaluations = trace_total(&trace, req.evaluations);
     let plan = build(
         cell,
         &decision,
@@ -93,7 +92,7 @@ pub fn run(cell: &PcbCell, req: &Request) -> Outcome {
             optimizer: req.optimizer.name().into(),
             seed: req.seed,
             compute_s: start.elapsed().as_secs_f64(),
-            evaluations,
+            evaluations: req.evaluations,
             lower_bound_s: lower_bound(cell),
         },
     );
@@ -104,10 +103,6 @@ pub fn run(cell: &PcbCell, req: &Request) -> Outcome {
         trace,
         time_limit_hit: hit,
     }
-}
-
-fn trace_total(_trace: &[(usize, f64)], budget: usize) -> usize {
-    budget
 }
 
 /// A plan with the placement order given (every component once) and the rest ours: the

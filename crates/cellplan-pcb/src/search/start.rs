@@ -219,7 +219,7 @@ pub fn initial(cell: &PcbCell) -> Decision {
         robot: vec![0; n],
         feeder: vec![0; n],
         slots,
-        carriage: cell_home_carriages(cell),
+        carriage: vec![cell.feeders[0].home; n],
         table: vec![cell.table.home; n],
     };
     let lookup = slot_lookup(cell, &d);
@@ -279,10 +279,6 @@ pub fn initial(cell: &PcbCell) -> Decision {
     let _ = fix_devices(cell, &mut d, Some([0.5; 4]));
     record_rendezvous(cell, &mut d);
     d
-}
-
-fn cell_home_carriages(cell: &PcbCell) -> Vec<f64> {
-    vec![cell.feeders[0].home; cell.len()]
 }
 
 /// The decision with the contents of the two feeders exchanged bin for bin (one robot, bins
