@@ -195,6 +195,7 @@ fn robot_x(cell: &PcbCell, s: &Schedule, r: usize, t: f64) -> f64 {
 #[test]
 fn safety_delays_keep_the_gap_and_the_exact_rule_waits_less() {
     let mut crossings_without = 0;
+    let mut compared = 0;
     for seed in 0..12 {
         let cell = random_cell(20, 5, 2, Configuration::AllMoving, seed);
         let d = random_decision(&cell, seed);
@@ -218,8 +219,19 @@ fn safety_delays_keep_the_gap_and_the_exact_rule_waits_less() {
         }
         let paper = simulate(&cell, &d, &mut Given(&d), DelayRule::Paper);
         let exact = simulate(&cell, &d, &mut Given(&d), DelayRule::Exact);
-        assert!(exact.cycles[0].safety_delay <= paper.cycles[0].safety_delay + 1e-12);
+        // Up to the first delay both rules share their history: there the exact one waits no
+        // longer than the paper's.
+        if let Some(i) = (0..exact.cycles.len())
+            .find(|&i| exact.cycles[i].safety_delay > 1e-12 || paper.cycles[i].safety_delay > 1e-12)
+        {
+            assert!(
+                exact.cycles[i].safety_delay <= paper.cycles[i].safety_delay + 1e-12,
+                "seed {seed}"
+            );
+            compared += 1;
+        }
     }
+    assert!(compared > 0, "some random cell must need a safety delay");
     assert!(
         crossings_without > 0,
         "the random cells must need collision avoidance at all"
