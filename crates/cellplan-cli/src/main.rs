@@ -355,7 +355,7 @@ fn run_gen_block(args: &GenBlockArgs) -> Result<(), Failure> {
             args.segments
         ),
     );
-    let csv = cellplan_cmm::part::to_csv(&mps);
+    let csv = cellplan_cmm::part::to_csv(&mps, &cellplan_cmm::part::BLOCK_FACES);
     let (a, b) = (args.out.join("block.obj"), args.out.join("tasks.csv"));
     write_all_atomic(&[(&a, obj.as_bytes()), (&b, csv.as_bytes())])
         .map_err(|e| Failure::Other(format!("cannot write into {}: {e}", args.out.display())))?;

@@ -51,16 +51,32 @@ impl Default for JobSettings {
     }
 }
 
+/// One planned group: its stored paths, the visiting order of its MPs, its MPs and faces.
+#[derive(Clone, Debug, PartialEq)]
+pub struct JobGroup {
+    /// RRT-MRNC's paths.
+    pub paths: GroupPaths,
+    /// Visiting order (indices into `members`).
+    pub order: Vec<usize>,
+    /// The MPs (indices into the job's MP list).
+    pub members: Vec<usize>,
+    /// The faces they lie on.
+    pub faces: Vec<usize>,
+}
+
 /// A planned job.
 #[derive(Clone, Debug)]
 pub struct Job {
-    /// Per group (in the classification's order): its paths and its MPs' visiting order
-    /// (indices into the group's members).
-    pub groups: Vec<(GroupPaths, Vec<usize>, Vec<usize>)>,
+    /// The groups planned (a classification's groups, less what could not be planned; a group
+    /// whose roots could not be found together is split in two).
+    pub groups: Vec<JobGroup>,
     /// The order of the groups.
     pub group_order: Vec<usize>,
     /// The whole path, configuration by configuration, from home back to home.
     pub path: Vec<Vec<f64>>,
+    /// Where MPs are touched: (index into `path`, MP). At that configuration the probe moves
+    /// along the MP's normal to touch it and back.
+    pub touches: Vec<(usize, usize)>,
     /// Movement time (s).
     pub movement_s: f64,
     /// Rotation time (s).
@@ -74,6 +90,43 @@ pub struct Job {
     pub turn_height: f64,
     /// Where the job starts and ends.
     pub home: Vec<f64>,
+    /// MPs of the groups that could not be planned, with the reason.
+    pub unmeasured: Vec<(usize, String)>,
+}
+
+/// A path being built: consecutive duplicates dropped, touches recorded.
+#[derive(Default)]
+struct PathBuilder {
+    path: Vec<Vec<f64>>,
+    touches: Vec<(usize, usize)>,
+}
+
+impl PathBuilder {
+    fn push(&mut self, q: &[f64]) {
+        if self.path.last().is_none_or(|l| l.as_slice() != q) {
+            self.path.push(q.to_vec());
+        }
+    }
+
+    fn extend(&mut self, qs: &[Vec<f64>]) {
+        for q in qs {
+            self.push(q);
+        }
+    }
+
+    /// The group's stored paths for its members at `wanted` (positions in the group, in
+    /// order): start → root → approach (touch) → root → … → start.
+    fn group(&mut self, g: &JobGroup, wanted: &[usize]) {
+        self.push(&g.paths.start);
+        for &k in wanted {
+            self.extend(&g.paths.local[k]);
+            self.touches.push((self.path.len() - 1, g.members[k]));
+            for q in g.paths.local[k].iter().rev().skip(1) {
+                self.push(q);
+            }
+        }
+        self.push(&g.paths.start);
+    }
 }
 
 impl Job {
@@ -88,9 +141,9 @@ impl Job {
     /// and no collision query. Every segment is one planning checked: a group's stored paths,
     /// the vertical move between a group's start and the turn height (the same whichever
     /// group comes before or after), the way from and to home, and moves and turns at the turn
-    /// height, which are clear by construction ([`Job::turn_height`]). MPs the job does not hold are returned as the error.
+    /// height, which are clear by construction ([`Job::turn_height`]). MPs the job does not
+    /// hold are returned as the error.
     pub fn reuse(&self, subset: &[usize], s: &JobSettings) -> Result<Reused, Vec<usize>> {
-        let home = &self.home;
         let started = Instant::now();
         let s = &JobSettings {
             turn_height: self.turn_height,
@@ -99,39 +152,45 @@ impl Job {
         let unknown: Vec<usize> = subset
             .iter()
             .copied()
-            .filter(|i| !self.groups.iter().any(|(_, _, members)| members.contains(i)))
+            .filter(|i| !self.groups.iter().any(|g| g.members.contains(i)))
             .collect();
         if !unknown.is_empty() {
             return Err(unknown);
         }
-        let mut path: Vec<Vec<f64>> = vec![home.to_vec()];
-        let mut at = home.to_vec();
-        let mut count = 0;
+        let mut b = PathBuilder::default();
+        b.push(&self.home);
+        let mut at = self.home.clone();
         for &g in &self.group_order {
-            let (paths, order, members) = &self.groups[g];
-            let wanted: Vec<usize> = order
+            let group = &self.groups[g];
+            let wanted: Vec<usize> = group
+                .order
                 .iter()
                 .copied()
-                .filter(|&k| subset.contains(&members[k]))
+                .filter(|&k| subset.contains(&group.members[k]))
                 .collect();
             if wanted.is_empty() {
                 continue;
             }
-            path.extend(transition(s, &at, &paths.start).into_iter().skip(1));
-            path.extend(paths.reuse(&wanted).into_iter().skip(1));
-            count += wanted.len();
-            at = paths.start.clone();
+            b.extend(&transition(s, &at, &group.paths.start));
+            b.group(group, &wanted);
+            at = group.paths.start.clone();
         }
-        path.extend(transition(s, &at, home).into_iter().skip(1));
-        path.dedup();
+        b.extend(&transition(s, &at, &self.home));
         let compute_s = started.elapsed().as_secs_f64();
-        Ok(Reused::new(path, count, s, compute_s))
+        Ok(Reused::new(b.path, b.touches, s, compute_s))
     }
 
     /// The paper's "reuse of the initial path": the whole stored path walked again, touching
     /// only the MPs of `subset`.
     pub fn reuse_initial_path(&self, subset: &[usize], s: &JobSettings) -> Reused {
-        Reused::new(self.path.clone(), subset.len(), s, 0.0)
+        let started = Instant::now();
+        let touches = self
+            .touches
+            .iter()
+            .copied()
+            .filter(|(_, mp)| subset.contains(mp))
+            .collect();
+        Reused::new(self.path.clone(), touches, s, started.elapsed().as_secs_f64())
     }
 }
 
@@ -140,6 +199,8 @@ impl Job {
 pub struct Reused {
     /// The path.
     pub path: Vec<Vec<f64>>,
+    /// Where MPs are touched (index into `path`, MP).
+    pub touches: Vec<(usize, usize)>,
     /// Movement time (s).
     pub movement_s: f64,
     /// Rotation time (s).
@@ -150,21 +211,28 @@ pub struct Reused {
     pub compute_s: f64,
 }
 
+/// Movement and rotation time of a path (s).
+pub fn path_times(path: &[Vec<f64>], speeds: &CmmSpeeds) -> (f64, f64) {
+    let movement_s = path
+        .windows(2)
+        .map(|w| speeds.movement_time(&q5(&w[0]), &q5(&w[1])))
+        .sum();
+    let rotation_s = path
+        .windows(2)
+        .map(|w| speeds.rotation_time(&q5(&w[0]), &q5(&w[1])))
+        .sum();
+    (movement_s, rotation_s)
+}
+
 impl Reused {
-    fn new(path: Vec<Vec<f64>>, inspections: usize, s: &JobSettings, compute_s: f64) -> Self {
-        let movement_s: f64 = path
-            .windows(2)
-            .map(|w| s.speeds.movement_time(&q5(&w[0]), &q5(&w[1])))
-            .sum();
-        let rotation_s: f64 = path
-            .windows(2)
-            .map(|w| s.speeds.rotation_time(&q5(&w[0]), &q5(&w[1])))
-            .sum();
+    fn new(path: Vec<Vec<f64>>, touches: Vec<(usize, usize)>, s: &JobSettings, compute_s: f64) -> Self {
+        let (movement_s, rotation_s) = path_times(&path, &s.speeds);
         Reused {
+            inspection_s: touches.len() as f64 * s.inspection_s,
             path,
+            touches,
             movement_s,
             rotation_s,
-            inspection_s: inspections as f64 * s.inspection_s,
             compute_s,
         }
     }
@@ -204,7 +272,7 @@ fn tour_from_depot(costs: CostMatrix, s: &JobSettings) -> Vec<usize> {
 }
 
 /// From one group's start to another's (or home): up to the turn height, turn, down.
-fn transition(s: &JobSettings, from: &[f64], to: &[f64]) -> Vec<Vec<f64>> {
+pub fn transition(s: &JobSettings, from: &[f64], to: &[f64]) -> Vec<Vec<f64>> {
     let lift = |q: &[f64]| vec![q[0], q[1], s.turn_height.max(q[2]), q[3], q[4]];
     let up = lift(from);
     let mut above = lift(to);
@@ -216,25 +284,39 @@ fn transition(s: &JobSettings, from: &[f64], to: &[f64]) -> Vec<Vec<f64>> {
     p
 }
 
-/// Why a job could not be planned.
+/// Why a job could not be planned at all.
 #[derive(Clone, Debug, PartialEq)]
 pub enum JobError {
-    /// A group has no clear start.
-    Start(usize),
-    /// RRT-MRNC failed in a group.
-    Group(usize, MrncError),
-    /// A move between groups (or to or from home) is not clear: the group (or `None` for the
-    /// way home).
-    Turn(Option<usize>),
     /// The turn height (above every static object by the probe's reach) is beyond the Z travel.
     TurnHeight(f64),
+    /// The vertical move from home up to the turn height is not clear.
+    Home,
 }
 
 fn q5(q: &[f64]) -> CmmQ {
     [q[0], q[1], q[2], q[3], q[4]]
 }
 
-/// Plans a job from the groups of a classification.
+/// The reason an MP is left unmeasured, in words.
+fn mrnc_reason(e: &MrncError, angles: (f64, f64)) -> String {
+    let at = format!(
+        "at head angles A {:.1}°, B {:.1}°",
+        angles.0.to_degrees(),
+        angles.1.to_degrees()
+    );
+    match e {
+        MrncError::Approach(_) => {
+            format!("its approach configuration is outside the travel or not clear {at}")
+        }
+        MrncError::Roots => format!("no root that sees the group's start and the other roots {at}"),
+        MrncError::Local(_) => format!("RRT* found no path from its root to its approach {at}"),
+    }
+}
+
+/// Plans a job from the groups of a classification. What cannot be planned is left out with its
+/// reason ([`Job::unmeasured`]): an MP whose approach or local path fails leaves its group, a
+/// group whose roots cannot all see each other is split in two, a group with no clear start or
+/// no clear way from the turn height is left out whole.
 #[allow(clippy::too_many_arguments)]
 pub fn plan_job(
     probe: &Probe,
@@ -257,10 +339,29 @@ pub fn plan_job(
     let s = &JobSettings { turn_height, ..*s };
     let move_time = |a: &[f64], b: &[f64]| s.speeds.move_time(&q5(a), &q5(b));
     let path_time = |p: &[Vec<f64>]| p.windows(2).map(|w| move_time(&w[0], &w[1])).sum::<f64>();
-    // Each group's paths.
-    let mut planned: Vec<(GroupPaths, Vec<usize>)> = Vec::with_capacity(groups.len());
-    for (g, group) in groups.iter().enumerate() {
-        let start = group_start(
+    let clear_path = |p: &[Vec<f64>]| {
+        p.windows(2)
+            .all(|w| check_segment(space, validity, &w[0], &w[1], s.mrnc.min_clearance).valid)
+    };
+    let lifted = |q: &[f64]| -> Vec<f64> {
+        let mut l = q.to_vec();
+        l[2] = l[2].max(turn_height);
+        l
+    };
+    if !clear_path(&[home.to_vec(), lifted(home)]) {
+        return Err(JobError::Home);
+    }
+    let mut unmeasured: Vec<(usize, String)> = Vec::new();
+    // Each group's paths; failures shrink or split the group.
+    let mut planned: Vec<JobGroup> = Vec::with_capacity(groups.len());
+    let mut queue: std::collections::VecDeque<Group> = groups.iter().cloned().collect();
+    let mut attempt = 0u64;
+    while let Some(group) = queue.pop_front() {
+        attempt += 1;
+        if group.members.is_empty() {
+            continue;
+        }
+        let Some(start) = group_start(
             probe,
             validity,
             space,
@@ -268,13 +369,34 @@ pub fn plan_job(
             &group.members,
             group.angles,
             s.start_height,
-        )
-        .ok_or(JobError::Start(g))?;
+        ) else {
+            for &i in &group.members {
+                unmeasured.push((
+                    i,
+                    format!(
+                        "no clear start above its group (head angles A {:.1}°, B {:.1}°) within the travel",
+                        group.angles.0.to_degrees(),
+                        group.angles.1.to_degrees()
+                    ),
+                ));
+            }
+            continue;
+        };
+        // The way from the turn height down to the start must be clear.
+        if !clear_path(&[start.clone(), lifted(&start)]) {
+            for &i in &group.members {
+                unmeasured.push((
+                    i,
+                    "the vertical move from the turn height to its group's start is not clear".into(),
+                ));
+            }
+            continue;
+        }
         let settings = MrncSettings {
-            seed: s.mrnc.seed.wrapping_add(g as u64),
+            seed: s.mrnc.seed.wrapping_add(attempt - 1),
             ..s.mrnc
         };
-        let paths = plan_group(
+        let paths = match plan_group(
             probe,
             validity,
             space,
@@ -283,8 +405,33 @@ pub fn plan_job(
             group.angles,
             &start,
             &settings,
-        )
-        .map_err(|e| JobError::Group(g, e))?;
+        ) {
+            Ok(p) => p,
+            Err(e @ (MrncError::Approach(i) | MrncError::Local(i))) => {
+                unmeasured.push((i, mrnc_reason(&e, group.angles)));
+                queue.push_front(Group {
+                    members: group.members.iter().copied().filter(|&m| m != i).collect(),
+                    ..group
+                });
+                continue;
+            }
+            Err(e @ MrncError::Roots) => {
+                if group.members.len() == 1 {
+                    unmeasured.push((group.members[0], mrnc_reason(&e, group.angles)));
+                } else {
+                    let half = group.members.len() / 2;
+                    queue.push_front(Group {
+                        members: group.members[half..].to_vec(),
+                        ..group.clone()
+                    });
+                    queue.push_front(Group {
+                        members: group.members[..half].to_vec(),
+                        ..group
+                    });
+                }
+                continue;
+            }
+        };
         // The group's tour: node 0 its start, node k + 1 its k-th MP.
         let n = group.members.len();
         let leg = |a: usize, b: usize| -> f64 {
@@ -305,69 +452,50 @@ pub fn plan_job(
         };
         let costs = CostMatrix::from_fn(n + 1, |a, b| if a == b { 0.0 } else { leg(a, b) });
         let order = tour_from_depot(costs, s);
-        planned.push((paths, order));
+        planned.push(JobGroup {
+            paths,
+            order,
+            members: group.members,
+            faces: group.faces,
+        });
     }
-    // The turns between groups: up above the next start, turn, down.
-    let transition = |from: &[f64], to: &[f64]| transition(s, from, to);
-    let m = groups.len();
-    // The group order: node 0 home, node g + 1 group g's start.
-    let starts: Vec<&Vec<f64>> = planned.iter().map(|(p, _)| &p.start).collect();
-    let node = |k: usize| -> &[f64] { if k == 0 { home } else { starts[k - 1] } };
+    // The group order: node 0 home, node g + 1 group g's start. Every move between them runs
+    // at the turn height (clear by construction) or vertically above a start (checked above).
+    let m = planned.len();
+    let node = |k: usize| -> &[f64] { if k == 0 { home } else { &planned[k - 1].paths.start } };
     let gcosts = CostMatrix::from_fn(m + 1, |a, b| {
         if a == b {
             0.0
         } else {
-            path_time(&transition(node(a), node(b)))
+            path_time(&transition(s, node(a), node(b)))
         }
     });
     let group_order = tour_from_depot(gcosts, s);
     // The whole path and its times.
-    let mut path: Vec<Vec<f64>> = vec![home.to_vec()];
+    let mut b = PathBuilder::default();
+    b.push(home);
     let mut at: Vec<f64> = home.to_vec();
-    let mut inspections = 0usize;
     for &g in &group_order {
-        let (paths, order) = &planned[g];
-        let t = transition(&at, &paths.start);
-        for w in t.windows(2) {
-            if !check_segment(space, validity, &w[0], &w[1], s.mrnc.min_clearance).valid {
-                return Err(JobError::Turn(Some(g)));
-            }
-        }
-        path.extend(t.into_iter().skip(1));
-        path.extend(paths.reuse(order).into_iter().skip(1));
-        inspections += order.len();
-        at = paths.start.clone();
+        let group = &planned[g];
+        b.extend(&transition(s, &at, &group.paths.start));
+        b.group(group, &group.order);
+        at = group.paths.start.clone();
     }
-    let back = transition(&at, home);
-    for w in back.windows(2) {
-        if !check_segment(space, validity, &w[0], &w[1], s.mrnc.min_clearance).valid {
-            return Err(JobError::Turn(None));
-        }
-    }
-    path.extend(back.into_iter().skip(1));
-    path.dedup();
-    let movement_s: f64 = path
-        .windows(2)
-        .map(|w| s.speeds.movement_time(&q5(&w[0]), &q5(&w[1])))
-        .sum();
-    let rotation_s: f64 = path
-        .windows(2)
-        .map(|w| s.speeds.rotation_time(&q5(&w[0]), &q5(&w[1])))
-        .sum();
+    b.extend(&transition(s, &at, home));
+    let (movement_s, rotation_s) = path_times(&b.path, &s.speeds);
+    unmeasured.sort_by_key(|u| u.0);
     Ok(Job {
-        groups: planned
-            .into_iter()
-            .zip(groups)
-            .map(|((p, o), g)| (p, o, g.members.clone()))
-            .collect(),
+        groups: planned,
         group_order,
-        path,
+        inspection_s: b.touches.len() as f64 * s.inspection_s,
+        path: b.path,
+        touches: b.touches,
         movement_s,
         rotation_s,
-        inspection_s: inspections as f64 * s.inspection_s,
         compute_s: started.elapsed().as_secs_f64(),
         turn_height,
         home: home.to_vec(),
+        unmeasured,
     })
 }
 
@@ -411,14 +539,24 @@ mod tests {
                 assert!(check_segment(&space, &validity, &w[0], &w[1], 1e-4).valid);
             }
             let mut visited = 0;
-            for (paths, order, members) in &job.groups {
-                assert_eq!(order.len(), members.len());
-                for &k in order {
-                    assert!(job.path.contains(&paths.approaches[k]));
+            for g in &job.groups {
+                assert_eq!(g.order.len(), g.members.len());
+                for &k in &g.order {
+                    assert!(job.path.contains(&g.paths.approaches[k]));
                     visited += 1;
                 }
             }
             assert_eq!(visited, 39);
+            assert!(job.unmeasured.is_empty());
+            // Each MP is touched once, at its approach configuration.
+            let mut touched: Vec<usize> = job.touches.iter().map(|t| t.1).collect();
+            touched.sort_unstable();
+            assert_eq!(touched, (0..39).collect::<Vec<_>>());
+            for &(at, mp) in &job.touches {
+                let g = job.groups.iter().find(|g| g.members.contains(&mp)).unwrap();
+                let k = g.members.iter().position(|&x| x == mp).unwrap();
+                assert_eq!(job.path[at], g.paths.approaches[k]);
+            }
             assert_eq!(job.path.first(), Some(&home));
             assert_eq!(job.path.last(), Some(&home));
             assert!((job.inspection_s - 39.0).abs() < 1e-9);
@@ -462,9 +600,15 @@ mod tests {
                 );
             }
             for &i in &subset {
-                let (paths, _, members) = job.groups.iter().find(|(_, _, m)| m.contains(&i)).unwrap();
-                let k = members.iter().position(|&x| x == i).unwrap();
-                assert!(reused.path.contains(&paths.approaches[k]));
+                let g = job.groups.iter().find(|g| g.members.contains(&i)).unwrap();
+                let k = g.members.iter().position(|&x| x == i).unwrap();
+                assert!(reused.path.contains(&g.paths.approaches[k]));
+                assert!(
+                    reused
+                        .touches
+                        .iter()
+                        .any(|&(at, mp)| mp == i && reused.path[at] == g.paths.approaches[k])
+                );
             }
             let initial = job.reuse_initial_path(&subset, &settings);
             assert!(reused.motion_s() <= initial.motion_s() + 1e-9);

@@ -14,11 +14,16 @@
 //!
 //! The machine's kinematics and motion model are `cellplan_kin::cmm`.
 #![warn(missing_docs)]
+// Input errors are built once, on the cold path of refusing a file.
+#![allow(clippy::result_large_err)]
 
+pub mod cell;
 pub mod classify;
+pub mod document;
 pub mod job;
 pub mod motion;
 pub mod mrnc;
 pub mod part;
+pub mod plan;
 #[cfg(test)]
 mod scene;

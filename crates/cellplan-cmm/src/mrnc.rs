@@ -8,7 +8,8 @@
 //!   of the vector library (the MPs' normals, the bisectors of the group's normals, the probe's
 //!   own axis backwards) with probability ε0, else a random one, each step `rand · Range` plus a
 //!   perturbation of size ζ, until the point lies in the safe space (clearance at least
-//!   `safety`);
+//!   `safety`); a walk that leaves the machine's travel starts again from the MP with a new
+//!   direction;
 //! - **RootRewire** (Alg. 4): `Root_max` rounds, each trying a new root per MP and keeping it
 //!   when eq. 4's cost `‖Q − root‖ + ‖start − root‖` falls — and, as Alg. 2 requires of every
 //!   root, its segments to the start and the other roots stay collision-free;
@@ -184,16 +185,25 @@ pub fn plan_group(
     let safe = |q: &[f64]| space.contains(q) && validity.clearance(q) >= safety;
     let clear = |a: &[f64], b: &[f64]| check_segment(&space, validity, a, b, s.min_clearance).valid;
     // Algorithm 3.
-    let search = |rng: &mut ChaCha8Rng, k: usize| -> Option<Vec<f64>> {
-        let v = if rng.random::<f64>() < s.eps0 {
+    let direction = |rng: &mut ChaCha8Rng| {
+        if rng.random::<f64>() < s.eps0 {
             library[rng.random_range(0..library.len())]
         } else {
             random_unit(rng)
-        };
+        }
+    };
+    let search = |rng: &mut ChaCha8Rng, k: usize| -> Option<Vec<f64>> {
+        let mut v = direction(rng);
         let mut p = xyz(&approaches[k]);
         for _ in 0..s.max_steps {
             p += v * (rng.random::<f64>() * s.range) + random_unit(rng) * s.zeta;
             let q = config(p);
+            if !space.contains(&q) {
+                // Out of the machine's travel: this direction is spent; again from the MP.
+                p = xyz(&approaches[k]);
+                v = direction(rng);
+                continue;
+            }
             if safe(&q) {
                 return Some(q);
             }
@@ -279,7 +289,8 @@ pub fn plan_group(
 
 /// A start for a group: above the middle of its MPs' approach positions, backed off along the
 /// probe's axis (so that the probe points at the part from outside it), at least at height
-/// `z_min`, stepping further back and up until the whole probe is 5 cm clear.
+/// `z_min`, stepping further back and up until the whole probe is 5 cm clear; kept within
+/// the travel.
 pub fn group_start(
     probe: &Probe,
     validity: &dyn StateValidity,
@@ -303,7 +314,12 @@ pub fn group_start(
         let back = 0.1 + 0.05 * k as f64;
         let mut p = centre - d * back;
         p.z = p.z.max(z_min) + 0.02 * k as f64;
-        let q = vec![p.x, p.y, p.z, angles.0, angles.1];
+        // Within the travel: a start the travel cuts off is taken at its edge (and higher).
+        let q: Vec<f64> = [p.x, p.y, p.z, angles.0, angles.1]
+            .iter()
+            .enumerate()
+            .map(|(j, &v)| v.clamp(space.lower[j], space.upper[j]))
+            .collect();
         if space.contains(&q) && validity.clearance(&q) >= 0.05 {
             return Some(q);
         }

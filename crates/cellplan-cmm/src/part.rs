@@ -580,6 +580,24 @@ pub fn block_adjacent(f: usize, g: usize) -> bool {
         || (f, g) == (13, 12)
 }
 
+/// Names of [`cylinder_block`]'s faces, by index (the task file's `face` column).
+pub const BLOCK_FACES: [&str; 14] = [
+    "deck",
+    "bores",
+    "unused-2",
+    "unused-3",
+    "unused-4",
+    "chamfer-y0",
+    "chamfer-y240",
+    "side-y0",
+    "boss-y240-1",
+    "boss-y240-2",
+    "side-y240",
+    "end-x0",
+    "boss-x400",
+    "end-x400",
+];
+
 /// The mesh as Wavefront OBJ text.
 pub fn to_obj(mesh: &Mesh, comment: &str) -> String {
     use std::fmt::Write;
@@ -596,14 +614,15 @@ pub fn to_obj(mesh: &Mesh, comment: &str) -> String {
     s
 }
 
-/// The MPs as a task CSV (`id,x,y,z,nx,ny,nz,feature,theta`; mm and degrees).
-pub fn to_csv(mps: &[Mp]) -> String {
+/// The MPs as a task CSV (`id,x,y,z,nx,ny,nz,feature,theta,face`; mm and degrees), the faces
+/// named by `faces`.
+pub fn to_csv(mps: &[Mp], faces: &[&str]) -> String {
     use std::fmt::Write;
-    let mut s = String::from("id,x,y,z,nx,ny,nz,feature,theta\n");
+    let mut s = String::from("id,x,y,z,nx,ny,nz,feature,theta,face\n");
     for m in mps {
         let _ = writeln!(
             s,
-            "{},{:.4},{:.4},{:.4},{:.6},{:.6},{:.6},{},{}",
+            "{},{:.4},{:.4},{:.4},{:.6},{:.6},{:.6},{},{},{}",
             m.name,
             m.position.x,
             m.position.y,
@@ -612,7 +631,8 @@ pub fn to_csv(mps: &[Mp]) -> String {
             m.normal.y,
             m.normal.z,
             m.feature.column(),
-            m.theta_deg
+            m.theta_deg,
+            faces.get(m.face).copied().unwrap_or("?")
         );
     }
     s
@@ -714,8 +734,9 @@ mod tests {
         let obj = to_obj(&mesh, "test");
         let back = cellplan_geom::mesh::parse_obj(obj.as_bytes(), std::path::Path::new("block.obj")).unwrap();
         assert_eq!(back.triangles.len(), mesh.triangles.len());
-        let csv = to_csv(&mps);
+        let csv = to_csv(&mps, &BLOCK_FACES);
         assert_eq!(csv.lines().count(), 40);
-        assert!(csv.starts_with("id,x,y,z,nx,ny,nz,feature,theta"));
+        assert!(csv.starts_with("id,x,y,z,nx,ny,nz,feature,theta,face"));
+        assert!(!csv.contains("unused") && !csv.contains('?'));
     }
 }

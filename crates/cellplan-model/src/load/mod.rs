@@ -578,3 +578,26 @@ fn shape(
     };
     Ok((shape, pose))
 }
+
+/// One shape entry (`box`, `cylinder`, `sphere` or `mesh`, with its pose) of another process's
+/// cell file at `path` (text `text`, the entry at `span`): the same rules and errors as the
+/// objects of an arm cell. Mesh paths are relative to the cell file; `to_m` and `to_rad` are the
+/// file's units.
+pub fn shape_entry(
+    path: &Path,
+    text: &str,
+    entry: &ShapeEntry,
+    span: Range<usize>,
+    owner: &str,
+    to_m: f64,
+    to_rad: f64,
+) -> Result<(ShapeSpec, Pose), InputError> {
+    let ctx = Ctx {
+        path,
+        dir: path.parent().map(Path::to_path_buf).unwrap_or_default(),
+        text,
+        to_m,
+        to_rad,
+    };
+    shape(&ctx, entry, span, owner)
+}
