@@ -19,6 +19,7 @@
 //!
 //! Before any of that the document is [`validate`](cellplan_core::document::validate)d, and a plan too
 //! large to check at the requested resolution is refused ([`workload`]).
+pub mod cmm;
 pub mod motion;
 mod paths;
 pub mod pcb;

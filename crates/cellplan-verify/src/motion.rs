@@ -55,7 +55,7 @@ pub struct ExactRobot<'a> {
 
 /// A parry shape for a shape spec, with its pose in the spec's frame, and the farthest distance
 /// of its points from that frame's origin. Meshes keep their triangles.
-fn exact_shape(spec: &ShapeSpec) -> Option<(SharedShape, Pose, f64)> {
+pub(crate) fn exact_shape(spec: &ShapeSpec) -> Option<(SharedShape, Pose, f64)> {
     match spec {
         ShapeSpec::Box { half_extents } => Some((
             SharedShape::new(Cuboid::new(half_extents.abs())),
@@ -182,7 +182,7 @@ impl ExactObstacle {
 
 /// Distance between two boxes (0 when they overlap): a lower bound on the distance of anything
 /// inside them.
-fn box_gap(a: &Aabb, b: &Aabb) -> f64 {
+pub(crate) fn box_gap(a: &Aabb, b: &Aabb) -> f64 {
     (a.mins - b.maxs)
         .max(b.mins - a.maxs)
         .max(cellplan_geom::DVec3::ZERO)
