@@ -27,7 +27,7 @@ pub struct CompareArgs {
     /// Instead of the cell's MPs, draw this many random MP sets on the part (as many MPs as
     /// the cell has, in the region and facing of the cell's MPs) and report mean and spread.
     #[arg(long, value_name = "K")]
-    random_tasks: Option<usize>,
+    pub random_tasks: Option<usize>,
     /// Print JSON (stable keys: strategies[].allocation, coordination, cycle_time_s,
     /// delta_t_s, conflicts_before, verified, compute_s).
     #[arg(long)]
@@ -109,6 +109,9 @@ const ALLOCATIONS: [Allocation; 4] = [
 pub fn run(args: &CompareArgs) -> Result<(), Failure> {
     if crate::pcb_cmd::is_pcb(&args.cell)? {
         return crate::pcb_cmd::compare(args);
+    }
+    if crate::cmm_cmd::is_cmm(&args.cell)? {
+        return crate::cmm_cmd::compare(args);
     }
     let show = !args.quiet && !args.json;
     let opts = load_options(false, &None);

@@ -7,6 +7,7 @@
 mod bench;
 mod bench_motion;
 mod compare_cmd;
+mod cmm_cmd;
 mod pcb_cmd;
 mod plan_cmd;
 mod report_cmd;
@@ -43,6 +44,8 @@ enum Command {
     Check(CheckArgs),
     /// Plan the cell: allocation, order, collision-free timed motion per robot; writes the plan.
     Plan(plan_cmd::PlanArgs),
+    /// Inspect a subset of a CMM plan's MPs again by reusing its stored paths: no planning.
+    Reuse(cmm_cmd::ReuseArgs),
     /// Check a plan independently: MPs, probe poses, limits, clearances, robot–robot, totals.
     Verify(verify_cmd::VerifyArgs),
     /// Run every allocation × coordination strategy on a cell (paper 000 Table 3), or on
@@ -256,6 +259,9 @@ fn load_options(no_cache: bool, cache_dir: &Option<PathBuf>) -> LoadOptions {
 fn run_check(args: &CheckArgs) -> Result<(), Failure> {
     if pcb_cmd::is_pcb(&args.cell)? {
         return pcb_cmd::check_cell(&args.cell, args.json);
+    }
+    if cmm_cmd::is_cmm(&args.cell)? {
+        return cmm_cmd::check_cell(&args.cell, args.json);
     }
     let start = Instant::now();
     let show = !args.quiet && !args.json;
@@ -477,6 +483,7 @@ fn main() -> ExitCode {
         Command::Check(a) => run_check(a),
         Command::Plan(a) => plan_cmd::run(a),
         Command::Verify(a) => verify_cmd::run(a),
+        Command::Reuse(a) => cmm_cmd::run_reuse(a),
         Command::Compare(a) => compare_cmd::run(a),
         Command::Report(a) => report_cmd::run_report(a),
         Command::Export(a) => report_cmd::run_export(a),

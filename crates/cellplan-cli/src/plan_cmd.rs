@@ -66,7 +66,8 @@ pub struct PlanArgs {
     /// unmeasured, compute_s).
     #[arg(long)]
     pub json: bool,
-    /// PCB assembly: the optimiser (`best` ours, `ga` paper 004's GA).
+    /// PCB assembly and CMM inspection: the optimiser (`best` ours, `ga` the paper's GA —
+    /// paper 004's for PCB, paper 003's enhanced GA for the CMM's orders).
     #[arg(long, value_enum, default_value_t = crate::pcb_cmd::OptimizerArg::Best)]
     pub optimizer: crate::pcb_cmd::OptimizerArg,
     /// PCB assembly: which devices move (default: the cell's `configuration`).
@@ -128,6 +129,9 @@ struct RobotSummary<'a> {
 pub fn run(args: &PlanArgs) -> Result<(), Failure> {
     if crate::pcb_cmd::is_pcb(&args.cell)? {
         return crate::pcb_cmd::plan(args);
+    }
+    if crate::cmm_cmd::is_cmm(&args.cell)? {
+        return crate::cmm_cmd::plan(args);
     }
     let start = Instant::now();
     if args

@@ -150,6 +150,17 @@ pub fn run_report(args: &ReportArgs) -> Result<(), Failure> {
         eprintln!("report written to {}", out.display());
         return Ok(());
     }
+    if let Some(cell) = &args.cell
+        && crate::cmm_cmd::is_cmm(cell)?
+    {
+        let out = args
+            .output
+            .clone()
+            .unwrap_or_else(|| args.plan.parent().unwrap_or(Path::new(".")).join("report.html"));
+        crate::cmm_cmd::report(&args.plan, cell, &out)?;
+        eprintln!("report written to {}", out.display());
+        return Ok(());
+    }
     let start = Instant::now();
     let plan = read_plan(&args.plan)?;
     let cell = load_cell(&args.plan, &plan, &args.cell)?;

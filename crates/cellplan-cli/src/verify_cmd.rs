@@ -26,6 +26,9 @@ pub fn run(args: &VerifyArgs) -> Result<(), Failure> {
     if crate::pcb_cmd::is_pcb(&args.cell)? {
         return crate::pcb_cmd::verify(&args.plan, &args.cell, args.json, !args.no_robot_robot);
     }
+    if crate::cmm_cmd::is_cmm(&args.cell)? {
+        return crate::cmm_cmd::verify(&args.plan, &args.cell, args.json);
+    }
     if !(args.time_step.is_finite() && (1e-4..=1.0).contains(&args.time_step)) {
         return Err(Failure::Usage(format!(
             "--time-step must be between 0.0001 and 1 s, not {}",

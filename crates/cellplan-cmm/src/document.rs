@@ -332,6 +332,7 @@ impl CmmPlan {
             rotation_s: self.rotation_s,
             inspection_s: self.inspection_s,
             compute_s: self.compute_s,
+            order_s: 0.0,
             turn_height: self.turn_height_m,
             home: self.home.to_vec(),
             unmeasured: Vec::new(),

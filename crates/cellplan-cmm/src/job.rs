@@ -85,6 +85,8 @@ pub struct Job {
     pub inspection_s: f64,
     /// Computation time (s).
     pub compute_s: f64,
+    /// Of it, the time of the orderings (§3.3: the groups' TSPs and the GTSP over groups) (s).
+    pub order_s: f64,
     /// The height the head turns at: high enough that every configuration there keeps the
     /// whole probe above every static object, so moves and turns at it need no check.
     pub turn_height: f64,
@@ -352,6 +354,7 @@ pub fn plan_job(
         return Err(JobError::Home);
     }
     let mut unmeasured: Vec<(usize, String)> = Vec::new();
+    let mut order_s = 0.0;
     // Each group's paths; failures shrink or split the group.
     let mut planned: Vec<JobGroup> = Vec::with_capacity(groups.len());
     let mut queue: std::collections::VecDeque<Group> = groups.iter().cloned().collect();
@@ -451,7 +454,9 @@ pub fn plan_job(
             out + move_time(from, to) + into
         };
         let costs = CostMatrix::from_fn(n + 1, |a, b| if a == b { 0.0 } else { leg(a, b) });
+        let lap = Instant::now();
         let order = tour_from_depot(costs, s);
+        order_s += lap.elapsed().as_secs_f64();
         planned.push(JobGroup {
             paths,
             order,
@@ -470,7 +475,9 @@ pub fn plan_job(
             path_time(&transition(s, node(a), node(b)))
         }
     });
+    let lap = Instant::now();
     let group_order = tour_from_depot(gcosts, s);
+    order_s += lap.elapsed().as_secs_f64();
     // The whole path and its times.
     let mut b = PathBuilder::default();
     b.push(home);
@@ -493,6 +500,7 @@ pub fn plan_job(
         movement_s,
         rotation_s,
         compute_s: started.elapsed().as_secs_f64(),
+        order_s,
         turn_height,
         home: home.to_vec(),
         unmeasured,

@@ -3,10 +3,12 @@
 //! [`scene`] is the cell to draw (shared, decimated meshes; robots as their URDF chains);
 //! [`playback`] reads a robot's intervals and joint values from a plan; [`charts`] draws the
 //! Gantt, time–position and strategy charts; [`html`] assembles the self-contained report with
-//! its WebGL viewer; [`gltf`] and [`csv`] export a plan for other tools.
+//! its WebGL viewer; [`gltf`] and [`csv`] export a plan for other tools; [`pcb`] and [`cmm`]
+//! are the pages of the PCB-assembly and CMM-inspection processes.
 #![warn(missing_docs)]
 
 pub mod charts;
+pub mod cmm;
 pub mod csv;
 pub mod gltf;
 pub mod html;

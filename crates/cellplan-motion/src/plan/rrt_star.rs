@@ -74,9 +74,19 @@ impl Tree {
     }
 }
 
+/// The dimension the search moves in: the joints whose range is not a single value (a joint
+/// held fixed, as the CMM head's angles within an orientation group, adds no volume and must
+/// not slow the shrinking of the rewiring radius).
+fn free_dim(space: &JointSpace) -> usize {
+    (0..space.dim())
+        .filter(|&j| space.upper[j] > space.lower[j])
+        .count()
+        .max(1)
+}
+
 /// `2 (1 + 1/d)^(1/d) (μ/ζ_d)^(1/d)`: the smallest `γ` of the theorem, for the space's box.
 fn gamma_min(space: &JointSpace) -> f64 {
-    let d = space.dim().max(1) as f64;
+    let d = free_dim(space) as f64;
     let volume: f64 = (0..space.dim())
         .map(|j| (space.weights[j] * (space.upper[j] - space.lower[j])).abs())
         .filter(|&w| w > 0.0)
@@ -110,7 +120,7 @@ pub(crate) fn search(
 ) -> Found {
     let space = run.space;
     let range = range_of(space, params);
-    let d = space.dim().max(1) as f64;
+    let d = free_dim(space) as f64;
     let gamma = params.rewire_factor * gamma_min(space);
     let mut rng = ChaCha8Rng::seed_from_u64(params.seed);
     let mut tree = Tree {
