@@ -21,6 +21,9 @@ pub enum Kind {
     Setcover,
     /// cellplan min-max multi-vehicle routing with alternatives (docs/minmax-format.md).
     Minmax,
+    /// The local paths (root → MP) of a CMM cell's plan, as problems for the OMPL peer
+    /// (bench/peers/cmm_local_ompl.py), with ours solved and timed: JSON on stdout.
+    CmmLocal,
     /// Motion planning problems without a cell (docs/motion-problems.md), every path
     /// re-checked exactly.
     Motion,
@@ -204,7 +207,7 @@ pub fn run(args: &BenchArgs) -> Result<Vec<Row>, BenchError> {
         return run_minmax(args, limit);
     }
     let method = args.method.unwrap_or(match args.kind {
-        Kind::Tsp | Kind::Gtsp | Kind::Minmax | Kind::Motion => Method::Ils,
+        Kind::Tsp | Kind::Gtsp | Kind::Minmax | Kind::Motion | Kind::CmmLocal => Method::Ils,
         Kind::Setcover => Method::Exact,
     });
     if matches!(method, Method::Algorithm1 | Method::Proximity) {
@@ -225,7 +228,7 @@ pub fn run(args: &BenchArgs) -> Result<Vec<Row>, BenchError> {
             Kind::Tsp => Instance::Route(Gtsp::tsp(read_tsplib(file).map_err(BenchError::Input)?.costs)),
             Kind::Gtsp => Instance::Route(read_gtsplib(file).map_err(BenchError::Input)?.gtsp),
             Kind::Setcover => Instance::Cover(read_orlib_setcover(file).map_err(BenchError::Input)?),
-            Kind::Minmax | Kind::Motion => {
+            Kind::Minmax | Kind::Motion | Kind::CmmLocal => {
                 return Err(BenchError::Usage(
                     "min-max and motion are benchmarked by their own runners".into(),
                 ));

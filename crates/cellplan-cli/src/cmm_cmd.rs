@@ -68,7 +68,9 @@ fn group_detail(doc: &CmmPlan) -> Vec<GroupSummary> {
         .iter()
         .map(|&g| {
             let gr = &doc.groups[g];
-            let turn = (gr.angles_deg[0] - at[0]).abs().max((gr.angles_deg[1] - at[1]).abs());
+            let turn = (gr.angles_deg[0] - at[0])
+                .abs()
+                .max((gr.angles_deg[1] - at[1]).abs());
             at = gr.angles_deg;
             GroupSummary {
                 angles_deg: gr.angles_deg,
@@ -134,7 +136,8 @@ fn write_plan(
     if let Some(p) = &page {
         files.push((&report_file, p.as_bytes()));
     }
-    write_all_atomic(&files).map_err(|e| Failure::Other(format!("cannot write into {}: {e}", dir.display())))?;
+    write_all_atomic(&files)
+        .map_err(|e| Failure::Other(format!("cannot write into {}: {e}", dir.display())))?;
     Ok((file, program_file, page.is_some().then_some(report_file)))
 }
 
@@ -190,7 +193,11 @@ pub fn plan(args: &PlanArgs) -> Result<(), Failure> {
             tasks: &doc.tasks,
             groups: doc.groups.len(),
             group_detail: group_detail(&doc),
-            unmeasured: doc.unmeasured.iter().map(|u| (u.id.as_str(), u.reason.as_str())).collect(),
+            unmeasured: doc
+                .unmeasured
+                .iter()
+                .map(|u| (u.id.as_str(), u.reason.as_str()))
+                .collect(),
             movement_s: doc.movement_s,
             rotation_s: doc.rotation_s,
             inspection_s: doc.inspection_s,
@@ -222,10 +229,17 @@ fn render(doc: &CmmPlan, verdict: &CmmReport) -> String {
         doc.tasks.len(),
         doc.groups.len(),
         doc.classification,
-        if doc.order == "ga" { "paper 003's GA" } else { "ours (ILS)" },
+        if doc.order == "ga" {
+            "paper 003's GA"
+        } else {
+            "ours (ILS)"
+        },
         doc.seed
     );
-    s += &format!("{:<6} {:>9} {:>9} {:>5} {:>8}  faces\n", "group", "A °", "B °", "MPs", "turn °");
+    s += &format!(
+        "{:<6} {:>9} {:>9} {:>5} {:>8}  faces\n",
+        "group", "A °", "B °", "MPs", "turn °"
+    );
     for (k, g) in group_detail(doc).iter().enumerate() {
         s += &format!(
             "{:<6} {:>9.1} {:>9.1} {:>5} {:>8.1}  {}\n",
@@ -360,8 +374,11 @@ fn parse_subset(arg: &str, cell: &CmmCell, plan: &CmmPlan) -> Result<Vec<usize>,
                 .enumerate()
                 .filter_map(|(i, l)| {
                     let id = l.split(',').next().unwrap_or("").trim().trim_matches('"');
-                    (!id.is_empty() && !id.starts_with('#') && !(i == 0 && id.eq_ignore_ascii_case("id")))
-                        .then(|| (id.to_string(), Some(i + 1)))
+                    {
+                        let header = i == 0 && id.eq_ignore_ascii_case("id");
+                        !(id.is_empty() || id.starts_with('#') || header)
+                    }
+                    .then(|| (id.to_string(), Some(i + 1)))
                 })
                 .collect();
             (ids, Some(path))
@@ -411,7 +428,11 @@ fn parse_subset(arg: &str, cell: &CmmCell, plan: &CmmPlan) -> Result<Vec<usize>,
             ));
         }
         if out.contains(&i) {
-            return Err(fail(line, format!("`{id}` is named twice"), "name each MP once".into()));
+            return Err(fail(
+                line,
+                format!("`{id}` is named twice"),
+                "name each MP once".into(),
+            ));
         }
         out.push(i);
     }
@@ -434,7 +455,10 @@ struct ReuseSummary<'a> {
 /// `cellplan reuse PLAN --tasks …`.
 pub fn run_reuse(args: &ReuseArgs) -> Result<(), Failure> {
     let plan = read_plan(&args.plan)?;
-    let cell_path = args.cell.clone().unwrap_or_else(|| PathBuf::from(&plan.cell_file));
+    let cell_path = args
+        .cell
+        .clone()
+        .unwrap_or_else(|| PathBuf::from(&plan.cell_file));
     if !cell_path.exists() {
         return Err(Failure::Usage(format!(
             "the plan's cell file {} does not exist; give it with --cell",
@@ -613,9 +637,10 @@ pub fn compare(args: &crate::compare_cmd::CompareArgs) -> Result<(), Failure> {
             subset.swap(i, rng.random_range(0..=i));
         }
         subset.truncate(size);
-        let roots = reuse(&cell, &base, &subset, Strategy::ReuseRoots).map_err(|e| Failure::Other(format!("{e:?}")))?;
-        let initial =
-            reuse(&cell, &base, &subset, Strategy::ReuseInitialPath).map_err(|e| Failure::Other(format!("{e:?}")))?;
+        let roots = reuse(&cell, &base, &subset, Strategy::ReuseRoots)
+            .map_err(|e| Failure::Other(format!("{e:?}")))?;
+        let initial = reuse(&cell, &base, &subset, Strategy::ReuseInitialPath)
+            .map_err(|e| Failure::Other(format!("{e:?}")))?;
         let req = Request {
             order: GtspMethod::Ils,
             classification: None,
@@ -714,7 +739,11 @@ fn compare_table(out: &CompareOut) -> String {
         let _ = writeln!(
             s,
             "| {} | {} | {:.1} | {:.1} | {:.1} | {:.2} | {:.3} | {} |",
-            if p.order == "ga" { "paper 003's GA" } else { "ours (ILS)" },
+            if p.order == "ga" {
+                "paper 003's GA"
+            } else {
+                "ours (ILS)"
+            },
             p.groups,
             p.movement_s,
             p.rotation_s,
@@ -768,8 +797,22 @@ pub fn check_cell(path: &Path, json: bool) -> Result<(), Failure> {
     let probe = cell.probe();
     let orientations = cell.orientations();
     let adjacent = |f: usize, g: usize| cell.adjacent(f, g);
-    let exact = classify(&cell.mps, &adjacent, &probe, &orientations, cell.touch_clearance, Method::Exact);
-    let greedy = classify(&cell.mps, &adjacent, &probe, &orientations, cell.touch_clearance, Method::Greedy);
+    let exact = classify(
+        &cell.mps,
+        &adjacent,
+        &probe,
+        &orientations,
+        cell.touch_clearance,
+        Method::Exact,
+    );
+    let greedy = classify(
+        &cell.mps,
+        &adjacent,
+        &probe,
+        &orientations,
+        cell.touch_clearance,
+        Method::Greedy,
+    );
     let out = CheckOut {
         cell: cell.name.clone(),
         mps: cell.mps.len(),
@@ -777,7 +820,11 @@ pub fn check_cell(path: &Path, json: bool) -> Result<(), Failure> {
         orientations: orientations.len(),
         groups_exact: exact.groups.len(),
         groups_greedy: greedy.groups.len(),
-        unmeasurable: exact.unmeasurable.iter().map(|&i| cell.mps[i].name.clone()).collect(),
+        unmeasurable: exact
+            .unmeasurable
+            .iter()
+            .map(|&i| cell.mps[i].name.clone())
+            .collect(),
     };
     if json {
         return crate::print_json(&out);
@@ -792,11 +839,134 @@ pub fn check_cell(path: &Path, json: bool) -> Result<(), Failure> {
             g.angles.0.to_degrees(),
             g.angles.1.to_degrees(),
             g.members.len(),
-            g.faces.iter().map(|&f| cell.faces[f].as_str()).collect::<Vec<_>>().join(" + ")
+            g.faces
+                .iter()
+                .map(|&f| cell.faces[f].as_str())
+                .collect::<Vec<_>>()
+                .join(" + ")
         );
     }
     for id in &out.unmeasurable {
         println!("  unmeasurable: {id} (no orientation within its cone touches it clear of the part)");
     }
     Ok(())
+}
+
+/// `cellplan bench cmm-local CELL`: every root → MP path of the cell's plan as a problem for
+/// the OMPL peer, with ours re-solved (straight segment, else RRT* with `samples` samples) and
+/// timed; the JSON goes to stdout (docs in bench/peers/README.md).
+pub fn bench_local(cell_path: &Path, samples: usize) -> Result<(), Failure> {
+    use cellplan_cmm::motion::{CmmValidity, space};
+    use cellplan_cmm::mrnc::{MrncSettings, local_path};
+    use serde_json::json;
+    let cell = load(cell_path)?;
+    let req = Request {
+        order: GtspMethod::Ils,
+        classification: None,
+        seed: 0,
+        subset: None,
+    };
+    let out = run(&cell, &req).map_err(|e| Failure::Other(e.to_string()))?;
+    let probe = cell.probe();
+    let full = space(&probe, &cell.travel);
+    let validity = CmmValidity {
+        probe: &probe,
+        margin: cell.clearance,
+    };
+    let s = MrncSettings {
+        rrt_samples: samples,
+        pretouch: cell.pretouch,
+        ..MrncSettings::default()
+    };
+    let pose = |p: &cellplan_geom::Pose| json!({"xyz": p.translation.to_array(), "quat": [p.rotation.x, p.rotation.y, p.rotation.z, p.rotation.w]});
+    let mut statics = Vec::new();
+    for (k, (name, spec, p)) in cell.statics.iter().enumerate() {
+        match spec {
+            cellplan_geom::ShapeSpec::Mesh(_) if k == 0 => statics.push(json!({
+                "name": name,
+                "mesh": std::fs::canonicalize(&cell.part_file.0).unwrap_or(cell.part_file.0.clone()),
+                "mesh_scale": cell.part_file.1,
+                "pose": pose(p),
+            })),
+            cellplan_geom::ShapeSpec::Box { half_extents } => statics.push(json!({
+                "name": name,
+                "box": (*half_extents * 2.0).to_array(),
+                "pose": pose(p),
+            })),
+            _ => {
+                return Err(Failure::Usage(format!(
+                    "cmm-local exports the part and box fixtures only; `{name}` is another shape"
+                )));
+            }
+        }
+    }
+    let mut problems = Vec::new();
+    for (g, group) in out.job.groups.iter().enumerate() {
+        let (a, b) = group.paths.angles;
+        let mut sp = full.clone();
+        sp.lower[3] = a;
+        sp.upper[3] = a;
+        sp.lower[4] = b;
+        sp.upper[4] = b;
+        // Each MP from its root (the paths RRT-MRNC stores) and from the group's start (what
+        // a planner without roots must solve).
+        let pairs = group.members.iter().enumerate().flat_map(|(k, &mp)| {
+            [("root", &group.paths.roots[k]), ("start", &group.paths.start)]
+                .map(|(kind, from)| (k, mp, kind, from))
+        });
+        for (k, mp, kind, root) in pairs {
+            let goal = &group.paths.approaches[k];
+            let started = Instant::now();
+            let found = local_path(&sp, &validity, root, goal, &s, k as u64);
+            let time_s = started.elapsed().as_secs_f64();
+            let length = |w: &[Vec<f64>]| {
+                w.windows(2)
+                    .map(|p| {
+                        ((p[1][0] - p[0][0]).powi(2)
+                            + (p[1][1] - p[0][1]).powi(2)
+                            + (p[1][2] - p[0][2]).powi(2))
+                        .sqrt()
+                    })
+                    .sum::<f64>()
+            };
+            let lo: Vec<f64> = (0..3)
+                .map(|j| full.lower[j].max(root[j].min(goal[j]) - s.local_margin))
+                .collect();
+            let hi: Vec<f64> = (0..3)
+                .map(|j| full.upper[j].min(root[j].max(goal[j]) + s.local_margin))
+                .collect();
+            problems.push(json!({
+                "group": g,
+                "mp": cell.mps[mp].name,
+                "from": kind,
+                "angles": [a, b],
+                "start": &root[..3],
+                "goal": &goal[..3],
+                "bounds": {"lower": lo, "upper": hi},
+                "ours": {
+                    "solved": found.is_some(),
+                    "length_m": found.as_ref().map(|f| length(&f.waypoints)),
+                    "time_s": time_s,
+                    "samples": samples,
+                    "straight": found.as_ref().is_some_and(|f| f.straight),
+                },
+            }));
+        }
+    }
+    let b = &cell.bodies;
+    let h = &cell.head;
+    let doc = json!({
+        "cell": cell.name,
+        "scene": {
+            "statics": statics,
+            "probe": {
+                "l1": h.l1, "l2": h.l2, "ball_diameter": h.ball_diameter,
+                "stem_diameter": b.stem_diameter, "extension_diameter": b.extension_diameter,
+                "head": [b.head.0, b.head.1], "ram": [b.ram.0, b.ram.1],
+            },
+            "clearance": cell.clearance,
+        },
+        "problems": problems,
+    });
+    crate::print_json(&doc)
 }

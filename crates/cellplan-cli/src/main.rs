@@ -6,8 +6,8 @@
 //! 1 anything else.
 mod bench;
 mod bench_motion;
-mod compare_cmd;
 mod cmm_cmd;
+mod compare_cmd;
 mod pcb_cmd;
 mod plan_cmd;
 mod report_cmd;
@@ -378,6 +378,12 @@ fn run_gen_block(args: &GenBlockArgs) -> Result<(), Failure> {
 fn run_bench(args: &bench::BenchArgs) -> Result<(), Failure> {
     if args.kind == bench::Kind::Motion {
         return run_bench_motion(args);
+    }
+    if args.kind == bench::Kind::CmmLocal {
+        let [cell] = args.files.as_slice() else {
+            return Err(Failure::Usage("cmm-local takes one CMM cell file".into()));
+        };
+        return cmm_cmd::bench_local(cell, args.max_samples);
     }
     let failure = |e| match e {
         bench::BenchError::Input(e) => Failure::Input(Box::new(

@@ -27,6 +27,8 @@ pub struct CmmCell {
     pub path: PathBuf,
     /// The part and the fixtures: name, shape, pose in the machine frame.
     pub statics: Vec<(String, ShapeSpec, Pose)>,
+    /// The part's mesh file and the metres per unit of its coordinates (for other tools).
+    pub part_file: (PathBuf, f64),
     /// The measuring points, in the machine frame.
     pub mps: Vec<Mp>,
     /// The task file, and each MP's line in it.

@@ -247,34 +247,10 @@ pub fn plan_group(
     // RRT* from each root to its MP.
     let mut local = Vec::with_capacity(n);
     for k in 0..n {
-        if clear(&roots[k], &approaches[k]) {
-            local.push(vec![roots[k].clone(), approaches[k].clone()]);
-            continue;
-        }
-        // The search stays near the two ends: their box, widened by `local_margin`.
-        let mut local_space = space.clone();
-        for j in 0..3 {
-            let (a, b) = (roots[k][j], approaches[k][j]);
-            local_space.lower[j] = space.lower[j].max(a.min(b) - s.local_margin);
-            local_space.upper[j] = space.upper[j].min(a.max(b) + s.local_margin);
-        }
-        let goals = [approaches[k].clone()];
-        let problem = Problem {
-            min_clearance: s.min_clearance,
-            ..Problem::new(&local_space, validity, &roots[k], &goals)
-        };
-        let params = PlannerParams {
-            seed: s.seed.wrapping_add(k as u64),
-            ..PlannerParams::default()
-        };
-        let mut rrt = (planner("rrt-star")
-            .map_err(|_| MrncError::Local(members[k]))?
-            .build)(&params);
-        let result = rrt.solve(&problem, &Termination::samples(s.rrt_samples));
-        if !result.status.is_solved() {
-            return Err(MrncError::Local(members[k]));
-        }
-        local.push(result.waypoints);
+        let seed = s.seed.wrapping_add(k as u64);
+        let path = local_path(&space, validity, &roots[k], &approaches[k], s, seed)
+            .ok_or(MrncError::Local(members[k]))?;
+        local.push(path.waypoints);
     }
     Ok(GroupPaths {
         angles,
@@ -284,6 +260,55 @@ pub fn plan_group(
         local,
         rounds,
         rewired,
+    })
+}
+
+/// A path from a root to its MP's approach (Alg. 1, lines 9–18).
+#[derive(Clone, Debug, PartialEq)]
+pub struct LocalPath {
+    /// Root to approach, inclusive.
+    pub waypoints: Vec<Vec<f64>>,
+    /// The straight segment was clear: no sampling.
+    pub straight: bool,
+}
+
+/// The path from `root` to `approach` in `space` (the group's, angles fixed): the straight
+/// segment when it is clear, else RRT* with `s.rrt_samples` samples in the box of the two ends
+/// widened by `s.local_margin`.
+pub fn local_path(
+    space: &JointSpace,
+    validity: &dyn StateValidity,
+    root: &[f64],
+    approach: &[f64],
+    s: &MrncSettings,
+    seed: u64,
+) -> Option<LocalPath> {
+    if check_segment(space, validity, root, approach, s.min_clearance).valid {
+        return Some(LocalPath {
+            waypoints: vec![root.to_vec(), approach.to_vec()],
+            straight: true,
+        });
+    }
+    let mut local_space = space.clone();
+    for j in 0..3 {
+        let (a, b) = (root[j], approach[j]);
+        local_space.lower[j] = space.lower[j].max(a.min(b) - s.local_margin);
+        local_space.upper[j] = space.upper[j].min(a.max(b) + s.local_margin);
+    }
+    let goals = [approach.to_vec()];
+    let problem = Problem {
+        min_clearance: s.min_clearance,
+        ..Problem::new(&local_space, validity, root, &goals)
+    };
+    let params = PlannerParams {
+        seed,
+        ..PlannerParams::default()
+    };
+    let mut rrt = (planner("rrt-star").ok()?.build)(&params);
+    let result = rrt.solve(&problem, &Termination::samples(s.rrt_samples));
+    result.status.is_solved().then_some(LocalPath {
+        waypoints: result.waypoints,
+        straight: false,
     })
 }
 

@@ -68,7 +68,8 @@ fn view(cell: &CmmCell, plan: &CmmPlan, tris: &[[DVec3; 3]], axes: (usize, usize
     }
     let (w, hgt) = (360.0, 300.0);
     let margin = 12.0;
-    let scale = ((w - 2.0 * margin) / (hi.0 - lo.0).max(1e-6)).min((hgt - 2.0 * margin) / (hi.1 - lo.1).max(1e-6));
+    let scale =
+        ((w - 2.0 * margin) / (hi.0 - lo.0).max(1e-6)).min((hgt - 2.0 * margin) / (hi.1 - lo.1).max(1e-6));
     let sx = |x: f64| margin + (x - lo.0) * scale;
     let sy = |y: f64| hgt - margin - (y - lo.1) * scale;
     let mut s = format!(
@@ -138,7 +139,12 @@ fn view(cell: &CmmCell, plan: &CmmPlan, tris: &[[DVec3; 3]], axes: (usize, usize
 }
 
 /// The whole page.
-pub fn html(plan: &CmmPlan, cell: &CmmCell, verdict: Option<&CmmReport>, table4: Option<&[Table4Row]>) -> String {
+pub fn html(
+    plan: &CmmPlan,
+    cell: &CmmCell,
+    verdict: Option<&CmmReport>,
+    table4: Option<&[Table4Row]>,
+) -> String {
     let title = format!("cellplan — {}", plan.cell);
     let tris = triangles(cell);
     let views = [

@@ -2,6 +2,7 @@
 //! family; the helpers here are shared.
 mod bench;
 mod check;
+mod cmm;
 mod gen_tasks;
 mod pcb;
 mod plan;

@@ -51,7 +51,144 @@ fn one_robot(c: String) -> String {
     format!("{}{}", &c[..at], &c[end..])
 }
 
+/// The CMM example's cell with `edit` applied, and its task file as `tasks(...)` gives it,
+/// written into `dir` (the part and the tasks read from the repository's data).
+fn cmm_with(dir: &Path, edit: impl Fn(String) -> String, tasks: impl Fn(String) -> String) -> String {
+    let ex = root().join("examples/cmm-block/cell.toml");
+    let data = root().join("data/parts/cmm-block");
+    let cell = std::fs::read_to_string(ex)
+        .unwrap()
+        .replace("../../data/parts/cmm-block/tasks.csv", "tasks.csv")
+        .replace(
+            "../../data/parts/cmm-block/block.obj",
+            &data.join("block.obj").display().to_string(),
+        );
+    let csv = std::fs::read_to_string(data.join("tasks.csv")).unwrap();
+    std::fs::write(dir.join("cell.toml"), edit(cell)).unwrap();
+    std::fs::write(dir.join("tasks.csv"), tasks(csv)).unwrap();
+    dir.join("cell.toml").display().to_string()
+}
+
+/// A CMM plan of the example written into `dir/out`, for the reuse cases.
+fn cmm_plan(dir: &Path) -> String {
+    let out = dir.join("planned");
+    let o = out.display().to_string();
+    let res = cellplan(
+        &["plan", "examples/cmm-block/cell.toml", "-o", &o, "--quiet"],
+        &dir.join("cache"),
+    );
+    assert_eq!(res.status.code(), Some(0));
+    out.join("plan.json").display().to_string()
+}
+
 const CASES: &[Case] = &[
+    Case {
+        name: "cmm: a cone half-angle of 0",
+        setup: |d| {
+            plan_args(
+                cmm_with(d, |c| c, |t| t.replacen(",surface,20,deck", ",surface,0,deck", 1)),
+                d,
+            )
+        },
+        says: &["tasks.csv:2", "θ = 0° must lie strictly between 0° and 90°"],
+    },
+    Case {
+        name: "cmm: a cone half-angle of 90°",
+        setup: |d| {
+            plan_args(
+                cmm_with(d, |c| c, |t| t.replacen(",hole,80,bores", ",hole,90,bores", 1)),
+                d,
+            )
+        },
+        says: &["tasks.csv:", "θ = 90°"],
+    },
+    Case {
+        name: "cmm: an MP outside the machine's range",
+        setup: |d| {
+            plan_args(
+                cmm_with(
+                    d,
+                    |c| c,
+                    |t| t.replacen("D1,20.0000,60.0000", "D1,2000.0000,60.0000", 1),
+                ),
+                d,
+            )
+        },
+        says: &["tasks.csv:2", "MP D1", "outside the machine's range"],
+    },
+    Case {
+        name: "cmm: a stylus longer than the Z travel",
+        setup: |d| plan_args(cmm_with(d, |c| c.replace("l2 = 150", "l2 = 900"), |t| t), d),
+        says: &["cell.toml:", "Z travel", "shorter stylus"],
+    },
+    Case {
+        name: "cmm: a head range beyond ±180°",
+        setup: |d| {
+            plan_args(
+                cmm_with(d, |c| c.replace("a = [0, 105]", "a = [0, 1050]"), |t| t),
+                d,
+            )
+        },
+        says: &["cell.toml:", "`a` = [0, 1050]"],
+    },
+    Case {
+        name: "cmm: an adjacency naming an unknown face",
+        setup: |d| {
+            plan_args(
+                cmm_with(
+                    d,
+                    |c| c.replace("[\"deck\", \"bores\"]", "[\"deck\", \"roof\"]"),
+                    |t| t,
+                ),
+                d,
+            )
+        },
+        says: &["cell.toml:", "face `roof`"],
+    },
+    Case {
+        name: "cmm: a reuse naming an unknown MP",
+        setup: |d| {
+            let plan = cmm_plan(d);
+            std::fs::write(d.join("subset.txt"), "D1\nS2\nQ9\n").unwrap();
+            vec![
+                "reuse".into(),
+                plan,
+                "--tasks".into(),
+                format!("@{}", d.join("subset.txt").display()),
+                "-o".into(),
+                d.join("out").display().to_string(),
+            ]
+        },
+        says: &["subset.txt:3", "`Q9` is not an MP of the cell"],
+    },
+    Case {
+        name: "cmm: a reuse naming an MP the plan never measured",
+        setup: |d| {
+            let plan = cmm_plan(d);
+            // The plan, its group of D1 cut down so that D1 is reported unmeasured.
+            let text = std::fs::read_to_string(&plan).unwrap();
+            let mut doc: serde_json::Value = serde_json::from_str(&text).unwrap();
+            for g in doc["groups"].as_array_mut().unwrap() {
+                let mps = g["mps"].as_array().unwrap().clone();
+                if let Some(k) = mps.iter().position(|m| m == "D1") {
+                    for key in ["mps", "roots", "local"] {
+                        g[key].as_array_mut().unwrap().remove(k);
+                    }
+                }
+            }
+            doc["unmeasured"] = serde_json::json!([{"id": "D1", "reason": "cut by the test"}]);
+            std::fs::write(&plan, doc.to_string()).unwrap();
+            vec![
+                "reuse".into(),
+                plan,
+                "--tasks".into(),
+                "S2,D1".into(),
+                "-o".into(),
+                d.join("out").display().to_string(),
+            ]
+        },
+        says: &["--tasks", "never measured MP `D1`", "cut by the test"],
+    },
     Case {
         name: "pcb: a board file that is not KiCad",
         setup: |d| plan_args(pcb_with(d, |c| c, |_| "hello, world\n".into()), d),

@@ -437,6 +437,12 @@ pub fn load(path: &Path) -> Result<CmmCell, InputError> {
     }
     let (part_shape, part_pose) =
         cellplan_model::load::shape_entry(path, &text, part_entry, part_span.clone(), "the part", to_m, deg)?;
+    let part_file = (
+        path.parent()
+            .unwrap_or(Path::new(""))
+            .join(part_entry.mesh.as_deref().unwrap_or_default()),
+        part_entry.mesh_units.map_or(to_m, |u| u.to_m()),
+    );
     let part_name = part_entry.name.clone().unwrap_or_else(|| "part".to_string());
     let mut statics = vec![(part_name, part_shape, part_pose)];
     for (i, f) in spec.fixtures.iter().enumerate() {
@@ -531,6 +537,7 @@ pub fn load(path: &Path) -> Result<CmmCell, InputError> {
         name,
         path: path.to_path_buf(),
         statics,
+        part_file,
         mps,
         tasks_file,
         mp_lines,
