@@ -176,6 +176,7 @@ pub fn html(
         html lang="en" {
             (crate::html::head(&title))
             body {
+                style { "div.views{display:flex;flex-wrap:wrap;gap:12px}figure.cmm-view{margin:0}#table3{width:auto}" }
                 main {
                     h1 { (title) }
                     p class="sub" {
@@ -193,10 +194,8 @@ pub fn html(
                             tr { th { "rotation" } td { (format!("{:.1} s", plan.rotation_s)) } td { "96 s" } }
                             tr { th { "inspection" } td { (format!("{:.1} s", plan.inspection_s)) } td { "39 s" } }
                             tr { th { "motion time" } td id="motion-time" { (format!("{:.1} s", plan.motion_time_s)) } td { "312 s" } }
-                            tr { th { "verification" } td id="verdict" colspan="2" {
-                                (verdict_text)
-                            } }
                         }
+                        p id="verdict" { (verdict_text) }
                         @if let Some(v) = verdict && !v.violations.is_empty() {
                             ul class="violations" {
                                 @for x in &v.violations { li { (format!("{:?}: {}", x.kind, x.detail)) } }
