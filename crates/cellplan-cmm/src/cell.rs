@@ -11,6 +11,8 @@ use std::path::PathBuf;
 
 mod load;
 pub use load::load;
+#[cfg(test)]
+pub(crate) use load::read_mps;
 
 /// The `[process] kind` of a CMM-inspection cell.
 pub const KIND: &str = "cmm-inspection";

@@ -3,6 +3,9 @@
 //!
 //! - [`part`]: the cylinder-block-like test part, generated as a mesh with its 39 measuring
 //!   points (the paper's case has 39 MPs on a cylinder block; its geometry is not published).
+//! - [`housing`]: a second test part, a gearbox or pump housing on a base flange, with 40
+//!   measuring points (a bore from the top, a bored boss on a side, a face inclined 30°, the
+//!   flange around the body).
 //! - [`classify`]: §3.1, the MPs grouped by probe orientation (eq. 3) as a set cover, greedy
 //!   (the paper's) or exact.
 //! - [`motion`]: the CMM's configuration space and the probe's clearance for the shared motion
@@ -17,9 +20,11 @@
 // Input errors are built once, on the cold path of refusing a file.
 #![allow(clippy::result_large_err)]
 
+mod builder;
 pub mod cell;
 pub mod classify;
 pub mod document;
+pub mod housing;
 pub mod job;
 pub mod motion;
 pub mod mrnc;

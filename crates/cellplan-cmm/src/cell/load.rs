@@ -569,11 +569,11 @@ pub fn load(path: &Path) -> Result<CmmCell, InputError> {
 }
 
 /// The MPs, each one's line, and the face names.
-type MpFile = (Vec<Mp>, Vec<usize>, Vec<String>);
+pub(crate) type MpFile = (Vec<Mp>, Vec<usize>, Vec<String>);
 
 /// Reads the MP CSV: `id,x,y,z,nx,ny,nz,feature,theta[,face]` (lengths in the cell's unit, θ in
 /// degrees). Without a `face` column, MPs with the same normal on the same plane share a face.
-fn read_mps(path: &Path, to_m: f64) -> Result<MpFile, InputError> {
+pub(crate) fn read_mps(path: &Path, to_m: f64) -> Result<MpFile, InputError> {
     let text = read_bounded(path, MAX_TASK_FILE).map_err(|e| {
         InputError::new(path, format!("cannot read the task file: {e}"))
             .hint("a CSV `id,x,y,z,nx,ny,nz,feature,theta[,face]`, at most 16 MiB")
