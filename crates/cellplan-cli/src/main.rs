@@ -95,6 +95,9 @@ enum GenCommand {
     /// Write paper 003's kind of test part: a cylinder-block-like machined block (mesh, mm) and
     /// its 39 measuring points with cone half-angles (task CSV), as `block.obj` and `tasks.csv`.
     Block(GenBlockArgs),
+    /// Write the second CMM test part: a gearbox-housing-like casting (mesh, mm) and its 40
+    /// measuring points (task CSV), as `housing.obj` and `tasks.csv`.
+    Housing(GenBlockArgs),
 }
 
 #[derive(Args)]
@@ -342,27 +345,46 @@ fn run_gen_tasks(args: &GenTasksArgs) -> Result<(), Failure> {
     Ok(())
 }
 
-fn run_gen_block(args: &GenBlockArgs) -> Result<(), Failure> {
+fn run_gen_block(args: &GenBlockArgs, housing: bool) -> Result<(), Failure> {
     if !(8..=720).contains(&args.segments) {
         return Err(Failure::Usage(format!(
             "--segments must be between 8 and 720, not {}",
             args.segments
         )));
     }
-    let spec = cellplan_cmm::part::BlockSpec {
-        segments: args.segments,
-        ..Default::default()
+    let (mesh, mps, faces, what, name): (_, _, &[&str], _, _) = if housing {
+        let spec = cellplan_cmm::housing::HousingSpec {
+            segments: args.segments,
+            ..Default::default()
+        };
+        let (mesh, mps) = cellplan_cmm::housing::housing(&spec);
+        (
+            mesh,
+            mps,
+            &cellplan_cmm::housing::HOUSING_FACES,
+            "a gearbox-housing-like casting, mm (crates/cellplan-cmm/src/housing.rs documents it)",
+            "housing",
+        )
+    } else {
+        let spec = cellplan_cmm::part::BlockSpec {
+            segments: args.segments,
+            ..Default::default()
+        };
+        let (mesh, mps) = cellplan_cmm::part::cylinder_block(&spec);
+        (
+            mesh,
+            mps,
+            &cellplan_cmm::part::BLOCK_FACES,
+            "paper 003's kind of cylinder block, mm (crates/cellplan-cmm/src/part.rs documents it)",
+            "block",
+        )
     };
-    let (mesh, mps) = cellplan_cmm::part::cylinder_block(&spec);
     let obj = cellplan_cmm::part::to_obj(
         &mesh,
-        &format!(
-            "cellplan gen block --segments {}: paper 003's kind of cylinder block, mm (crates/cellplan-cmm/src/part.rs documents it)",
-            args.segments
-        ),
+        &format!("cellplan gen {name} --segments {}: {what}", args.segments),
     );
-    let csv = cellplan_cmm::part::to_csv(&mps, &cellplan_cmm::part::BLOCK_FACES);
-    let (a, b) = (args.out.join("block.obj"), args.out.join("tasks.csv"));
+    let csv = cellplan_cmm::part::to_csv(&mps, faces);
+    let (a, b) = (args.out.join(format!("{name}.obj")), args.out.join("tasks.csv"));
     write_all_atomic(&[(&a, obj.as_bytes()), (&b, csv.as_bytes())])
         .map_err(|e| Failure::Other(format!("cannot write into {}: {e}", args.out.display())))?;
     eprintln!(
@@ -494,7 +516,8 @@ fn main() -> ExitCode {
         Command::Report(a) => report_cmd::run_report(a),
         Command::Export(a) => report_cmd::run_export(a),
         Command::Gen(GenCommand::Tasks(a)) => run_gen_tasks(a),
-        Command::Gen(GenCommand::Block(a)) => run_gen_block(a),
+        Command::Gen(GenCommand::Block(a)) => run_gen_block(a, false),
+        Command::Gen(GenCommand::Housing(a)) => run_gen_block(a, true),
         Command::Bench(a) => run_bench(a),
     };
     match result {

@@ -317,7 +317,7 @@ fn mrnc_reason(e: &MrncError, angles: (f64, f64)) -> String {
 
 /// Plans a job from the groups of a classification. What cannot be planned is left out with its
 /// reason ([`Job::unmeasured`]): an MP whose approach or local path fails leaves its group, a
-/// group whose roots cannot all see each other is split in two, a group with no clear start or
+/// group whose roots cannot all see each other is split in two across its widest spread, a group with no clear start or
 /// no clear way from the turn height is left out whole.
 #[allow(clippy::too_many_arguments)]
 pub fn plan_job(
@@ -422,13 +422,25 @@ pub fn plan_job(
                 if group.members.len() == 1 {
                     unmeasured.push((group.members[0], mrnc_reason(&e, group.angles)));
                 } else {
-                    let half = group.members.len() / 2;
+                    // Split across the members' widest spread: roots that must see each other
+                    // across the part end up in different halves.
+                    let mut members = group.members.clone();
+                    let pos = |i: usize| mps[i].position.to_array();
+                    let spread = |j: usize| {
+                        let v = members.iter().map(|&i| pos(i)[j]);
+                        v.clone().fold(f64::NEG_INFINITY, f64::max) - v.fold(f64::INFINITY, f64::min)
+                    };
+                    let axis = (0..3)
+                        .max_by(|&a, &b| spread(a).total_cmp(&spread(b)))
+                        .unwrap_or(0);
+                    members.sort_by(|&a, &b| pos(a)[axis].total_cmp(&pos(b)[axis]).then(a.cmp(&b)));
+                    let half = members.len() / 2;
                     queue.push_front(Group {
-                        members: group.members[half..].to_vec(),
+                        members: members[half..].to_vec(),
                         ..group.clone()
                     });
                     queue.push_front(Group {
-                        members: group.members[..half].to_vec(),
+                        members: members[..half].to_vec(),
                         ..group
                     });
                 }

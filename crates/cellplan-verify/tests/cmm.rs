@@ -190,3 +190,36 @@ fn a_path_through_a_thin_wall_between_two_clear_waypoints_is_caught() {
     let k = kinds(&p);
     assert!(k.contains(&CmmViolationKind::Collision), "{k:?}");
 }
+
+#[test]
+fn the_second_example_the_housing_is_planned_whole_and_verifies() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/cmm-housing/cell.toml");
+    let cell = cellplan_cmm::cell::load(&path).unwrap_or_else(|e| panic!("{e}"));
+    // The cell's adjacency is the generator's.
+    for (f, a) in cell.faces.iter().enumerate() {
+        for (g, b) in cell.faces.iter().enumerate() {
+            let i = cellplan_cmm::housing::HOUSING_FACES
+                .iter()
+                .position(|x| x == a)
+                .unwrap();
+            let j = cellplan_cmm::housing::HOUSING_FACES
+                .iter()
+                .position(|x| x == b)
+                .unwrap();
+            assert_eq!(
+                cell.adjacent(f, g),
+                cellplan_cmm::housing::housing_adjacent(i, j),
+                "{a} {b}"
+            );
+        }
+    }
+    let req = request(GtspMethod::Ils, 0);
+    let out = run(&cell, &req).unwrap();
+    let doc = document(&cell, &out, &req, Strategy::Plan);
+    let r = verify_cmm(&cell, &doc);
+    assert!(r.ok, "{:?}", r.violations);
+    assert_eq!(doc.tasks.len(), 40, "unmeasured: {:?}", doc.unmeasured);
+    let subset: Vec<usize> = (0..40).step_by(3).collect();
+    let again = reuse(&cell, &doc, &subset, Strategy::ReuseRoots).unwrap();
+    assert!(verify_cmm(&cell, &again).ok);
+}
