@@ -5,7 +5,7 @@
 //!
 //! As a set cover: a column is an orientation together with a face or a pair of adjacent faces;
 //! it covers the MPs on those faces that the orientation measures. The paper solves it with
-//! the greedy rule (its ref. [29]); [`Method::Exact`] is `cellplan-solve`'s branch and bound.
+//! the greedy rule (its ref. \[29\]); [`Method::Exact`] is `cellplan-solve`'s branch and bound.
 use cellplan_geom::{CollisionWorld, DQuat, DVec3, GroupBody, GroupId, Pose, ShapeSpec};
 use cellplan_kin::cmm::{CmmHead, CmmQ};
 use cellplan_solve::SetCover;

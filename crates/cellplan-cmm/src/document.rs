@@ -386,3 +386,41 @@ pub fn schema() -> String {
     text.push('\n');
     text
 }
+
+#[cfg(test)]
+mod tests {
+    use std::path::Path;
+
+    /// `docs/cmm-plan.schema.json` is the schema of these types (regenerate it with
+    /// `CELLPLAN_UPDATE_SCHEMA=1 cargo test -p cellplan-cmm schema`).
+    #[test]
+    fn the_schema_in_docs_is_generated_from_the_types() {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../docs/cmm-plan.schema.json");
+        let generated = super::schema();
+        if std::env::var_os("CELLPLAN_UPDATE_SCHEMA").is_some() {
+            std::fs::write(&path, &generated).unwrap();
+        }
+        let on_disk = std::fs::read_to_string(&path).unwrap_or_default();
+        assert!(
+            on_disk == generated,
+            "docs/cmm-plan.schema.json is not the schema of the document's types; regenerate it with \
+             CELLPLAN_UPDATE_SCHEMA=1 cargo test -p cellplan-cmm schema"
+        );
+        let schema: serde_json::Value = serde_json::from_str(&on_disk).unwrap();
+        let required = schema["required"].as_array().unwrap();
+        for key in [
+            "path",
+            "groups",
+            "tasks",
+            "motion_time_s",
+            "movement_s",
+            "rotation_s",
+            "inspection_s",
+        ] {
+            assert!(
+                required.iter().any(|k| k == key),
+                "{key} not required: {required:?}"
+            );
+        }
+    }
+}

@@ -1,6 +1,9 @@
 //! Paper 003 (Zhao, Wang, Liu: path planning for 5-axis CMM inspection considering path reuse)
-//! as a cellplan process — in progress. Built so far:
+//! as a cellplan process (`[process] kind = "cmm-inspection"`):
 //!
+//! - [`cell`]: the cell file — machine, head, probe, the part posed, fixtures, the MPs.
+//! - [`plan`]: plan a cell (or a subset), reuse a plan for a subset; [`document`]: the plan
+//!   document (`cellplan-cmm-plan` v1), checked by `cellplan-verify::cmm`.
 //! - [`part`]: the cylinder-block-like test part, generated as a mesh with its 39 measuring
 //!   points (the paper's case has 39 MPs on a cylinder block; its geometry is not published).
 //! - [`housing`]: a second test part, a gearbox or pump housing on a base flange, with 40
