@@ -144,6 +144,14 @@ fn write_plan(
 /// `cellplan plan` on a CMM cell.
 pub fn plan(args: &PlanArgs) -> Result<(), Failure> {
     let start = Instant::now();
+    if args.time_limit.is_some() {
+        return Err(Failure::Usage(
+            "--time-limit does not apply to CMM cells: the planner's budget is its work (RRT-MRNC rounds and samples, ordering iterations), so the plan depends only on the cell and the seed".into(),
+        ));
+    }
+    if args.order.is_some() {
+        return Err(Failure::Usage("--order is a PCB-assembly option".into()));
+    }
     let cell = load(&args.cell)?;
     let dir = match &args.output {
         Some(d) => d.clone(),
