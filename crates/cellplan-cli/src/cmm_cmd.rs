@@ -4,7 +4,7 @@
 use crate::Failure;
 use crate::plan_cmd::PlanArgs;
 use cellplan_cmm::cell::{CmmCell, KIND};
-use cellplan_cmm::classify::{Method, classify};
+use cellplan_cmm::classify::{Method, classify_with};
 use cellplan_cmm::document::{CmmPlan, Strategy};
 use cellplan_cmm::plan::{Request, ReuseError, document, reuse, run};
 use cellplan_model::InputError;
@@ -659,7 +659,29 @@ pub fn compare(args: &crate::compare_cmd::CompareArgs) -> Result<(), Failure> {
         let replan = document(&cell, &out, &req, Strategy::Replan);
         let docs = [&roots, &initial, &replan];
         for (j, d) in docs.iter().enumerate() {
-            verified[j] &= verify_cmm(&cell, d).ok && d.tasks.len() == subset.len();
+            let verdict = verify_cmm(&cell, d);
+            let whole = d.tasks.len() == subset.len();
+            if !(verdict.ok && whole) {
+                pb.suspend(|| {
+                    eprintln!(
+                        "subset {}: the {} plan {}",
+                        s + 1,
+                        d.strategy.name(),
+                        match verdict.violations.first() {
+                            Some(v) => format!("is not verified: {}", describe(v)),
+                            None => format!(
+                                "leaves MPs unmeasured: {}",
+                                d.unmeasured
+                                    .iter()
+                                    .map(|u| format!("{} ({})", u.id, u.reason))
+                                    .collect::<Vec<_>>()
+                                    .join("; ")
+                            ),
+                        }
+                    )
+                });
+            }
+            verified[j] &= verdict.ok && whole;
             sums[j][0] += d.motion_time_s;
             sums[j][1] += d.movement_s;
             sums[j][2] += d.rotation_s;
@@ -805,22 +827,25 @@ pub fn check_cell(path: &Path, json: bool) -> Result<(), Failure> {
     let probe = cell.probe();
     let orientations = cell.orientations();
     let adjacent = |f: usize, g: usize| cell.adjacent(f, g);
-    let exact = classify(
-        &cell.mps,
-        &adjacent,
-        &probe,
-        &orientations,
-        cell.touch_clearance,
-        Method::Exact,
-    );
-    let greedy = classify(
-        &cell.mps,
-        &adjacent,
-        &probe,
-        &orientations,
-        cell.touch_clearance,
-        Method::Greedy,
-    );
+    let space = cellplan_cmm::motion::space(&probe, &cell.travel);
+    let validity = cellplan_cmm::motion::CmmValidity {
+        probe: &probe,
+        margin: cell.clearance,
+    };
+    let usable = cellplan_cmm::plan::approach_usable(&cell, &space, &validity, &cell.mps);
+    let by = |m| {
+        classify_with(
+            &cell.mps,
+            &adjacent,
+            &probe,
+            &orientations,
+            cell.touch_clearance,
+            m,
+            &usable,
+        )
+    };
+    let exact = by(Method::Exact);
+    let greedy = by(Method::Greedy);
     let out = CheckOut {
         cell: cell.name.clone(),
         mps: cell.mps.len(),

@@ -208,6 +208,23 @@ pub fn classify(
     clearance: f64,
     method: Method,
 ) -> Classification {
+    classify_with(mps, adjacent, probe, orientations, clearance, method, &|_, _| {
+        true
+    })
+}
+
+/// [`classify`], an orientation counting for an MP only where `usable(mp, angles)` also holds —
+/// the planner's own test of the MP's approach configuration, so that no group is formed that
+/// the planner cannot then reach (a candidate the planner cannot leave is not a candidate).
+pub fn classify_with(
+    mps: &[Mp],
+    adjacent: &dyn Fn(usize, usize) -> bool,
+    probe: &Probe,
+    orientations: &[(f64, f64)],
+    clearance: f64,
+    method: Method,
+    usable: &(dyn Fn(usize, (f64, f64)) -> bool + Sync),
+) -> Classification {
     let n = mps.len();
     // feasible[o] = MPs orientation o measures.
     let feasible: Vec<Vec<usize>> = orientations
@@ -220,6 +237,7 @@ pub fn classify(
                     let angle = (-d).dot(m.normal).clamp(-1.0, 1.0).acos();
                     angle <= m.theta_deg.to_radians() + 1e-12
                         && probe.touch_clear(m.position, m.normal, d, clearance)
+                        && usable(i, (a, b))
                 })
                 .collect()
         })

@@ -2,10 +2,11 @@
 //! order groups and MPs (§3.3); and the three ways of inspecting a subset later (Table 4):
 //! through the stored roots, along the initial path, or planned from scratch.
 use crate::cell::CmmCell;
-use crate::classify::{Method, classify};
+use crate::classify::{Method, classify_with};
 use crate::document::{CmmPlan, Parts, Strategy, settings};
 use crate::job::{Job, JobError, Reused, plan_job};
 use crate::motion::{CmmValidity, space};
+use cellplan_motion::plan::{JointSpace, StateValidity};
 use cellplan_solve::GtspMethod;
 use std::time::Instant;
 
@@ -65,13 +66,20 @@ pub fn run(cell: &CmmCell, req: &Request) -> Result<Outcome, PlanError> {
     let sub: Vec<_> = chosen.iter().map(|&i| cell.mps[i].clone()).collect();
     let orientations = cell.orientations();
     let adjacent = |f: usize, g: usize| cell.adjacent(f, g);
-    let c = classify(
+    let space = space(&probe, &cell.travel);
+    let validity = CmmValidity {
+        probe: &probe,
+        margin: cell.clearance,
+    };
+    let usable = approach_usable(cell, &space, &validity, &sub);
+    let c = classify_with(
         &sub,
         &adjacent,
         &probe,
         &orientations,
         cell.touch_clearance,
         method,
+        &usable,
     );
     let groups: Vec<_> = c
         .groups
@@ -81,11 +89,6 @@ pub fn run(cell: &CmmCell, req: &Request) -> Result<Outcome, PlanError> {
             g
         })
         .collect();
-    let space = space(&probe, &cell.travel);
-    let validity = CmmValidity {
-        probe: &probe,
-        margin: cell.clearance,
-    };
     let s = settings(cell, req.order, req.seed);
     let mut job =
         plan_job(&probe, &validity, &space, &cell.mps, &groups, &cell.home, &s).map_err(PlanError::Job)?;
@@ -105,6 +108,22 @@ pub fn run(cell: &CmmCell, req: &Request) -> Result<Outcome, PlanError> {
         classification: method,
         orientations: c.orientations,
     })
+}
+
+/// RRT-MRNC's own test of an MP's approach configuration at head angles: within the travel and
+/// clear by the cell's clearance (with the planner's `min_clearance`), so that classification
+/// never forms a group the planner then cannot enter.
+pub fn approach_usable<'a>(
+    cell: &'a CmmCell,
+    space: &'a JointSpace,
+    validity: &'a CmmValidity<'a>,
+    mps: &'a [crate::part::Mp],
+) -> impl Fn(usize, (f64, f64)) -> bool + Sync + 'a {
+    let min = crate::mrnc::MrncSettings::default().min_clearance;
+    move |i: usize, angles: (f64, f64)| {
+        let q = crate::mrnc::approach(&cell.head, &mps[i], angles, cell.pretouch);
+        space.contains(&q) && validity.clearance(&q) > min
+    }
 }
 
 /// The plan document of an outcome.
