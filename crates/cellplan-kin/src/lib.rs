@@ -16,6 +16,7 @@
 
 pub mod chain;
 pub mod cmm;
+pub mod dynamics;
 pub mod error;
 pub mod ik;
 pub mod opw;

@@ -27,6 +27,10 @@ pub struct RobotModel {
     /// belongs to (the chain link itself, or a link rigidly attached off the chain, such as a
     /// gripper finger). SRDF collision rules name these links.
     pub collision_links: Vec<Vec<String>>,
+    /// Inertial parameters per chain link (same index as `chain.links`), in the link frame:
+    /// the link's own `<inertial>` with those of links rigidly attached off the chain lumped in;
+    /// `None` where no `<inertial>` with a positive mass was given.
+    pub inertia: Vec<Option<crate::dynamics::LinkInertia>>,
 }
 
 /// Loads a URDF. `packages` maps a ROS package name to its folder (for `package://name/...`);
@@ -120,7 +124,9 @@ impl Loader<'_> {
         let (chain, chain_pos) = self.chain(&doc, &robot, &tree, &path_links)?;
         let attach = self.attachments(&robot, &tree, &chain_pos)?;
         let (collision, collision_links) = self.collision(&doc, &robot, &attach, chain.links.len())?;
+        let inertia = inertias(&robot, &attach, chain.links.len());
         Ok(RobotModel {
+            inertia,
             name: robot.name.clone(),
             path: self.path.to_path_buf(),
             chain,
@@ -692,6 +698,42 @@ fn capsule(radius: f64, length: f64) -> Vec<(ShapeSpec, Pose)> {
 }
 
 /// The pose of a URDF `<origin xyz rpy>`: `Rz(yaw) · Ry(pitch) · Rx(roll)` then translation.
+/// Per chain link, the inertials of the URDF links hanging from it, lumped in its frame.
+fn inertias(
+    robot: &urdf_rs::Robot,
+    attach: &[Option<Attachment>],
+    chain_links: usize,
+) -> Vec<Option<crate::dynamics::LinkInertia>> {
+    use crate::dynamics::LinkInertia;
+    let mut out: Vec<Option<LinkInertia>> = vec![None; chain_links];
+    for (l, link) in robot.links.iter().enumerate() {
+        let Some(at) = attach.get(l).copied().flatten() else {
+            continue;
+        };
+        let i = &link.inertial;
+        if i.mass.value.is_nan() || i.mass.value <= 0.0 {
+            continue;
+        }
+        let t = &i.inertia;
+        let own = LinkInertia {
+            mass: i.mass.value,
+            com: DVec3::ZERO,
+            inertia: glam::DMat3::from_cols_array(&[
+                t.ixx, t.ixy, t.ixz, t.ixy, t.iyy, t.iyz, t.ixz, t.iyz, t.izz,
+            ]),
+        };
+        // The inertial frame in the link frame, then the link frame in the chain link's.
+        let pose = at.pose * origin_pose(&i.origin);
+        let body = own.transformed(glam::DMat3::from_quat(pose.rotation), pose.translation);
+        let slot = &mut out[at.chain_link];
+        *slot = Some(match slot {
+            Some(prev) => prev.combined(&body),
+            None => body,
+        });
+    }
+    out
+}
+
 fn origin_pose(o: &urdf_rs::Pose) -> Pose {
     let [r, p, y] = o.rpy.0;
     let rot = DQuat::from_rotation_z(y) * DQuat::from_rotation_y(p) * DQuat::from_rotation_x(r);
