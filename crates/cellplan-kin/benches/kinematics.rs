@@ -60,5 +60,44 @@ fn kinematics(c: &mut Criterion) {
     });
 }
 
-criterion_group!(benches, kinematics);
+/// The recursive Newton–Euler dynamics on the KR 210 L150 and the UR10 (issue 18): τ, M(q),
+/// and τ with its exact derivatives by dual numbers.
+fn dynamics(c: &mut Criterion) {
+    use cellplan_kin::dynamics::Dynamics;
+    let robots = [
+        (
+            "KR 210 L150",
+            "kuka_kr210/urdf/kr210l150.urdf",
+            "kuka_kr210_support",
+            "kuka_kr210/kuka_kr210_support",
+        ),
+        (
+            "UR10",
+            "ur10/urdf/ur10.urdf",
+            "ur_description",
+            "ur10/ur_description",
+        ),
+    ];
+    let (q, v, a) = (
+        [0.3, -0.8, 0.9, 0.4, -0.7, 1.2],
+        [0.5, -0.4, 0.3, 1.0, -0.9, 1.5],
+        [2.0, -1.0, 3.0, -4.0, 5.0, -6.0],
+    );
+    for (name, urdf, pkg, dir) in robots {
+        let packages = BTreeMap::from([(pkg.to_string(), data().join(dir))]);
+        let model = load_urdf(&data().join(urdf), &packages, None).expect("URDF");
+        let d = Dynamics::new(&model.chain, &model.inertia);
+        c.bench_function(&format!("rnea {name}"), |b| {
+            b.iter(|| d.inverse_dynamics(black_box(&q), black_box(&v), black_box(&a)))
+        });
+        c.bench_function(&format!("mass matrix {name}"), |b| {
+            b.iter(|| d.mass_matrix(black_box(&q[..])))
+        });
+        c.bench_function(&format!("rnea with derivatives {name}"), |b| {
+            b.iter(|| d.inverse_dynamics_derivatives(black_box(&q), black_box(&v), black_box(&a)))
+        });
+    }
+}
+
+criterion_group!(benches, kinematics, dynamics);
 criterion_main!(benches);
