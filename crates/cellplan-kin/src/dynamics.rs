@@ -94,26 +94,35 @@ impl Real for f64 {
     }
 }
 
-/// A dual number: a value and its derivatives with respect to `N` variables.
+/// A dual number: a value and its derivatives with respect to `N` variables, over a scalar `T`
+/// that may itself be a dual number (nested duals give second derivatives).
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Dual<const N: usize> {
+pub struct Dual<const N: usize, T = f64> {
     /// The value.
-    pub v: f64,
+    pub v: T,
     /// The derivatives.
-    pub d: [f64; N],
+    pub d: [T; N],
 }
 
-impl<const N: usize> Dual<N> {
+impl<const N: usize, T: Real> Dual<N, T> {
     /// The `k`-th variable at value `v` (derivative 1 along `k`).
-    pub fn variable(v: f64, k: usize) -> Self {
-        let mut d = [0.0; N];
+    pub fn variable(v: T, k: usize) -> Self {
+        let mut d = [T::from_f64(0.0); N];
         if k < N {
-            d[k] = 1.0;
+            d[k] = T::from_f64(1.0);
         }
         Dual { v, d }
     }
 
-    fn map(self, v: f64, slope: f64) -> Self {
+    /// A constant.
+    pub fn constant(v: T) -> Self {
+        Dual {
+            v,
+            d: [T::from_f64(0.0); N],
+        }
+    }
+
+    fn chain(self, v: T, slope: T) -> Self {
         Dual {
             v,
             d: self.d.map(|x| x * slope),
@@ -121,7 +130,7 @@ impl<const N: usize> Dual<N> {
     }
 }
 
-impl<const N: usize> Add for Dual<N> {
+impl<const N: usize, T: Real> Add for Dual<N, T> {
     type Output = Self;
     fn add(self, o: Self) -> Self {
         Dual {
@@ -131,7 +140,7 @@ impl<const N: usize> Add for Dual<N> {
     }
 }
 
-impl<const N: usize> Sub for Dual<N> {
+impl<const N: usize, T: Real> Sub for Dual<N, T> {
     type Output = Self;
     fn sub(self, o: Self) -> Self {
         Dual {
@@ -141,7 +150,7 @@ impl<const N: usize> Sub for Dual<N> {
     }
 }
 
-impl<const N: usize> Mul for Dual<N> {
+impl<const N: usize, T: Real> Mul for Dual<N, T> {
     type Output = Self;
     // The product rule: d(uv) = u dv + v du.
     #[allow(clippy::suspicious_arithmetic_impl)]
@@ -153,20 +162,21 @@ impl<const N: usize> Mul for Dual<N> {
     }
 }
 
-impl<const N: usize> Div for Dual<N> {
+impl<const N: usize, T: Real> Div for Dual<N, T> {
     type Output = Self;
     // The quotient rule.
     #[allow(clippy::suspicious_arithmetic_impl)]
     fn div(self, o: Self) -> Self {
-        let inv = 1.0 / o.v;
+        let inv = T::from_f64(1.0) / o.v;
+        let q = self.v * inv;
         Dual {
-            v: self.v * inv,
-            d: std::array::from_fn(|k| (self.d[k] - self.v * inv * o.d[k]) * inv),
+            v: q,
+            d: std::array::from_fn(|k| (self.d[k] - q * o.d[k]) * inv),
         }
     }
 }
 
-impl<const N: usize> Neg for Dual<N> {
+impl<const N: usize, T: Real> Neg for Dual<N, T> {
     type Output = Self;
     fn neg(self) -> Self {
         Dual {
@@ -176,18 +186,18 @@ impl<const N: usize> Neg for Dual<N> {
     }
 }
 
-impl<const N: usize> Real for Dual<N> {
+impl<const N: usize, T: Real> Real for Dual<N, T> {
     fn from_f64(v: f64) -> Self {
-        Dual { v, d: [0.0; N] }
+        Dual::constant(T::from_f64(v))
     }
     fn sin(self) -> Self {
-        self.map(self.v.sin(), self.v.cos())
+        self.chain(self.v.sin(), self.v.cos())
     }
     fn cos(self) -> Self {
-        self.map(self.v.cos(), -self.v.sin())
+        self.chain(self.v.cos(), -self.v.sin())
     }
     fn value(self) -> f64 {
-        self.v
+        self.v.value()
     }
 }
 
@@ -439,6 +449,22 @@ impl Dynamics {
         m
     }
 
+    /// The kinetic energy ½ q̇ᵀ M(q) q̇ (one recursion: M(q) q̇ is the torque for acceleration
+    /// q̇ at rest without gravity).
+    pub fn kinetic<T: Real>(&self, q: &[T], qd: &[T]) -> T {
+        let p = self.rnea_with(q, &[], qd, 0.0);
+        let mut e = T::from_f64(0.0);
+        for (a, b) in p.iter().zip(qd) {
+            e = e + *a * *b;
+        }
+        e * T::from_f64(0.5)
+    }
+
+    /// The generalised momentum ∂L/∂q̇ = M(q) q̇.
+    pub fn momentum<T: Real>(&self, q: &[T], qd: &[T]) -> Vec<T> {
+        self.rnea_with(q, &[], qd, 0.0)
+    }
+
     /// The potential energy of gravity, −Σ mᵢ g·cᵢ (J), with the root's origin as zero.
     pub fn potential<T: Real>(&self, q: &[T]) -> T {
         let zero = T::from_f64(0.0);
@@ -483,7 +509,7 @@ impl Dynamics {
             .map(|j| Dual::variable(qd.get(j).copied().unwrap_or(0.0), 8 + j))
             .collect();
         let aa: Vec<Dual<16>> = (0..n)
-            .map(|j| Dual::from_f64(qdd.get(j).copied().unwrap_or(0.0)))
+            .map(|j| Dual::constant(qdd.get(j).copied().unwrap_or(0.0)))
             .collect();
         let tau = self.rnea_with(&qq, &vv, &aa, 1.0);
         let value = tau.iter().map(|t| t.v).collect();
