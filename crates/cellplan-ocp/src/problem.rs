@@ -1,0 +1,462 @@
+//! One move as a nonlinear program (paper 002 §2.3): the DMOC transcription of [`crate::dmoc`]
+//! between two configurations at rest, with free final time, in the standard form
+//!
+//! `min f(x)  s.t.  c(x) = 0,  A x ≤ 0,  x_L ≤ x ≤ x_U`
+//!
+//! - variables `x = [q_0 … q_N, u_½ … u_{N−½}, h, q̇_0, q̇_N]` ([`Layout`]);
+//! - `f = Σ h (c_t + c_e |u_{i+½}|² + c_v |(q_{i+1} − q_i)/h|²)` (the paper's §3 cost);
+//! - `c`: the start condition, the N−1 forced discrete Euler–Lagrange equations, the end
+//!   condition (n rows each);
+//! - `A x ≤ 0`: the velocity bounds as differences, `±(q_{i+1} − q_i) − h v̇_max ≤ 0`, linear;
+//! - bounds: joint limits, torque limits, the step's range, the fixed ends (`q_0`, `q_N`,
+//!   `q̇_0 = q̇_N = 0` as equal bounds).
+//!
+//! The Jacobian of `c` is exact (dual numbers over each block's positions and step; the torques
+//! enter linearly) and sparse: row block k touches `q_{k−1}, q_k, q_{k+1}`, `h` and two torques.
+use crate::dmoc::{MAX_DOF, del_residual, end_residual, start_residual};
+use cellplan_kin::dynamics::{Dual, Dynamics};
+
+/// Width of the duals over one block's positions (three grid points) and the step.
+const BLOCK: usize = 3 * MAX_DOF + 1;
+
+/// The cost weights (paper 002 §3: c_t = 1, c_e = 1e-6, c_v = 1).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Weights {
+    /// Per second.
+    pub time: f64,
+    /// Per (N·m)²·s of torque.
+    pub effort: f64,
+    /// Per (rad/s)²·s of joint velocity.
+    pub velocity: f64,
+}
+
+impl Default for Weights {
+    fn default() -> Self {
+        Weights {
+            time: 1.0,
+            effort: 1e-6,
+            velocity: 1.0,
+        }
+    }
+}
+
+/// Where each variable lives in `x`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Layout {
+    /// Joints.
+    pub n: usize,
+    /// Steps.
+    pub steps: usize,
+}
+
+impl Layout {
+    /// Index of `q_i[j]`.
+    pub fn q(&self, i: usize, j: usize) -> usize {
+        i * self.n + j
+    }
+    /// Index of `u_{i+½}[j]`.
+    pub fn u(&self, i: usize, j: usize) -> usize {
+        (self.steps + 1) * self.n + i * self.n + j
+    }
+    /// Index of `h`.
+    pub fn h(&self) -> usize {
+        (2 * self.steps + 1) * self.n
+    }
+    /// Index of `q̇_0[j]`.
+    pub fn qd0(&self, j: usize) -> usize {
+        self.h() + 1 + j
+    }
+    /// Index of `q̇_N[j]`.
+    pub fn qdn(&self, j: usize) -> usize {
+        self.h() + 1 + self.n + j
+    }
+    /// Number of variables.
+    pub fn vars(&self) -> usize {
+        self.h() + 1 + 2 * self.n
+    }
+    /// Number of equality constraints.
+    pub fn equalities(&self) -> usize {
+        (self.steps + 1) * self.n
+    }
+}
+
+/// One move between two configurations at rest.
+#[derive(Clone, Debug)]
+pub struct Move<'a> {
+    /// The robot.
+    pub dynamics: &'a Dynamics,
+    /// Where it starts and ends.
+    pub start: Vec<f64>,
+    /// Where it ends.
+    pub goal: Vec<f64>,
+    /// Steps N.
+    pub steps: usize,
+    /// Joint limits.
+    pub q_bounds: Vec<[f64; 2]>,
+    /// Joint speed limits (rad/s).
+    pub v_max: Vec<f64>,
+    /// Torque limits (N·m).
+    pub u_max: Vec<f64>,
+    /// The step's range (s).
+    pub h_bounds: [f64; 2],
+    /// The cost.
+    pub weights: Weights,
+}
+
+/// A sparse matrix as (row, column, value) triplets.
+pub type Triplets = Vec<(usize, usize, f64)>;
+
+impl Move<'_> {
+    /// The layout.
+    pub fn layout(&self) -> Layout {
+        Layout {
+            n: self.start.len(),
+            steps: self.steps,
+        }
+    }
+
+    /// The variable bounds `(x_L, x_U)`.
+    pub fn bounds(&self) -> (Vec<f64>, Vec<f64>) {
+        let l = self.layout();
+        let mut lo = vec![0.0; l.vars()];
+        let mut hi = vec![0.0; l.vars()];
+        for i in 0..=l.steps {
+            for j in 0..l.n {
+                let k = l.q(i, j);
+                (lo[k], hi[k]) = if i == 0 {
+                    (self.start[j], self.start[j])
+                } else if i == l.steps {
+                    (self.goal[j], self.goal[j])
+                } else {
+                    (self.q_bounds[j][0], self.q_bounds[j][1])
+                };
+            }
+        }
+        for i in 0..l.steps {
+            for j in 0..l.n {
+                let k = l.u(i, j);
+                (lo[k], hi[k]) = (-self.u_max[j], self.u_max[j]);
+            }
+        }
+        (lo[l.h()], hi[l.h()]) = (self.h_bounds[0], self.h_bounds[1]);
+        // q̇_0 and q̇_N: at rest (already 0).
+        (lo, hi)
+    }
+
+    /// The cost.
+    pub fn objective(&self, x: &[f64]) -> f64 {
+        let l = self.layout();
+        let w = self.weights;
+        let h = x[l.h()];
+        let mut f = 0.0;
+        for i in 0..l.steps {
+            let mut uu = 0.0;
+            let mut dq = 0.0;
+            for j in 0..l.n {
+                uu += x[l.u(i, j)].powi(2);
+                dq += (x[l.q(i + 1, j)] - x[l.q(i, j)]).powi(2);
+            }
+            f += h * (w.time + w.effort * uu) + w.velocity * dq / h;
+        }
+        f
+    }
+
+    /// The cost's gradient.
+    pub fn gradient(&self, x: &[f64]) -> Vec<f64> {
+        let l = self.layout();
+        let w = self.weights;
+        let h = x[l.h()];
+        let mut g = vec![0.0; l.vars()];
+        for i in 0..l.steps {
+            let mut uu = 0.0;
+            let mut dq = 0.0;
+            for j in 0..l.n {
+                let u = x[l.u(i, j)];
+                uu += u * u;
+                g[l.u(i, j)] += 2.0 * h * w.effort * u;
+                let d = x[l.q(i + 1, j)] - x[l.q(i, j)];
+                dq += d * d;
+                g[l.q(i + 1, j)] += 2.0 * w.velocity * d / h;
+                g[l.q(i, j)] -= 2.0 * w.velocity * d / h;
+            }
+            g[l.h()] += w.time + w.effort * uu - w.velocity * dq / (h * h);
+        }
+        g
+    }
+
+    /// The equality constraints `c(x)`: start, interior, end, n rows each.
+    pub fn constraints(&self, x: &[f64]) -> Vec<f64> {
+        let l = self.layout();
+        let n = l.n;
+        let q = |i: usize| -> Vec<f64> { (0..n).map(|j| x[l.q(i, j)]).collect() };
+        let u = |i: usize| -> Vec<f64> { (0..n).map(|j| x[l.u(i, j)]).collect() };
+        let h = x[l.h()];
+        let qd0: Vec<f64> = (0..n).map(|j| x[l.qd0(j)]).collect();
+        let qdn: Vec<f64> = (0..n).map(|j| x[l.qdn(j)]).collect();
+        let d = self.dynamics;
+        let s = l.steps;
+        let mut c = Vec::with_capacity(l.equalities());
+        c.extend(start_residual(d, &q(0), &qd0, &q(1), h, &u(0)));
+        for k in 1..s {
+            c.extend(del_residual(d, &q(k - 1), &q(k), &q(k + 1), h, &u(k - 1), &u(k)));
+        }
+        c.extend(end_residual(d, &q(s - 1), &q(s), &qdn, h, &u(s - 1)));
+        c
+    }
+
+    /// The Jacobian of `c`, exact, as triplets.
+    pub fn jacobian(&self, x: &[f64]) -> Triplets {
+        let l = self.layout();
+        let n = l.n;
+        let d = self.dynamics;
+        let h = x[l.h()];
+        let mut t: Triplets = Vec::new();
+        // Duals over a block's positions (slot 0, 1, 2 → n each) and h (the last).
+        let var = |i: usize, slot: usize| -> Vec<Dual<BLOCK>> {
+            (0..n)
+                .map(|j| Dual::variable(x[l.q(i, j)], slot * MAX_DOF + j))
+                .collect()
+        };
+        let hd: Dual<BLOCK> = Dual::variable(h, 3 * MAX_DOF);
+        let consts = |v: Vec<f64>| -> Vec<Dual<BLOCK>> { v.into_iter().map(Dual::constant).collect() };
+        let u = |i: usize| -> Vec<f64> { (0..n).map(|j| x[l.u(i, j)]).collect() };
+        let mut emit = |row0: usize,
+                        r: &[Dual<BLOCK>],
+                        cols: &[(usize, usize)],
+                        u_cols: &[usize],
+                        qd: Option<(usize, Vec<Vec<f64>>)>| {
+            for (a, e) in r.iter().enumerate() {
+                for &(slot, grid) in cols {
+                    for j in 0..n {
+                        let v = e.d[slot * MAX_DOF + j];
+                        if v != 0.0 {
+                            t.push((row0 + a, l.q(grid, j), v));
+                        }
+                    }
+                }
+                let dh = e.d[3 * MAX_DOF];
+                if dh != 0.0 {
+                    t.push((row0 + a, l.h(), dh));
+                }
+                // The torques enter as h/2 · u.
+                for &ui in u_cols {
+                    t.push((row0 + a, l.u(ui, a), 0.5 * h));
+                }
+            }
+            if let Some((first, m)) = qd {
+                // ∂(±M(q) q̇)/∂q̇ = ±M(q).
+                for (a, row) in m.iter().enumerate() {
+                    for (j, v) in row.iter().enumerate() {
+                        if *v != 0.0 {
+                            t.push((row0 + a, first + j, *v));
+                        }
+                    }
+                }
+            }
+        };
+        // Start: q_0 (slot 0), q_1 (slot 1), h, u_½, q̇_0 (M(q_0)).
+        let qd0: Vec<f64> = (0..n).map(|j| x[l.qd0(j)]).collect();
+        let r = start_residual(d, &var(0, 0), &consts(qd0), &var(1, 1), hd, &consts(u(0)));
+        let q0: Vec<f64> = (0..n).map(|j| x[l.q(0, j)]).collect();
+        emit(
+            0,
+            &r,
+            &[(0, 0), (1, 1)],
+            &[0],
+            Some((l.qd0(0), d.mass_matrix(&q0))),
+        );
+        for k in 1..l.steps {
+            let r = del_residual(
+                d,
+                &var(k - 1, 0),
+                &var(k, 1),
+                &var(k + 1, 2),
+                hd,
+                &consts(u(k - 1)),
+                &consts(u(k)),
+            );
+            emit(k * n, &r, &[(0, k - 1), (1, k), (2, k + 1)], &[k - 1, k], None);
+        }
+        let s = l.steps;
+        let qdn: Vec<f64> = (0..n).map(|j| x[l.qdn(j)]).collect();
+        let r = end_residual(d, &var(s - 1, 0), &var(s, 1), &consts(qdn), hd, &consts(u(s - 1)));
+        let qn: Vec<f64> = (0..n).map(|j| x[l.q(s, j)]).collect();
+        let minus_m: Vec<Vec<f64>> = d
+            .mass_matrix(&qn)
+            .into_iter()
+            .map(|row| row.into_iter().map(|v| -v).collect())
+            .collect();
+        emit(
+            s * n,
+            &r,
+            &[(0, s - 1), (1, s)],
+            &[s - 1],
+            Some((l.qdn(0), minus_m)),
+        );
+        t
+    }
+
+    /// The linear inequalities `A x ≤ 0` (velocity bounds) as triplets, `2 n N` rows.
+    pub fn inequalities(&self) -> Triplets {
+        let l = self.layout();
+        let mut t = Vec::with_capacity(6 * l.n * l.steps);
+        let mut row = 0;
+        for i in 0..l.steps {
+            for j in 0..l.n {
+                for sign in [1.0, -1.0] {
+                    t.push((row, l.q(i + 1, j), sign));
+                    t.push((row, l.q(i, j), -sign));
+                    t.push((row, l.h(), -self.v_max[j]));
+                    row += 1;
+                }
+            }
+        }
+        t
+    }
+
+    /// A starting point: q linear from start to goal, the torques that hold each midpoint
+    /// against gravity, and a step giving the slowest joint 1.5× its least time.
+    pub fn initial_guess(&self) -> Vec<f64> {
+        let l = self.layout();
+        let mut x = vec![0.0; l.vars()];
+        let least = (0..l.n)
+            .map(|j| (self.goal[j] - self.start[j]).abs() / self.v_max[j])
+            .fold(0.0, f64::max);
+        let h = (1.5 * least / l.steps as f64).clamp(self.h_bounds[0], self.h_bounds[1]);
+        for i in 0..=l.steps {
+            let s = i as f64 / l.steps as f64;
+            for j in 0..l.n {
+                x[l.q(i, j)] = self.start[j] + s * (self.goal[j] - self.start[j]);
+            }
+        }
+        for i in 0..l.steps {
+            let mid: Vec<f64> = (0..l.n)
+                .map(|j| 0.5 * (x[l.q(i, j)] + x[l.q(i + 1, j)]))
+                .collect();
+            let g = self.dynamics.gravity_torques(&mid);
+            for j in 0..l.n {
+                x[l.u(i, j)] = g[j].clamp(-self.u_max[j], self.u_max[j]);
+            }
+        }
+        x[l.h()] = h;
+        x
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use cellplan_kin::load_urdf;
+    use std::collections::BTreeMap;
+    use std::path::Path;
+
+    fn ur10() -> Dynamics {
+        let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data/robots/ur10");
+        let packages = BTreeMap::from([("ur_description".to_string(), root.join("ur_description"))]);
+        let model = load_urdf(&root.join("urdf/ur10.urdf"), &packages, None).unwrap();
+        Dynamics::new(&model.chain, &model.inertia)
+    }
+
+    fn a_move(d: &Dynamics) -> Move<'_> {
+        Move {
+            dynamics: d,
+            start: vec![0.0, -1.2, 1.0, -1.4, -1.5, 0.3],
+            goal: vec![1.2, -0.8, 0.6, -1.0, -1.2, -0.4],
+            steps: 8,
+            q_bounds: vec![[-std::f64::consts::TAU, std::f64::consts::TAU]; 6],
+            v_max: vec![2.0, 2.0, 3.0, 3.0, 3.0, 3.0],
+            u_max: vec![330.0, 330.0, 150.0, 54.0, 54.0, 54.0],
+            h_bounds: [1e-3, 1.0],
+            weights: Weights::default(),
+        }
+    }
+
+    #[test]
+    fn the_jacobian_and_gradient_match_central_differences() {
+        let d = ur10();
+        let m = a_move(&d);
+        let l = m.layout();
+        let mut x = m.initial_guess();
+        // Off the straight line and with velocities at the ends, so every term is exercised.
+        for (k, v) in x.iter_mut().enumerate() {
+            *v += 0.01 * ((k as f64) * 0.7).sin();
+        }
+        x[l.h()] = 0.1;
+        let jac = m.jacobian(&x);
+        let mut dense = vec![vec![0.0; l.vars()]; l.equalities()];
+        for &(r, c, v) in &jac {
+            dense[r][c] += v;
+        }
+        let eps = 1e-6;
+        let g = m.gradient(&x);
+        for c in 0..l.vars() {
+            let mut up = x.clone();
+            let mut down = x.clone();
+            up[c] += eps;
+            down[c] -= eps;
+            let (cu, cd) = (m.constraints(&up), m.constraints(&down));
+            for r in 0..l.equalities() {
+                let fd = (cu[r] - cd[r]) / (2.0 * eps);
+                assert!(
+                    (fd - dense[r][c]).abs() < 1e-5 * fd.abs().max(1.0),
+                    "∂c{r}/∂x{c}: {} vs {fd}",
+                    dense[r][c]
+                );
+            }
+            let fd = (m.objective(&up) - m.objective(&down)) / (2.0 * eps);
+            assert!(
+                (fd - g[c]).abs() < 1e-6 * fd.abs().max(1.0),
+                "∂f/∂x{c}: {} vs {fd}",
+                g[c]
+            );
+        }
+    }
+
+    #[test]
+    fn a_trajectory_of_the_integrator_satisfies_the_equalities() {
+        // Integrate from rest under constant torques: the positions, torques and step then make
+        // the interior and start rows vanish; the end row vanishes with the velocity the end
+        // condition implies.
+        let d = ur10();
+        let n = 6;
+        let steps = 8;
+        let h = 0.02;
+        let u: Vec<Vec<f64>> = (0..steps)
+            .map(|i| (0..n).map(|j| 10.0 + i as f64 + j as f64).collect())
+            .collect();
+        let q0 = vec![0.0, -1.2, 1.0, -1.4, -1.5, 0.3];
+        let qs = crate::dmoc::integrate(&d, &q0, &[0.0; 6], h, &u).unwrap();
+        let m = Move {
+            goal: qs[steps].clone(),
+            ..a_move(&d)
+        };
+        let l = m.layout();
+        let mut x = vec![0.0; l.vars()];
+        for (i, q) in qs.iter().enumerate() {
+            for j in 0..n {
+                x[l.q(i, j)] = q[j];
+            }
+        }
+        for (i, ui) in u.iter().enumerate() {
+            for j in 0..n {
+                x[l.u(i, j)] = ui[j];
+            }
+        }
+        x[l.h()] = h;
+        let c = m.constraints(&x);
+        assert!(
+            c[..steps * n].iter().all(|v| v.abs() < 1e-9),
+            "{:?}",
+            &c[..steps * n]
+        );
+        // The end row is affine in q̇_N with slope −M(q_N): one Newton step zeroes it.
+        let r: Vec<f64> = c[steps * n..].to_vec();
+        let mm = d.mass_matrix(&qs[steps]);
+        let vn = crate::dmoc::solve_dense(mm, r).unwrap();
+        for j in 0..n {
+            x[l.qdn(j)] = vn[j];
+        }
+        let c = m.constraints(&x);
+        assert!(c.iter().all(|v| v.abs() < 1e-9));
+    }
+}
