@@ -296,6 +296,142 @@ impl Move<'_> {
         t
     }
 
+    /// The Hessian of the Lagrangian `σ ∇²f(x) + Σ λ_r ∇²c_r(x)`, exact, as triplets of its
+    /// lower triangle (row ≥ column). The constraints' part comes block by block from
+    /// second-order dual numbers over the block's positions, its end velocity (start and end
+    /// blocks) and h; the torques enter only through `h/2 · u`, whose cross terms with h are
+    /// added in closed form.
+    pub fn hessian(&self, x: &[f64], lambda: &[f64], sigma: f64) -> Triplets {
+        type D2 = Dual<BLOCK, Dual<1>>;
+        let l = self.layout();
+        let n = l.n;
+        let d = self.dynamics;
+        let w = self.weights;
+        let h = x[l.h()];
+        let mut t: Triplets = Vec::new();
+        let mut put = |a: usize, b: usize, v: f64| {
+            if v != 0.0 {
+                t.push((a.max(b), a.min(b), v));
+            }
+        };
+        // The cost: h (c_t + c_e |u|²) + c_v |Δq|² / h per step.
+        for i in 0..l.steps {
+            let mut dq2 = 0.0;
+            for j in 0..n {
+                let (a, b) = (l.q(i, j), l.q(i + 1, j));
+                let dq = x[b] - x[a];
+                dq2 += dq * dq;
+                let c = 2.0 * sigma * w.velocity / h;
+                put(a, a, c);
+                put(b, b, c);
+                put(b, a, -c);
+                // ∂²/∂h∂q: ∓2 c_v Δq / h².
+                let e = 2.0 * sigma * w.velocity * dq / (h * h);
+                put(l.h(), b, -e);
+                put(l.h(), a, e);
+                let u = l.u(i, j);
+                put(u, u, 2.0 * sigma * w.effort * h);
+                put(l.h(), u, 2.0 * sigma * w.effort * x[u]);
+            }
+            put(l.h(), l.h(), 2.0 * sigma * w.velocity * dq2 / (h * h * h));
+        }
+        // The constraints' part, one column of each block's Hessian per pass: the outer duals
+        // carry the gradient over the block's variables, the inner one the direction `dir`.
+        // (Nesting two full gradients would need ~50 kB per scalar.)
+        let grid_slots = |k: usize| -> Vec<(usize, usize)> {
+            if k == 0 {
+                vec![(0, 0), (1, 1)]
+            } else if k == l.steps {
+                vec![(0, k - 1), (1, k)]
+            } else {
+                vec![(0, k - 1), (1, k), (2, k + 1)]
+            }
+        };
+        for k in 0..=l.steps {
+            let row0 = k * n;
+            let lam: Vec<f64> = (0..n).map(|a| lambda[row0 + a]).collect();
+            // Where each dual slot lives in x.
+            let mut index = vec![None; BLOCK];
+            for (sl, grid) in grid_slots(k) {
+                for j in 0..n {
+                    index[sl * MAX_DOF + j] = Some(l.q(grid, j));
+                }
+            }
+            let velocity = if k == 0 {
+                Some(l.qd0(0))
+            } else if k == l.steps {
+                Some(l.qdn(0))
+            } else {
+                None
+            };
+            if let Some(first) = velocity {
+                for j in 0..n {
+                    index[2 * MAX_DOF + j] = Some(first + j);
+                }
+            }
+            index[3 * MAX_DOF] = Some(l.h());
+            for dir in 0..BLOCK {
+                let Some(idir) = index[dir] else { continue };
+                let var = |v: f64, k: usize| -> D2 {
+                    let mut d = [Dual::<1>::constant(0.0); BLOCK];
+                    d[k] = Dual::constant(1.0);
+                    let inner = if k == dir {
+                        Dual::variable(v, 0)
+                    } else {
+                        Dual::constant(v)
+                    };
+                    Dual { v: inner, d }
+                };
+                let slot = |i: usize, s: usize| -> Vec<D2> {
+                    (0..n).map(|j| var(x[l.q(i, j)], s * MAX_DOF + j)).collect()
+                };
+                let zeros: Vec<D2> = vec![Dual::constant(Dual::constant(0.0)); n];
+                let hd = var(h, 3 * MAX_DOF);
+                let r = if k == 0 {
+                    let qd0: Vec<D2> = (0..n).map(|j| var(x[l.qd0(j)], 2 * MAX_DOF + j)).collect();
+                    start_residual(d, &slot(0, 0), &qd0, &slot(1, 1), hd, &zeros)
+                } else if k == l.steps {
+                    let qdn: Vec<D2> = (0..n).map(|j| var(x[l.qdn(j)], 2 * MAX_DOF + j)).collect();
+                    end_residual(d, &slot(k - 1, 0), &slot(k, 1), &qdn, hd, &zeros)
+                } else {
+                    del_residual(
+                        d,
+                        &slot(k - 1, 0),
+                        &slot(k, 1),
+                        &slot(k + 1, 2),
+                        hd,
+                        &zeros,
+                        &zeros,
+                    )
+                };
+                let mut phi: D2 = Dual::constant(Dual::constant(0.0));
+                for (e, &lm) in r.iter().zip(&lam) {
+                    phi = phi + *e * Dual::constant(Dual::constant(lm));
+                }
+                for (b, ib) in index.iter().enumerate() {
+                    let Some(ib) = *ib else { continue };
+                    if ib <= idir {
+                        put(idir, ib, phi.d[b].d[0]);
+                    }
+                }
+            }
+            // λᵀ (h/2)(u…): ∂²/∂h∂u_j = λ_j / 2.
+            let torques: &[usize] = if k == 0 {
+                &[0]
+            } else if k == l.steps {
+                &[l.steps - 1]
+            } else {
+                &[k - 1, k]
+            };
+            for &ui in torques {
+                for (j, lm) in lam.iter().enumerate() {
+                    put(l.h(), l.u(ui, j), 0.5 * lm);
+                }
+            }
+        }
+        t
+    }
+
     /// The linear inequalities `A x ≤ 0` (velocity bounds) as triplets, `2 n N` rows.
     pub fn inequalities(&self) -> Triplets {
         let l = self.layout();
@@ -409,6 +545,63 @@ mod tests {
                 "∂f/∂x{c}: {} vs {fd}",
                 g[c]
             );
+        }
+    }
+
+    #[test]
+    fn the_hessian_matches_differences_of_the_exact_gradients() {
+        let d = ur10();
+        let m = Move {
+            steps: 4,
+            ..a_move(&d)
+        };
+        let l = m.layout();
+        let mut x = m.initial_guess();
+        for (k, v) in x.iter_mut().enumerate() {
+            *v += 0.01 * ((k as f64) * 0.37).cos();
+        }
+        x[l.h()] = 0.12;
+        let lambda: Vec<f64> = (0..l.equalities()).map(|r| ((r as f64) * 1.3).sin()).collect();
+        let sigma = 0.7;
+        let started = std::time::Instant::now();
+        let hess = m.hessian(&x, &lambda, sigma);
+        eprintln!(
+            "hessian of {} steps in {:.1} ms",
+            l.steps,
+            started.elapsed().as_secs_f64() * 1e3
+        );
+        let nv = l.vars();
+        let mut dense = vec![vec![0.0; nv]; nv];
+        for &(r, c, v) in &hess {
+            assert!(r >= c, "lower triangle only");
+            dense[r][c] += v;
+            if r != c {
+                dense[c][r] += v;
+            }
+        }
+        // ∇_x (σ f + λᵀ c) by the exact gradient and Jacobian, differenced.
+        let grad_lag = |x: &[f64]| -> Vec<f64> {
+            let mut g: Vec<f64> = m.gradient(x).into_iter().map(|v| sigma * v).collect();
+            for (r, c, v) in m.jacobian(x) {
+                g[c] += lambda[r] * v;
+            }
+            g
+        };
+        let eps = 1e-6;
+        for c in 0..nv {
+            let mut up = x.clone();
+            let mut down = x.clone();
+            up[c] += eps;
+            down[c] -= eps;
+            let (gu, gd) = (grad_lag(&up), grad_lag(&down));
+            for r in 0..nv {
+                let fd = (gu[r] - gd[r]) / (2.0 * eps);
+                assert!(
+                    (fd - dense[r][c]).abs() < 1e-5 * fd.abs().max(1.0),
+                    "H[{r}][{c}]: {} vs {fd}",
+                    dense[r][c]
+                );
+            }
         }
     }
 
