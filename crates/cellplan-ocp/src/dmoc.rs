@@ -13,20 +13,25 @@
 //!
 //! The slot derivatives at the midpoint m = (a + b)/2, velocity v = (b − a)/h:
 //! `D1 L_d(a, b) = h/2 ∂L/∂q(m, v) − ∂L/∂q̇(m, v)`, `D2 L_d(a, b) = h/2 ∂L/∂q(m, v) + ∂L/∂q̇(m, v)`.
-//! ∂L/∂q̇ = M(q) q̇ is one Newton–Euler recursion; ∂L/∂q comes from the Lagrangian run on dual
-//! numbers. Every function is generic over the scalar, so the NLP's exact Jacobians and
+//! ∂L/∂q̇ = M(q) q̇ is one Newton–Euler recursion; ∂L/∂q is the momentum's derivative along q̇
+//! less the Newton–Euler torques at zero acceleration (the Christoffel identity). Every
+//! function is generic over the scalar, so the NLP's exact Jacobians and
 //! Hessians are the same code run on (nested) dual numbers.
 use cellplan_kin::dynamics::{Dual, Dynamics, Real};
 
 /// Most joints a chain may have here (the width of the inner dual numbers).
 pub const MAX_DOF: usize = 8;
 
-/// ∂L/∂q at (q, v): the kinetic energy's gradient in q less the gravity torques, exactly.
+/// ∂L/∂q at (q, v), exactly: `½ ∂(vᵀM(q)v)/∂q − g(q) = Ṁv − (C(q, v)v + g(q))`, where `Ṁv` is
+/// the derivative of the momentum `M(q)v` along `v` (one dual direction) and `Cv + g` the
+/// Newton–Euler torques at zero acceleration — the Christoffel identity
+/// `(Cv)_i = (Ṁv)_i − ½ ∂(vᵀMv)/∂q_i`.
 pub fn lagrangian_dq<T: Real>(d: &Dynamics, q: &[T], v: &[T]) -> Vec<T> {
-    let qd: Vec<Dual<MAX_DOF, T>> = q.iter().enumerate().map(|(j, &x)| Dual::variable(x, j)).collect();
-    let vd: Vec<Dual<MAX_DOF, T>> = v.iter().map(|&x| Dual::constant(x)).collect();
-    let l = d.kinetic(&qd, &vd) - d.potential(&qd);
-    (0..q.len()).map(|j| l.d[j]).collect()
+    let qd: Vec<Dual<1, T>> = q.iter().zip(v).map(|(&x, &dx)| Dual { v: x, d: [dx] }).collect();
+    let vd: Vec<Dual<1, T>> = v.iter().map(|&x| Dual::constant(x)).collect();
+    let mdot_v = d.momentum(&qd, &vd);
+    let bias = d.rnea_with(q, v, &[], 1.0);
+    mdot_v.iter().zip(bias).map(|(m, b)| m.d[0] - b).collect()
 }
 
 /// ∂L/∂q̇ at (q, v) = M(q) v.
