@@ -339,6 +339,21 @@ impl CmmPlan {
         })
     }
 
+    /// Per group in visiting order: its index and the head's turn into it from the group
+    /// before (or home), the larger of the two angle changes (deg).
+    pub fn group_turns(&self) -> Vec<(usize, f64)> {
+        let mut at = [self.home[3].to_degrees(), self.home[4].to_degrees()];
+        self.group_order
+            .iter()
+            .map(|&g| {
+                let a = self.groups[g].angles_deg;
+                let turn = (a[0] - at[0]).abs().max((a[1] - at[1]).abs());
+                at = a;
+                (g, turn)
+            })
+            .collect()
+    }
+
     /// The groups as a classification would give them (for re-planning a subset).
     pub fn classification_groups(&self, cell: &CmmCell) -> Vec<Group> {
         self.groups

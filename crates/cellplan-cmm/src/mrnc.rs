@@ -263,6 +263,16 @@ pub fn plan_group(
     })
 }
 
+/// The space RRT* searches between `a` and `b`: their box widened by `margin`, within `space`.
+pub fn local_space(space: &JointSpace, a: &[f64], b: &[f64], margin: f64) -> JointSpace {
+    let mut local = space.clone();
+    for j in 0..3 {
+        local.lower[j] = space.lower[j].max(a[j].min(b[j]) - margin);
+        local.upper[j] = space.upper[j].min(a[j].max(b[j]) + margin);
+    }
+    local
+}
+
 /// A path from a root to its MP's approach (Alg. 1, lines 9–18).
 #[derive(Clone, Debug, PartialEq)]
 pub struct LocalPath {
@@ -289,12 +299,7 @@ pub fn local_path(
             straight: true,
         });
     }
-    let mut local_space = space.clone();
-    for j in 0..3 {
-        let (a, b) = (root[j], approach[j]);
-        local_space.lower[j] = space.lower[j].max(a.min(b) - s.local_margin);
-        local_space.upper[j] = space.upper[j].min(a.max(b) + s.local_margin);
-    }
+    let local_space = local_space(space, root, approach, s.local_margin);
     let goals = [approach.to_vec()];
     let problem = Problem {
         min_clearance: s.min_clearance,

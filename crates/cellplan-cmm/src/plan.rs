@@ -2,7 +2,7 @@
 //! order groups and MPs (§3.3); and the three ways of inspecting a subset later (Table 4):
 //! through the stored roots, along the initial path, or planned from scratch.
 use crate::cell::CmmCell;
-use crate::classify::{Method, classify_with};
+use crate::classify::{Classification, Method, classify_with};
 use crate::document::{CmmPlan, Parts, Strategy, settings};
 use crate::job::{Job, JobError, Reused, plan_job};
 use crate::motion::{CmmValidity, space};
@@ -64,23 +64,12 @@ pub fn run(cell: &CmmCell, req: &Request) -> Result<Outcome, PlanError> {
     let all: Vec<usize> = (0..cell.mps.len()).collect();
     let chosen = req.subset.clone().unwrap_or(all);
     let sub: Vec<_> = chosen.iter().map(|&i| cell.mps[i].clone()).collect();
-    let orientations = cell.orientations();
-    let adjacent = |f: usize, g: usize| cell.adjacent(f, g);
     let space = space(&probe, &cell.travel);
     let validity = CmmValidity {
         probe: &probe,
         margin: cell.clearance,
     };
-    let usable = approach_usable(cell, &space, &validity, &sub);
-    let c = classify_with(
-        &sub,
-        &adjacent,
-        &probe,
-        &orientations,
-        cell.touch_clearance,
-        method,
-        &usable,
-    );
+    let c = classification(cell, &probe, &space, &validity, &sub, method);
     let groups: Vec<_> = c
         .groups
         .into_iter()
@@ -108,6 +97,30 @@ pub fn run(cell: &CmmCell, req: &Request) -> Result<Outcome, PlanError> {
         classification: method,
         orientations: c.orientations,
     })
+}
+
+/// §3.1 on `mps` (a cell's MPs or a subset): the cell's candidate orientations, faces'
+/// adjacency and touch clearance, an orientation counting for an MP only where RRT-MRNC can
+/// also reach its approach ([`approach_usable`]).
+pub fn classification(
+    cell: &CmmCell,
+    probe: &crate::classify::Probe,
+    space: &JointSpace,
+    validity: &CmmValidity,
+    mps: &[crate::part::Mp],
+    method: Method,
+) -> Classification {
+    let adjacent = |f: usize, g: usize| cell.adjacent(f, g);
+    let usable = approach_usable(cell, space, validity, mps);
+    classify_with(
+        mps,
+        &adjacent,
+        probe,
+        &cell.orientations(),
+        cell.touch_clearance,
+        method,
+        &usable,
+    )
 }
 
 /// RRT-MRNC's own test of an MP's approach configuration at head angles: within the travel and

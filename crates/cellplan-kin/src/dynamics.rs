@@ -494,14 +494,18 @@ impl Dynamics {
     }
 
     /// τ and its exact derivatives ∂τ/∂q and ∂τ/∂q̇ (row i, column j: ∂τᵢ/∂xⱼ), by dual
-    /// numbers. Chains of up to 8 joints.
+    /// numbers; `None` for a chain of more than 8 joints.
+    #[allow(clippy::type_complexity)]
     pub fn inverse_dynamics_derivatives(
         &self,
         q: &[f64],
         qd: &[f64],
         qdd: &[f64],
-    ) -> (Vec<f64>, Vec<Vec<f64>>, Vec<Vec<f64>>) {
-        let n = self.dof.min(8);
+    ) -> Option<(Vec<f64>, Vec<Vec<f64>>, Vec<Vec<f64>>)> {
+        let n = self.dof;
+        if n > 8 {
+            return None;
+        }
         let qq: Vec<Dual<16>> = (0..n)
             .map(|j| Dual::variable(q.get(j).copied().unwrap_or(0.0), j))
             .collect();
@@ -515,7 +519,7 @@ impl Dynamics {
         let value = tau.iter().map(|t| t.v).collect();
         let dq = tau.iter().map(|t| (0..n).map(|j| t.d[j]).collect()).collect();
         let dv = tau.iter().map(|t| (0..n).map(|j| t.d[8 + j]).collect()).collect();
-        (value, dq, dv)
+        Some((value, dq, dv))
     }
 }
 
@@ -724,7 +728,7 @@ mod tests {
     fn derivatives_by_dual_numbers_match_central_differences() {
         let d = six();
         for (q, v, a) in states(10, 6) {
-            let (tau, dq, dv) = d.inverse_dynamics_derivatives(&q, &v, &a);
+            let (tau, dq, dv) = d.inverse_dynamics_derivatives(&q, &v, &a).unwrap();
             assert_eq!(tau, d.inverse_dynamics(&q, &v, &a));
             let h = 1e-6;
             for j in 0..6 {

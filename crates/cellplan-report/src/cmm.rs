@@ -49,8 +49,7 @@ fn triangles(cell: &CmmCell) -> Vec<[DVec3; 3]> {
 
 /// The ball centre at a configuration.
 fn ball(cell: &CmmCell, q: &[f64; 5]) -> DVec3 {
-    let d = DVec3::new(q[3].sin() * q[4].cos(), q[3].sin() * q[4].sin(), -q[3].cos());
-    DVec3::new(q[0], q[1], q[2]) + d * (cell.head.l1 + cell.head.l2)
+    cell.head.forward(q).0
 }
 
 /// One orthographic view: `axes` picks the horizontal and vertical coordinate (vertical up).
@@ -152,17 +151,7 @@ pub fn html(
         view(cell, plan, &tris, (0, 2), "from the front (X right, Z up)"),
         view(cell, plan, &tris, (1, 2), "from the side (Y right, Z up)"),
     ];
-    let mut at = [plan.home[3].to_degrees(), plan.home[4].to_degrees()];
-    let turns: Vec<(usize, f64)> = plan
-        .group_order
-        .iter()
-        .map(|&g| {
-            let a = plan.groups[g].angles_deg;
-            let t = (a[0] - at[0]).abs().max((a[1] - at[1]).abs());
-            at = a;
-            (g, t)
-        })
-        .collect();
+    let turns = plan.group_turns();
     let verdict_text = match verdict {
         Some(v) if v.ok => format!(
             "verified: every segment clear by the clearance (closest {:.1} mm), every touch within its cone, the stored paths clear, times recomputed",

@@ -78,12 +78,8 @@ pub fn bench_local(cell_path: &Path, samples: usize) -> Result<(), Failure> {
                     })
                     .sum::<f64>()
             };
-            let lo: Vec<f64> = (0..3)
-                .map(|j| full.lower[j].max(root[j].min(goal[j]) - s.local_margin))
-                .collect();
-            let hi: Vec<f64> = (0..3)
-                .map(|j| full.upper[j].min(root[j].max(goal[j]) + s.local_margin))
-                .collect();
+            let local = cellplan_cmm::mrnc::local_space(&sp, root, goal, s.local_margin);
+            let (lo, hi) = (&local.lower[..3], &local.upper[..3]);
             problems.push(json!({
                 "group": g,
                 "mp": cell.mps[mp].name,

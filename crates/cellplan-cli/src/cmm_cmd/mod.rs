@@ -12,7 +12,7 @@ use crate::Failure;
 use crate::plan_cmd::PlanArgs;
 pub use bench_local::bench_local;
 use cellplan_cmm::cell::{CmmCell, KIND};
-use cellplan_cmm::classify::{Method, classify_with};
+use cellplan_cmm::classify::Method;
 use cellplan_cmm::document::{CmmPlan, Strategy};
 use cellplan_cmm::plan::{Request, document, reuse, run};
 use cellplan_model::InputError;
@@ -72,15 +72,10 @@ struct Summary<'a> {
 
 /// Per group in visiting order: its summary with the head's turn into it.
 fn group_detail(doc: &CmmPlan) -> Vec<GroupSummary> {
-    let mut at = [doc.home[3].to_degrees(), doc.home[4].to_degrees()];
-    doc.group_order
-        .iter()
-        .map(|&g| {
+    doc.group_turns()
+        .into_iter()
+        .map(|(g, turn)| {
             let gr = &doc.groups[g];
-            let turn = (gr.angles_deg[0] - at[0])
-                .abs()
-                .max((gr.angles_deg[1] - at[1]).abs());
-            at = gr.angles_deg;
             GroupSummary {
                 angles_deg: gr.angles_deg,
                 faces: gr.faces.clone(),
@@ -133,14 +128,13 @@ fn write_plan(
     cell: &CmmCell,
     verdict: &CmmReport,
     no_report: bool,
-    table4: Option<&[cellplan_report::cmm::Table4Row]>,
 ) -> Result<(PathBuf, PathBuf, Option<PathBuf>), Failure> {
     let file = dir.join("plan.json");
     let program_file = dir.join("program.csv");
     let report_file = dir.join("report.html");
     let text = serde_json::to_string_pretty(doc).map_err(|e| Failure::Other(e.to_string()))?;
     let program = program_csv(doc);
-    let page = (!no_report).then(|| cellplan_report::cmm::html(doc, cell, Some(verdict), table4));
+    let page = (!no_report).then(|| cellplan_report::cmm::html(doc, cell, Some(verdict), None));
     let mut files: Vec<(&Path, &[u8])> = vec![(&file, text.as_bytes()), (&program_file, program.as_bytes())];
     if let Some(p) = &page {
         files.push((&report_file, p.as_bytes()));
@@ -200,7 +194,7 @@ pub fn plan(args: &PlanArgs) -> Result<(), Failure> {
         )));
     }
     doc.compute_s = start.elapsed().as_secs_f64();
-    let (file, program_file, report_file) = write_plan(&dir, &doc, &cell, &verdict, args.no_report, None)?;
+    let (file, program_file, report_file) = write_plan(&dir, &doc, &cell, &verdict, args.no_report)?;
     pb.finish_and_clear();
     if args.json {
         crate::print_json(&Summary {
@@ -356,32 +350,19 @@ struct CheckOut {
 pub fn check_cell(path: &Path, json: bool) -> Result<(), Failure> {
     let cell = load(path)?;
     let probe = cell.probe();
-    let orientations = cell.orientations();
-    let adjacent = |f: usize, g: usize| cell.adjacent(f, g);
     let space = cellplan_cmm::motion::space(&probe, &cell.travel);
     let validity = cellplan_cmm::motion::CmmValidity {
         probe: &probe,
         margin: cell.clearance,
     };
-    let usable = cellplan_cmm::plan::approach_usable(&cell, &space, &validity, &cell.mps);
-    let by = |m| {
-        classify_with(
-            &cell.mps,
-            &adjacent,
-            &probe,
-            &orientations,
-            cell.touch_clearance,
-            m,
-            &usable,
-        )
-    };
+    let by = |m| cellplan_cmm::plan::classification(&cell, &probe, &space, &validity, &cell.mps, m);
     let exact = by(Method::Exact);
     let greedy = by(Method::Greedy);
     let out = CheckOut {
         cell: cell.name.clone(),
         mps: cell.mps.len(),
         faces: cell.faces.len(),
-        orientations: orientations.len(),
+        orientations: exact.orientations,
         groups_exact: exact.groups.len(),
         groups_greedy: greedy.groups.len(),
         unmeasurable: exact

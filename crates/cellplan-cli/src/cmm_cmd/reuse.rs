@@ -182,7 +182,7 @@ pub fn run_reuse(args: &ReuseArgs) -> Result<(), Failure> {
             dir.display()
         ))
     })?;
-    let (file, _, report_file) = write_plan(&dir, &doc, &cell, &verdict, args.no_report, None)?;
+    let (file, _, report_file) = write_plan(&dir, &doc, &cell, &verdict, args.no_report)?;
     if args.json {
         crate::print_json(&ReuseSummary {
             plan_file: file.display().to_string(),
