@@ -220,7 +220,12 @@ const MAX_GENERATED_TASKS: usize = 100_000;
 /// `out/<cell name>`, refused when the name would lead outside `out/` (an absolute path, `..`,
 /// a separator): the name comes from the cell file.
 pub(crate) fn default_output_dir(cell: &Cell) -> Result<PathBuf, Failure> {
-    let name = &cell.name;
+    output_dir_named(&cell.name, &cell.path)
+}
+
+/// `out/<name>` for the cell file `cell_path` of any process, refused as
+/// [`default_output_dir`] says.
+pub(crate) fn output_dir_named(name: &str, cell_path: &std::path::Path) -> Result<PathBuf, Failure> {
     let plain = !name.is_empty()
         && name != "."
         && name != ".."
@@ -230,7 +235,7 @@ pub(crate) fn default_output_dir(cell: &Cell) -> Result<PathBuf, Failure> {
         return Err(Failure::Usage(format!(
             "the cell name `{name}` is not a plain folder name, so it cannot name the output folder out/<name>; \
              give the output folder with -o, or change `name` in {}",
-            cell.path.display()
+            cell_path.display()
         )));
     }
     Ok(PathBuf::from("out").join(name))

@@ -11,7 +11,7 @@ use cellplan_pcb::document::PcbPlan;
 use cellplan_pcb::plan::{Optimizer, Outcome, Request};
 use cellplan_verify::pcb::{PcbReport, PcbVerifySettings, verify_pcb};
 use serde::Serialize;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::time::{Duration, Instant};
 
 /// Whether the cell file is a PCB-assembly cell (read by its `[process] kind`).
@@ -171,7 +171,7 @@ pub fn plan(args: &PlanArgs) -> Result<(), Failure> {
     let cell = variant(&loaded, args)?;
     let dir = match &args.output {
         Some(d) => d.clone(),
-        None => output_dir(&cell)?,
+        None => crate::output_dir_named(&cell.name, &cell.path)?,
     };
     check_writable(&dir).map_err(|e| {
         Failure::Usage(format!(
@@ -310,21 +310,6 @@ fn read_order(path: &Path, cell: &PcbCell) -> Result<Vec<usize>, Failure> {
 /// (cycle − bound) / bound.
 pub fn gap(cycle: f64, bound: f64) -> f64 {
     if bound > 0.0 { cycle / bound - 1.0 } else { 0.0 }
-}
-
-fn output_dir(cell: &PcbCell) -> Result<PathBuf, Failure> {
-    let name = &cell.name;
-    let plain = !name.is_empty()
-        && name != "."
-        && name != ".."
-        && !name.contains(['/', '\\', '\0'])
-        && Path::new(name).components().count() == 1;
-    if !plain {
-        return Err(Failure::Usage(format!(
-            "the cell name `{name}` is not a plain folder name; give the output folder with -o"
-        )));
-    }
-    Ok(PathBuf::from("out").join(name))
 }
 
 fn render(doc: &PcbPlan, verdict: &PcbReport, hit: bool) -> String {

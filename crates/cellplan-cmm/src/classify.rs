@@ -341,27 +341,7 @@ mod tests {
         let mut counts = Vec::new();
         for method in [Method::Greedy, Method::Exact] {
             let c = classify(&mps, &block_adjacent, &probe, &orientations, 0.001, method);
-            assert!(
-                c.unmeasurable.is_empty(),
-                "{method:?}: unmeasurable {:?}",
-                c.unmeasurable
-            );
-            let mut seen = vec![0; mps.len()];
-            for g in &c.groups {
-                assert!(g.faces.len() <= 2);
-                if g.faces.len() == 2 {
-                    assert!(block_adjacent(g.faces[0], g.faces[1]));
-                }
-                let d = CmmHead::direction(g.angles.0, g.angles.1);
-                for &i in &g.members {
-                    seen[i] += 1;
-                    assert!(g.faces.contains(&mps[i].face));
-                    let angle = (-d).dot(mps[i].normal).acos().to_degrees();
-                    assert!(angle <= mps[i].theta_deg + 1e-9, "{}: {angle}°", mps[i].name);
-                    assert!(probe.touch_clear(mps[i].position, mps[i].normal, d, 0.001));
-                }
-            }
-            assert!(seen.iter().all(|&k| k == 1), "each MP in one group");
+            crate::scene::assert_grouped(&mps, &c, &block_adjacent, &probe, 0.001);
             counts.push(c.groups.len());
         }
         assert!(

@@ -381,25 +381,14 @@ pub fn order_name(m: cellplan_solve::GtspMethod) -> &'static str {
 
 /// Reads a plan document.
 pub fn read(path: &std::path::Path) -> Result<CmmPlan, String> {
-    let text = cellplan_model::io::read_bounded(path, MAX_PLAN_BYTES)
-        .map_err(|e| format!("cannot read the plan: {e}"))?;
-    let plan: CmmPlan = serde_json::from_str(&text)
-        .map_err(|e| format!("line {}: not a CMM plan document: {e}", e.line()))?;
-    if plan.format != FORMAT || plan.version != VERSION {
-        return Err(format!(
-            "a `{}` version {} document; this cellplan reads `{FORMAT}` version {VERSION}",
-            plan.format, plan.version
-        ));
-    }
+    let plan: CmmPlan = cellplan_model::document::read_json(path, MAX_PLAN_BYTES, "a CMM plan document")?;
+    cellplan_model::document::check_version((&plan.format, plan.version), (FORMAT, VERSION))?;
     Ok(plan)
 }
 
 /// The JSON Schema of the document, as `docs/cmm-plan.schema.json` holds it.
 pub fn schema() -> String {
-    let schema = schemars::schema_for!(CmmPlan);
-    let mut text = serde_json::to_string_pretty(&schema).unwrap_or_default();
-    text.push('\n');
-    text
+    cellplan_model::document::schema_text(&schemars::schema_for!(CmmPlan))
 }
 
 #[cfg(test)]
@@ -411,17 +400,10 @@ mod tests {
     #[test]
     fn the_schema_in_docs_is_generated_from_the_types() {
         let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../docs/cmm-plan.schema.json");
-        let generated = super::schema();
-        if std::env::var_os("CELLPLAN_UPDATE_SCHEMA").is_some() {
-            std::fs::write(&path, &generated).unwrap();
-        }
-        let on_disk = std::fs::read_to_string(&path).unwrap_or_default();
-        assert!(
-            on_disk == generated,
-            "docs/cmm-plan.schema.json is not the schema of the document's types; regenerate it with \
-             CELLPLAN_UPDATE_SCHEMA=1 cargo test -p cellplan-cmm schema"
-        );
-        let schema: serde_json::Value = serde_json::from_str(&on_disk).unwrap();
+        let schema =
+            cellplan_model::document::schema_file_matches(&path, &super::schema()).unwrap_or_else(|e| {
+                panic!("{e}; regenerate it with CELLPLAN_UPDATE_SCHEMA=1 cargo test -p cellplan-cmm schema")
+            });
         let required = schema["required"].as_array().unwrap();
         for key in [
             "path",

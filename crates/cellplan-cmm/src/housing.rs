@@ -479,7 +479,6 @@ mod tests {
     use crate::classify::{Method, classify};
     use crate::part::to_csv;
     use crate::scene::closest;
-    use cellplan_kin::cmm::CmmHead;
 
     #[test]
     fn the_housing_has_40_mps_on_its_surface_facing_out() {
@@ -571,24 +570,7 @@ mod tests {
         let mut counts = Vec::new();
         for method in [Method::Greedy, Method::Exact] {
             let c = classify(&mps, &housing_adjacent, &probe, &orientations, 0.001, method);
-            let names: Vec<&str> = c.unmeasurable.iter().map(|&i| mps[i].name.as_str()).collect();
-            assert!(names.is_empty(), "{method:?}: unmeasurable {names:?}");
-            let mut seen = vec![0; mps.len()];
-            for g in &c.groups {
-                assert!(g.faces.len() <= 2);
-                if g.faces.len() == 2 {
-                    assert!(housing_adjacent(g.faces[0], g.faces[1]));
-                }
-                let d = CmmHead::direction(g.angles.0, g.angles.1);
-                for &i in &g.members {
-                    seen[i] += 1;
-                    assert!(g.faces.contains(&mps[i].face));
-                    let angle = (-d).dot(mps[i].normal).acos().to_degrees();
-                    assert!(angle <= mps[i].theta_deg + 1e-9, "{}: {angle}°", mps[i].name);
-                    assert!(probe.touch_clear(mps[i].position, mps[i].normal, d, 0.001));
-                }
-            }
-            assert!(seen.iter().all(|&k| k == 1), "each MP in one group");
+            crate::scene::assert_grouped(&mps, &c, &housing_adjacent, &probe, 0.001);
             eprintln!("housing, {method:?}: {} groups", c.groups.len());
             for g in &c.groups {
                 let faces: Vec<&str> = g.faces.iter().map(|&f| HOUSING_FACES[f]).collect();

@@ -115,3 +115,33 @@ fn closest_on_triangle(p: DVec3, a: DVec3, b: DVec3, c: DVec3) -> DVec3 {
     let denom = 1.0 / (va + vb + vc);
     a + ab * (vb * denom) + ac * (vc * denom)
 }
+
+/// Asserts what §3.1 promises of a classification of `mps`: every MP measurable and in exactly
+/// one group, each group on one face or two adjacent ones, each member on the group's faces,
+/// within its cone and touched clear by `clearance`.
+pub(crate) fn assert_grouped(
+    mps: &[Mp],
+    c: &crate::classify::Classification,
+    adjacent: &dyn Fn(usize, usize) -> bool,
+    probe: &Probe,
+    clearance: f64,
+) {
+    let names: Vec<&str> = c.unmeasurable.iter().map(|&i| mps[i].name.as_str()).collect();
+    assert!(names.is_empty(), "unmeasurable {names:?}");
+    let mut seen = vec![0; mps.len()];
+    for g in &c.groups {
+        assert!(g.faces.len() <= 2);
+        if g.faces.len() == 2 {
+            assert!(adjacent(g.faces[0], g.faces[1]));
+        }
+        let d = CmmHead::direction(g.angles.0, g.angles.1);
+        for &i in &g.members {
+            seen[i] += 1;
+            assert!(g.faces.contains(&mps[i].face));
+            let angle = (-d).dot(mps[i].normal).acos().to_degrees();
+            assert!(angle <= mps[i].theta_deg + 1e-9, "{}: {angle}°", mps[i].name);
+            assert!(probe.touch_clear(mps[i].position, mps[i].normal, d, clearance));
+        }
+    }
+    assert!(seen.iter().all(|&k| k == 1), "each MP in one group");
+}

@@ -9,6 +9,7 @@
 #![allow(clippy::result_large_err)]
 
 pub mod cell;
+pub mod document;
 pub mod error;
 pub mod io;
 pub mod load;

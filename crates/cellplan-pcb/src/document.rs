@@ -373,25 +373,14 @@ pub fn robot_totals(
 
 /// Reads a PCB plan document (bounded), or says why not.
 pub fn read(path: &std::path::Path) -> Result<PcbPlan, String> {
-    let text = cellplan_model::io::read_bounded(path, MAX_PLAN_BYTES)
-        .map_err(|e| format!("cannot read the plan: {e}"))?;
-    let plan: PcbPlan = serde_json::from_str(&text)
-        .map_err(|e| format!("line {}: not a PCB plan document: {e}", e.line()))?;
-    if plan.format != FORMAT || plan.version != VERSION {
-        return Err(format!(
-            "a `{}` version {} document; this cellplan reads `{FORMAT}` version {VERSION}",
-            plan.format, plan.version
-        ));
-    }
+    let plan: PcbPlan = cellplan_model::document::read_json(path, MAX_PLAN_BYTES, "a PCB plan document")?;
+    cellplan_model::document::check_version((&plan.format, plan.version), (FORMAT, VERSION))?;
     Ok(plan)
 }
 
 /// The JSON Schema of the document, as `docs/pcb-plan.schema.json` holds it.
 pub fn schema() -> String {
-    let schema = schemars::schema_for!(PcbPlan);
-    let mut text = serde_json::to_string_pretty(&schema).unwrap_or_default();
-    text.push('\n');
-    text
+    cellplan_model::document::schema_text(&schemars::schema_for!(PcbPlan))
 }
 
 #[cfg(test)]
@@ -403,17 +392,10 @@ mod tests {
     #[test]
     fn the_schema_in_docs_is_generated_from_the_types() {
         let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../docs/pcb-plan.schema.json");
-        let generated = super::schema();
-        if std::env::var_os("CELLPLAN_UPDATE_SCHEMA").is_some() {
-            std::fs::write(&path, &generated).unwrap();
-        }
-        let on_disk = std::fs::read_to_string(&path).unwrap_or_default();
-        assert!(
-            on_disk == generated,
-            "docs/pcb-plan.schema.json is not the schema of the document's types; regenerate it with \
-             CELLPLAN_UPDATE_SCHEMA=1 cargo test -p cellplan-pcb schema"
-        );
-        let schema: serde_json::Value = serde_json::from_str(&on_disk).unwrap();
+        let schema =
+            cellplan_model::document::schema_file_matches(&path, &super::schema()).unwrap_or_else(|e| {
+                panic!("{e}; regenerate it with CELLPLAN_UPDATE_SCHEMA=1 cargo test -p cellplan-pcb schema")
+            });
         let required = schema["required"].as_array().unwrap();
         for key in ["placements", "devices", "cycle_time_s", "lower_bound_s"] {
             assert!(

@@ -106,21 +106,6 @@ pub fn program_csv(doc: &CmmPlan) -> String {
     s
 }
 
-fn output_dir(cell: &CmmCell) -> Result<PathBuf, Failure> {
-    let name = &cell.name;
-    let plain = !name.is_empty()
-        && name != "."
-        && name != ".."
-        && !name.contains(['/', '\\', '\0'])
-        && Path::new(name).components().count() == 1;
-    if !plain {
-        return Err(Failure::Usage(format!(
-            "the cell name `{name}` is not a plain folder name; give the output folder with -o"
-        )));
-    }
-    Ok(PathBuf::from("out").join(name))
-}
-
 /// Writes plan.json, program.csv and (unless `no_report`) report.html into `dir`.
 fn write_plan(
     dir: &Path,
@@ -158,7 +143,7 @@ pub fn plan(args: &PlanArgs) -> Result<(), Failure> {
     let cell = load(&args.cell)?;
     let dir = match &args.output {
         Some(d) => d.clone(),
-        None => output_dir(&cell)?,
+        None => crate::output_dir_named(&cell.name, &cell.path)?,
     };
     check_writable(&dir).map_err(|e| {
         Failure::Usage(format!(

@@ -11,8 +11,6 @@ use std::ops::Range;
 use std::path::Path;
 use toml::Spanned;
 
-/// Largest cell file read.
-const MAX_CELL_FILE: u64 = 1 << 20;
 /// Largest task file read.
 const MAX_TASK_FILE: u64 = 16 << 20;
 /// Largest length anywhere in the cell (m).
@@ -172,19 +170,11 @@ fn positive_opt(
 
 /// Loads a CMM-inspection cell file, its part and fixtures, and its MPs.
 pub fn load(path: &Path) -> Result<CmmCell, InputError> {
-    let text = read_bounded(path, MAX_CELL_FILE).map_err(|e| {
-        InputError::new(path, format!("cannot read the cell file: {e}"))
-            .hint("give the path of a cell TOML file, e.g. examples/cmm-block/cell.toml")
-    })?;
-    let spec: Spec = toml::from_str(&text).map_err(|e| {
-        InputError::at_span(
-            path,
-            &text,
-            e.span().unwrap_or(0..0),
-            format!("invalid cell file: {}", e.message().trim()),
-        )
-        .hint("docs/cell-format.md (CMM inspection) lists every key and its type")
-    })?;
+    let (text, spec): (String, Spec) = cellplan_model::load::read_cell_toml(
+        path,
+        "examples/cmm-block/cell.toml",
+        "docs/cell-format.md (CMM inspection)",
+    )?;
     let ctx = Ctx {
         path,
         text: &text,

@@ -427,10 +427,7 @@ pub struct ComputeTimes {
 
 /// The JSON Schema of the document, as `docs/plan.schema.json` holds it.
 pub fn schema() -> String {
-    let schema = schemars::schema_for!(Plan);
-    let mut text = serde_json::to_string_pretty(&schema).unwrap_or_default();
-    text.push('\n');
-    text
+    cellplan_model::document::schema_text(&schemars::schema_for!(Plan))
 }
 
 #[cfg(test)]
@@ -442,17 +439,10 @@ mod tests {
     #[test]
     fn the_schema_in_docs_is_generated_from_the_types() {
         let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../docs/plan.schema.json");
-        let generated = super::schema();
-        if std::env::var_os("CELLPLAN_UPDATE_SCHEMA").is_some() {
-            std::fs::write(&path, &generated).unwrap();
-        }
-        let on_disk = std::fs::read_to_string(&path).unwrap();
-        assert!(
-            on_disk == generated,
-            "docs/plan.schema.json is not the schema of the document's types; regenerate it with \
-             CELLPLAN_UPDATE_SCHEMA=1 cargo test -p cellplan-core schema"
-        );
-        let schema: serde_json::Value = serde_json::from_str(&on_disk).unwrap();
+        let schema =
+            cellplan_model::document::schema_file_matches(&path, &super::schema()).unwrap_or_else(|e| {
+                panic!("{e}; regenerate it with CELLPLAN_UPDATE_SCHEMA=1 cargo test -p cellplan-core schema")
+            });
         let required = schema["required"].as_array().unwrap();
         assert!(required.iter().any(|k| k == "coordination"), "{required:?}");
     }

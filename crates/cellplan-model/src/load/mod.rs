@@ -189,11 +189,22 @@ pub fn process_kind(path: &Path) -> Result<String, InputError> {
 
 /// Reads the cell file (at most [`MAX_CELL_FILE`] bytes) and parses it as TOML.
 fn read_spec(path: &Path) -> Result<(String, CellSpec), InputError> {
+    read_cell_toml(path, "examples/autobody-4r/cell.toml", "docs/cell-format.md")
+}
+
+/// A cell file's text and its TOML read into `S` (any process's layout), at most 1 MiB; a
+/// file that cannot be read or parsed is an error at its line, with `example` (a cell file to
+/// point to) and `docs` (where the keys are listed) in the hints.
+pub fn read_cell_toml<S: serde::de::DeserializeOwned>(
+    path: &Path,
+    example: &str,
+    docs: &str,
+) -> Result<(String, S), InputError> {
     let text = read_bounded(path, MAX_CELL_FILE).map_err(|e| {
         InputError::new(path, format!("cannot read the cell file: {e}"))
-            .hint("give the path of a cell TOML file, e.g. examples/autobody-4r/cell.toml")
+            .hint(format!("give the path of a cell TOML file, e.g. {example}"))
     })?;
-    let spec: CellSpec = toml::from_str(&text).map_err(|e| {
+    let spec: S = toml::from_str(&text).map_err(|e| {
         let span = e.span().unwrap_or(0..0);
         InputError::at_span(
             path,
@@ -201,7 +212,7 @@ fn read_spec(path: &Path) -> Result<(String, CellSpec), InputError> {
             span,
             format!("invalid cell file: {}", e.message().trim()),
         )
-        .hint("docs/cell-format.md lists every key and its type")
+        .hint(format!("{docs} lists every key and its type"))
     })?;
     Ok((text, spec))
 }

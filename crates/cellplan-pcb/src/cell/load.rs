@@ -3,13 +3,9 @@
 use super::*;
 use crate::board::{Mount, Selection, Side};
 use cellplan_model::InputError;
-use cellplan_model::io::read_bounded;
 use cellplan_model::spec::LengthUnit;
 use std::path::Path;
 use toml::Spanned;
-
-/// Largest cell file read.
-const MAX_CELL_FILE: u64 = 1 << 20;
 
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -198,19 +194,11 @@ impl Ctx<'_> {
 
 /// Loads a PCB-assembly cell file and its board.
 pub fn load(path: &Path) -> Result<PcbCell, InputError> {
-    let text = read_bounded(path, MAX_CELL_FILE).map_err(|e| {
-        InputError::new(path, format!("cannot read the cell file: {e}"))
-            .hint("give the path of a cell TOML file, e.g. examples/pcb-bitsy-1r/cell.toml")
-    })?;
-    let spec: Spec = toml::from_str(&text).map_err(|e| {
-        InputError::at_span(
-            path,
-            &text,
-            e.span().unwrap_or(0..0),
-            format!("invalid cell file: {}", e.message().trim()),
-        )
-        .hint("docs/cell-format.md (PCB assembly) lists every key and its type")
-    })?;
+    let (text, spec): (String, Spec) = cellplan_model::load::read_cell_toml(
+        path,
+        "examples/pcb-bitsy-1r/cell.toml",
+        "docs/cell-format.md (PCB assembly)",
+    )?;
     let ctx = Ctx {
         path,
         text: &text,
