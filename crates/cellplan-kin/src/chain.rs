@@ -147,8 +147,36 @@ impl Chain {
     /// reach`. Along a straight joint-space segment, `p` then moves at most
     /// `Σ_j r_j·|b_j − a_j|`.
     pub fn joint_radii(&self, bodies: &[(usize, f64)]) -> Vec<f64> {
-        let offset: Vec<f64> = self
-            .links
+        let offset = self.link_offsets();
+        let mut radii = vec![0.0; self.dof()];
+        for &(k, reach) in bodies {
+            for (r, b) in radii.iter_mut().zip(self.body_radii_with(&offset, k, reach)) {
+                *r = f64::max(*r, b);
+            }
+        }
+        for (j, r) in radii.iter_mut().enumerate() {
+            if self.joints[j].kind == JointKind::Prismatic {
+                *r = 1.0;
+            }
+        }
+        radii
+    }
+
+    /// [`Chain::joint_radii`] for one body, `(link, reach)`: for each joint, a bound on the
+    /// distance from its axis of any point of that body, valid in every configuration (0 for
+    /// a joint that does not move the body, 1 for a prismatic joint that does). Tighter than
+    /// the whole chain's radii for a body near the root, and for the relative motion of two
+    /// bodies: along a segment, the points of a body on link `k` move relative to a body on an
+    /// earlier link `a` by at most `Σ_j r_j·|b_j − a_j|` over the joints between `a` and `k`
+    /// (the joints before `a` move both alike).
+    pub fn body_radii(&self, link: usize, reach: f64) -> Vec<f64> {
+        self.body_radii_with(&self.link_offsets(), link, reach)
+    }
+
+    /// Each link's largest offset from its parent's origin: the length of its fixed origin
+    /// translation plus a prismatic joint's largest travel.
+    fn link_offsets(&self) -> Vec<f64> {
+        self.links
             .iter()
             .map(|l| {
                 let travel = l.joint.and_then(|j| self.joints.get(j)).map_or(0.0, |j| {
@@ -160,20 +188,22 @@ impl Chain {
                 });
                 l.origin.translation.length() + travel
             })
-            .collect();
+            .collect()
+    }
+
+    fn body_radii_with(&self, offset: &[f64], k: usize, reach: f64) -> Vec<f64> {
         (0..self.dof())
             .map(|j| {
-                if self.joints[j].kind == JointKind::Prismatic {
-                    return 1.0;
-                }
                 let Some(lj) = self.joint_link(j) else {
                     return 0.0;
                 };
-                bodies
-                    .iter()
-                    .filter(|&&(k, _)| k >= lj && k < offset.len())
-                    .map(|&(k, reach)| offset[lj + 1..=k].iter().sum::<f64>() + reach)
-                    .fold(0.0, f64::max)
+                if k < lj || k >= offset.len() {
+                    return 0.0;
+                }
+                if self.joints[j].kind == JointKind::Prismatic {
+                    return 1.0;
+                }
+                offset[lj + 1..=k].iter().sum::<f64>() + reach
             })
             .collect()
     }
@@ -310,6 +340,42 @@ mod tests {
             assert!((p.x * p.x + p.y * p.y).sqrt() <= radii[0] - 0.1 + 1e-12);
         }
         assert_eq!(c.joint_radii(&[]), [0.0, 0.0, 1.0]);
+    }
+
+    #[test]
+    fn body_radii_bound_relative_motion() {
+        let c = arm();
+        // A body of reach 0.1 on l2: j1 carries it 0.5 m out, j2 only its reach, j3 not at all.
+        assert_eq!(c.body_radii(2, 0.1), [0.6, 0.1, 0.0]);
+        // On the tip it is the whole arm's bound for that body alone.
+        assert_eq!(c.body_radii(4, 0.1), c.joint_radii(&[(4, 0.1)]));
+        // The whole arm's radii are the largest of its bodies'.
+        let whole = c.joint_radii(&[(4, 0.1), (2, 0.7)]);
+        let (tip, l2) = (c.body_radii(4, 0.1), c.body_radii(2, 0.7));
+        for (j, w) in whole.iter().enumerate() {
+            assert_eq!(*w, tip[j].max(l2[j]));
+        }
+        // Relative motion: a point of the tip body seen from l1's frame moves along a segment by
+        // at most Σ_{j after l1} r_j·|Δq_j| (the joints before l1 move both alike).
+        let r = c.body_radii(4, 0.1);
+        let p_local = DVec3::new(0.0, 0.06, 0.08);
+        let (a, b): ([f64; 3], [f64; 3]) = ([0.4, -2.0, 0.0], [-1.1, 1.5, 0.2]);
+        let bound: f64 = (1..3).map(|j| r[j] * (b[j] - a[j]).abs()).sum();
+        let mut poses = vec![Pose::IDENTITY; c.links.len()];
+        let seen = |q: &[f64], poses: &mut Vec<Pose>| {
+            c.fk_all(q, poses);
+            poses[1]
+                .inverse()
+                .transform_point(poses[4].transform_point(p_local))
+        };
+        let start = seen(&a, &mut poses);
+        let mut worst = 0.0f64;
+        for k in 0..=200 {
+            let t = k as f64 / 200.0;
+            let q: Vec<f64> = a.iter().zip(&b).map(|(x, y)| x + t * (y - x)).collect();
+            worst = worst.max((seen(&q, &mut poses) - start).length());
+        }
+        assert!(worst > 0.3 && worst <= bound, "moved {worst}, bound {bound}");
     }
 
     #[test]

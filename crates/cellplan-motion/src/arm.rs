@@ -20,7 +20,17 @@
 //! skipped. Only the objects and pairs whose bound falls short pay for the exact query, which
 //! then decides. Bounds never exceed exact distances, so the guarantee of the segment check is
 //! unchanged.
-use crate::plan::{Clearance, JointSpace, StateValidity, narrow_step};
+//!
+//! # Each part's own motion bound
+//!
+//! The space's radii bound how far *any* point of the arm moves; a part's clearance only has
+//! to outlast the motion of the points it involves. A body's clearance to the scene is reduced
+//! by its own motion ([`Chain::body_radii`]: the forearm is not carried as far by the base
+//! joint as the gripper is), and a self pair's by the motion of its distal body relative to
+//! the proximal one, over the joints between them only. The segment check steps by these
+//! tighter bounds ([`SegmentMotion::bound_with`]); on the MBM UR5 problems the base–upper-arm
+//! pair, which bound nearly every step with the whole arm's radii, no longer does.
+use crate::plan::{Clearance, JointSpace, SegmentMotion, StateValidity, narrow_step};
 use cellplan_geom::{BroadPhase, CollisionWorld, GroupId, PlacedCovers, Pose};
 use cellplan_kin::Chain;
 use std::cell::RefCell;
@@ -105,16 +115,19 @@ pub fn joint_radii(arm: &Arm) -> Vec<f64> {
         .body_links
         .iter()
         .enumerate()
-        .filter_map(|(i, &link)| {
-            let cover = arm.world.body_cover(arm.group, i);
-            let reach = cover
-                .iter()
-                .map(|s| s.centre.length() + s.radius)
-                .fold(None, |m: Option<f64>, v| Some(m.map_or(v, |m| m.max(v))))?;
-            Some((link, reach))
-        })
+        .filter_map(|(i, &link)| Some((link, body_reach(arm, i)?)))
         .collect();
     arm.chain.joint_radii(&bodies)
+}
+
+/// The largest distance of body `i`'s points from its link's origin, from its cover (`None`
+/// for a body without shapes).
+fn body_reach(arm: &Arm, i: usize) -> Option<f64> {
+    arm.world
+        .body_cover(arm.group, i)
+        .iter()
+        .map(|s| s.centre.length() + s.radius)
+        .fold(None, |m: Option<f64>, v| Some(m.map_or(v, |m| m.max(v))))
 }
 
 /// The configurations that move the tool point `tcp` (a pose in the chain's tip frame) from
@@ -184,10 +197,17 @@ pub struct ArmValidity<'a> {
     /// Whether the sphere-cover bounds are asked before exact distances (on by default; off
     /// only to measure what the broad phase saves).
     pub broad_phase: bool,
+    /// Whether a segment check bounds each part's motion by the radii of the body concerned
+    /// (the distal one of a self pair; [`Chain::body_radii`]) rather than the space's (on by
+    /// default; off only to compare with the plain bound).
+    pub own_radii: bool,
     /// Bodies checked against the scene (those moved by some joint), with their joints.
     moving: Vec<(usize, Range<usize>)>,
-    /// Checked self pairs with the joints between them.
-    pairs: Vec<(usize, usize, Range<usize>)>,
+    /// Checked self pairs with the joints between them and the body whose radii bound their
+    /// relative motion (the one farther down the chain).
+    pairs: Vec<(usize, usize, Range<usize>, usize)>,
+    /// Each body's radii ([`Chain::body_radii`], its reach taken from its cover).
+    body_radii: Vec<Vec<f64>>,
     /// Other groups standing still (obstacles like the scene), with their body poses.
     parked: Vec<(GroupId, Vec<Pose>)>,
     /// Distance (m) kept from the parked groups beyond the margin.
@@ -222,10 +242,17 @@ impl<'a> ArmValidity<'a> {
             .iter()
             .map(|&(i, j)| {
                 let (a, b) = (moved_by(i), moved_by(j));
-                (i, j, a.min(b)..a.max(b))
+                (i, j, a.min(b)..a.max(b), if b >= a { j } else { i })
             })
-            .filter(|(i, j, r)| {
+            .filter(|(i, j, r, _)| {
                 !r.is_empty() || arm.world.pair_distance(arm.group, *i, *j, &poses, 1.0) <= DISTANCE_SLACK
+            })
+            .collect();
+        let body_radii = (0..arm.body_links.len())
+            .map(|i| {
+                let link = arm.body_links[i].min(tip);
+                arm.chain
+                    .body_radii(link, body_reach(&arm, i).unwrap_or(f64::INFINITY))
             })
             .collect();
         ArmValidity {
@@ -234,7 +261,9 @@ impl<'a> ArmValidity<'a> {
             margin,
             cap: DEFAULT_CLEARANCE_CAP,
             broad_phase: true,
+            own_radii: true,
             moving,
+            body_radii,
             pairs,
             parked,
             parked_extra: 0.0,
@@ -317,7 +346,7 @@ impl<'a> ArmValidity<'a> {
                 && self
                     .pairs
                     .iter()
-                    .all(|&(i, j, _)| self.pair_part(i, j, bodies, placed, apart + tiny) > apart)
+                    .all(|&(i, j, _, _)| self.pair_part(i, j, bodies, placed, apart + tiny) > apart)
         })
     }
 
@@ -335,6 +364,15 @@ impl<'a> ArmValidity<'a> {
             let min = |parts: &[Clearance]| parts.iter().map(|c| c.distance).fold(self.cap, f64::min);
             (min(scene), min(pairs))
         })
+    }
+
+    /// How far the points of a part move over a segment: by the radii of `body` (the moving
+    /// body, or a pair's distal one) when [`Self::own_radii`] is on, else the space's.
+    fn part_bound(&self, motion: &SegmentMotion, joints: &Range<usize>, body: usize) -> f64 {
+        match self.body_radii.get(body) {
+            Some(own) if self.own_radii => motion.bound_with(joints, own),
+            _ => motion.bound(joints),
+        }
     }
 
     /// The distance of one part, asked only as far as it matters: `wanted` is the clearance
@@ -392,7 +430,7 @@ impl StateValidity for ArmValidity<'_> {
                     joints: joints.clone(),
                 });
             }
-            for (i, j, joints) in &self.pairs {
+            for (i, j, joints, _) in &self.pairs {
                 let d = self.pair_part(*i, *j, bodies, placed, self.cap);
                 out.push(Clearance {
                     distance: trusted(d),
@@ -405,13 +443,7 @@ impl StateValidity for ArmValidity<'_> {
     /// As the default, with every part asked only as far as it matters (see `capped_part`):
     /// bodies from the tip inwards (the tool is the usual tightest part, and its step then caps
     /// the others' queries), then the self pairs.
-    fn segment_step(
-        &self,
-        q: &[f64],
-        bound: &dyn Fn(&Range<usize>) -> f64,
-        floor: f64,
-        limit: f64,
-    ) -> Option<f64> {
+    fn segment_step(&self, q: &[f64], motion: &SegmentMotion, floor: f64, limit: f64) -> Option<f64> {
         if !self.arm.chain.within_limits(q, 1e-9) {
             return None;
         }
@@ -419,7 +451,7 @@ impl StateValidity for ArmValidity<'_> {
         self.posed(q, |bodies, placed| {
             let mut step = limit;
             for (i, joints) in self.moving.iter().rev() {
-                let b = bound(joints);
+                let b = self.part_bound(motion, joints, *i);
                 let part = self.capped_part(
                     |cap| self.scene_part(*i, bodies, placed, cap),
                     margin,
@@ -429,8 +461,8 @@ impl StateValidity for ArmValidity<'_> {
                 );
                 step = narrow_step(step, part, b, floor)?;
             }
-            for (i, j, joints) in &self.pairs {
-                let b = bound(joints);
+            for (i, j, joints, distal) in &self.pairs {
+                let b = self.part_bound(motion, joints, *distal);
                 let part = self.capped_part(
                     |cap| self.pair_part(*i, *j, bodies, placed, cap),
                     0.0,

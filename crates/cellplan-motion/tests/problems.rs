@@ -1,7 +1,7 @@
 //! The motion-problem format and the arm set up from it, on the MBM UR5 files of bench/motion
 //! and on broken files.
 use cellplan_motion::arm;
-use cellplan_motion::plan::{self, PlannerParams, Termination, check_segment};
+use cellplan_motion::plan::{self, PlannerParams, SegmentMotion, Termination, check_segment};
 use cellplan_motion::problem::{ArmSetup, ProblemError, read_problems};
 use std::path::{Path, PathBuf};
 
@@ -78,9 +78,9 @@ fn the_broad_phase_changes_no_answer() {
             "is_valid and clearance disagree at {k}"
         );
         valid += usize::from(a);
-        let bound = |_: &std::ops::Range<usize>| 1.0;
-        let s1 = fast.segment_step(&q, &bound, 1e-4, 1.0);
-        let s2 = exact.segment_step(&q, &bound, 1e-4, 1.0);
+        let motion = SegmentMotion::new(&vec![1.0; q.len()], &vec![1.0; q.len()]);
+        let s1 = fast.segment_step(&q, &motion, 1e-4, 1.0);
+        let s2 = exact.segment_step(&q, &motion, 1e-4, 1.0);
         assert_eq!(s1.is_some(), s2.is_some(), "at {k}");
         if let (Some(s1), Some(s2)) = (s1, s2) {
             // The broad phase answers only what it proves: never a longer step (up to GJK's

@@ -329,18 +329,18 @@ fn capped_segment_step_agrees_with_the_default() {
     let mut rng = ChaCha8Rng::seed_from_u64(11);
     let mut checked = 0;
     for robot in &f.cell.robots {
-        let v = robot_validity(&f.cell, robot, margin(&f.cell));
+        let mut v = robot_validity(&f.cell, robot, margin(&f.cell));
+        v.own_radii = false;
         let plain = Plain(&v);
         let mut qs = f.candidates[robot.id.0].clone();
         qs.extend((0..40).map(|_| random_q(robot, &mut rng)));
         for q in &qs {
             let per_joint: Vec<f64> = (0..q.len()).map(|_| rng.random_range(0.0..3.0)).collect();
-            let bound =
-                |j: &std::ops::Range<usize>| per_joint[j.start.min(q.len())..j.end.min(q.len())].iter().sum();
+            let motion = cellplan_motion::plan::SegmentMotion::new(&vec![1.0; q.len()], &per_joint);
             let floor = 1e-4;
             let limit = rng.random_range(0.05..1.0);
-            let fast = v.segment_step(q, &bound, floor, limit);
-            let slow = plain.segment_step(q, &bound, floor, limit);
+            let fast = v.segment_step(q, &motion, floor, limit);
+            let slow = plain.segment_step(q, &motion, floor, limit);
             match (fast, slow) {
                 (None, None) => {}
                 (Some(a), Some(b)) => {

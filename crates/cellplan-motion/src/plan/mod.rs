@@ -77,7 +77,7 @@ pub use simplify::{path_length, shortcut};
 pub use space::JointSpace;
 pub use straight::Straight;
 use validity::segment_valid;
-pub use validity::{Clearance, SegmentCheck, StateValidity, check_segment, narrow_step};
+pub use validity::{Clearance, SegmentCheck, SegmentMotion, StateValidity, check_segment, narrow_step};
 
 /// Limits and knobs of a planning query.
 #[derive(Clone, Debug, PartialEq)]

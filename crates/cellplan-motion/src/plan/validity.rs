@@ -58,19 +58,14 @@ pub trait StateValidity: Sync {
     }
 
     /// The radius, in segment parameter, of the piece of a segment around `q` proven valid:
-    /// `min_k distance_k / bound(joints_k)` over [`StateValidity::clearances`], at most
-    /// `limit`; `None` when some distance is below `floor` (or NaN). `bound(joints)` is the
-    /// Cartesian displacement bound of those joints over the whole segment (0 when they do not
-    /// move). The segment check calls this; an implementation may override it to skip work
-    /// the answer does not need — a distance query capped at `step · bound` (the step found so
-    /// far) answers as well as an exact one. The result must not exceed the default's.
-    fn segment_step(
-        &self,
-        q: &[f64],
-        bound: &dyn Fn(&Range<usize>) -> f64,
-        floor: f64,
-        limit: f64,
-    ) -> Option<f64> {
+    /// `min_k distance_k / motion.bound(joints_k)` over [`StateValidity::clearances`], at
+    /// most `limit`; `None` when some distance is below `floor` (or NaN). `motion` says how far
+    /// each joint moves over the whole segment ([`SegmentMotion`]). The segment check calls
+    /// this; an implementation may override it to skip work the answer does not need — a
+    /// distance query capped at `step · bound` (the step found so far) answers as well as an
+    /// exact one — or to bound a part's motion more tightly than the space's radii do
+    /// ([`SegmentMotion::bound_with`]: the radii of the bodies involved in that part).
+    fn segment_step(&self, q: &[f64], motion: &SegmentMotion, floor: f64, limit: f64) -> Option<f64> {
         // One buffer per thread, taken out while in use (so a nested call gets its own).
         thread_local! {
             static BUF: std::cell::Cell<Vec<Clearance>> = const { std::cell::Cell::new(Vec::new()) };
@@ -78,10 +73,79 @@ pub trait StateValidity: Sync {
         let mut buf = BUF.take();
         self.clearances(q, &mut buf);
         let step = buf.iter().try_fold(limit, |step, c| {
-            narrow_step(step, c.distance, bound(&c.joints), floor)
+            narrow_step(step, c.distance, motion.bound(&c.joints), floor)
         });
         BUF.set(buf);
         step
+    }
+}
+
+/// How far a straight joint-space segment moves each joint, and the Cartesian bounds that
+/// follow (the `bound` of [`StateValidity::segment_step`]).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct SegmentMotion {
+    /// `|b_j − a_j|` per joint.
+    delta: Vec<f64>,
+    /// The space's radius per joint.
+    radii: Vec<f64>,
+    /// Prefix sums of `radii[j]·delta[j]`.
+    prefix: Vec<f64>,
+}
+
+impl SegmentMotion {
+    /// The motion of a segment moving joint `j` by `delta[j]` (absolute values are taken) in a
+    /// space with Cartesian radii `radii` (see [`JointSpace::radii`]; missing radii are
+    /// infinite).
+    pub fn new(radii: &[f64], delta: &[f64]) -> SegmentMotion {
+        let n = delta.len();
+        let delta: Vec<f64> = delta.iter().map(|d| d.abs()).collect();
+        let radii: Vec<f64> = (0..n)
+            .map(|j| radii.get(j).copied().unwrap_or(f64::INFINITY))
+            .collect();
+        let mut prefix = Vec::with_capacity(n + 1);
+        prefix.push(0.0);
+        for j in 0..n {
+            let term = if delta[j] == 0.0 { 0.0 } else { radii[j] * delta[j] };
+            prefix.push(prefix[j] + term);
+        }
+        SegmentMotion { delta, radii, prefix }
+    }
+
+    /// The motion of the segment `a → b` in `space`.
+    pub fn of(space: &JointSpace, a: &[f64], b: &[f64]) -> SegmentMotion {
+        let n = space.dim().min(a.len()).min(b.len());
+        let delta: Vec<f64> = (0..n).map(|j| b[j] - a[j]).collect();
+        SegmentMotion::new(&space.radii, &delta)
+    }
+
+    /// Bound (m) on how far the points move, along the whole segment, by the joints
+    /// `joints` (clipped to the space): `Σ_{j in joints} radii[j]·|Δq_j|`.
+    pub fn bound(&self, joints: &Range<usize>) -> f64 {
+        let n = self.delta.len();
+        let (lo, hi) = (joints.start.min(n), joints.end.min(n));
+        if hi > lo {
+            self.prefix[hi] - self.prefix[lo]
+        } else {
+            0.0
+        }
+    }
+
+    /// The same bound with per-joint radii of the points concerned (`own[j]`, each used only
+    /// where it is below the space's): `Σ_{j in joints} min(own[j], radii[j])·|Δq_j|`. For
+    /// the points of one body, `own` may be that body's radii
+    /// ([`cellplan_kin::Chain::body_radii`]), which are smaller than the whole arm's.
+    pub fn bound_with(&self, joints: &Range<usize>, own: &[f64]) -> f64 {
+        let n = self.delta.len();
+        let (lo, hi) = (joints.start.min(n), joints.end.min(n));
+        (lo..hi)
+            .filter(|&j| self.delta[j] != 0.0)
+            .map(|j| own.get(j).map_or(self.radii[j], |&r| r.min(self.radii[j])) * self.delta[j])
+            .sum()
+    }
+
+    /// The bound over every joint.
+    pub fn total(&self) -> f64 {
+        self.prefix.last().copied().unwrap_or(0.0)
     }
 }
 
@@ -172,26 +236,14 @@ fn segment_valid_counted(
 ) -> bool {
     let floor = min_clearance.max(1e-9);
     let n = space.dim().min(a.len()).min(b.len());
-    // Bound of each joint over the whole segment, and prefix sums for the ranges.
-    let mut prefix = Vec::with_capacity(n + 1);
-    prefix.push(0.0);
-    for j in 0..n {
-        let r = space.radii.get(j).copied().unwrap_or(f64::INFINITY);
-        let d = (a[j] - b[j]).abs();
-        let term = if d == 0.0 { 0.0 } else { r * d };
-        prefix.push(prefix[j] + term);
-    }
-    if !prefix[n].is_finite() {
+    let motion = SegmentMotion::of(space, a, b);
+    if !motion.total().is_finite() {
         return false;
     }
-    let bound = |joints: &Range<usize>| {
-        let (lo, hi) = (joints.start.min(n), joints.end.min(n));
-        if hi > lo { prefix[hi] - prefix[lo] } else { 0.0 }
-    };
     // Probes: a contact inside the segment is found in a few yes-or-no tests, in bisection
     // order, rather than by covering the segment up to it (steps shrink geometrically towards
     // a contact). Only an invalid point rejects, so the answer is unchanged.
-    let probes = ((prefix[n] / PROBE_SPACING) as usize).min(MAX_PROBES);
+    let probes = ((motion.total() / PROBE_SPACING) as usize).min(MAX_PROBES);
     if probes > 0 {
         let mut q = Vec::with_capacity(n);
         let mut level = 2usize;
@@ -214,7 +266,7 @@ fn segment_valid_counted(
     let mut measure = |q: &[f64], limit: f64| -> Option<f64> {
         *calls += 1;
         validity
-            .segment_step(q, &bound, floor, limit)
+            .segment_step(q, &motion, floor, limit)
             .map(|r| r * STEP_SAFETY)
     };
     let Some(ra) = measure(a, 1.0) else {
