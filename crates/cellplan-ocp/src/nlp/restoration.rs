@@ -1,0 +1,1 @@
+//! The feasibility restoration phase (placeholder until written).
