@@ -21,6 +21,9 @@ pub struct Options {
     pub scaling_max_gradient: f64,
     /// Print one line per iteration to stderr.
     pub verbose: bool,
+    /// Run the feasibility restoration phase when the line search fails (off inside the
+    /// restoration phase itself).
+    pub restoration: bool,
 }
 
 impl Default for Options {
@@ -34,6 +37,7 @@ impl Default for Options {
             mu_init: 0.1,
             scaling_max_gradient: 100.0,
             verbose: false,
+            restoration: true,
         }
     }
 }
@@ -156,6 +160,33 @@ impl<P: Nlp + ?Sized> Scaled<'_, P> {
     }
 }
 
+impl<P: Nlp + ?Sized> Scaled<'_, P> {
+    /// The barrier function `φ_μ` and infeasibility `θ` (1-norm) at a point.
+    pub fn merit(&self, x: &[f64], s: &[f64], e: &Eval, mu: f64) -> (f64, f64) {
+        let p = self;
+        let mut phi = e.f;
+        for i in 0..p.n {
+            if p.xl[i].is_finite() && !p.fixed[i] {
+                phi -= mu * (x[i] - p.xl[i]).ln();
+            }
+            if p.xu[i].is_finite() && !p.fixed[i] {
+                phi -= mu * (p.xu[i] - x[i]).ln();
+            }
+        }
+        for r in 0..p.md {
+            if p.dl[r].is_finite() {
+                phi -= mu * (s[r] - p.dl[r]).ln();
+            }
+            if p.du[r].is_finite() {
+                phi -= mu * (p.du[r] - s[r]).ln();
+            }
+        }
+        let theta =
+            e.c.iter().map(|v| v.abs()).sum::<f64>() + (0..p.md).map(|r| (e.d[r] - s[r]).abs()).sum::<f64>();
+        (phi, theta)
+    }
+}
+
 /// `A x` and `Aᵀ y` for triplets.
 pub(crate) fn mul(t: &Triplets, x: &[f64], rows: usize) -> Vec<f64> {
     let mut out = vec![0.0; rows];
@@ -213,6 +244,16 @@ pub fn solve<P: Nlp + ?Sized>(nlp: &P, opt: &Options) -> Solution {
 
 /// Solves `nlp` from `x0`.
 pub fn solve_from<P: Nlp + ?Sized>(nlp: &P, x0: &[f64], opt: &Options) -> Solution {
+    solve_with(nlp, x0, opt, None)
+}
+
+/// Solves `nlp` from `x0`, ending as `Solved` as soon as `early` accepts an iterate.
+pub(crate) fn solve_with<P: Nlp + ?Sized>(
+    nlp: &P,
+    x0: &[f64],
+    opt: &Options,
+    early: Option<super::iterate::EarlyStop>,
+) -> Solution {
     let (n, m, md) = (nlp.num_vars(), nlp.num_eq(), nlp.num_ineq());
     let (xl, xu) = nlp.bounds();
     let (dl, du) = nlp.ineq_bounds();
@@ -337,7 +378,7 @@ pub fn solve_from<P: Nlp + ?Sized>(nlp: &P, x0: &[f64], opt: &Options) -> Soluti
         reg: Regularisation::default(),
         iterations: 0,
     };
-    let (status, it) = state.run(it, opt.mu_init, None);
+    let (status, it) = state.run(it, opt.mu_init, early);
     state.finish(status, it)
 }
 
@@ -450,30 +491,5 @@ impl<P: Nlp + ?Sized> Driver<'_, '_, P> {
                 }
             })
             .collect()
-    }
-
-    /// The barrier function `φ_μ` and infeasibility `θ` (1-norm) at a point.
-    pub fn merit(&self, x: &[f64], s: &[f64], e: &Eval, mu: f64) -> (f64, f64) {
-        let p = self.p;
-        let mut phi = e.f;
-        for i in 0..p.n {
-            if self.has_lower(i) {
-                phi -= mu * (x[i] - p.xl[i]).ln();
-            }
-            if self.has_upper(i) {
-                phi -= mu * (p.xu[i] - x[i]).ln();
-            }
-        }
-        for r in 0..p.md {
-            if p.dl[r].is_finite() {
-                phi -= mu * (s[r] - p.dl[r]).ln();
-            }
-            if p.du[r].is_finite() {
-                phi -= mu * (p.du[r] - s[r]).ln();
-            }
-        }
-        let theta =
-            e.c.iter().map(|v| v.abs()).sum::<f64>() + (0..p.md).map(|r| (e.d[r] - s[r]).abs()).sum::<f64>();
-        (phi, theta)
     }
 }

@@ -1,7 +1,7 @@
 //! One barrier iteration after another: the μ update, the Newton step, the filter line search
 //! with second-order corrections, the multiplier updates (IPOPT paper §2–3).
 use super::Nlp;
-use super::ipm::{Driver, Eval, Iterate, Status, mul, mul_t, norm_inf};
+use super::ipm::{Driver, Eval, Iterate, Status, mul, mul_t, norm_inf, push_inside};
 use super::kkt::{Factored, KktValues};
 
 const KAPPA_EPS: f64 = 10.0;
@@ -53,7 +53,7 @@ impl<P: Nlp + ?Sized> Driver<'_, '_, P> {
         let Some(mut e) = p.eval(&it.x) else {
             return (Status::NumericalFailure, it);
         };
-        let theta_start = self.merit(&it.x, &it.s, &e, mu).1;
+        let theta_start = self.p.merit(&it.x, &it.s, &e, mu).1;
         let theta_max = 1e4 * theta_start.max(1.0);
         let theta_min = 1e-4 * theta_start.max(1.0);
         let mut tau = (1.0 - mu).max(0.99);
@@ -164,7 +164,7 @@ impl<P: Nlp + ?Sized> Driver<'_, '_, P> {
             let dphi: f64 = (0..p.n).map(|i| (rx[i] - a[i] - b[i]) * step.dx[i]).sum::<f64>()
                 + (0..p.md).map(|r| (rs[r] + it.yd[r]) * step.ds[r]).sum::<f64>();
             let alpha_max = self.fraction_to_boundary(&it, &step.dx, &step.ds, tau);
-            let (phi0, theta0) = self.merit(&it.x, &it.s, &e, mu);
+            let (phi0, theta0) = self.p.merit(&it.x, &it.s, &e, mu);
             let tiny = (0..p.n).all(|i| step.dx[i].abs() <= 10.0 * f64::EPSILON * (1.0 + it.x[i].abs()));
             let accepted = if tiny {
                 let xt: Vec<f64> = (0..p.n).map(|i| it.x[i] + alpha_max * step.dx[i]).collect();
@@ -198,7 +198,34 @@ impl<P: Nlp + ?Sized> Driver<'_, '_, P> {
                 if self.iterations >= self.opt.max_iter {
                     return (Status::MaxIterations, it);
                 }
-                return (Status::RestorationFailed, it);
+                if !self.opt.restoration {
+                    return (Status::RestorationFailed, it);
+                }
+                // Restoration: the current point joins the filter, and the original
+                // iteration resumes at the first point that cuts θ to 0.9 and passes it.
+                filter
+                    .0
+                    .push(((1.0 - GAMMA_THETA) * theta0, phi0 - GAMMA_PHI * theta0));
+                let filter_now = &filter;
+                let accept = |x: &[f64]| -> bool {
+                    let Some(ex) = p.eval(x) else { return false };
+                    let sx: Vec<f64> = (0..p.md)
+                        .map(|r| push_inside(ex.d[r], p.dl[r], p.du[r]))
+                        .collect();
+                    let (phi, theta) = p.merit(x, &sx, &ex, mu);
+                    theta <= 0.9 * theta0 && !filter_now.rejects(theta, phi)
+                };
+                match self.restore(&it, mu, &accept) {
+                    Ok(next) => {
+                        it = next;
+                        let Some(en) = p.eval(&it.x) else {
+                            return (Status::NumericalFailure, it);
+                        };
+                        e = en;
+                        continue;
+                    }
+                    Err(status) => return (status, it),
+                }
             };
             // Bound multipliers: their Newton steps, the fraction to the boundary, κ_Σ.
             let dzl: Vec<f64> = (0..p.n)
@@ -408,7 +435,7 @@ impl<P: Nlp + ?Sized> Driver<'_, '_, P> {
                 first = false;
                 continue;
             };
-            let (phi, theta) = self.merit(&xt, &st, &et, ctx.mu);
+            let (phi, theta) = self.p.merit(&xt, &st, &et, ctx.mu);
             if let Some(f_type) = self.accepts(ctx, alpha, phi, theta, filter) {
                 if !f_type {
                     filter
@@ -429,7 +456,7 @@ impl<P: Nlp + ?Sized> Driver<'_, '_, P> {
                     let a_soc = self.fraction_to_boundary(it, &soc.dx, &soc.ds, ctx.tau);
                     let (xs, ss) = point(a_soc, &soc.dx, &soc.ds);
                     let Some(es) = p.eval(&xs) else { break };
-                    let (phi_s, theta_s) = self.merit(&xs, &ss, &es, ctx.mu);
+                    let (phi_s, theta_s) = self.p.merit(&xs, &ss, &es, ctx.mu);
                     if let Some(f_type) = self.accepts(ctx, alpha, phi_s, theta_s, filter) {
                         if !f_type {
                             filter
