@@ -7,4 +7,6 @@
 #![warn(missing_docs)]
 
 pub mod dmoc;
+pub mod nlp;
 pub mod problem;
+pub mod taylor;

@@ -11,13 +11,14 @@
 //! - bounds: joint limits, torque limits, the step's range, the fixed ends (`q_0`, `q_N`,
 //!   `q̇_0 = q̇_N = 0` as equal bounds).
 //!
-//! The Jacobian of `c` is exact (dual numbers over each block's positions and step; the torques
-//! enter linearly) and sparse: row block k touches `q_{k−1}, q_k, q_{k+1}`, `h` and two torques.
-use crate::dmoc::{MAX_DOF, del_residual, end_residual, start_residual};
-use cellplan_kin::dynamics::{Dual, Dynamics};
+//! The Jacobian of `c` and the Hessian of the Lagrangian are exact and sparse (row block k
+//! touches `q_{k−1}, q_k, q_{k+1}`, `h` and two torques), computed step by step in [`exact`]
+//! by second-order forward differentiation over each midpoint ([`crate::taylor`]).
+use crate::dmoc::{del_residual, end_residual, start_residual};
+use cellplan_kin::dynamics::Dynamics;
 
-/// Width of the duals over one block's positions (three grid points) and the step.
-const BLOCK: usize = 3 * MAX_DOF + 1;
+mod as_nlp;
+mod exact;
 
 /// The cost weights (paper 002 §3: c_t = 1, c_e = 1e-6, c_v = 1).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -103,8 +104,7 @@ pub struct Move<'a> {
     pub weights: Weights,
 }
 
-/// A sparse matrix as (row, column, value) triplets.
-pub type Triplets = Vec<(usize, usize, f64)>;
+pub use crate::nlp::Triplets;
 
 impl Move<'_> {
     /// The layout.
@@ -202,234 +202,6 @@ impl Move<'_> {
         }
         c.extend(end_residual(d, &q(s - 1), &q(s), &qdn, h, &u(s - 1)));
         c
-    }
-
-    /// The Jacobian of `c`, exact, as triplets.
-    pub fn jacobian(&self, x: &[f64]) -> Triplets {
-        let l = self.layout();
-        let n = l.n;
-        let d = self.dynamics;
-        let h = x[l.h()];
-        let mut t: Triplets = Vec::new();
-        // Duals over a block's positions (slot 0, 1, 2 → n each) and h (the last).
-        let var = |i: usize, slot: usize| -> Vec<Dual<BLOCK>> {
-            (0..n)
-                .map(|j| Dual::variable(x[l.q(i, j)], slot * MAX_DOF + j))
-                .collect()
-        };
-        let hd: Dual<BLOCK> = Dual::variable(h, 3 * MAX_DOF);
-        let consts = |v: Vec<f64>| -> Vec<Dual<BLOCK>> { v.into_iter().map(Dual::constant).collect() };
-        let u = |i: usize| -> Vec<f64> { (0..n).map(|j| x[l.u(i, j)]).collect() };
-        let mut emit = |row0: usize,
-                        r: &[Dual<BLOCK>],
-                        cols: &[(usize, usize)],
-                        u_cols: &[usize],
-                        qd: Option<(usize, Vec<Vec<f64>>)>| {
-            for (a, e) in r.iter().enumerate() {
-                for &(slot, grid) in cols {
-                    for j in 0..n {
-                        let v = e.d[slot * MAX_DOF + j];
-                        if v != 0.0 {
-                            t.push((row0 + a, l.q(grid, j), v));
-                        }
-                    }
-                }
-                let dh = e.d[3 * MAX_DOF];
-                if dh != 0.0 {
-                    t.push((row0 + a, l.h(), dh));
-                }
-                // The torques enter as h/2 · u.
-                for &ui in u_cols {
-                    t.push((row0 + a, l.u(ui, a), 0.5 * h));
-                }
-            }
-            if let Some((first, m)) = qd {
-                // ∂(±M(q) q̇)/∂q̇ = ±M(q).
-                for (a, row) in m.iter().enumerate() {
-                    for (j, v) in row.iter().enumerate() {
-                        if *v != 0.0 {
-                            t.push((row0 + a, first + j, *v));
-                        }
-                    }
-                }
-            }
-        };
-        // Start: q_0 (slot 0), q_1 (slot 1), h, u_½, q̇_0 (M(q_0)).
-        let qd0: Vec<f64> = (0..n).map(|j| x[l.qd0(j)]).collect();
-        let r = start_residual(d, &var(0, 0), &consts(qd0), &var(1, 1), hd, &consts(u(0)));
-        let q0: Vec<f64> = (0..n).map(|j| x[l.q(0, j)]).collect();
-        emit(
-            0,
-            &r,
-            &[(0, 0), (1, 1)],
-            &[0],
-            Some((l.qd0(0), d.mass_matrix(&q0))),
-        );
-        for k in 1..l.steps {
-            let r = del_residual(
-                d,
-                &var(k - 1, 0),
-                &var(k, 1),
-                &var(k + 1, 2),
-                hd,
-                &consts(u(k - 1)),
-                &consts(u(k)),
-            );
-            emit(k * n, &r, &[(0, k - 1), (1, k), (2, k + 1)], &[k - 1, k], None);
-        }
-        let s = l.steps;
-        let qdn: Vec<f64> = (0..n).map(|j| x[l.qdn(j)]).collect();
-        let r = end_residual(d, &var(s - 1, 0), &var(s, 1), &consts(qdn), hd, &consts(u(s - 1)));
-        let qn: Vec<f64> = (0..n).map(|j| x[l.q(s, j)]).collect();
-        let minus_m: Vec<Vec<f64>> = d
-            .mass_matrix(&qn)
-            .into_iter()
-            .map(|row| row.into_iter().map(|v| -v).collect())
-            .collect();
-        emit(
-            s * n,
-            &r,
-            &[(0, s - 1), (1, s)],
-            &[s - 1],
-            Some((l.qdn(0), minus_m)),
-        );
-        t
-    }
-
-    /// The Hessian of the Lagrangian `σ ∇²f(x) + Σ λ_r ∇²c_r(x)`, exact, as triplets of its
-    /// lower triangle (row ≥ column). The constraints' part comes block by block from
-    /// second-order dual numbers over the block's positions, its end velocity (start and end
-    /// blocks) and h; the torques enter only through `h/2 · u`, whose cross terms with h are
-    /// added in closed form.
-    pub fn hessian(&self, x: &[f64], lambda: &[f64], sigma: f64) -> Triplets {
-        type D2 = Dual<BLOCK, Dual<1>>;
-        let l = self.layout();
-        let n = l.n;
-        let d = self.dynamics;
-        let w = self.weights;
-        let h = x[l.h()];
-        let mut t: Triplets = Vec::new();
-        let mut put = |a: usize, b: usize, v: f64| {
-            if v != 0.0 {
-                t.push((a.max(b), a.min(b), v));
-            }
-        };
-        // The cost: h (c_t + c_e |u|²) + c_v |Δq|² / h per step.
-        for i in 0..l.steps {
-            let mut dq2 = 0.0;
-            for j in 0..n {
-                let (a, b) = (l.q(i, j), l.q(i + 1, j));
-                let dq = x[b] - x[a];
-                dq2 += dq * dq;
-                let c = 2.0 * sigma * w.velocity / h;
-                put(a, a, c);
-                put(b, b, c);
-                put(b, a, -c);
-                // ∂²/∂h∂q: ∓2 c_v Δq / h².
-                let e = 2.0 * sigma * w.velocity * dq / (h * h);
-                put(l.h(), b, -e);
-                put(l.h(), a, e);
-                let u = l.u(i, j);
-                put(u, u, 2.0 * sigma * w.effort * h);
-                put(l.h(), u, 2.0 * sigma * w.effort * x[u]);
-            }
-            put(l.h(), l.h(), 2.0 * sigma * w.velocity * dq2 / (h * h * h));
-        }
-        // The constraints' part, one column of each block's Hessian per pass: the outer duals
-        // carry the gradient over the block's variables, the inner one the direction `dir`.
-        // (Nesting two full gradients would need ~50 kB per scalar.)
-        let grid_slots = |k: usize| -> Vec<(usize, usize)> {
-            if k == 0 {
-                vec![(0, 0), (1, 1)]
-            } else if k == l.steps {
-                vec![(0, k - 1), (1, k)]
-            } else {
-                vec![(0, k - 1), (1, k), (2, k + 1)]
-            }
-        };
-        for k in 0..=l.steps {
-            let row0 = k * n;
-            let lam: Vec<f64> = (0..n).map(|a| lambda[row0 + a]).collect();
-            // Where each dual slot lives in x.
-            let mut index = vec![None; BLOCK];
-            for (sl, grid) in grid_slots(k) {
-                for j in 0..n {
-                    index[sl * MAX_DOF + j] = Some(l.q(grid, j));
-                }
-            }
-            let velocity = if k == 0 {
-                Some(l.qd0(0))
-            } else if k == l.steps {
-                Some(l.qdn(0))
-            } else {
-                None
-            };
-            if let Some(first) = velocity {
-                for j in 0..n {
-                    index[2 * MAX_DOF + j] = Some(first + j);
-                }
-            }
-            index[3 * MAX_DOF] = Some(l.h());
-            for dir in 0..BLOCK {
-                let Some(idir) = index[dir] else { continue };
-                let var = |v: f64, k: usize| -> D2 {
-                    let mut d = [Dual::<1>::constant(0.0); BLOCK];
-                    d[k] = Dual::constant(1.0);
-                    let inner = if k == dir {
-                        Dual::variable(v, 0)
-                    } else {
-                        Dual::constant(v)
-                    };
-                    Dual { v: inner, d }
-                };
-                let slot = |i: usize, s: usize| -> Vec<D2> {
-                    (0..n).map(|j| var(x[l.q(i, j)], s * MAX_DOF + j)).collect()
-                };
-                let zeros: Vec<D2> = vec![Dual::constant(Dual::constant(0.0)); n];
-                let hd = var(h, 3 * MAX_DOF);
-                let r = if k == 0 {
-                    let qd0: Vec<D2> = (0..n).map(|j| var(x[l.qd0(j)], 2 * MAX_DOF + j)).collect();
-                    start_residual(d, &slot(0, 0), &qd0, &slot(1, 1), hd, &zeros)
-                } else if k == l.steps {
-                    let qdn: Vec<D2> = (0..n).map(|j| var(x[l.qdn(j)], 2 * MAX_DOF + j)).collect();
-                    end_residual(d, &slot(k - 1, 0), &slot(k, 1), &qdn, hd, &zeros)
-                } else {
-                    del_residual(
-                        d,
-                        &slot(k - 1, 0),
-                        &slot(k, 1),
-                        &slot(k + 1, 2),
-                        hd,
-                        &zeros,
-                        &zeros,
-                    )
-                };
-                let mut phi: D2 = Dual::constant(Dual::constant(0.0));
-                for (e, &lm) in r.iter().zip(&lam) {
-                    phi = phi + *e * Dual::constant(Dual::constant(lm));
-                }
-                for (b, ib) in index.iter().enumerate() {
-                    let Some(ib) = *ib else { continue };
-                    if ib <= idir {
-                        put(idir, ib, phi.d[b].d[0]);
-                    }
-                }
-            }
-            // λᵀ (h/2)(u…): ∂²/∂h∂u_j = λ_j / 2.
-            let torques: &[usize] = if k == 0 {
-                &[0]
-            } else if k == l.steps {
-                &[l.steps - 1]
-            } else {
-                &[k - 1, k]
-            };
-            for &ui in torques {
-                for (j, lm) in lam.iter().enumerate() {
-                    put(l.h(), l.u(ui, j), 0.5 * lm);
-                }
-            }
-        }
-        t
     }
 
     /// The linear inequalities `A x ≤ 0` (velocity bounds) as triplets, `2 n N` rows.

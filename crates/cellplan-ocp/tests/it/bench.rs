@@ -1,0 +1,99 @@
+//! Reading `bench/ocp/*.json` (problem) and `*_casadi*.json` (reference solve); the format is
+//! in `bench/ocp/README.md`.
+use cellplan_kin::dynamics::Dynamics;
+use cellplan_kin::load_urdf;
+use cellplan_ocp::problem::{Move, Weights};
+use serde_json::Value;
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+pub fn root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+fn read(rel: &str) -> Value {
+    let text = std::fs::read_to_string(root().join(rel)).unwrap_or_else(|e| panic!("{rel}: {e}"));
+    serde_json::from_str(&text).unwrap()
+}
+
+fn floats(v: &Value) -> Vec<f64> {
+    v.as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x.as_f64().unwrap())
+        .collect()
+}
+
+/// One bench problem: the robot's dynamics and the move's data.
+pub struct Problem {
+    pub dynamics: Dynamics,
+    pub start: Vec<f64>,
+    pub goal: Vec<f64>,
+    pub steps: usize,
+    pub q_bounds: Vec<[f64; 2]>,
+    pub v_max: Vec<f64>,
+    pub u_max: Vec<f64>,
+    pub h_bounds: [f64; 2],
+    pub weights: Weights,
+    /// The reference: J, iterations and solve time of CasADi + IPOPT.
+    pub casadi_j: f64,
+    pub casadi_iterations: u64,
+    pub casadi_solve_s: f64,
+}
+
+impl Problem {
+    /// `name` as in `bench/ocp/NAME.json`; `reference` the suffix of the solution file
+    /// (`casadi` or `casadi_best`).
+    pub fn load(name: &str, reference: &str) -> Problem {
+        let p = read(&format!("bench/ocp/{name}.json"));
+        let r = read(&format!("bench/ocp/{name}_{reference}.json"));
+        let packages: BTreeMap<String, PathBuf> = p["packages"]
+            .as_object()
+            .unwrap()
+            .iter()
+            .map(|(k, v)| (k.clone(), root().join(v.as_str().unwrap())))
+            .collect();
+        let model = load_urdf(
+            &root().join(p["urdf"].as_str().unwrap()),
+            &packages,
+            p["tip"].as_str(),
+        )
+        .unwrap();
+        let dynamics = Dynamics::new(&model.chain, &model.inertia);
+        let limits = &r["limits"];
+        let q_bounds = model.chain.joints.iter().map(|j| [j.lower, j.upper]).collect();
+        let w = &p["weights"];
+        Problem {
+            dynamics,
+            start: floats(&p["q_start"]),
+            goal: floats(&p["q_goal"]),
+            steps: p["N"].as_u64().unwrap() as usize,
+            q_bounds,
+            v_max: floats(&limits["v_max"]),
+            u_max: floats(&limits["u_max"]),
+            h_bounds: [p["h_min"].as_f64().unwrap(), p["h_max"].as_f64().unwrap()],
+            weights: Weights {
+                time: w["c_t"].as_f64().unwrap(),
+                effort: w["c_e"].as_f64().unwrap(),
+                velocity: w["c_v"].as_f64().unwrap(),
+            },
+            casadi_j: r["J"].as_f64().unwrap(),
+            casadi_iterations: r["iterations"].as_u64().unwrap(),
+            casadi_solve_s: r["solve_wall_s"].as_f64().unwrap(),
+        }
+    }
+
+    pub fn as_move(&self) -> Move<'_> {
+        Move {
+            dynamics: &self.dynamics,
+            start: self.start.clone(),
+            goal: self.goal.clone(),
+            steps: self.steps,
+            q_bounds: self.q_bounds.clone(),
+            v_max: self.v_max.clone(),
+            u_max: self.u_max.clone(),
+            h_bounds: self.h_bounds,
+            weights: self.weights,
+        }
+    }
+}
