@@ -180,6 +180,25 @@ pub fn joint_space(arm: &Arm, max_velocity: &[f64]) -> JointSpace {
     JointSpace::new(lower, upper, joint_radii(arm)).with_weights(weights)
 }
 
+/// A part index shared by the threads that use one checker (relaxed: a hint, never a result).
+#[derive(Debug, Default)]
+struct PartHint(std::sync::atomic::AtomicUsize);
+
+impl PartHint {
+    fn get(&self) -> usize {
+        self.0.load(std::sync::atomic::Ordering::Relaxed)
+    }
+    fn set(&self, k: usize) {
+        self.0.store(k, std::sync::atomic::Ordering::Relaxed);
+    }
+}
+
+impl Clone for PartHint {
+    fn clone(&self) -> Self {
+        PartHint(std::sync::atomic::AtomicUsize::new(self.get()))
+    }
+}
+
 /// The clearance of an arm's configurations (see the module documentation).
 ///
 /// [`StateValidity::clearances`] splits it by the joints that can reduce each part: the
@@ -208,6 +227,8 @@ pub struct ArmValidity<'a> {
     pairs: Vec<(usize, usize, Range<usize>, usize)>,
     /// Each body's radii ([`Chain::body_radii`], its reach taken from its cover).
     body_radii: Vec<Vec<f64>>,
+    /// The part that last proved a configuration invalid (asked first next time).
+    last_failed: PartHint,
     /// Other groups standing still (obstacles like the scene), with their body poses.
     parked: Vec<(GroupId, Vec<Pose>)>,
     /// Distance (m) kept from the parked groups beyond the margin.
@@ -262,6 +283,7 @@ impl<'a> ArmValidity<'a> {
             cap: DEFAULT_CLEARANCE_CAP,
             broad_phase: true,
             own_radii: true,
+            last_failed: PartHint::default(),
             moving,
             body_radii,
             pairs,
@@ -339,14 +361,31 @@ impl<'a> ArmValidity<'a> {
         let need = measured_for(self.margin.max(0.0));
         let apart = measured_for(0.0);
         let tiny = 1e-9;
+        let m = self.moving.len();
+        // Part `k`: a moving body against the scene (k < m), else a self pair.
+        let clear = |k: usize, bodies: &[Pose], placed: &PlacedCovers| {
+            if let Some((i, _)) = self.moving.get(k) {
+                self.scene_part(*i, bodies, placed, need + tiny) > need
+            } else if let Some(&(i, j, _, _)) = self.pairs.get(k - m) {
+                self.pair_part(i, j, bodies, placed, apart + tiny) > apart
+            } else {
+                true
+            }
+        };
         self.posed(q, |bodies, placed| {
-            self.moving
-                .iter()
-                .all(|(i, _)| self.scene_part(*i, bodies, placed, need + tiny) > need)
-                && self
-                    .pairs
-                    .iter()
-                    .all(|&(i, j, _, _)| self.pair_part(i, j, bodies, placed, apart + tiny) > apart)
+            // The part that failed last is asked first: samples near each other usually fail
+            // on the same part. Only the work depends on it, never the answer.
+            let first = self.last_failed.get();
+            if !clear(first, bodies, placed) {
+                return false;
+            }
+            match (0..m + self.pairs.len()).find(|&k| k != first && !clear(k, bodies, placed)) {
+                Some(k) => {
+                    self.last_failed.set(k);
+                    false
+                }
+                None => true,
+            }
         })
     }
 
