@@ -8,7 +8,7 @@ use cellplan_core::pipeline;
 use cellplan_core::plan::{self, Allocation, PlanSettings};
 use cellplan_geom::ShapeSpec;
 use cellplan_model::taskgen::{GenOptions, sample_tasks};
-use cellplan_model::{Cell, InputError, io::write_atomic};
+use cellplan_model::{Cell, InputError};
 use cellplan_report::charts::StrategyBar;
 use cellplan_report::html::{CompareRow, compare_html};
 use cellplan_verify::{VerifySettings, verify_with};
@@ -196,19 +196,9 @@ pub fn run(args: &CompareArgs) -> Result<(), Failure> {
     };
     let json = serde_json::to_string_pretty(&report).map_err(|e| Failure::Other(e.to_string()))?;
     let md = markdown(&report);
-    if let Some(dir) = &args.output {
-        std::fs::create_dir_all(dir)
-            .and_then(|()| write_atomic(&dir.join("compare.json"), json.as_bytes()))
-            .and_then(|()| write_atomic(&dir.join("compare.md"), md.as_bytes()))
-            .and_then(|()| write_atomic(&dir.join("compare.html"), html(&report).as_bytes()))
-            .map_err(|e| Failure::Other(format!("cannot write to {}: {e}", dir.display())))?;
-    }
-    if args.json {
-        println!("{json}");
-    } else {
-        print!("{md}");
-    }
-    Ok(())
+    crate::finish_compare(args.output.as_deref(), args.json, &json, &md, || {
+        vec![("compare.html", html(&report))]
+    })
 }
 
 /// The comparison as an HTML page: the table and the bar chart of paper 000 Fig. 10.

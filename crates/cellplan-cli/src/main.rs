@@ -492,6 +492,35 @@ fn run_bench_motion(args: &bench::BenchArgs) -> Result<(), Failure> {
     }
 }
 
+/// How every `compare` ends: `compare.json` (the JSON `text`), `compare.md` (the markdown
+/// `table`) and the `extra` files (named within the folder; made only when there is one)
+/// written all or nothing into `output`, then `text` (with `json`) or `table` printed.
+fn finish_compare(
+    output: Option<&std::path::Path>,
+    json: bool,
+    text: &str,
+    table: &str,
+    extra: impl FnOnce() -> Vec<(&'static str, String)>,
+) -> Result<(), Failure> {
+    if let Some(dir) = output {
+        let extra = extra();
+        let mut files = vec![
+            (dir.join("compare.json"), text.as_bytes()),
+            (dir.join("compare.md"), table.as_bytes()),
+        ];
+        files.extend(extra.iter().map(|(name, body)| (dir.join(name), body.as_bytes())));
+        let files: Vec<(&std::path::Path, &[u8])> = files.iter().map(|(p, b)| (p.as_path(), *b)).collect();
+        cellplan_model::io::write_all_atomic(&files)
+            .map_err(|e| Failure::Other(format!("cannot write into {}: {e}", dir.display())))?;
+    }
+    if json {
+        println!("{text}");
+    } else {
+        print!("{table}");
+    }
+    Ok(())
+}
+
 /// Prints `value` as pretty JSON.
 fn print_json<T: serde::Serialize>(value: &T) -> Result<(), Failure> {
     println!(

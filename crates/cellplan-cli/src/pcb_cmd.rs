@@ -3,6 +3,7 @@
 //! `cellplan-verify::pcb`, the page in `cellplan-report::pcb`.
 use crate::Failure;
 use crate::plan_cmd::PlanArgs;
+use crate::verify_cmd::print_verdict;
 use cellplan_model::InputError;
 use cellplan_model::io::{check_writable, write_all_atomic};
 use cellplan_pcb::PcbCell;
@@ -385,29 +386,20 @@ pub fn verify(plan_path: &Path, cell_path: &Path, json: bool, robot_robot: bool)
         ))
     })?;
     let report = verify_pcb(&cell, &plan, &PcbVerifySettings { robot_robot });
-    if json {
-        crate::print_json(&report)?;
-    } else {
-        for v in &report.violations {
-            println!("{}", describe(v));
+    let summary = format!(
+        "assembly time {:.3} s (recomputed), lower bound {:.3} s{}",
+        report.cycle_time_s,
+        report.lower_bound_s,
+        if report.crossings > 0 && report.ok {
+            format!(
+                "; {} robot crossing(s), not checked (--no-robot-robot)",
+                report.crossings
+            )
+        } else {
+            String::new()
         }
-        println!(
-            "{}: {} violation(s); assembly time {:.3} s (recomputed), lower bound {:.3} s{}",
-            if report.ok { "ok" } else { "NOT OK" },
-            report.violations.len(),
-            report.cycle_time_s,
-            report.lower_bound_s,
-            if report.crossings > 0 && report.ok {
-                format!(
-                    "; {} robot crossing(s), not checked (--no-robot-robot)",
-                    report.crossings
-                )
-            } else {
-                String::new()
-            }
-        );
-    }
-    if report.ok { Ok(()) } else { Err(Failure::Rejected) }
+    );
+    print_verdict(&report, report.ok, &report.violations, describe, &summary, json)
 }
 
 /// `cellplan report` on a PCB plan.
@@ -548,18 +540,7 @@ pub fn compare(args: &crate::compare_cmd::CompareArgs) -> Result<(), Failure> {
     };
     let text = serde_json::to_string_pretty(&out).map_err(|e| Failure::Other(e.to_string()))?;
     let table = compare_table(&out);
-    if let Some(dir) = &args.output {
-        let md = dir.join("compare.md");
-        let js = dir.join("compare.json");
-        write_all_atomic(&[(&md, table.as_bytes()), (&js, text.as_bytes())])
-            .map_err(|e| Failure::Other(format!("cannot write into {}: {e}", dir.display())))?;
-    }
-    if args.json {
-        println!("{text}");
-    } else {
-        print!("{table}");
-    }
-    Ok(())
+    crate::finish_compare(args.output.as_deref(), args.json, &text, &table, Vec::new)
 }
 
 fn compare_table(out: &CompareOut) -> String {

@@ -49,25 +49,43 @@ pub fn run(args: &VerifyArgs) -> Result<(), Failure> {
         )));
     }
     let report = verify(&cell, &plan, &settings);
-    if args.json {
-        println!(
-            "{}",
-            serde_json::to_string_pretty(&report).map_err(|e| Failure::Other(e.to_string()))?
-        );
+    let summary = format!(
+        "cycle time {:.2} s, Δt {:.2} s (recomputed); {} configurations checked",
+        report.cycle_time_s, report.delta_t_s, report.configurations_checked
+    );
+    print_verdict(
+        &report,
+        report.ok,
+        &report.violations,
+        describe,
+        &summary,
+        args.json,
+    )
+}
+
+/// How every `verify` ends: the report as JSON, or one line per violation and `ok` / `NOT OK`
+/// with the count and `summary`; [`Failure::Rejected`] (exit 4) when not `ok`.
+pub(crate) fn print_verdict<R: serde::Serialize, V>(
+    report: &R,
+    ok: bool,
+    violations: &[V],
+    describe: impl Fn(&V) -> String,
+    summary: &str,
+    json: bool,
+) -> Result<(), Failure> {
+    if json {
+        crate::print_json(report)?;
     } else {
-        for v in &report.violations {
+        for v in violations {
             println!("{}", describe(v));
         }
         println!(
-            "{}: {} violation(s); cycle time {:.2} s, Δt {:.2} s (recomputed); {} configurations checked",
-            if report.ok { "ok" } else { "NOT OK" },
-            report.violations.len(),
-            report.cycle_time_s,
-            report.delta_t_s,
-            report.configurations_checked
+            "{}: {} violation(s); {summary}",
+            if ok { "ok" } else { "NOT OK" },
+            violations.len()
         );
     }
-    if report.ok { Ok(()) } else { Err(Failure::Rejected) }
+    if ok { Ok(()) } else { Err(Failure::Rejected) }
 }
 
 /// One violation on one line.

@@ -184,10 +184,7 @@ pub fn compare(args: &crate::compare_cmd::CompareArgs) -> Result<(), Failure> {
     };
     let text = serde_json::to_string_pretty(&out).map_err(|e| Failure::Other(e.to_string()))?;
     let table = compare_table(&out);
-    if let Some(dir) = &args.output {
-        let md = dir.join("compare.md");
-        let js = dir.join("compare.json");
-        let rp = dir.join("report.html");
+    crate::finish_compare(args.output.as_deref(), args.json, &text, &table, || {
         let table4: Vec<cellplan_report::cmm::Table4Row> = out
             .strategies
             .iter()
@@ -201,20 +198,11 @@ pub fn compare(args: &crate::compare_cmd::CompareArgs) -> Result<(), Failure> {
             })
             .collect();
         let verdict = verify_cmm(&cell, &base);
-        let page = cellplan_report::cmm::html(&base, &cell, Some(&verdict), Some(&table4));
-        write_all_atomic(&[
-            (&md, table.as_bytes()),
-            (&js, text.as_bytes()),
-            (&rp, page.as_bytes()),
-        ])
-        .map_err(|e| Failure::Other(format!("cannot write into {}: {e}", dir.display())))?;
-    }
-    if args.json {
-        println!("{text}");
-    } else {
-        print!("{table}");
-    }
-    Ok(())
+        vec![(
+            "report.html",
+            cellplan_report::cmm::html(&base, &cell, Some(&verdict), Some(&table4)),
+        )]
+    })
 }
 
 fn compare_table(out: &CompareOut) -> String {

@@ -10,6 +10,7 @@ mod reuse;
 
 use crate::Failure;
 use crate::plan_cmd::PlanArgs;
+use crate::verify_cmd::print_verdict;
 pub use bench_local::bench_local;
 use cellplan_cmm::cell::{CmmCell, KIND};
 use cellplan_cmm::classify::Method;
@@ -288,23 +289,14 @@ pub fn verify(plan_path: &Path, cell_path: &Path, json: bool) -> Result<(), Fail
     let cell = load(cell_path)?;
     let plan = read_plan(plan_path)?;
     let report = verify_cmm(&cell, &plan);
-    if json {
-        crate::print_json(&report)?;
-    } else {
-        for v in &report.violations {
-            println!("{}", describe(v));
-        }
-        println!(
-            "{}: {} violation(s); {} MPs touched; motion time {:.3} s (recomputed); closest approach {:.2} mm over {} samples",
-            if report.ok { "ok" } else { "NOT OK" },
-            report.violations.len(),
-            report.touched,
-            report.motion_time_s,
-            report.closest_m * 1e3,
-            report.samples
-        );
-    }
-    if report.ok { Ok(()) } else { Err(Failure::Rejected) }
+    let summary = format!(
+        "{} MPs touched; motion time {:.3} s (recomputed); closest approach {:.2} mm over {} samples",
+        report.touched,
+        report.motion_time_s,
+        report.closest_m * 1e3,
+        report.samples
+    );
+    print_verdict(&report, report.ok, &report.violations, describe, &summary, json)
 }
 
 /// `cellplan report` on a CMM plan.

@@ -83,15 +83,9 @@ fn plan_reuse_verify_report_and_compare_a_cmm_cell() {
     );
     // The report command.
     let page2 = dir.join("page.html");
-    let res = cellplan(
+    run_ok(
         &["report", &plan_file, cell, "-o", &page2.display().to_string()],
         &cache,
-    );
-    assert_eq!(
-        res.status.code(),
-        Some(0),
-        "{}",
-        String::from_utf8_lossy(&res.stderr)
     );
     assert!(
         std::fs::read_to_string(&page2)

@@ -29,8 +29,8 @@ pub(crate) fn cellplan(args: &[&str], cache: &Path) -> Output {
         .expect("run cellplan")
 }
 
-/// Runs `cellplan args`, asserts exit 0 (showing stderr otherwise) and parses stdout as JSON.
-pub(crate) fn json_ok(args: &[&str], cache: &Path) -> Value {
+/// Runs `cellplan args` and asserts exit 0 (showing stderr otherwise).
+pub(crate) fn run_ok(args: &[&str], cache: &Path) -> Output {
     let out = cellplan(args, cache);
     assert_eq!(
         out.status.code(),
@@ -38,7 +38,12 @@ pub(crate) fn json_ok(args: &[&str], cache: &Path) -> Value {
         "cellplan {args:?}: {}",
         String::from_utf8_lossy(&out.stderr)
     );
-    serde_json::from_slice(&out.stdout).expect("stdout is JSON")
+    out
+}
+
+/// Runs `cellplan args`, asserts exit 0 (showing stderr otherwise) and parses stdout as JSON.
+pub(crate) fn json_ok(args: &[&str], cache: &Path) -> Value {
+    serde_json::from_slice(&run_ok(args, cache).stdout).expect("stdout is JSON")
 }
 
 /// A fresh scratch folder per test (kept after the run, for a look at what a test wrote).

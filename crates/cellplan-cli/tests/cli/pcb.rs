@@ -58,15 +58,9 @@ fn plan_verify_report_and_compare_a_pcb_cell() {
     assert_eq!(res.status.code(), Some(4));
     // The report command on the written plan.
     let page2 = dir.join("page.html");
-    let res = cellplan(
+    run_ok(
         &["report", &plan_file, cell, "-o", &page2.display().to_string()],
         &cache,
-    );
-    assert_eq!(
-        res.status.code(),
-        Some(0),
-        "{}",
-        String::from_utf8_lossy(&res.stderr)
     );
     assert!(std::fs::read_to_string(&page2).unwrap().contains("id=\"x-time\""));
     // Compare: four one-robot configurations and two robots with and without avoidance.
