@@ -161,15 +161,26 @@ impl<P: Nlp + ?Sized> Scaled<'_, P> {
 }
 
 impl<P: Nlp + ?Sized> Scaled<'_, P> {
+    /// Whether variable `i` has a lower bound with a barrier (finite, and the variable not
+    /// fixed).
+    pub fn has_lower(&self, i: usize) -> bool {
+        self.xl[i].is_finite() && !self.fixed[i]
+    }
+
+    /// Whether variable `i` has an upper bound with a barrier.
+    pub fn has_upper(&self, i: usize) -> bool {
+        self.xu[i].is_finite() && !self.fixed[i]
+    }
+
     /// The barrier function `φ_μ` and infeasibility `θ` (1-norm) at a point.
     pub fn merit(&self, x: &[f64], s: &[f64], e: &Eval, mu: f64) -> (f64, f64) {
         let p = self;
         let mut phi = e.f;
         for i in 0..p.n {
-            if p.xl[i].is_finite() && !p.fixed[i] {
+            if p.has_lower(i) {
                 phi -= mu * (x[i] - p.xl[i]).ln();
             }
-            if p.xu[i].is_finite() && !p.fixed[i] {
+            if p.has_upper(i) {
                 phi -= mu * (p.xu[i] - x[i]).ln();
             }
         }
@@ -345,24 +356,8 @@ pub(crate) fn solve_with<P: Nlp + ?Sized>(
         s,
         yc: vec![0.0; m],
         yd: vec![0.0; md],
-        zl: (0..n)
-            .map(|i| {
-                if p.xl[i].is_finite() && !p.fixed[i] {
-                    1.0
-                } else {
-                    0.0
-                }
-            })
-            .collect(),
-        zu: (0..n)
-            .map(|i| {
-                if p.xu[i].is_finite() && !p.fixed[i] {
-                    1.0
-                } else {
-                    0.0
-                }
-            })
-            .collect(),
+        zl: (0..n).map(|i| if p.has_lower(i) { 1.0 } else { 0.0 }).collect(),
+        zu: (0..n).map(|i| if p.has_upper(i) { 1.0 } else { 0.0 }).collect(),
         vl: (0..md)
             .map(|r| if p.dl[r].is_finite() { 1.0 } else { 0.0 })
             .collect(),
@@ -447,12 +442,12 @@ impl<P: Nlp + ?Sized> Driver<'_, '_, P> {
         let mut zsum = 0.0;
         let mut zcount = 0usize;
         for i in 0..p.n {
-            if self.has_lower(i) {
+            if self.p.has_lower(i) {
                 compl = compl.max((sl[i] * it.zl[i] - mu).abs());
                 zsum += it.zl[i];
                 zcount += 1;
             }
-            if self.has_upper(i) {
+            if self.p.has_upper(i) {
                 compl = compl.max((su[i] * it.zu[i] - mu).abs());
                 zsum += it.zu[i];
                 zcount += 1;

@@ -18,6 +18,28 @@ const KAPPA_SIGMA: f64 = 1e10;
 const KAPPA_SOC: f64 = 0.99;
 const MAX_SOC: usize = 4;
 
+/// The Newton step of bound multipliers `z` on slacks `slack` (0 where `active` is false): the
+/// primal-dual step `(μ − z·slack − sign·z·d)/slack`, where the slack changes by `sign·d` along
+/// the primal step `d` (+1 for a lower bound, −1 for an upper one).
+fn dual_step(
+    active: impl Fn(usize) -> bool,
+    z: &[f64],
+    slack: &[f64],
+    d: &[f64],
+    sign: f64,
+    mu: f64,
+) -> Vec<f64> {
+    (0..z.len())
+        .map(|i| {
+            if active(i) {
+                (mu - z[i] * slack[i] - sign * z[i] * d[i]) / slack[i]
+            } else {
+                0.0
+            }
+        })
+        .collect()
+}
+
 /// A Newton direction over every part of the iterate.
 struct Step {
     dx: Vec<f64>,
@@ -97,10 +119,10 @@ impl<P: Nlp + ?Sized> Driver<'_, '_, P> {
             let sigma_x: Vec<f64> = (0..p.n)
                 .map(|i| {
                     let mut s = 0.0;
-                    if self.has_lower(i) {
+                    if self.p.has_lower(i) {
                         s += it.zl[i] / sl[i];
                     }
-                    if self.has_upper(i) {
+                    if self.p.has_upper(i) {
                         s += it.zu[i] / su[i];
                     }
                     s
@@ -137,10 +159,10 @@ impl<P: Nlp + ?Sized> Driver<'_, '_, P> {
                         return 0.0;
                     }
                     let mut r = grad[i] + a[i] + b[i];
-                    if self.has_lower(i) {
+                    if self.p.has_lower(i) {
                         r -= mu / sl[i];
                     }
-                    if self.has_upper(i) {
+                    if self.p.has_upper(i) {
                         r += mu / su[i];
                     }
                     r
@@ -228,42 +250,10 @@ impl<P: Nlp + ?Sized> Driver<'_, '_, P> {
                 }
             };
             // Bound multipliers: their Newton steps, the fraction to the boundary, κ_Σ.
-            let dzl: Vec<f64> = (0..p.n)
-                .map(|i| {
-                    if self.has_lower(i) {
-                        (mu - it.zl[i] * sl[i] - it.zl[i] * step.dx[i]) / sl[i]
-                    } else {
-                        0.0
-                    }
-                })
-                .collect();
-            let dzu: Vec<f64> = (0..p.n)
-                .map(|i| {
-                    if self.has_upper(i) {
-                        (mu - it.zu[i] * su[i] + it.zu[i] * step.dx[i]) / su[i]
-                    } else {
-                        0.0
-                    }
-                })
-                .collect();
-            let dvl: Vec<f64> = (0..p.md)
-                .map(|r| {
-                    if p.dl[r].is_finite() {
-                        (mu - it.vl[r] * tl[r] - it.vl[r] * step.ds[r]) / tl[r]
-                    } else {
-                        0.0
-                    }
-                })
-                .collect();
-            let dvu: Vec<f64> = (0..p.md)
-                .map(|r| {
-                    if p.du[r].is_finite() {
-                        (mu - it.vu[r] * tu[r] + it.vu[r] * step.ds[r]) / tu[r]
-                    } else {
-                        0.0
-                    }
-                })
-                .collect();
+            let dzl = dual_step(|i| p.has_lower(i), &it.zl, &sl, &step.dx, 1.0, mu);
+            let dzu = dual_step(|i| p.has_upper(i), &it.zu, &su, &step.dx, -1.0, mu);
+            let dvl = dual_step(|r| p.dl[r].is_finite(), &it.vl, &tl, &step.ds, 1.0, mu);
+            let dvu = dual_step(|r| p.du[r].is_finite(), &it.vu, &tu, &step.ds, -1.0, mu);
             let mut alpha_z: f64 = 1.0;
             for (z, dz) in [(&it.zl, &dzl), (&it.zu, &dzu), (&it.vl, &dvl), (&it.vu, &dvu)] {
                 for (zi, di) in z.iter().zip(dz.iter()) {
@@ -285,10 +275,10 @@ impl<P: Nlp + ?Sized> Driver<'_, '_, P> {
                 z.min(KAPPA_SIGMA * mu / slack).max(mu / (KAPPA_SIGMA * slack))
             };
             for i in 0..p.n {
-                if self.has_lower(i) {
+                if self.p.has_lower(i) {
                     it.zl[i] = clamp(it.zl[i] + alpha_z * dzl[i], sl[i]);
                 }
-                if self.has_upper(i) {
+                if self.p.has_upper(i) {
                     it.zu[i] = clamp(it.zu[i] + alpha_z * dzu[i], su[i]);
                 }
             }
@@ -308,13 +298,6 @@ impl<P: Nlp + ?Sized> Driver<'_, '_, P> {
                 return (Status::Solved, it);
             }
         }
-    }
-
-    pub(crate) fn has_lower(&self, i: usize) -> bool {
-        self.p.xl[i].is_finite() && !self.p.fixed[i]
-    }
-    pub(crate) fn has_upper(&self, i: usize) -> bool {
-        self.p.xu[i].is_finite() && !self.p.fixed[i]
     }
 
     /// Largest unscaled violation of the constraints at `x`.
@@ -372,10 +355,10 @@ impl<P: Nlp + ?Sized> Driver<'_, '_, P> {
         let [sl, su, tl, tu] = self.slacks(it);
         let mut a: f64 = 1.0;
         for i in 0..p.n {
-            if self.has_lower(i) && dx[i] < 0.0 {
+            if self.p.has_lower(i) && dx[i] < 0.0 {
                 a = a.min(-tau * sl[i] / dx[i]);
             }
-            if self.has_upper(i) && dx[i] > 0.0 {
+            if self.p.has_upper(i) && dx[i] > 0.0 {
                 a = a.min(tau * su[i] / dx[i]);
             }
         }

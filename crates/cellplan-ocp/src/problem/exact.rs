@@ -34,6 +34,18 @@ struct StepFirst {
     mass: Vec<Vec<f64>>,
 }
 
+/// The momentum `p = M(m) v` and the Lagrangian `L = ½ vᵀ p − V(m)` at midpoint `m` (any
+/// scalar: the derivatives ride on it) and velocity `v` (constants).
+fn lagrangian<T: Real>(d: &Dynamics, m: &[T], v: &[f64]) -> (Vec<T>, T) {
+    let vc: Vec<T> = v.iter().map(|&x| T::from_f64(x)).collect();
+    let p = d.momentum(m, &vc);
+    let mut lag = -d.potential(m);
+    for (pj, &vj) in p.iter().zip(v) {
+        lag = lag + *pj * T::from_f64(0.5 * vj);
+    }
+    (p, lag)
+}
+
 fn step_first<const K: usize, const P: usize>(d: &Dynamics, m: &[f64], v: &[f64]) -> StepFirst {
     let n = m.len();
     let mv: Vec<Taylor2<K, P>> = m
@@ -41,14 +53,7 @@ fn step_first<const K: usize, const P: usize>(d: &Dynamics, m: &[f64], v: &[f64]
         .enumerate()
         .map(|(j, &x)| Taylor2::variable(x, j))
         .collect();
-    let vc: Vec<Taylor2<K, P>> = v.iter().map(|&x| Taylor2::constant(x)).collect();
-    let p = d.momentum(&mv, &vc);
-    let pot = d.potential(&mv);
-    // L = ½ vᵀ p − V as a function of m.
-    let mut lag = -pot;
-    for (pj, &vj) in p.iter().zip(v) {
-        lag = lag + *pj * Taylor2::constant(0.5 * vj);
-    }
+    let (p, lag) = lagrangian(d, &mv, v);
     StepFirst {
         lq: lag.g[..n].to_vec(),
         lq_m: (0..n).map(|j| (0..n).map(|l| lag.hess(j, l)).collect()).collect(),
@@ -94,13 +99,7 @@ fn step_second<const K: usize, const P: usize>(
             d: [Taylor2::constant(alpha[j])],
         })
         .collect();
-    let vc: Vec<T<K, P>> = v.iter().map(|&x| T::from_f64(x)).collect();
-    let p = d.momentum(&mv, &vc);
-    let pot = d.potential(&mv);
-    let mut lag = -pot;
-    for (pj, &vj) in p.iter().zip(v) {
-        lag = lag + *pj * T::from_f64(0.5 * vj);
-    }
+    let (p, lag) = lagrangian(d, &mv, v);
     // A = ∂_α L as a function of m; ∇_v A = M_α v; ∇²_v A = M_α.
     let a = lag.d[0];
     let a_v: Vec<f64> = p.iter().map(|x| x.d[0].v).collect();

@@ -24,17 +24,10 @@ fn floats(v: &Value) -> Vec<f64> {
         .collect()
 }
 
-/// One bench problem: the robot's dynamics and the move's data.
+/// One bench problem: the move (its robot's dynamics live for the whole test run) and the
+/// reference.
 pub struct Problem {
-    pub dynamics: Dynamics,
-    pub start: Vec<f64>,
-    pub goal: Vec<f64>,
-    pub steps: usize,
-    pub q_bounds: Vec<[f64; 2]>,
-    pub v_max: Vec<f64>,
-    pub u_max: Vec<f64>,
-    pub h_bounds: [f64; 2],
-    pub weights: Weights,
+    pub mv: Move<'static>,
     /// The reference: J, iterations and solve time of CasADi + IPOPT.
     pub casadi_j: f64,
     pub casadi_iterations: u64,
@@ -59,41 +52,31 @@ impl Problem {
             p["tip"].as_str(),
         )
         .unwrap();
-        let dynamics = Dynamics::new(&model.chain, &model.inertia);
+        // A handful of problems per test run: the dynamics are leaked so that the move can
+        // borrow them for as long as the problem lives.
+        let dynamics: &'static Dynamics = Box::leak(Box::new(Dynamics::new(&model.chain, &model.inertia)));
         let limits = &r["limits"];
         let q_bounds = model.chain.joints.iter().map(|j| [j.lower, j.upper]).collect();
         let w = &p["weights"];
         Problem {
-            dynamics,
-            start: floats(&p["q_start"]),
-            goal: floats(&p["q_goal"]),
-            steps: p["N"].as_u64().unwrap() as usize,
-            q_bounds,
-            v_max: floats(&limits["v_max"]),
-            u_max: floats(&limits["u_max"]),
-            h_bounds: [p["h_min"].as_f64().unwrap(), p["h_max"].as_f64().unwrap()],
-            weights: Weights {
-                time: w["c_t"].as_f64().unwrap(),
-                effort: w["c_e"].as_f64().unwrap(),
-                velocity: w["c_v"].as_f64().unwrap(),
+            mv: Move {
+                dynamics,
+                start: floats(&p["q_start"]),
+                goal: floats(&p["q_goal"]),
+                steps: p["N"].as_u64().unwrap() as usize,
+                q_bounds,
+                v_max: floats(&limits["v_max"]),
+                u_max: floats(&limits["u_max"]),
+                h_bounds: [p["h_min"].as_f64().unwrap(), p["h_max"].as_f64().unwrap()],
+                weights: Weights {
+                    time: w["c_t"].as_f64().unwrap(),
+                    effort: w["c_e"].as_f64().unwrap(),
+                    velocity: w["c_v"].as_f64().unwrap(),
+                },
             },
             casadi_j: r["J"].as_f64().unwrap(),
             casadi_iterations: r["iterations"].as_u64().unwrap(),
             casadi_solve_s: r["solve_wall_s"].as_f64().unwrap(),
-        }
-    }
-
-    pub fn as_move(&self) -> Move<'_> {
-        Move {
-            dynamics: &self.dynamics,
-            start: self.start.clone(),
-            goal: self.goal.clone(),
-            steps: self.steps,
-            q_bounds: self.q_bounds.clone(),
-            v_max: self.v_max.clone(),
-            u_max: self.u_max.clone(),
-            h_bounds: self.h_bounds,
-            weights: self.weights,
         }
     }
 }

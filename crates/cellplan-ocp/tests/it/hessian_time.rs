@@ -8,7 +8,7 @@ use std::time::Instant;
 #[ignore = "timing: cargo test -p cellplan-ocp --release --test it -- --ignored --nocapture hessian_time"]
 fn hessian_time() {
     let p = Problem::load("ur10_b", "casadi");
-    let m = p.as_move();
+    let m = &p.mv;
     let l = m.layout();
     let mut x = m.initial_guess();
     for (k, v) in x.iter_mut().enumerate() {

@@ -16,7 +16,7 @@ pub struct Outcome {
 /// Solves `name` from the initial guess the reference used and checks the answer.
 pub fn solve_and_check(name: &str, reference: &str) -> Outcome {
     let p = Problem::load(name, reference);
-    let m = p.as_move();
+    let m = &p.mv;
     let opt = Options {
         tol: 1e-10,
         max_iter: 1000,
@@ -37,7 +37,7 @@ pub fn solve_and_check(name: &str, reference: &str) -> Outcome {
         m.initial_guess()
     };
     let started = Instant::now();
-    let s = nlp::ipm::solve_from(&m, &x0, &opt);
+    let s = nlp::ipm::solve_from(m, &x0, &opt);
     let seconds = started.elapsed().as_secs_f64();
     assert_eq!(
         s.status,
