@@ -566,12 +566,9 @@ mod tests {
     #[test]
     fn every_mp_of_the_housing_is_grouped_within_its_cone_on_adjacent_faces() {
         let (mps, probe) = crate::scene::housing();
-        let orientations = crate::scene::grid();
-        let mut counts = Vec::new();
-        for method in [Method::Greedy, Method::Exact] {
-            let c = classify(&mps, &housing_adjacent, &probe, &orientations, 0.001, method);
-            crate::scene::assert_grouped(&mps, &c, &housing_adjacent, &probe, 0.001);
-            eprintln!("housing, {method:?}: {} groups", c.groups.len());
+        let both = crate::scene::classify_both(&mps, &probe, &housing_adjacent);
+        for (method, c) in ["greedy", "exact"].iter().zip(&both) {
+            eprintln!("housing, {method}: {} groups", c.groups.len());
             for g in &c.groups {
                 let faces: Vec<&str> = g.faces.iter().map(|&f| HOUSING_FACES[f]).collect();
                 let members: Vec<&str> = g.members.iter().map(|&i| mps[i].name.as_str()).collect();
@@ -581,14 +578,8 @@ mod tests {
                     g.angles.1.to_degrees()
                 );
             }
-            counts.push(c.groups.len());
         }
-        assert!(
-            counts[1] <= counts[0],
-            "exact {} vs greedy {}",
-            counts[1],
-            counts[0]
-        );
+        let counts = both.map(|c| c.groups.len());
         // Eleven: the top with the slope (tilted 15°), the flange's top (straight down), the
         // front, the back with the boss's face, the bore's wall in two tilts (one with its
         // floor), the boss's bore, each end, and each of the flange's sides alone (eq. 3 does
@@ -617,7 +608,6 @@ mod tests {
     fn the_housing_is_planned_whole() {
         use crate::job::{JobSettings, plan_job};
         use crate::motion::{CmmValidity, space};
-        use cellplan_motion::plan::check_segment;
         let (mps, probe) = crate::scene::housing();
         let groups = classify(
             &mps,
@@ -644,20 +634,7 @@ mod tests {
             &JobSettings::default(),
         )
         .unwrap_or_else(|e| panic!("{e:?}"));
-        let unmeasured: Vec<(&str, &str)> = job
-            .unmeasured
-            .iter()
-            .map(|(i, why)| (mps[*i].name.as_str(), why.as_str()))
-            .collect();
-        assert!(unmeasured.is_empty(), "{unmeasured:?}");
-        for w in job.path.windows(2) {
-            assert!(check_segment(&space, &validity, &w[0], &w[1], 1e-4).valid);
-        }
-        let mut touched: Vec<usize> = job.touches.iter().map(|t| t.1).collect();
-        touched.sort_unstable();
-        assert_eq!(touched, (0..mps.len()).collect::<Vec<_>>());
-        assert_eq!(job.path.first(), Some(&home));
-        assert_eq!(job.path.last(), Some(&home));
+        crate::scene::assert_job_whole(&job, &space, &validity, mps.len(), &home);
         eprintln!(
             "housing: {} groups planned, movement {:.1} s, rotation {:.1} s, inspection {:.1} s, motion {:.1} s, computed in {:.2} s",
             job.groups.len(),

@@ -554,10 +554,8 @@ mod tests {
                 },
             )
             .unwrap_or_else(|e| panic!("{order:?}: {e:?}"));
-            // Every segment of the whole path is clear; every MP's approach is visited.
-            for w in job.path.windows(2) {
-                assert!(check_segment(&space, &validity, &w[0], &w[1], 1e-4).valid);
-            }
+            crate::scene::assert_job_whole(&job, &space, &validity, 39, &home);
+            // Every MP's approach is visited.
             let mut visited = 0;
             for g in &job.groups {
                 assert_eq!(g.order.len(), g.members.len());
@@ -567,18 +565,6 @@ mod tests {
                 }
             }
             assert_eq!(visited, 39);
-            assert!(job.unmeasured.is_empty());
-            // Each MP is touched once, at its approach configuration.
-            let mut touched: Vec<usize> = job.touches.iter().map(|t| t.1).collect();
-            touched.sort_unstable();
-            assert_eq!(touched, (0..39).collect::<Vec<_>>());
-            for &(at, mp) in &job.touches {
-                let g = job.groups.iter().find(|g| g.members.contains(&mp)).unwrap();
-                let k = g.members.iter().position(|&x| x == mp).unwrap();
-                assert_eq!(job.path[at], g.paths.approaches[k]);
-            }
-            assert_eq!(job.path.first(), Some(&home));
-            assert_eq!(job.path.last(), Some(&home));
             assert!((job.inspection_s - 39.0).abs() < 1e-9);
             eprintln!(
                 "{order:?}: {} groups, movement {:.1} s, rotation {:.1} s, inspection {:.1} s, motion {:.1} s, computed in {:.2} s",

@@ -8,6 +8,8 @@ use crate::motion::Travel;
 use crate::part::{BlockSpec, Mp, cylinder_block};
 use cellplan_geom::{DQuat, DVec3, Mesh, Pose, ShapeSpec};
 use cellplan_kin::cmm::CmmHead;
+use parry3d_f64::query::PointQuery;
+use parry3d_f64::shape::Triangle;
 use std::sync::Arc;
 
 /// The block's MPs (m) and the probe in the block's scene.
@@ -74,46 +76,13 @@ pub(crate) fn closest(mesh: &Mesh, p: DVec3) -> (f64, DVec3) {
     let mut best = (f64::INFINITY, DVec3::ZERO);
     for (i, _) in mesh.triangles.iter().enumerate() {
         let [a, b, c] = mesh.corners(i);
-        let q = closest_on_triangle(p, a, b, c);
+        let q = Triangle::new(a, b, c).project_local_point(p, true).point;
         let d = (q - p).length();
         if d < best.0 - 1e-9 || (d < best.0 + 1e-9 && mesh.triangle_area(i) > 0.0 && best.1 == DVec3::ZERO) {
             best = (d, mesh.triangle_normal(i));
         }
     }
     best
-}
-
-/// Closest point on a triangle (Ericson, Real-Time Collision Detection, 5.1.5).
-fn closest_on_triangle(p: DVec3, a: DVec3, b: DVec3, c: DVec3) -> DVec3 {
-    let (ab, ac, ap) = (b - a, c - a, p - a);
-    let (d1, d2) = (ab.dot(ap), ac.dot(ap));
-    if d1 <= 0.0 && d2 <= 0.0 {
-        return a;
-    }
-    let bp = p - b;
-    let (d3, d4) = (ab.dot(bp), ac.dot(bp));
-    if d3 >= 0.0 && d4 <= d3 {
-        return b;
-    }
-    let vc = d1 * d4 - d3 * d2;
-    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
-        return a + ab * (d1 / (d1 - d3));
-    }
-    let cp = p - c;
-    let (d5, d6) = (ab.dot(cp), ac.dot(cp));
-    if d6 >= 0.0 && d5 <= d6 {
-        return c;
-    }
-    let vb = d5 * d2 - d1 * d6;
-    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
-        return a + ac * (d2 / (d2 - d6));
-    }
-    let va = d3 * d6 - d5 * d4;
-    if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
-        return b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)));
-    }
-    let denom = 1.0 / (va + vb + vc);
-    a + ab * (vb * denom) + ac * (vc * denom)
 }
 
 /// Asserts what §3.1 promises of a classification of `mps`: every MP measurable and in exactly
@@ -144,4 +113,53 @@ pub(crate) fn assert_grouped(
         }
     }
     assert!(seen.iter().all(|&k| k == 1), "each MP in one group");
+}
+
+/// A whole job holds up: nothing unmeasured, every segment of its path clear (the conservative
+/// check), every one of the `mps` MPs touched exactly once at its group's approach
+/// configuration, and the path from `home` back to `home`.
+pub(crate) fn assert_job_whole(
+    job: &crate::job::Job,
+    space: &cellplan_motion::plan::JointSpace,
+    validity: &crate::motion::CmmValidity,
+    mps: usize,
+    home: &[f64],
+) {
+    assert!(job.unmeasured.is_empty(), "unmeasured: {:?}", job.unmeasured);
+    for w in job.path.windows(2) {
+        assert!(cellplan_motion::plan::check_segment(space, validity, &w[0], &w[1], 1e-4).valid);
+    }
+    let mut touched: Vec<usize> = job.touches.iter().map(|t| t.1).collect();
+    touched.sort_unstable();
+    assert_eq!(touched, (0..mps).collect::<Vec<_>>());
+    for &(at, mp) in &job.touches {
+        let g = job.groups.iter().find(|g| g.members.contains(&mp)).unwrap();
+        let k = g.members.iter().position(|&x| x == mp).unwrap();
+        assert_eq!(job.path[at], g.paths.approaches[k]);
+    }
+    assert_eq!(job.path.first().map(Vec::as_slice), Some(home));
+    assert_eq!(job.path.last().map(Vec::as_slice), Some(home));
+}
+
+/// The classification of `mps` by both methods over [`grid`], each checked by
+/// [`assert_grouped`]; the exact one never has more groups than the greedy one. Returns both.
+pub(crate) fn classify_both(
+    mps: &[Mp],
+    probe: &Probe,
+    adjacent: &dyn Fn(usize, usize) -> bool,
+) -> [crate::classify::Classification; 2] {
+    use crate::classify::{Method, classify};
+    let orientations = grid();
+    let [greedy, exact] = [Method::Greedy, Method::Exact].map(|method| {
+        let c = classify(mps, adjacent, probe, &orientations, 0.001, method);
+        assert_grouped(mps, &c, adjacent, probe, 0.001);
+        c
+    });
+    assert!(
+        exact.groups.len() <= greedy.groups.len(),
+        "exact {} vs greedy {}",
+        exact.groups.len(),
+        greedy.groups.len()
+    );
+    [greedy, exact]
 }
