@@ -128,8 +128,25 @@ pub struct Sequence {
 /// Most DP states for the exact solver; beyond, the iterated local search.
 pub const EXACT_STATES: u128 = 4_000_000;
 
+/// Kicks of the iterated local search per GTSP (beyond [`EXACT_STATES`]).
+pub const ILS_KICKS: usize = 100;
+
+/// Whether to print one line per lazy round to stderr (`CELLPLAN_STUDWELD_VERBOSE`).
+fn verbose() -> bool {
+    std::env::var_os("CELLPLAN_STUDWELD_VERBOSE").is_some()
+}
+
 /// Solves the GTSP on `costs` with `service` (start and end at home).
 fn tour(g: &Graph, costs: &[Vec<f64>], service: &[f64], seed: u64) -> (Vec<usize>, bool) {
+    let started = std::time::Instant::now();
+    let out = tour_inner(g, costs, service, seed);
+    if verbose() {
+        eprintln!("  gtsp: {:.2} s (exact: {})", started.elapsed().as_secs_f64(), out.1);
+    }
+    out
+}
+
+fn tour_inner(g: &Graph, costs: &[Vec<f64>], service: &[f64], seed: u64) -> (Vec<usize>, bool) {
     let n = g.q.len();
     let m = CostMatrix::from_fn(n, |i, j| costs[i][j]);
     let p = Gtsp::new(m, g.clusters.clone())
@@ -143,7 +160,7 @@ fn tour(g: &Graph, costs: &[Vec<f64>], service: &[f64], seed: u64) -> (Vec<usize
     }
     let params = GtspParams {
         seed,
-        max_iterations: Some(300),
+        max_iterations: Some(ILS_KICKS),
         time_limit: std::time::Duration::from_secs(600),
         ..GtspParams::default()
     };
@@ -276,7 +293,17 @@ pub fn optimal_control(w: &WeldCell, g: &Graph, s: &LegSettings, cache: &mut Cac
             };
         }
         let over = cache.solves >= w.process.ocp_budget;
+        let started = std::time::Instant::now();
         solve_legs(w, g, &open, s, cache);
+        if verbose() {
+            eprintln!(
+                "optimal-control round {rounds}: {} legs solved in {:.1} s ({} OCPs so far, estimate × {:.2})",
+                open.len(),
+                started.elapsed().as_secs_f64(),
+                cache.solves,
+                ratio.0
+            );
+        }
         if over {
             return Sequence {
                 nodes,
@@ -346,6 +373,9 @@ pub fn travel_time(w: &WeldCell, g: &Graph, s: &LegSettings, cache: &mut Cache) 
                 ((a, b), t)
             })
             .collect();
+        if verbose() {
+            eprintln!("travel-time round {rounds}: {} paths planned", timed.len());
+        }
         cache.paths.extend(timed);
     }
 }
