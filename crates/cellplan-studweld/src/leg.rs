@@ -94,27 +94,113 @@ fn segment_time(a: &[f64], b: &[f64], v: &[f64]) -> f64 {
         .fold(0.0, f64::max)
 }
 
-/// `steps + 1` points along the polyline, spaced evenly in least time.
-fn resample(path: &[Vec<f64>], v: &[f64], steps: usize) -> Vec<Vec<f64>> {
+/// The quintic rest-to-rest profile `10τ³ − 15τ⁴ + 6τ⁵` (zero speed and acceleration at both
+/// ends).
+fn quintic(t: f64) -> f64 {
+    t * t * t * (10.0 - 15.0 * t + 6.0 * t * t)
+}
+
+/// `steps + 1` points along the polyline, at the fractions `profile(τ)` of its least time for
+/// τ spread over [0, 1], with every waypoint among them (so that the straight pieces between
+/// grid points are pieces of the path, which the planner proved clear): segment k spans
+/// `τ ∈ [τ_k, τ_{k+1}]` (`profile(τ_k)` its start's fraction); it gets at least one step and the
+/// rest in proportion to its span (largest remainders), its points at evenly spaced τ.
+/// `profile` must increase from 0 to 1; `steps` must be at least the number of segments.
+fn resample(path: &[Vec<f64>], v: &[f64], steps: usize, profile: fn(f64) -> f64) -> Vec<Vec<f64>> {
     let lengths: Vec<f64> = path.windows(2).map(|s| segment_time(&s[0], &s[1], v)).collect();
     let total: f64 = lengths.iter().sum();
-    (0..=steps)
-        .map(|i| {
-            let mut at = total * i as f64 / steps as f64;
-            for (k, l) in lengths.iter().enumerate() {
-                if at <= *l || k + 1 == lengths.len() {
-                    let s = if *l > 0.0 { (at / l).clamp(0.0, 1.0) } else { 1.0 };
-                    return path[k]
-                        .iter()
-                        .zip(&path[k + 1])
-                        .map(|(a, b)| a + s * (b - a))
-                        .collect();
-                }
-                at -= l;
+    let segments = lengths.len();
+    // τ at each waypoint, by bisection of the profile.
+    let mut cum = 0.0;
+    let mut tau = vec![0.0];
+    for l in &lengths {
+        cum += l;
+        let target = if total > 0.0 { cum / total } else { 1.0 };
+        let (mut lo, mut hi) = (0.0f64, 1.0f64);
+        for _ in 0..60 {
+            let mid = 0.5 * (lo + hi);
+            if profile(mid) < target { lo = mid } else { hi = mid }
+        }
+        tau.push(hi);
+    }
+    if let Some(last) = tau.last_mut() {
+        *last = 1.0;
+    }
+    let spare = steps.saturating_sub(segments);
+    let share: Vec<f64> = (0..segments)
+        .map(|k| spare as f64 * (tau[k + 1] - tau[k]))
+        .collect();
+    let mut count: Vec<usize> = share.iter().map(|x| 1 + x.floor() as usize).collect();
+    let mut order: Vec<usize> = (0..segments).collect();
+    order.sort_by(|&a, &b| {
+        (share[b] - share[b].floor())
+            .total_cmp(&(share[a] - share[a].floor()))
+            .then(a.cmp(&b))
+    });
+    let mut left = steps.saturating_sub(count.iter().sum::<usize>());
+    for &k in order.iter().cycle().take(4 * segments.max(1)) {
+        if left == 0 {
+            break;
+        }
+        count[k] += 1;
+        left -= 1;
+    }
+    let mut grid = vec![path[0].clone()];
+    for (k, c) in count.iter().enumerate() {
+        let start: f64 = lengths[..k].iter().sum();
+        for i in 1..=*c {
+            if i == *c {
+                grid.push(path[k + 1].clone());
+                continue;
             }
-            path.last().cloned().unwrap_or_default()
-        })
-        .collect()
+            let t = tau[k] + (tau[k + 1] - tau[k]) * i as f64 / *c as f64;
+            let s = if lengths[k] > 0.0 {
+                ((profile(t) * total - start) / lengths[k]).clamp(0.0, 1.0)
+            } else {
+                1.0
+            };
+            grid.push(
+                path[k]
+                    .iter()
+                    .zip(&path[k + 1])
+                    .map(|(a, b)| a + s * (b - a))
+                    .collect(),
+            );
+        }
+    }
+    grid
+}
+
+/// A starting point for the trust regions: the grid at rest-to-rest positions along the path
+/// ([`quintic`] in time, waypoints on the grid), so that the dynamics rows nearly hold with the
+/// grid pinned in small boxes; the step giving a mean speed of half the slowest joint's limit
+/// (the quintic peaks at 1.875× the mean); zero torques.
+pub fn rest_to_rest_guess(m: &Move, path: &[Vec<f64>]) -> Vec<f64> {
+    let l = m.layout();
+    let least: f64 = path
+        .windows(2)
+        .map(|s| segment_time(&s[0], &s[1], &m.v_max))
+        .sum();
+    let grid = resample(path, &m.v_max, l.steps, quintic);
+    let mut x = vec![0.0; l.vars()];
+    for (i, q) in grid.iter().enumerate() {
+        for j in 0..l.n {
+            x[l.q(i, j)] = if i == 0 {
+                m.start[j]
+            } else if i == l.steps {
+                m.goal[j]
+            } else {
+                q[j].clamp(m.q_bounds[j][0], m.q_bounds[j][1])
+            };
+        }
+    }
+    x[l.h()] = (2.0 * least / l.steps as f64).clamp(m.h_bounds[0], m.h_bounds[1]);
+    x
+}
+
+/// DMOC steps for a move along `path`: the process's, or one per path segment when more.
+pub fn steps_for(w: &WeldCell, path: &[Vec<f64>]) -> usize {
+    w.process.steps.max(path.len().saturating_sub(1))
 }
 
 /// The OCP of the move `a → b` in the cell.
@@ -136,7 +222,7 @@ pub fn ocp<'a>(w: &'a WeldCell, a: &[f64], b: &[f64]) -> Move<'a> {
 /// 1.5× its least time, torques zero or the gravity torques at the midpoints.
 fn guess(m: &Move, path: &[Vec<f64>], gravity: bool) -> Vec<f64> {
     let l = m.layout();
-    let grid = resample(path, &m.v_max, l.steps);
+    let grid = resample(path, &m.v_max, l.steps, |t| t);
     let least: f64 = path
         .windows(2)
         .map(|s| segment_time(&s[0], &s[1], &m.v_max))
@@ -208,7 +294,10 @@ pub fn path(w: &WeldCell, a: &[f64], b: &[f64], s: &LegSettings) -> Option<Vec<V
 /// The move `a → b`: `None` when the planner finds no collision-free path.
 pub fn solve(w: &WeldCell, a: &[f64], b: &[f64], s: &LegSettings) -> Option<Leg> {
     let path = path(w, a, b, s)?;
-    let m = ocp(w, a, b);
+    let m = Move {
+        steps: steps_for(w, &path),
+        ..ocp(w, a, b)
+    };
     let opt = nlp::Options {
         tol: 1e-8,
         max_iter: s.max_iter,
@@ -249,7 +338,13 @@ pub fn solve(w: &WeldCell, a: &[f64], b: &[f64], s: &LegSettings) -> Option<Leg>
         break;
     }
     // Collision trust regions from the planner's path (§2.4).
-    let t = trust::iterate(w, &m, &guess(&m, &path, false), &opt, &TrustSettings::default());
+    let t = trust::iterate(
+        w,
+        &m,
+        &rest_to_rest_guess(&m, &path),
+        &opt,
+        &TrustSettings::default(),
+    );
     iterations += t.iterations;
     solves += t.solves;
     if let Some((traj, cost)) = t.best {
@@ -390,4 +485,44 @@ pub fn timed_path_cost(w: &WeldCell, path: &[Vec<f64>], scale: f64) -> (f64, f64
         duration += t;
     }
     (cost, duration, peak)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn resampled_grids_keep_every_waypoint_and_follow_the_profile() {
+        let path = vec![vec![0.0, 0.0], vec![1.0, 0.0], vec![1.0, 0.1], vec![3.0, 0.1]];
+        let v = [1.0, 1.0];
+        for profile in [(|t| t) as fn(f64) -> f64, quintic] {
+            for steps in [3, 7, 12] {
+                let g = resample(&path, &v, steps, profile);
+                assert_eq!(g.len(), steps + 1);
+                for w in &path {
+                    assert!(
+                        g.iter().any(|q| q == w),
+                        "waypoint {w:?} not on the grid of {steps}"
+                    );
+                }
+                // Every grid point lies on the path, in order along it.
+                let mut last = 0.0;
+                for q in &g {
+                    let at = if q[1] == 0.0 {
+                        q[0]
+                    } else if q[0] == 1.0 {
+                        1.0 + q[1]
+                    } else {
+                        1.1 + q[0] - 1.0
+                    };
+                    assert!(at >= last - 1e-12, "{q:?} goes back");
+                    last = at;
+                }
+            }
+        }
+        // The quintic starts slower than the uniform grid.
+        let u = resample(&path, &v, 12, |t| t);
+        let q = resample(&path, &v, 12, quintic);
+        assert!(q[1][0] < u[1][0]);
+    }
 }

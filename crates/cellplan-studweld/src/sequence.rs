@@ -141,7 +141,11 @@ fn tour(g: &Graph, costs: &[Vec<f64>], service: &[f64], seed: u64) -> (Vec<usize
     let started = std::time::Instant::now();
     let out = tour_inner(g, costs, service, seed);
     if verbose() {
-        eprintln!("  gtsp: {:.2} s (exact: {})", started.elapsed().as_secs_f64(), out.1);
+        eprintln!(
+            "  gtsp: {:.2} s (exact: {})",
+            started.elapsed().as_secs_f64(),
+            out.1
+        );
     }
     out
 }

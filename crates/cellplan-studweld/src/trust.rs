@@ -146,12 +146,19 @@ pub fn iterate(w: &WeldCell, m: &Move, x0: &[f64], opt: &nlp::Options, s: &Trust
             let sol = nlp::ipm::solve_from(&b, &x, opt);
             out.iterations += sol.iterations;
             out.solves += 1;
+            let verbose = std::env::var_os("CELLPLAN_STUDWELD_VERBOSE").is_some();
             if !matches!(sol.status, Status::Solved | Status::SolvedToAcceptableLevel) {
+                if verbose {
+                    eprintln!("    trust region ×{scale}: {:?}", sol.status);
+                }
                 scale *= 0.5;
                 continue;
             }
             let traj = unpack(m, &sol.x);
             if !crate::leg::clear(w, &traj.q) {
+                if verbose {
+                    eprintln!("    trust region ×{scale}: J {:.2}, collides", sol.objective);
+                }
                 scale *= 0.5;
                 continue;
             }
