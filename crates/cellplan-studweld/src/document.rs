@@ -230,3 +230,40 @@ pub fn read(path: &std::path::Path) -> Result<WeldPlan, String> {
     cellplan_model::document::check_version((&doc.format, doc.version), (FORMAT, VERSION))?;
     Ok(doc)
 }
+
+/// The JSON Schema of the document, as `docs/studweld-plan.schema.json` holds it.
+pub fn schema() -> String {
+    cellplan_model::document::schema_text(&schemars::schema_for!(WeldPlan))
+}
+
+#[cfg(test)]
+mod tests {
+    use std::path::Path;
+
+    /// `docs/studweld-plan.schema.json` is the schema of these types (regenerate it with
+    /// `CELLPLAN_UPDATE_SCHEMA=1 cargo test -p cellplan-studweld schema`).
+    #[test]
+    fn the_schema_in_docs_is_generated_from_the_types() {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../docs/studweld-plan.schema.json");
+        let schema =
+            cellplan_model::document::schema_file_matches(&path, &super::schema()).unwrap_or_else(|e| {
+                panic!(
+                    "{e}; regenerate it with CELLPLAN_UPDATE_SCHEMA=1 cargo test -p cellplan-studweld schema"
+                )
+            });
+        let required = schema["required"].as_array().unwrap();
+        for key in [
+            "visits",
+            "legs",
+            "totals",
+            "alternatives",
+            "unweldable",
+            "sequencing",
+        ] {
+            assert!(
+                required.iter().any(|k| k == key),
+                "{key} not required: {required:?}"
+            );
+        }
+    }
+}
