@@ -5,10 +5,12 @@
 //!   legs, replace by the timed paths' durations, re-sequence until the tour's legs are all
 //!   planned) — then each leg of that tour optimised by the OCP;
 //! - [`Sequencer::OptimalControl`] ("new", §2.1): node cost = holding the alternative for the
-//!   weld time, edge cost = J of the leg's OCP; lazy — start from the paper's estimates (the
-//!   best J of a straight move whose effort is the static one at its ends), solve the OCPs of
-//!   the edges the tour uses, re-sequence until every edge of the tour is solved, or the OCP
-//!   budget ends (then the current tour's remaining edges are solved and the outcome says so).
+//!   weld time, edge cost = J of the leg's OCP; lazy — first the legs of the tour on
+//!   travel-time bounds with the node costs (a complete cycle, solved), then from the paper's
+//!   estimates (the best J of a straight move whose effort is the static one at its ends,
+//!   scaled by the solved legs' median J/estimate), solve the OCPs of the edges the tour uses,
+//!   re-sequence until every edge of the tour is solved, or the OCP budget ends (then the
+//!   current tour's remaining edges are solved and the outcome says so).
 //!
 //! Legs are symmetric (the dynamics have no friction and the midpoint rule is symmetric, so a
 //! DMOC trajectory run backwards with its torques reversed in order solves the reverse move
@@ -265,8 +267,17 @@ pub fn optimal_control(w: &WeldCell, g: &Graph, s: &LegSettings, cache: &mut Cac
         .into_par_iter()
         .map(|i| (0..n).map(|j| estimate(w, &g.q[i], &g.q[j])).collect())
         .collect();
+    // Round 0: the tour on travel-time bounds (straight moves at the joints' limits) with the
+    // node costs — its legs, solved, are a complete cycle whose J the loop can only improve on,
+    // and the first calibration of the estimates.
+    let bound: Vec<Vec<f64>> = (0..n)
+        .into_par_iter()
+        .map(|i| (0..n).map(|j| travel_bound(w, &g.q[i], &g.q[j])).collect())
+        .collect();
+    let (first, ex) = tour(g, &bound, &g.weld_cost, s.seed);
+    let mut exact = ex;
+    solve_legs(w, g, &edges(&first), s, cache);
     let mut rounds = 0;
-    let mut exact = true;
     loop {
         rounds += 1;
         let ratio = calibration(cache, &est);
