@@ -110,6 +110,9 @@ pub fn run(args: &CompareArgs) -> Result<(), Failure> {
     if crate::pcb_cmd::is_pcb(&args.cell)? {
         return crate::pcb_cmd::compare(args);
     }
+    if crate::studweld_cmd::is_studweld(&args.cell)? {
+        return crate::studweld_cmd::compare(args);
+    }
     if crate::cmm_cmd::is_cmm(&args.cell)? {
         return crate::cmm_cmd::compare(args);
     }

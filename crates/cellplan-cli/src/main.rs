@@ -11,6 +11,7 @@ mod compare_cmd;
 mod pcb_cmd;
 mod plan_cmd;
 mod report_cmd;
+mod studweld_cmd;
 mod verify_cmd;
 
 use cellplan_core::{candidates, check};
@@ -243,7 +244,9 @@ pub(crate) fn output_dir_named(name: &str, cell_path: &std::path::Path) -> Resul
 
 /// The processes this binary knows.
 pub(crate) fn registry() -> Registry {
-    Registry::new().with(cellplan_optical::ENTRY)
+    Registry::new()
+        .with(cellplan_optical::ENTRY)
+        .with(cellplan_studweld::ENTRY)
 }
 
 /// Loads a cell with the processes of [`registry`].

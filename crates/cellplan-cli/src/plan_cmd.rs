@@ -130,6 +130,9 @@ pub fn run(args: &PlanArgs) -> Result<(), Failure> {
     if crate::pcb_cmd::is_pcb(&args.cell)? {
         return crate::pcb_cmd::plan(args);
     }
+    if crate::studweld_cmd::is_studweld(&args.cell)? {
+        return crate::studweld_cmd::plan(args);
+    }
     if crate::cmm_cmd::is_cmm(&args.cell)? {
         return crate::cmm_cmd::plan(args);
     }

@@ -26,6 +26,9 @@ pub fn run(args: &VerifyArgs) -> Result<(), Failure> {
     if crate::pcb_cmd::is_pcb(&args.cell)? {
         return crate::pcb_cmd::verify(&args.plan, &args.cell, args.json, !args.no_robot_robot);
     }
+    if crate::studweld_cmd::is_studweld(&args.cell)? {
+        return crate::studweld_cmd::verify(&args.plan, &args.cell, args.json);
+    }
     if crate::cmm_cmd::is_cmm(&args.cell)? {
         return crate::cmm_cmd::verify(&args.plan, &args.cell, args.json);
     }

@@ -25,6 +25,7 @@ mod paths;
 pub mod pcb;
 mod record;
 mod robots;
+pub mod studweld;
 mod tasks;
 mod timing;
 

@@ -7,6 +7,7 @@ mod gen_tasks;
 mod pcb;
 mod plan;
 mod refusals;
+mod studweld;
 
 use serde_json::Value;
 use std::path::{Path, PathBuf};

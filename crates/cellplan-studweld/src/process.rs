@@ -1,0 +1,283 @@
+//! The `stud-weld` process (paper 002): its `[process]` table, the gun poses of a stud (the gun's
+//! axis along the stud's normal, turned about it in steps), and the work at a stud (holding the
+//! pose for the weld time).
+use cellplan_geom::{CollisionWorld, DQuat, DVec3, Pose};
+use cellplan_model::{
+    Figure, InputError, Process, ProcessInput, ProcessReason, Robot, Task, TaskId, Words, Work,
+};
+pub use cellplan_ocp::problem::Weights;
+use serde::Deserialize;
+use std::sync::Arc;
+
+/// The `[process] kind` of stud-weld cells.
+pub const KIND: &str = "stud-weld";
+
+/// Most gun rotations about the stud axis (a step of 1° gives 360).
+pub const MAX_ROTATIONS: usize = 360;
+
+/// The `[process]` table as written.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct StudWeldSpec {
+    /// Seconds the gun stands at a stud.
+    weld_time: f64,
+    /// c_t, c_e, c_v.
+    #[serde(default)]
+    cost: Option<CostSpec>,
+    /// Step of the gun's rotation about the stud axis (file angle unit).
+    gun_rotation_step: f64,
+    /// Torque limit of every joint (N·m).
+    max_torque: Vec<f64>,
+    /// DMOC steps of one move (default 12).
+    #[serde(default)]
+    steps: Option<usize>,
+    /// Most optimal-control problems one plan may solve (default 400).
+    #[serde(default)]
+    ocp_budget: Option<usize>,
+    /// Mass of the gun (kg, default 0), carried by the tip link.
+    #[serde(default)]
+    gun_mass: Option<f64>,
+    /// The gun's centre of mass in the tip-link frame (file length unit).
+    #[serde(default)]
+    gun_com: Option<[f64; 3]>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct CostSpec {
+    time: Option<f64>,
+    effort: Option<f64>,
+    velocity: Option<f64>,
+}
+
+/// The stud-weld process, in SI.
+#[derive(Clone, Debug)]
+pub struct StudWeld {
+    /// Seconds the gun stands at each stud.
+    pub weld_time: f64,
+    /// The cost J = ∫ c_t + c_e uᵀu + c_v q̇ᵀq̇ dt.
+    pub weights: Weights,
+    /// Step of the gun's rotation about the stud axis (rad).
+    pub rotation_step: f64,
+    /// Torque limits (N·m), one per joint.
+    pub max_torque: Vec<f64>,
+    /// DMOC steps per move.
+    pub steps: usize,
+    /// Most optimal-control problems one plan solves.
+    pub ocp_budget: usize,
+    /// Mass of the gun (kg) and its centre of mass in the tip-link frame (m).
+    pub gun_mass: f64,
+    /// See `gun_mass`.
+    pub gun_com: DVec3,
+}
+
+static WORDS: Words = Words {
+    task: "stud",
+    tasks: "studs",
+    working: "welding",
+    tool: "gun",
+};
+
+fn positive(input: &ProcessInput, key: &str, v: f64) -> Result<f64, InputError> {
+    if v.is_finite() && v > 0.0 {
+        Ok(v)
+    } else {
+        Err(input.error(key, format!("`{key}` must be positive, not {v}")))
+    }
+}
+
+/// Builds the process from its `[process]` table.
+pub fn build(input: &ProcessInput) -> Result<Arc<dyn Process>, InputError> {
+    let s: StudWeldSpec = input.parse()?;
+    let weld_time = positive(input, "weld_time", s.weld_time)?;
+    let d = Weights::default();
+    let weights = match &s.cost {
+        None => d,
+        Some(c) => Weights {
+            time: positive(input, "time", c.time.unwrap_or(d.time))?,
+            effort: positive(input, "effort", c.effort.unwrap_or(d.effort))?,
+            velocity: positive(input, "velocity", c.velocity.unwrap_or(d.velocity))?,
+        },
+    };
+    let rotation_step = positive(input, "gun_rotation_step", s.gun_rotation_step)? * input.to_rad;
+    if (std::f64::consts::TAU / rotation_step).ceil() as usize > MAX_ROTATIONS {
+        return Err(input.error(
+            "gun_rotation_step",
+            format!("`gun_rotation_step` gives more than {MAX_ROTATIONS} rotations"),
+        ));
+    }
+    for &t in &s.max_torque {
+        positive(input, "max_torque", t)?;
+    }
+    if s.max_torque.is_empty() {
+        return Err(input
+            .error("max_torque", "`max_torque` lists no joint")
+            .hint("one torque limit (N·m) per joint of the robot"));
+    }
+    let steps = s.steps.unwrap_or(12);
+    if !(2..=200).contains(&steps) {
+        return Err(input.error("steps", format!("`steps` must be 2 to 200, not {steps}")));
+    }
+    let ocp_budget = s.ocp_budget.unwrap_or(400);
+    let gun_mass = s.gun_mass.unwrap_or(0.0);
+    if !(gun_mass.is_finite() && gun_mass >= 0.0) {
+        return Err(input.error(
+            "gun_mass",
+            format!("`gun_mass` must be 0 or more, not {gun_mass}"),
+        ));
+    }
+    let gun_com = DVec3::from_array(s.gun_com.unwrap_or([0.0; 3])) * input.to_m;
+    if !gun_com.is_finite() {
+        return Err(input.error("gun_com", "`gun_com` must be finite"));
+    }
+    Ok(Arc::new(StudWeld {
+        gun_mass,
+        gun_com,
+        weld_time,
+        weights,
+        rotation_step,
+        max_torque: s.max_torque,
+        steps,
+        ocp_budget,
+    }))
+}
+
+impl StudWeld {
+    /// The number of gun rotations about a stud's axis.
+    pub fn rotations(&self) -> usize {
+        ((std::f64::consts::TAU / self.rotation_step) - 1e-9)
+            .ceil()
+            .max(1.0) as usize
+    }
+}
+
+/// The gun pose at a stud with the gun turned by `angle` about the stud axis: the TCP on the
+/// stud, its z axis along the inward normal (`−n`), its x axis the stud frame's x turned by
+/// `angle` about z. The stud frame's x is the world axis least aligned with `n`, made
+/// orthogonal to it (a fixed rule, so the verifier rebuilds the same frame).
+pub fn gun_pose(position: DVec3, normal: DVec3, angle: f64) -> Pose {
+    let z = -normal.normalize();
+    let pick = [DVec3::X, DVec3::Y, DVec3::Z]
+        .into_iter()
+        .min_by(|a, b| a.dot(z).abs().total_cmp(&b.dot(z).abs()))
+        .unwrap_or(DVec3::X);
+    let x0 = (pick - z * pick.dot(z)).normalize();
+    let y0 = z.cross(x0);
+    let frame = DQuat::from_mat3(&glam::DMat3::from_cols(x0, y0, z));
+    Pose::from_parts(position, frame * DQuat::from_rotation_z(angle))
+}
+
+impl Process for StudWeld {
+    fn kind(&self) -> &'static str {
+        KIND
+    }
+
+    fn as_any(&self) -> &dyn std::any::Any {
+        self
+    }
+
+    fn words(&self) -> &'static Words {
+        &WORDS
+    }
+
+    fn parameters(&self) -> serde_json::Value {
+        serde_json::json!({
+            "weld_time_s": self.weld_time,
+            "cost": { "time": self.weights.time, "effort": self.weights.effort, "velocity": self.weights.velocity },
+            "gun_rotation_step_rad": self.rotation_step,
+            "max_torque_nm": self.max_torque,
+            "steps": self.steps,
+            "ocp_budget": self.ocp_budget,
+            "gun_mass_kg": self.gun_mass,
+            "gun_com_m": self.gun_com.to_array(),
+        })
+    }
+
+    fn tool_reach(&self) -> f64 {
+        0.0
+    }
+
+    fn tool_poses(&self, task: &Task) -> Vec<Pose> {
+        (0..self.rotations())
+            .map(|k| gun_pose(task.position, task.normal, k as f64 * self.rotation_step))
+            .collect()
+    }
+
+    fn pose_check(&self, _task: &Task, _tcp: &Pose) -> Result<(), ProcessReason> {
+        Ok(())
+    }
+
+    fn reached_check(&self, _world: &CollisionWorld, _task: &Task, _tcp: &Pose) -> Result<(), ProcessReason> {
+        Ok(())
+    }
+
+    fn arm_check(
+        &self,
+        _world: &CollisionWorld,
+        _robot: &Robot,
+        _bodies: &[Pose],
+        _task: &Task,
+        _tcp: &Pose,
+    ) -> Result<(), ProcessReason> {
+        Ok(())
+    }
+
+    fn work(&self, _task: &Task) -> Work {
+        Work::Dwell(self.weld_time)
+    }
+
+    fn visit_figures(&self, _task: &Task, _tcp: &Pose) -> Vec<Figure> {
+        Vec::new()
+    }
+
+    fn local_sets(&self, _tasks: &[Task], _members: &[TaskId], _radius: f64) -> Option<Vec<Vec<TaskId>>> {
+        None
+    }
+
+    fn nearby_poses(&self, task: &Task, tcp: &Pose, step: f64) -> Vec<Pose> {
+        // The gun turned by ±step about the stud axis.
+        let axis = tcp.rotation * DVec3::Z;
+        [-step, step]
+            .into_iter()
+            .map(|a| Pose::from_parts(task.position, DQuat::from_axis_angle(axis, a) * tcp.rotation))
+            .collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_gun_points_into_the_surface_and_turns_about_the_stud_axis() {
+        let p = DVec3::new(0.8, -0.2, 1.1);
+        for n in [DVec3::X, DVec3::new(0.7, 0.1, 0.7).normalize(), -DVec3::Z] {
+            let a = gun_pose(p, n, 0.0);
+            let b = gun_pose(p, n, 0.5);
+            assert!((a.translation - p).length() < 1e-12);
+            assert!((a.rotation * DVec3::Z + n).length() < 1e-12);
+            assert!((b.rotation * DVec3::Z + n).length() < 1e-12);
+            let turn = (a.rotation * DVec3::X).angle_between(b.rotation * DVec3::X);
+            assert!((turn - 0.5).abs() < 1e-12, "{turn}");
+        }
+    }
+
+    #[test]
+    fn rotations_cover_the_circle_once() {
+        let mut p = StudWeld {
+            weld_time: 2.0,
+            weights: Weights::default(),
+            rotation_step: 45f64.to_radians(),
+            max_torque: vec![1.0],
+            steps: 12,
+            ocp_budget: 1,
+            gun_mass: 0.0,
+            gun_com: DVec3::ZERO,
+        };
+        assert_eq!(p.rotations(), 8);
+        p.rotation_step = 50f64.to_radians();
+        assert_eq!(p.rotations(), 8);
+        p.rotation_step = 400f64.to_radians();
+        assert_eq!(p.rotations(), 1);
+    }
+}

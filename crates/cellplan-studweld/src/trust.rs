@@ -1,0 +1,182 @@
+//! Collision trust regions (paper 002 §2.4): starting from a collision-free path, each
+//! iteration solves the OCP with every grid point `q_i` kept in a box around the previous
+//! iterate's, `n · max_j w_j |q_ij^{k+1} − q_ij^k| ≤ φ(q_i^k) − d_c`, then checks the new
+//! trajectory densely; a trajectory that breaks the clearance is rejected and the boxes halved
+//! (backtracking); the iteration stops when the cost falls by less than [`TrustSettings::
+//! min_gain`] (relative) or after [`TrustSettings::iterations`].
+//!
+//! Here `φ` is the clearance of `q_i^k` in the leg planner's validity test (the distance of the
+//! bodies to the scene less the cell's clearance, half the smallest self distance), and `w_j`
+//! is the joint's radius — an upper bound, valid in every configuration, on the distance of any
+//! body point from joint j's axis — in place of the paper's `max_p ‖∂p/∂q_j‖₁` at `q_i^k`. Since
+//! no point moves farther than `Σ_j w_j |Δq_j| ≤ n max_j w_j |Δq_j|`, every grid point of the new
+//! trajectory is proven clear (not only to first order); the pieces between grid points are
+//! then checked by the motion core's segment check.
+use crate::cell::WeldCell;
+use crate::leg::{Dmoc, unpack};
+use cellplan_core::motion::{joint_radii, robot_validity};
+use cellplan_ocp::nlp::{self, Nlp, Status, Triplets};
+use cellplan_ocp::problem::Move;
+
+/// Tunables of the trust-region iteration.
+#[derive(Clone, Copy, Debug)]
+pub struct TrustSettings {
+    /// Most accepted iterations.
+    pub iterations: usize,
+    /// Most halvings of the boxes after a rejected trajectory.
+    pub backtracks: usize,
+    /// Stop when the cost falls by less than this fraction.
+    pub min_gain: f64,
+    /// `d_c` (m): clearance kept beyond the cell's at grid points.
+    pub extra_clearance: f64,
+}
+
+impl Default for TrustSettings {
+    fn default() -> Self {
+        TrustSettings {
+            iterations: 8,
+            backtracks: 3,
+            min_gain: 1e-3,
+            extra_clearance: 0.0,
+        }
+    }
+}
+
+/// A [`Move`] with its grid points boxed.
+struct Boxed<'a, 'b> {
+    m: &'b Move<'a>,
+    lo: Vec<f64>,
+    hi: Vec<f64>,
+}
+
+impl Nlp for Boxed<'_, '_> {
+    fn num_vars(&self) -> usize {
+        self.m.num_vars()
+    }
+    fn num_eq(&self) -> usize {
+        self.m.num_eq()
+    }
+    fn num_ineq(&self) -> usize {
+        self.m.num_ineq()
+    }
+    fn bounds(&self) -> (Vec<f64>, Vec<f64>) {
+        (self.lo.clone(), self.hi.clone())
+    }
+    fn ineq_bounds(&self) -> (Vec<f64>, Vec<f64>) {
+        self.m.ineq_bounds()
+    }
+    fn initial_point(&self) -> Vec<f64> {
+        self.m.initial_point()
+    }
+    fn objective(&self, x: &[f64]) -> f64 {
+        Nlp::objective(self.m, x)
+    }
+    fn gradient(&self, x: &[f64]) -> Vec<f64> {
+        Nlp::gradient(self.m, x)
+    }
+    fn eq(&self, x: &[f64]) -> Vec<f64> {
+        self.m.eq(x)
+    }
+    fn eq_jacobian(&self, x: &[f64]) -> Triplets {
+        self.m.eq_jacobian(x)
+    }
+    fn ineq(&self, x: &[f64]) -> Vec<f64> {
+        self.m.ineq(x)
+    }
+    fn ineq_jacobian(&self, x: &[f64]) -> Triplets {
+        self.m.ineq_jacobian(x)
+    }
+    fn hessian(&self, x: &[f64], sigma: f64, lambda: &[f64], mu: &[f64]) -> Triplets {
+        Nlp::hessian(self.m, x, sigma, lambda, mu)
+    }
+    fn kkt_order(&self) -> Option<(Vec<usize>, usize)> {
+        self.m.kkt_order()
+    }
+}
+
+/// The outcome of the iteration.
+pub struct Trusted {
+    /// The last accepted trajectory and its J (`None` when no iterate was accepted).
+    pub best: Option<(Dmoc, f64)>,
+    /// Interior-point iterations spent.
+    pub iterations: usize,
+    /// OCPs solved.
+    pub solves: usize,
+    /// Accepted iterations.
+    pub accepted: usize,
+}
+
+/// Runs the trust-region iteration for `m` from `x0` (whose grid points must be clear: the
+/// planner's path resampled).
+pub fn iterate(w: &WeldCell, m: &Move, x0: &[f64], opt: &nlp::Options, s: &TrustSettings) -> Trusted {
+    let l = m.layout();
+    let validity = robot_validity(w.cell, w.robot, w.cell.planning.clearance);
+    let radii = joint_radii(w.cell, w.robot);
+    let (base_lo, base_hi) = m.bounds();
+    let mut x = x0.to_vec();
+    let mut out = Trusted {
+        best: None,
+        iterations: 0,
+        solves: 0,
+        accepted: 0,
+    };
+    let mut last = f64::INFINITY;
+    while out.accepted < s.iterations {
+        // φ(q_i^k) − d_c per grid point.
+        let room: Vec<f64> = (0..=l.steps)
+            .map(|i| {
+                let q: Vec<f64> = (0..l.n).map(|j| x[l.q(i, j)]).collect();
+                let (scene, own) = validity.scene_and_self_clearance(&q);
+                (scene.min(0.5 * own) - s.extra_clearance).max(0.0)
+            })
+            .collect();
+        let mut scale = 1.0;
+        let mut accepted = false;
+        for _ in 0..=s.backtracks {
+            let (mut lo, mut hi) = (base_lo.clone(), base_hi.clone());
+            for i in 1..l.steps {
+                for j in 0..l.n {
+                    let k = l.q(i, j);
+                    let half = scale * room[i] / (l.n as f64 * radii[j].max(1e-9));
+                    lo[k] = (x[k] - half).max(base_lo[k]).min(x[k]);
+                    hi[k] = (x[k] + half).min(base_hi[k]).max(x[k]);
+                }
+            }
+            let b = Boxed { m, lo, hi };
+            let sol = nlp::ipm::solve_from(&b, &x, opt);
+            out.iterations += sol.iterations;
+            out.solves += 1;
+            let verbose = std::env::var_os("CELLPLAN_STUDWELD_VERBOSE").is_some();
+            if !matches!(sol.status, Status::Solved | Status::SolvedToAcceptableLevel) {
+                if verbose {
+                    eprintln!("    trust region ×{scale}: {:?}", sol.status);
+                }
+                scale *= 0.5;
+                continue;
+            }
+            let traj = unpack(m, &sol.x);
+            if !crate::leg::clear(w, &traj.q) {
+                if verbose {
+                    eprintln!("    trust region ×{scale}: J {:.2}, collides", sol.objective);
+                }
+                scale *= 0.5;
+                continue;
+            }
+            if sol.objective >= last {
+                // No progress: keep the previous trajectory.
+                break;
+            }
+            let gain = (last - sol.objective) / sol.objective.abs().max(1e-12);
+            x = sol.x;
+            last = sol.objective;
+            out.best = Some((traj, sol.objective));
+            out.accepted += 1;
+            accepted = gain >= s.min_gain;
+            break;
+        }
+        if !accepted {
+            break;
+        }
+    }
+    out
+}
