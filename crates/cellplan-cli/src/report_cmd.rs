@@ -139,27 +139,26 @@ pub fn write_report(
 }
 
 pub fn run_report(args: &ReportArgs) -> Result<(), Failure> {
-    if let Some(cell) = &args.cell
-        && crate::pcb_cmd::is_pcb(cell)?
-    {
-        let out = args
-            .output
-            .clone()
-            .unwrap_or_else(|| args.plan.parent().unwrap_or(Path::new(".")).join("report.html"));
-        crate::pcb_cmd::report(&args.plan, cell, &out)?;
-        eprintln!("report written to {}", out.display());
-        return Ok(());
-    }
-    if let Some(cell) = &args.cell
-        && crate::cmm_cmd::is_cmm(cell)?
-    {
-        let out = args
-            .output
-            .clone()
-            .unwrap_or_else(|| args.plan.parent().unwrap_or(Path::new(".")).join("report.html"));
-        crate::cmm_cmd::report(&args.plan, cell, &out)?;
-        eprintln!("report written to {}", out.display());
-        return Ok(());
+    // The pages of the other processes: (is this kind, write its page).
+    type IsKind = fn(&Path) -> Result<bool, Failure>;
+    type PageFn = fn(&Path, &Path, &Path) -> Result<(), Failure>;
+    let pages: [(IsKind, PageFn); 3] = [
+        (crate::pcb_cmd::is_pcb, crate::pcb_cmd::report),
+        (crate::cmm_cmd::is_cmm, crate::cmm_cmd::report),
+        (crate::studweld_cmd::is_studweld, crate::studweld_cmd::report),
+    ];
+    if let Some(cell) = &args.cell {
+        for (is_kind, page) in pages {
+            if is_kind(cell)? {
+                let out = args
+                    .output
+                    .clone()
+                    .unwrap_or_else(|| args.plan.parent().unwrap_or(Path::new(".")).join("report.html"));
+                page(&args.plan, cell, &out)?;
+                eprintln!("report written to {}", out.display());
+                return Ok(());
+            }
+        }
     }
     let start = Instant::now();
     let plan = read_plan(&args.plan)?;

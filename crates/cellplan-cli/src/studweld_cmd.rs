@@ -171,15 +171,30 @@ pub fn plan(args: &PlanArgs) -> Result<(), Failure> {
     }
 }
 
-/// `cellplan verify` on a stud-weld plan.
-pub fn verify(plan_path: &Path, cell_path: &Path, json: bool) -> Result<(), Failure> {
-    let cell = load(cell_path)?;
-    let plan = cellplan_studweld::document::read(plan_path).map_err(|e| {
+fn read_plan(plan_path: &Path) -> Result<WeldPlan, Failure> {
+    cellplan_studweld::document::read(plan_path).map_err(|e| {
         Failure::Input(Box::new(
             InputError::new(plan_path, e)
                 .hint("give a plan.json that `cellplan plan` wrote for a stud-weld cell"),
         ))
-    })?;
+    })
+}
+
+/// `cellplan report` on a stud-weld plan: the page, verified.
+pub fn report(plan_path: &Path, cell_path: &Path, out: &Path) -> Result<(), Failure> {
+    let cell = load(cell_path)?;
+    let plan = read_plan(plan_path)?;
+    let w = WeldCell::new(&cell)?;
+    let verdict = verify_weld(&cell, &plan);
+    let page = cellplan_report::studweld::html(&plan, &w, Some(&verdict));
+    write_atomic(out, page.as_bytes())
+        .map_err(|e| Failure::Other(format!("cannot write {}: {e}", out.display())))
+}
+
+/// `cellplan verify` on a stud-weld plan.
+pub fn verify(plan_path: &Path, cell_path: &Path, json: bool) -> Result<(), Failure> {
+    let cell = load(cell_path)?;
+    let plan = read_plan(plan_path)?;
     let report = verify_weld(&cell, &plan);
     let summary = format!(
         "largest discrete Euler–Lagrange residual {:.1e} (relative); {} pieces proven clear",

@@ -3,8 +3,8 @@
 //! [`scene`] is the cell to draw (shared, decimated meshes; robots as their URDF chains);
 //! [`playback`] reads a robot's intervals and joint values from a plan; [`charts`] draws the
 //! Gantt, time–position and strategy charts; [`html`] assembles the self-contained report with
-//! its WebGL viewer; [`gltf`] and [`csv`] export a plan for other tools; [`pcb`] and [`cmm`]
-//! are the pages of the PCB-assembly and CMM-inspection processes.
+//! its WebGL viewer; [`gltf`] and [`csv`] export a plan for other tools; [`pcb`], [`cmm`] and
+//! [`studweld`] are the pages of the PCB-assembly, CMM-inspection and stud-weld processes.
 #![warn(missing_docs)]
 
 pub mod charts;
@@ -15,6 +15,7 @@ pub mod html;
 pub mod pcb;
 pub mod playback;
 pub mod scene;
+pub mod studweld;
 pub mod svg;
 
 /// Text made safe for XML and HTML (element text and quoted attributes).

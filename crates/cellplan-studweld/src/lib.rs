@@ -11,7 +11,8 @@
 //!   planner, then the DMOC optimal-control problem started along it, checked densely for
 //!   collisions, with a timed-path fallback;
 //! - [`sequence`]: the two sequencers of Table 2 (travel time, optimal control — lazy);
-//! - [`plan`] and [`document`]: one run and the plan document (`cellplan-studweld-plan` v1).
+//! - [`plan`] and [`document`]: one run and the plan document (`cellplan-studweld-plan` v1);
+//! - [`profile`]: a move's velocities and torques over time (the report's plots).
 #![warn(missing_docs)]
 #![allow(clippy::result_large_err)]
 // Index loops over several arrays at once read as the formulas do.
@@ -23,6 +24,7 @@ pub mod document;
 pub mod leg;
 pub mod plan;
 pub mod process;
+pub mod profile;
 pub mod sequence;
 pub mod trust;
 

@@ -1,5 +1,5 @@
-//! Stud-weld cells (paper 002) through the binary: plan, verify and compare with their stable
-//! JSON keys, an unweldable stud (exit 3, the plan still written and verified), and a refused
+//! Stud-weld cells (paper 002) through the binary: plan, verify, report and compare with their
+//! stable JSON keys, an unweldable stud (exit 3, the plan still written and verified), and a refused
 //! weld time (exit 2 at its line, nothing written). Small copies of `examples/studweld-kr210`.
 use super::*;
 
@@ -49,6 +49,34 @@ fn plan_verify_and_compare_a_stud_weld_cell() {
     let plan_file = out.join("plan.json").display().to_string();
     let v = json_ok(&["verify", &plan_file, &cell, "--json"], &cache);
     assert_eq!(v["ok"], true, "{v}");
+
+    // The page: Table 2's figures as the plan states them, the cycle's torques, one torque and
+    // one velocity chart per move, one row per weld.
+    let page_file = out.join("report.html");
+    run_ok(
+        &[
+            "report",
+            &plan_file,
+            &cell,
+            "-o",
+            &page_file.display().to_string(),
+        ],
+        &cache,
+    );
+    let page = std::fs::read_to_string(&page_file).unwrap();
+    assert!(
+        page.contains(&format!("id=\"cost\">{:.1}<", plan["cost"].as_f64().unwrap())),
+        "{page}"
+    );
+    assert!(page.contains("id=\"cycle-torques\""));
+    assert!(page.contains("verified: every move"));
+    let moves = plan["welded"].as_u64().unwrap() + 1;
+    for k in 1..=moves {
+        assert!(page.contains(&format!("id=\"leg-{k}-torque\"")), "move {k}");
+        assert!(page.contains(&format!("id=\"leg-{k}-velocity\"")), "move {k}");
+    }
+    assert!(!page.contains(&format!("id=\"leg-{}-torque\"", moves + 1)));
+    assert_eq!(page.matches("<path d=\"M").count() as u64, (2 * moves + 1) * 6);
 
     // A changed torque is caught.
     let mut doc: Value = serde_json::from_str(&std::fs::read_to_string(&plan_file).unwrap()).unwrap();
