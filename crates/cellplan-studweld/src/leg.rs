@@ -3,10 +3,11 @@
 //! solved by [`cellplan_ocp::nlp`]) started along that path — zero torques first, then the
 //! gravity torques (the KR 210 has several local optima, and from some starts the solver ends
 //! `RestorationFailed`); the solved trajectory is checked densely for collisions (every
-//! segment between grid points by the motion core's conservative segment check); when no
-//! solve gives a collision-free trajectory, the leg is the planner's path timed (a
-//! synchronised trapezoid in the path parameter on each segment, rest at each waypoint) with
-//! its J integrated along it, and the leg says why.
+//! segment between grid points by the motion core's conservative segment check); when the
+//! optimum collides, the §2.4 trust regions ([`crate::trust`]) from a path with room
+//! ([`roomy_path`]); when they give no collision-free trajectory, or one dearer than the
+//! planner's path timed (a synchronised trapezoid in the path parameter on each segment, rest
+//! at each waypoint, J integrated along it), the leg is that timed path, and it says why.
 use crate::cell::WeldCell;
 use crate::trust::{self, TrustSettings};
 use cellplan_core::motion::{joint_space, plan_leg, robot_validity};
@@ -171,9 +172,9 @@ fn resample(path: &[Vec<f64>], v: &[f64], steps: usize, profile: fn(f64) -> f64)
     grid
 }
 
-/// A starting point for the trust regions: the grid at rest-to-rest positions along the path
-/// ([`quintic`] in time, waypoints on the grid), so that the dynamics rows nearly hold with the
-/// grid pinned in small boxes; the step giving a mean speed of half the slowest joint's limit
+/// The target of the trust regions' first iterate: the grid at rest-to-rest positions along
+/// the path ([`quintic`] in time, waypoints on the grid), so that a trajectory of the dynamics
+/// lies near it; the step giving a mean speed of half the slowest joint's limit
 /// (the quintic peaks at 1.875× the mean); zero torques.
 pub fn rest_to_rest_guess(m: &Move, path: &[Vec<f64>]) -> Vec<f64> {
     let l = m.layout();
@@ -291,6 +292,47 @@ pub fn path(w: &WeldCell, a: &[f64], b: &[f64], s: &LegSettings) -> Option<Vec<V
         .map(|p| p.waypoints)
 }
 
+/// How far (m) the start of a trust-region iteration backs the gun out along its axis at
+/// either end before its middle is planned with [`ROOM`] more clearance.
+pub const RETRACT: f64 = 0.1;
+
+/// Clearance (m) beyond the cell's that the middle of a trust-region start keeps, tried in
+/// turn: the boxes of §2.4 are as wide as the grid's clearance allows.
+pub const ROOM: [f64; 2] = [0.05, 0.02];
+
+/// A path `a → b` with room for the trust regions: out along the gun's axis by [`RETRACT`],
+/// the middle planned with the cell's clearance plus [`ROOM`], in along the axis; each retract
+/// one straight joint segment to the end of the gun's line, checked with the cell's clearance. `None` when no such path is found.
+pub fn roomy_path(w: &WeldCell, a: &[f64], b: &[f64], s: &LegSettings) -> Option<Vec<Vec<f64>>> {
+    let chain = &w.robot.model.chain;
+    // The retracts' ends, reached by one straight joint segment each (a grid point per
+    // retract: the DMOC's steps are equal in time).
+    let out_of = |q: &[f64]| -> Option<Vec<Vec<f64>>> {
+        let line = cellplan_motion::arm::tool_retract(chain, &w.robot.tool.tcp, q, RETRACT, 0.01)?;
+        let seg = vec![q.to_vec(), line.last()?.clone()];
+        clear(w, &seg).then_some(seg)
+    };
+    let exit = out_of(a)?;
+    let mut entry = out_of(b)?;
+    entry.reverse();
+    let space = joint_space(w.cell, w.robot);
+    let settings = PlanSettings {
+        seed: s.seed,
+        max_samples: s.max_samples,
+        time_limit: Duration::from_secs(600),
+        ..PlanSettings::default()
+    };
+    let (from, to) = (exit.last()?, entry.first()?);
+    ROOM.iter().find_map(|extra| {
+        let validity = robot_validity(w.cell, w.robot, w.cell.planning.clearance + extra);
+        let middle = cellplan_motion::plan::plan_leg(&space, &validity, from, to, &settings).ok()?;
+        let mut path = exit.clone();
+        path.extend(middle.waypoints.into_iter().skip(1));
+        path.extend(entry.iter().skip(1).cloned());
+        Some(path)
+    })
+}
+
 /// The move `a → b`: `None` when the planner finds no collision-free path.
 pub fn solve(w: &WeldCell, a: &[f64], b: &[f64], s: &LegSettings) -> Option<Leg> {
     let path = path(w, a, b, s)?;
@@ -337,36 +379,46 @@ pub fn solve(w: &WeldCell, a: &[f64], b: &[f64], s: &LegSettings) -> Option<Leg>
         why.push(format!("from {start}: the optimum collides"));
         break;
     }
-    // Collision trust regions from the planner's path (§2.4).
+    // Collision trust regions (§2.4) from a path with room, else from the planner's path.
+    let start = roomy_path(w, a, b, s).unwrap_or_else(|| path.clone());
+    let tm = Move {
+        steps: steps_for(w, &start),
+        ..ocp(w, a, b)
+    };
     let t = trust::iterate(
         w,
-        &m,
-        &rest_to_rest_guess(&m, &path),
+        &tm,
+        &rest_to_rest_guess(&tm, &start),
         &opt,
         &TrustSettings::default(),
     );
     iterations += t.iterations;
     solves += t.solves;
-    if let Some((traj, cost)) = t.best {
-        return Some(Leg {
-            cost,
-            duration: traj.h * m.steps as f64,
-            motion: Motion::Ocp(traj),
-            iterations,
-            solves,
-            trust_iterations: t.accepted,
-            fallback: None,
-        });
+    let (timed_cost, timed_duration, scale) = timed_path(w, &path);
+    match t.best {
+        Some((_, cost)) if cost > timed_cost => why.push(format!(
+            "trust regions: J {cost:.2} above the timed path's {timed_cost:.2}"
+        )),
+        Some((traj, cost)) => {
+            return Some(Leg {
+                cost,
+                duration: traj.h * tm.steps as f64,
+                motion: Motion::Ocp(traj),
+                iterations,
+                solves,
+                trust_iterations: t.accepted,
+                fallback: None,
+            });
+        }
+        None => why.push("trust regions: no iterate kept the clearance".into()),
     }
-    why.push("trust regions: no iterate kept the clearance".into());
-    let (cost, duration, scale) = timed_path(w, &path);
     Some(Leg {
         motion: Motion::TimedPath {
             waypoints: path,
             acceleration_scale: scale,
         },
-        cost,
-        duration,
+        cost: timed_cost,
+        duration: timed_duration,
         iterations,
         solves,
         trust_iterations: 0,

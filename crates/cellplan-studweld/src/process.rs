@@ -31,7 +31,7 @@ struct StudWeldSpec {
     /// DMOC steps of one move (default 12).
     #[serde(default)]
     steps: Option<usize>,
-    /// Most optimal-control problems one plan may solve (default 400).
+    /// Most optimal-control problems one plan may solve (default 1500).
     #[serde(default)]
     ocp_budget: Option<usize>,
     /// Mass of the gun (kg, default 0), carried by the tip link.
@@ -118,7 +118,7 @@ pub fn build(input: &ProcessInput) -> Result<Arc<dyn Process>, InputError> {
     if !(2..=200).contains(&steps) {
         return Err(input.error("steps", format!("`steps` must be 2 to 200, not {steps}")));
     }
-    let ocp_budget = s.ocp_budget.unwrap_or(400);
+    let ocp_budget = s.ocp_budget.unwrap_or(1500);
     let gun_mass = s.gun_mass.unwrap_or(0.0);
     if !(gun_mass.is_finite() && gun_mass >= 0.0) {
         return Err(input.error(

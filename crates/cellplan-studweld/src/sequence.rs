@@ -10,7 +10,8 @@
 //!   estimates (the best J of a straight move whose effort is the static one at its ends,
 //!   scaled by the solved legs' median J/estimate), solve the OCPs of the edges the tour uses,
 //!   re-sequence until every edge of the tour is solved, or the OCP budget ends (then the
-//!   current tour's remaining edges are solved and the outcome says so).
+//!   current tour's remaining edges are solved and the outcome says so); the result is the
+//!   cheapest fully solved tour met on the way (round 0's included).
 //!
 //! Legs are symmetric (the dynamics have no friction and the midpoint rule is symmetric, so a
 //! DMOC trajectory run backwards with its torques reversed in order solves the reverse move
@@ -260,6 +261,25 @@ pub fn calibration(cache: &Cache, est: &[Vec<f64>]) -> (f64, [f64; 3]) {
     (med.max(1.0), [r[0], med, r[r.len() - 1]])
 }
 
+/// J of the tour `nodes` when every edge of it is solved: Σ legs + Σ node costs.
+fn solved_cost(g: &Graph, cache: &Cache, nodes: &[usize]) -> Option<f64> {
+    let travel: Option<f64> = edges(nodes)
+        .iter()
+        .map(|&(a, b)| cache.legs.get(&key(a, b))?.as_ref().map(|l| l.cost))
+        .sum();
+    Some(travel? + nodes.iter().map(|&v| g.weld_cost[v]).sum::<f64>())
+}
+
+/// The better of the lazy loop's last tour and the best fully solved tour it met before (the
+/// estimates are not bounds, so a later round can end dearer than an earlier one).
+fn best_of(g: &Graph, cache: &Cache, nodes: Vec<usize>, best: &Option<(f64, Vec<usize>)>) -> Vec<usize> {
+    match (solved_cost(g, cache, &nodes), best) {
+        (Some(c), Some((b, bn))) if *b < c => bn.clone(),
+        (None, Some((_, bn))) => bn.clone(),
+        _ => nodes,
+    }
+}
+
 /// Sequences on optimal-control costs (lazy), solving the legs it needs into `cache`.
 pub fn optimal_control(w: &WeldCell, g: &Graph, s: &LegSettings, cache: &mut Cache) -> Sequence {
     let n = g.q.len();
@@ -277,6 +297,7 @@ pub fn optimal_control(w: &WeldCell, g: &Graph, s: &LegSettings, cache: &mut Cac
     let (first, ex) = tour(g, &bound, &g.weld_cost, s.seed);
     let mut exact = ex;
     solve_legs(w, g, &edges(&first), s, cache);
+    let mut best = solved_cost(g, cache, &first).map(|c| (c, first));
     let mut rounds = 0;
     loop {
         rounds += 1;
@@ -300,7 +321,7 @@ pub fn optimal_control(w: &WeldCell, g: &Graph, s: &LegSettings, cache: &mut Cac
             .collect();
         if open.is_empty() {
             return Sequence {
-                nodes,
+                nodes: best_of(g, cache, nodes, &best),
                 rounds,
                 converged: true,
                 exact,
@@ -319,9 +340,14 @@ pub fn optimal_control(w: &WeldCell, g: &Graph, s: &LegSettings, cache: &mut Cac
                 ratio.0
             );
         }
+        if let Some(c) = solved_cost(g, cache, &nodes)
+            && best.as_ref().is_none_or(|(b, _)| c < *b)
+        {
+            best = Some((c, nodes.clone()));
+        }
         if over {
             return Sequence {
-                nodes,
+                nodes: best_of(g, cache, nodes, &best),
                 rounds,
                 converged: false,
                 exact,

@@ -1,6 +1,6 @@
-//! Collision trust regions (paper 002 §2.4): starting from a collision-free path, each
+//! Collision trust regions (paper 002 §2.4): starting from a collision-free trajectory, each
 //! iteration solves the OCP with every grid point `q_i` kept in a box around the previous
-//! iterate's, `n · max_j w_j |q_ij^{k+1} − q_ij^k| ≤ φ(q_i^k) − d_c`, then checks the new
+//! iterate's, `n · max_j w_j |q_ij^{k+1} − q_ij^k| ≤ s · (φ(q_i^k) − d_c)`, then checks the new
 //! trajectory densely; a trajectory that breaks the clearance is rejected and the boxes halved
 //! (backtracking); the iteration stops when the cost falls by less than [`TrustSettings::
 //! min_gain`] (relative) or after [`TrustSettings::iterations`].
@@ -9,9 +9,22 @@
 //! bodies to the scene less the cell's clearance, half the smallest self distance), and `w_j`
 //! is the joint's radius — an upper bound, valid in every configuration, on the distance of any
 //! body point from joint j's axis — in place of the paper's `max_p ‖∂p/∂q_j‖₁` at `q_i^k`. Since
-//! no point moves farther than `Σ_j w_j |Δq_j| ≤ n max_j w_j |Δq_j|`, every grid point of the new
-//! trajectory is proven clear (not only to first order); the pieces between grid points are
-//! then checked by the motion core's segment check.
+//! no point moves farther than `Σ_j w_j |Δq_j| ≤ n max_j w_j |Δq_j|`, at `s = 1` (the paper's
+//! box) every grid point of the new trajectory is proven clear (not only to first order); the
+//! pieces between grid points are checked by the motion core's segment check.
+//!
+//! Two things the paper leaves open, measured on `examples/studweld-kr210`:
+//! - **The first iterate.** A path is not a trajectory: with its grid pinned in boxes of a few
+//!   millimetres (planner paths graze the obstacles at the clearance) the DMOC rows have no
+//!   solution — every boxed solve from the path's grid ended `LocallyInfeasible`, and 6 of 21
+//!   moves fell back to timed paths. The iteration therefore starts from the dynamics'
+//!   trajectory nearest the path (J plus a tracking term, [`TRACKING`]), kept when it is clear:
+//!   it satisfies every constraint, so every boxed problem after it has a solution (the iterate
+//!   itself). The path given should have room ([`crate::leg::roomy_path`]).
+//! - **The boxes' scale `s`.** At the paper's `s = 1` each step moves the grid by millimetres
+//!   and J falls by about 1 % per solve; `s` doubles after each accepted iterate (up to
+//!   [`TrustSettings::max_scale`]) and halves after each rejected one — the dense check, not
+//!   the box, decides what is kept.
 use crate::cell::WeldCell;
 use crate::leg::{Dmoc, unpack};
 use cellplan_core::motion::{joint_radii, robot_validity};
@@ -29,27 +42,32 @@ pub struct TrustSettings {
     pub min_gain: f64,
     /// `d_c` (m): clearance kept beyond the cell's at grid points.
     pub extra_clearance: f64,
+    /// Largest scale of the boxes over the paper's (which prove the grid points clear).
+    pub max_scale: f64,
 }
 
 impl Default for TrustSettings {
     fn default() -> Self {
         TrustSettings {
-            iterations: 8,
+            iterations: 20,
             backtracks: 3,
             min_gain: 1e-3,
             extra_clearance: 0.0,
+            max_scale: 1024.0,
         }
     }
 }
 
-/// A [`Move`] with its grid points boxed.
-struct Boxed<'a, 'b> {
+/// A [`Move`] with its variables boxed in `lo..hi` and, when `track` is given as
+/// `(target, weight)`, `Σ_k weight_k (x_k − target_k)²` added to J.
+struct Shaped<'a, 'b> {
     m: &'b Move<'a>,
     lo: Vec<f64>,
     hi: Vec<f64>,
+    track: Option<(Vec<f64>, Vec<f64>)>,
 }
 
-impl Nlp for Boxed<'_, '_> {
+impl Nlp for Shaped<'_, '_> {
     fn num_vars(&self) -> usize {
         self.m.num_vars()
     }
@@ -69,10 +87,22 @@ impl Nlp for Boxed<'_, '_> {
         self.m.initial_point()
     }
     fn objective(&self, x: &[f64]) -> f64 {
-        Nlp::objective(self.m, x)
+        let mut f = Nlp::objective(self.m, x);
+        if let Some((target, weight)) = &self.track {
+            for k in 0..x.len() {
+                f += weight[k] * (x[k] - target[k]).powi(2);
+            }
+        }
+        f
     }
     fn gradient(&self, x: &[f64]) -> Vec<f64> {
-        Nlp::gradient(self.m, x)
+        let mut g = Nlp::gradient(self.m, x);
+        if let Some((target, weight)) = &self.track {
+            for k in 0..x.len() {
+                g[k] += 2.0 * weight[k] * (x[k] - target[k]);
+            }
+        }
+        g
     }
     fn eq(&self, x: &[f64]) -> Vec<f64> {
         self.m.eq(x)
@@ -87,7 +117,17 @@ impl Nlp for Boxed<'_, '_> {
         self.m.ineq_jacobian(x)
     }
     fn hessian(&self, x: &[f64], sigma: f64, lambda: &[f64], mu: &[f64]) -> Triplets {
-        Nlp::hessian(self.m, x, sigma, lambda, mu)
+        let mut h = Nlp::hessian(self.m, x, sigma, lambda, mu);
+        if let Some((_, weight)) = &self.track {
+            h.extend(
+                weight
+                    .iter()
+                    .enumerate()
+                    .filter(|(_, w)| **w > 0.0)
+                    .map(|(k, w)| (k, k, 2.0 * sigma * w)),
+            );
+        }
+        h
     }
     fn kkt_order(&self) -> Option<(Vec<usize>, usize)> {
         self.m.kkt_order()
@@ -106,6 +146,10 @@ pub struct Trusted {
     pub accepted: usize,
 }
 
+/// Weights of the tracking term that makes the first iterate (per m² of the farthest body
+/// point's displacement from the path's grid), lightest first.
+pub const TRACKING: [f64; 4] = [1e3, 1e5, 1e7, 1e9];
+
 /// Runs the trust-region iteration for `m` from `x0` (whose grid points must be clear: the
 /// planner's path resampled).
 pub fn iterate(w: &WeldCell, m: &Move, x0: &[f64], opt: &nlp::Options, s: &TrustSettings) -> Trusted {
@@ -113,14 +157,50 @@ pub fn iterate(w: &WeldCell, m: &Move, x0: &[f64], opt: &nlp::Options, s: &Trust
     let validity = robot_validity(w.cell, w.robot, w.cell.planning.clearance);
     let radii = joint_radii(w.cell, w.robot);
     let (base_lo, base_hi) = m.bounds();
-    let mut x = x0.to_vec();
     let mut out = Trusted {
         best: None,
         iterations: 0,
         solves: 0,
         accepted: 0,
     };
-    let mut last = f64::INFINITY;
+    // The first iterate: the dynamics' trajectory nearest the path (J plus the tracking term,
+    // lightest first), kept when it is clear. It satisfies every constraint, so each boxed
+    // problem after it has a solution (the iterate itself).
+    let mut x = None;
+    for rho in TRACKING {
+        let mut weight = vec![0.0; l.vars()];
+        for i in 1..l.steps {
+            for j in 0..l.n {
+                weight[l.q(i, j)] = rho * radii[j] * radii[j];
+            }
+        }
+        let t = Shaped {
+            m,
+            lo: base_lo.clone(),
+            hi: base_hi.clone(),
+            track: Some((x0.to_vec(), weight)),
+        };
+        let sol = nlp::ipm::solve_from(&t, x0, opt);
+        out.iterations += sol.iterations;
+        out.solves += 1;
+        let ok = matches!(sol.status, Status::Solved | Status::SolvedToAcceptableLevel);
+        let clear = ok && crate::leg::clear(w, &unpack(m, &sol.x).q);
+        if std::env::var_os("CELLPLAN_STUDWELD_VERBOSE").is_some() {
+            eprintln!("    tracking ρ {rho:.0e}: {:?}, clear {clear}", sol.status);
+        }
+        if clear {
+            x = Some(sol.x);
+            break;
+        }
+    }
+    let Some(mut x) = x else {
+        return out;
+    };
+    // The boxes' scale: 1 is the paper's (grid points proven clear); doubled after an accepted
+    // iterate, halved after a rejected one (the dense check decides).
+    let mut scale: f64 = 1.0;
+    let mut last = Nlp::objective(m, &x);
+    out.best = Some((unpack(m, &x), last));
     while out.accepted < s.iterations {
         // φ(q_i^k) − d_c per grid point.
         let room: Vec<f64> = (0..=l.steps)
@@ -130,7 +210,6 @@ pub fn iterate(w: &WeldCell, m: &Move, x0: &[f64], opt: &nlp::Options, s: &Trust
                 (scene.min(0.5 * own) - s.extra_clearance).max(0.0)
             })
             .collect();
-        let mut scale = 1.0;
         let mut accepted = false;
         for _ in 0..=s.backtracks {
             let (mut lo, mut hi) = (base_lo.clone(), base_hi.clone());
@@ -142,7 +221,12 @@ pub fn iterate(w: &WeldCell, m: &Move, x0: &[f64], opt: &nlp::Options, s: &Trust
                     hi[k] = (x[k] + half).min(base_hi[k]).max(x[k]);
                 }
             }
-            let b = Boxed { m, lo, hi };
+            let b = Shaped {
+                m,
+                lo,
+                hi,
+                track: None,
+            };
             let sol = nlp::ipm::solve_from(&b, &x, opt);
             out.iterations += sol.iterations;
             out.solves += 1;
@@ -167,11 +251,15 @@ pub fn iterate(w: &WeldCell, m: &Move, x0: &[f64], opt: &nlp::Options, s: &Trust
                 break;
             }
             let gain = (last - sol.objective) / sol.objective.abs().max(1e-12);
+            if verbose {
+                eprintln!("    trust region ×{scale}: J {:.2} accepted", sol.objective);
+            }
             x = sol.x;
             last = sol.objective;
             out.best = Some((traj, sol.objective));
             out.accepted += 1;
             accepted = gain >= s.min_gain;
+            scale = (2.0 * scale).min(s.max_scale);
             break;
         }
         if !accepted {

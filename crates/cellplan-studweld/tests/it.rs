@@ -206,3 +206,55 @@ fn the_example_cell_plans_and_verifies() {
         );
     }
 }
+
+/// §2.4 on moves whose unconstrained optimum collides: the trust-region iteration starts from
+/// the dynamics' trajectory nearest a path with room and returns a clear DMOC trajectory cheaper
+/// than the timed path — where it used to fall back to the timed path.
+#[test]
+fn trust_regions_give_clear_trajectories_where_the_optimum_collides() {
+    use cellplan_ocp::nlp;
+    use cellplan_studweld::leg;
+    let (_d, path) = cell(2, "", &quick);
+    let c = load(&path).unwrap();
+    let w = WeldCell::new(&c).unwrap();
+    let alts = cellplan_studweld::alternatives::alternatives(&w);
+    let s = LegSettings::default();
+    let opt = nlp::Options {
+        tol: 1e-8,
+        max_iter: s.max_iter,
+        ..nlp::Options::default()
+    };
+    let mut tried = 0;
+    for a in alts.per_stud[1].iter().take(4) {
+        let (from, to) = (&w.robot.home, &a.q);
+        let p = leg::path(&w, from, to, &s).expect("a path from home");
+        let m = cellplan_ocp::problem::Move {
+            steps: leg::steps_for(&w, &p),
+            ..leg::ocp(&w, from, to)
+        };
+        let free = nlp::ipm::solve(&m, &opt);
+        if leg::clear(&w, &leg::unpack(&m, &free.x).q) {
+            continue;
+        }
+        tried += 1;
+        let l = leg::solve(&w, from, to, &s).unwrap();
+        let Motion::Ocp(traj) = &l.motion else {
+            panic!("a timed path: {:?}", l.fallback)
+        };
+        assert!(l.trust_iterations > 0 && l.fallback.is_none());
+        assert!(leg::clear(&w, &traj.q));
+        assert_eq!((traj.q.first(), traj.q.last()), (Some(from), Some(to)));
+        let (timed, _, _) = leg::timed_path(&w, &p);
+        assert!(l.cost < timed, "J {} against the timed path's {timed}", l.cost);
+        assert!(
+            l.cost >= free.objective - 1e-6,
+            "J {} below the unconstrained optimum {}",
+            l.cost,
+            free.objective
+        );
+    }
+    assert!(
+        tried > 0,
+        "no move of the first alternatives collides unconstrained"
+    );
+}
