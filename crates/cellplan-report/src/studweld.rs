@@ -195,7 +195,7 @@ pub fn html(plan: &WeldPlan, w: &WeldCell, verdict: Option<&WeldReport>) -> Stri
                             span style=(format!("width:{:.1}%;background:#1f77b4", 100.0 * plan.totals.travel_cost / total)) {}
                             span style=(format!("width:{:.1}%;background:#ff7f0e", 100.0 * plan.totals.weld_cost / total)) {}
                         }
-                        p { (format!("J = ∫ c_t + c_e uᵀu + c_v q̇ᵀq̇ dt; travel {:.0} %, welding {:.0} %. {} of {} moves are timed paths (their optimal-control solution collided).", 100.0 * plan.totals.travel_cost / total, 100.0 * plan.totals.weld_cost / total, fallbacks, plan.legs.len())) }
+                        p { (format!("J = ∫ c_t + c_e uᵀu + c_v q̇ᵀq̇ dt; travel {:.0} %, welding {:.0} %. {} of {} moves are timed paths (the moves table says why).", 100.0 * plan.totals.travel_cost / total, 100.0 * plan.totals.weld_cost / total, fallbacks, plan.legs.len())) }
                         p id="verdict" { (verdict_text) }
                         @if let Some(v) = verdict && !v.violations.is_empty() {
                             ul class="violations" {
