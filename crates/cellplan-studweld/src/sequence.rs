@@ -1,9 +1,9 @@
 //! The two sequencers of paper 002's Table 2 on one GTSP graph (home and every alternative):
 //!
-//! - [`Sequencer::TravelTime`] ("old"): the order and alternatives that minimise travel time —
-//!   lazy on the motion planner (start from the straight-line trapezoid times, plan the tour's
-//!   legs, replace by the timed paths' durations, re-sequence until the tour's legs are all
-//!   planned) — then each leg of that tour optimised by the OCP;
+//! - [`Sequencer::TravelTime`] ("old", the paper's "approximate travel time minimization"): the
+//!   order and alternatives that minimise the straight moves' times at the joints' speed and
+//!   acceleration limits, then each leg of that tour optimised by the OCP (an edge without a
+//!   collision-free path barred and the tour re-sequenced);
 //! - [`Sequencer::OptimalControl`] ("new", §2.1): node cost = holding the alternative for the
 //!   weld time, edge cost = J of the leg's OCP; lazy — first the legs of the tour on
 //!   travel-time bounds with the node costs (a complete cycle, solved), then from the paper's
@@ -86,8 +86,6 @@ impl Graph {
 pub struct Cache {
     /// OCP legs (`None`: no collision-free path).
     pub legs: BTreeMap<(usize, usize), Option<Leg>>,
-    /// Timed-path durations of planned paths (`None`: no path).
-    pub paths: BTreeMap<(usize, usize), Option<f64>>,
     /// OCPs solved.
     pub solves: usize,
 }
@@ -357,7 +355,10 @@ pub fn optimal_control(w: &WeldCell, g: &Graph, s: &LegSettings, cache: &mut Cac
     }
 }
 
-/// Sequences on travel time (lazy on the motion planner), then solves the tour's legs.
+/// Sequences on approximate travel time (the paper's old sequencer): the straight move at the
+/// joints' speed and acceleration limits per edge, the weld time per node; then solves the
+/// tour's legs (planner path, OCP). An edge whose move has no collision-free path is barred and
+/// the tour re-sequenced.
 pub fn travel_time(w: &WeldCell, g: &Graph, s: &LegSettings, cache: &mut Cache) -> Sequence {
     let n = g.q.len();
     let bound: Vec<Vec<f64>> = (0..n)
@@ -374,49 +375,28 @@ pub fn travel_time(w: &WeldCell, g: &Graph, s: &LegSettings, cache: &mut Cache) 
         let costs: Vec<Vec<f64>> = (0..n)
             .map(|i| {
                 (0..n)
-                    .map(|j| match cache.paths.get(&key(i, j)) {
-                        Some(Some(t)) => *t,
+                    .map(|j| match cache.legs.get(&key(i, j)) {
                         Some(None) => 1e12,
-                        None => bound[i][j],
+                        _ => bound[i][j],
                     })
                     .collect()
             })
             .collect();
         let (nodes, ex) = tour(g, &costs, &service, s.seed);
         exact &= ex;
-        let mut open: Vec<(usize, usize)> = edges(&nodes)
-            .into_iter()
-            .map(|(a, b)| key(a, b))
-            .filter(|k| !cache.paths.contains_key(k))
-            .collect();
-        open.sort();
-        open.dedup();
-        if open.is_empty() {
-            solve_legs(w, g, &edges(&nodes), s, cache);
+        let tour_edges = edges(&nodes);
+        solve_legs(w, g, &tour_edges, s, cache);
+        let barred = tour_edges
+            .iter()
+            .any(|&(a, b)| matches!(cache.legs.get(&key(a, b)), Some(None)));
+        if !barred || rounds >= n {
             return Sequence {
                 nodes,
                 rounds,
-                converged: true,
+                converged: !barred,
                 exact,
                 estimate_ratio: None,
             };
         }
-        let timed: Vec<((usize, usize), Option<f64>)> = open
-            .par_iter()
-            .map(|&(a, b)| {
-                let t = leg::path(w, &g.q[a], &g.q[b], s).map(|p| {
-                    p.windows(2)
-                        .map(|sg| {
-                            leg::segment_profile(&sg[0], &sg[1], &w.v_max, &w.robot.max_acceleration, 1.0).0
-                        })
-                        .sum()
-                });
-                ((a, b), t)
-            })
-            .collect();
-        if verbose() {
-            eprintln!("travel-time round {rounds}: {} paths planned", timed.len());
-        }
-        cache.paths.extend(timed);
     }
 }
