@@ -29,9 +29,13 @@
 //! joint as the gripper is), and a self pair's by the motion of its distal body relative to
 //! the proximal one, over the joints between them only. The segment check steps by these
 //! tighter bounds ([`SegmentMotion::bound_with`]). On the MBM UR5, the upper arm's points lie
-//! within 0.67 m and 0.53 m of the first two axes, where the whole arm's radii are 1.45 m and
-//! 1.31 m; the base/upper-arm pair, which cut most steps short with the latter, allows steps
-//! about twice as long (`bench/motion/README.md`).
+//! within 0.64 m and 0.50 m of the first two axes, where the whole arm's radii are 1.45 m and
+//! 1.31 m. Two joints are bounded tighter still (`body_radii`, `pair_radii`): a body's
+//! own joint, the last before its link, by its reach from that joint's axis, and a self pair's
+//! first joint by the nearer body's reach from its axis — the base reaches 0.11 m from the
+//! first axis, so the base/upper-arm pair, which cuts most steps short, allows longer ones
+//! (`bench/motion/README.md`). Pairs proven apart everywhere are not checked at all
+//! ([`apart_everywhere`]).
 use crate::plan::{Clearance, JointSpace, SegmentMotion, StateValidity, narrow_step};
 use cellplan_geom::{BroadPhase, CollisionWorld, GroupId, PlacedCovers, Pose};
 use cellplan_kin::Chain;
@@ -181,7 +185,7 @@ fn body_radii(arm: &Arm, i: usize) -> Vec<f64> {
 /// axis stands still in the frame of the proximal body `near`: turning it turns the distal
 /// body about that axis, or equally the proximal body about it the other way, so the distance
 /// changes no faster than the nearer of the two bodies' reaches from the axis allows. The
-/// upper arm reaches 0.67 m from the UR5's base axis; the base, 0.1 m.
+/// upper arm reaches 0.64 m from the UR5's base axis; the base, 0.11 m.
 fn pair_radii(arm: &Arm, near: usize, first: usize, far: &[f64]) -> Vec<f64> {
     let mut radii = far.to_vec();
     if let Some(r) = axis_reach(arm, near, first, body_link(arm, near))
