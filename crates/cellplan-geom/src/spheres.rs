@@ -6,17 +6,21 @@
 //! cover is therefore a lower bound on the body's distance to `O`: cheap (a point query per
 //! sphere), and exact enough to dismiss everything not near the body.
 //!
-//! How the cover is built: the body is cut into slabs along the longest axis of its bounding
-//! box (as many as its length holds its width, at most [`MAX_SLABS`]). The part of a convex
-//! polyhedron inside a slab is the convex hull of its vertices inside the slab and of the
-//! points where its edges cross the slab's two planes; a sphere holding those points holds that
-//! part (a sphere is convex). Boxes and cylinders are cut the same way in closed form; a ball is
-//! its own cover.
+//! How the cover is built ([`fit`]): every shape but a ball (its own cover) is taken as a
+//! convex polytope — a body's hull as it is, a box by its corners, a cylinder by the prism
+//! circumscribing it, a mesh by its hull — and cut by a grid of planes into cells; each cell's
+//! part is held by one sphere about points whose convex hull provably contains that part (the
+//! proof is in [`fit`]). Of a few grids (along the body's axes and its principal axes, cells
+//! about as long as wide, at most [`MAX_SPHERES`]), the one whose cover sticks out of the body
+//! least on average, counting [`SPHERE_COST`] per sphere, is kept, its centres moved to stick
+//! out less.
 use crate::{DVec3, Pose};
-use parry3d_f64::shape::{Shape, TypedShape};
+use fit::Polytope;
+use parry3d_f64::shape::{ConvexPolyhedron, Shape, TypedShape};
 
-/// Most slabs a body is cut into.
-pub const MAX_SLABS: usize = 8;
+pub mod fit;
+
+pub use fit::{MAX_SPHERES, SPHERE_COST};
 
 /// Relative and absolute slack added to every radius, for rounding.
 const RADIUS_SLACK: (f64, f64) = (1e-9, 1e-9);
@@ -28,26 +32,6 @@ pub struct Sphere {
     pub centre: DVec3,
     /// Radius (m).
     pub radius: f64,
-}
-
-impl Sphere {
-    /// The smallest sphere about `centre` holding `points` (a little larger, for rounding).
-    fn around(centre: DVec3, points: &[DVec3]) -> Sphere {
-        let r = points.iter().map(|p| (*p - centre).length()).fold(0.0, f64::max);
-        Sphere {
-            centre,
-            radius: r * (1.0 + RADIUS_SLACK.0) + RADIUS_SLACK.1,
-        }
-    }
-
-    /// The sphere about the centre of the bounding box of `points` holding them.
-    fn bounding(points: &[DVec3]) -> Option<Sphere> {
-        let first = *points.first()?;
-        let (lo, hi) = points
-            .iter()
-            .fold((first, first), |(lo, hi), &p| (lo.min(p), hi.max(p)));
-        Some(Sphere::around((lo + hi) * 0.5, points))
-    }
 }
 
 /// A body's cover with a sphere holding the whole cover (for a first test).
@@ -93,145 +77,120 @@ fn enclosing(spheres: &[Sphere]) -> Option<Sphere> {
     })
 }
 
-/// Number of slabs for a body `length` long and `width` wide.
-fn slab_count(length: f64, width: f64) -> usize {
-    if length.is_nan() || length <= 0.0 || !length.is_finite() {
-        return 1;
-    }
-    if width.is_nan() || width <= 0.0 {
-        return MAX_SLABS;
-    }
-    ((length / width).ceil() as usize).clamp(1, MAX_SLABS)
-}
-
 /// The cover in the shape's own frame.
 fn local_cover(shape: &dyn Shape) -> Vec<Sphere> {
-    match shape.as_typed_shape() {
-        TypedShape::Ball(b) => vec![Sphere {
-            centre: DVec3::ZERO,
-            radius: b.radius,
-        }],
-        TypedShape::Cuboid(c) => box_cover(c.half_extents),
-        TypedShape::Cylinder(c) => cylinder_cover(c.half_height, c.radius),
-        TypedShape::ConvexPolyhedron(c) => {
-            let edges: Vec<[usize; 2]> = c
-                .edges()
-                .iter()
-                .map(|e| [e.vertices[0] as usize, e.vertices[1] as usize])
-                .collect();
-            polytope_cover(c.points(), &edges)
+    let polytope = match shape.as_typed_shape() {
+        TypedShape::Ball(b) => {
+            return vec![Sphere {
+                centre: DVec3::ZERO,
+                radius: b.radius,
+            }];
         }
-        TypedShape::TriMesh(m) => {
-            let edges: Vec<[usize; 2]> = m
-                .indices()
-                .iter()
-                .flat_map(|t| [[t[0], t[1]], [t[1], t[2]], [t[2], t[0]]])
-                .map(|[a, b]| [a as usize, b as usize])
-                .collect();
-            polytope_cover(m.vertices(), &edges)
-        }
-        _ => {
-            // Any other shape: the sphere about its bounding box.
-            let aabb = shape.compute_local_aabb();
-            let c = aabb.center();
-            let r = aabb.half_extents().length();
-            if r.is_finite() {
-                vec![Sphere { centre: c, radius: r }]
-            } else {
-                Vec::new()
-            }
-        }
+        TypedShape::Cuboid(c) => box_polytope(c.half_extents),
+        TypedShape::Cylinder(c) => cylinder_polytope(c.half_height, c.radius),
+        TypedShape::ConvexPolyhedron(c) => convex_polytope(c),
+        TypedShape::TriMesh(m) => match ConvexPolyhedron::from_convex_hull(m.vertices()) {
+            Some(hull) => convex_polytope(&hull),
+            // A flat mesh: its own edges, bounded by the grid's box alone.
+            None => Polytope::new(
+                m.vertices(),
+                m.indices()
+                    .iter()
+                    .flat_map(|t| [[t[0], t[1]], [t[1], t[2]], [t[2], t[0]]])
+                    .map(|[a, b]| [a as usize, b as usize]),
+                [],
+            ),
+        },
+        _ => None,
+    };
+    if let Some(p) = polytope {
+        return fit::fitted_cover(&p);
+    }
+    // Any other shape: the sphere about its bounding box.
+    let aabb = shape.compute_local_aabb();
+    let c = aabb.center();
+    let r = aabb.half_extents().length();
+    if r.is_finite() {
+        vec![Sphere { centre: c, radius: r }]
+    } else {
+        Vec::new()
     }
 }
 
-/// A box cut along its longest axis: each slab is a box, held by the sphere of its half
-/// diagonal.
-fn box_cover(half: DVec3) -> Vec<Sphere> {
-    let k = half.max_position();
-    let width = 2.0 * (0..3).filter(|&i| i != k).map(|i| half[i]).fold(0.0, f64::max);
-    let n = slab_count(2.0 * half[k], width);
-    let mut slab = half;
-    slab[k] = half[k] / n as f64;
-    let radius = slab.length() * (1.0 + RADIUS_SLACK.0) + RADIUS_SLACK.1;
-    (0..n)
+/// A convex polyhedron: its points, every edge of its triangulated surface (parry keeps the
+/// edges inside merged coplanar faces too) and its faces' normals.
+fn convex_polytope(c: &ConvexPolyhedron) -> Option<Polytope> {
+    Polytope::new(
+        c.points(),
+        c.edges()
+            .iter()
+            .map(|e| [e.vertices[0] as usize, e.vertices[1] as usize]),
+        c.faces().iter().map(|f| f.normal),
+    )
+}
+
+/// A box of half extents `half` as a polytope.
+fn box_polytope(half: DVec3) -> Option<Polytope> {
+    let corners: Vec<DVec3> = (0..8)
         .map(|i| {
-            let mut centre = DVec3::ZERO;
-            centre[k] = -half[k] + slab[k] * (2 * i + 1) as f64;
-            Sphere { centre, radius }
+            let s = |bit: usize| if i & bit == 0 { -1.0 } else { 1.0 };
+            half * DVec3::new(s(1), s(2), s(4))
         })
-        .collect()
+        .collect();
+    // Corners differing in one bit share an edge.
+    let edges = (0..8usize).flat_map(|a| {
+        [1, 2, 4]
+            .into_iter()
+            .filter(move |b| a & b == 0)
+            .map(move |b| [a, a | b])
+    });
+    let normals = [
+        DVec3::X,
+        DVec3::NEG_X,
+        DVec3::Y,
+        DVec3::NEG_Y,
+        DVec3::Z,
+        DVec3::NEG_Z,
+    ];
+    Polytope::new(&corners, edges, normals)
 }
 
-/// A cylinder (axis y, as parry's) cut across its axis into slabs when it is longer than
-/// wide: each slab is a shorter cylinder, held by the sphere through its rims.
-fn cylinder_cover(half_height: f64, radius: f64) -> Vec<Sphere> {
-    let n = slab_count(2.0 * half_height, 2.0 * radius);
-    let h = half_height / n as f64;
-    let r = (radius * radius + h * h).sqrt() * (1.0 + RADIUS_SLACK.0) + RADIUS_SLACK.1;
-    (0..n)
-        .map(|i| Sphere {
-            centre: DVec3::new(0.0, -half_height + h * (2 * i + 1) as f64, 0.0),
-            radius: r,
-        })
-        .collect()
-}
+/// Sides of the prism circumscribing a cylinder for its cover.
+const CYLINDER_SIDES: usize = 32;
 
-/// A convex polytope (its vertices and edges) cut into slabs along the longest axis of its
-/// bounding box; each slab's part is held by the sphere about the points that span it (the
-/// vertices inside the slab and the edges' crossings of its planes).
-fn polytope_cover(points: &[DVec3], edges: &[[usize; 2]]) -> Vec<Sphere> {
-    let points: Vec<DVec3> = points.iter().copied().filter(|p| p.is_finite()).collect();
-    let Some(&first) = points.first() else {
-        return Vec::new();
-    };
-    let (lo, hi) = points
-        .iter()
-        .fold((first, first), |(lo, hi), &p| (lo.min(p), hi.max(p)));
-    let extent = hi - lo;
-    let k = extent.max_position();
-    let width = (0..3).filter(|&i| i != k).map(|i| extent[i]).fold(0.0, f64::max);
-    let n = slab_count(extent[k], width);
-    if n == 1 {
-        return Sphere::bounding(&points).into_iter().collect();
-    }
-    let cut = |i: usize| {
-        if i == n {
-            hi[k]
-        } else {
-            lo[k] + extent[k] * i as f64 / n as f64
-        }
-    };
-    let mut out = Vec::with_capacity(n);
-    let mut held = Vec::new();
-    for i in 0..n {
-        let (t0, t1) = (cut(i), cut(i + 1));
-        held.clear();
-        held.extend(points.iter().copied().filter(|p| p[k] >= t0 && p[k] <= t1));
-        for &[a, b] in edges {
-            let (Some(&pa), Some(&pb)) = (points.get(a), points.get(b)) else {
-                continue;
-            };
-            for t in [t0, t1] {
-                let (da, db) = (pa[k] - t, pb[k] - t);
-                if (da < 0.0) != (db < 0.0) && da != db {
-                    let s = da / (da - db);
-                    let mut p = pa + (pb - pa) * s;
-                    p[k] = t;
-                    held.push(p);
-                }
-            }
-        }
-        if let Some(s) = Sphere::bounding(&held) {
-            out.push(s);
-        }
-    }
-    out
+/// A cylinder (axis y, as parry's) as the prism circumscribing it (its sides touch it).
+fn cylinder_polytope(half_height: f64, radius: f64) -> Option<Polytope> {
+    let n = CYLINDER_SIDES;
+    // The polygon's apothem is the radius: its vertices lie at r / cos(π/n).
+    let r = radius / (std::f64::consts::PI / n as f64).cos();
+    let angle = |k: usize| std::f64::consts::TAU * k as f64 / n as f64;
+    let points: Vec<DVec3> = (0..n)
+        .flat_map(|k| {
+            let (s, c) = angle(k).sin_cos();
+            [
+                DVec3::new(r * c, -half_height, r * s),
+                DVec3::new(r * c, half_height, r * s),
+            ]
+        })
+        .collect();
+    // Point 2k is at the bottom, 2k + 1 at the top of corner k.
+    let edges = (0..n).flat_map(|k| {
+        let m = (k + 1) % n;
+        [[2 * k, 2 * m], [2 * k + 1, 2 * m + 1], [2 * k, 2 * k + 1]]
+    });
+    let normals = (0..n)
+        .map(|k| {
+            let (s, c) = (angle(k) + std::f64::consts::PI / n as f64).sin_cos();
+            DVec3::new(c, 0.0, s)
+        })
+        .chain([DVec3::Y, DVec3::NEG_Y]);
+    Polytope::new(&points, edges, normals)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use parry3d_f64::shape::{Ball, ConvexPolyhedron, Cuboid, Cylinder, SharedShape};
+    use parry3d_f64::shape::{Ball, ConvexPolyhedron, Cuboid, Cylinder, SharedShape, TriMesh};
     use rand::{RngExt, SeedableRng};
     use rand_chacha::ChaCha8Rng;
 
@@ -244,14 +203,14 @@ mod tests {
         let aabb = shape.compute_local_aabb();
         let mut rng = ChaCha8Rng::seed_from_u64(7);
         let mut inside = 0;
-        for _ in 0..20_000 {
+        for k in 0..20_000 {
             let p = DVec3::new(
                 rng.random_range(aabb.mins.x..=aabb.maxs.x),
                 rng.random_range(aabb.mins.y..=aabb.maxs.y),
                 rng.random_range(aabb.mins.z..=aabb.maxs.z),
             );
             // Points on the surface matter most: push some to the boundary.
-            let p = if inside % 2 == 0 {
+            let p = if k % 2 == 0 {
                 shape.project_local_point(p, false).point
             } else {
                 p
@@ -268,7 +227,7 @@ mod tests {
             );
             assert!((w - outer.centre).length() <= outer.radius);
         }
-        assert!(inside > 1000);
+        assert!(inside > 1000, "{inside} samples inside");
         // Not too loose: the cover's spheres stay within the shape's bounding sphere.
         let bound = aabb.half_extents().length();
         for s in &cover.spheres {
@@ -286,6 +245,41 @@ mod tests {
         assert_covers(&Cuboid::new(DVec3::new(0.5, 0.05, 0.1)), local);
         assert_covers(&Cylinder::new(0.4, 0.05), local);
         assert_covers(&Cylinder::new(0.02, 0.3), local);
+        // Fat shapes, cut in two or three directions.
+        assert_covers(&Cuboid::new(DVec3::new(0.2, 0.2, 0.2)), local);
+        assert_covers(&Cuboid::new(DVec3::new(0.3, 0.25, 0.01)), local);
+        assert_covers(&Cylinder::new(0.1, 0.3), local);
+        // A mesh: covered by its hull; a flat one by its own triangles.
+        let mesh = |vertices: Vec<DVec3>| {
+            TriMesh::new(vertices, vec![[0, 1, 2], [0, 2, 3], [0, 3, 1], [1, 3, 2]]).unwrap()
+        };
+        let tetra = mesh(vec![
+            DVec3::new(0.0, 0.0, 0.0),
+            DVec3::new(0.4, 0.0, 0.0),
+            DVec3::new(0.0, 0.3, 0.0),
+            DVec3::new(0.1, 0.1, 0.2),
+        ]);
+        assert_covers(&tetra, local);
+        let flat = mesh(vec![
+            DVec3::new(0.0, 0.0, 0.0),
+            DVec3::new(0.4, 0.0, 0.0),
+            DVec3::new(0.0, 0.3, 0.0),
+            DVec3::new(0.3, 0.2, 0.0),
+        ]);
+        let cover = Cover::of(&flat, &Pose::IDENTITY);
+        for (a, b) in [
+            (0.0, 0.0),
+            (1.0, 0.0),
+            (0.0, 1.0),
+            (0.5, 0.5),
+            (0.2, 0.7),
+            (0.9, 0.05),
+        ] {
+            for t in flat.triangles() {
+                let p = t.a + (t.b - t.a) * a * (1.0 - b) + (t.c - t.a) * b * (1.0 - a);
+                assert!(cover.spheres.iter().any(|s| (p - s.centre).length() <= s.radius));
+            }
+        }
         let mut rng = ChaCha8Rng::seed_from_u64(3);
         let pts: Vec<DVec3> = (0..60)
             .map(|_| {
@@ -303,14 +297,5 @@ mod tests {
             Cover::of(&*shared, &local).spheres.len() > 2,
             "a long hull is cut into slabs"
         );
-    }
-
-    #[test]
-    fn slab_count_is_bounded() {
-        assert_eq!(slab_count(1.0, 1.0), 1);
-        assert_eq!(slab_count(1.0, 0.3), 4);
-        assert_eq!(slab_count(1.0, 0.0), MAX_SLABS);
-        assert_eq!(slab_count(f64::NAN, 1.0), 1);
-        assert_eq!(slab_count(100.0, 1.0), MAX_SLABS);
     }
 }

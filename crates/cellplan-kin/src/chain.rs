@@ -191,6 +191,44 @@ impl Chain {
             .collect()
     }
 
+    /// The axis of revolute joint `j` in the frame of link `k` — a point on it and its unit
+    /// direction — when that line stands still in link `k`'s frame: when no other joint lies
+    /// between `k` and the link `j` moves (`k` is that link or a fixed descendant of it, or a
+    /// fixed ancestor of it, joined to it only by `j`). `None` otherwise, and for a prismatic
+    /// joint.
+    ///
+    /// A body on such a link turns about this line as `j` turns (or, on the ancestor side,
+    /// sees the bodies beyond `j` turn about it): how far the body reaches from the line bounds
+    /// the motion that `j` causes, in every configuration.
+    pub fn joint_axis_in(&self, j: usize, k: usize) -> Option<(DVec3, DVec3)> {
+        let joint = self.joints.get(j)?;
+        let lj = self.joint_link(j)?;
+        if !joint.is_rotational() || k >= self.links.len() {
+            return None;
+        }
+        let fixed = |links: &[ChainLink]| links.iter().all(|l| l.joint.is_none());
+        if k >= lj {
+            // Link k in the frame of link lj, through fixed origins only.
+            if !fixed(&self.links[lj + 1..=k]) {
+                return None;
+            }
+            let t = self.links[lj + 1..=k]
+                .iter()
+                .fold(Pose::IDENTITY, |t, l| t * l.origin);
+            let inv = t.inverse();
+            Some((inv.translation, inv.rotation * joint.axis))
+        } else {
+            // Link lj (at joint value 0: the axis does not turn with it) in link k's frame.
+            if !fixed(&self.links[k + 1..lj]) {
+                return None;
+            }
+            let t = self.links[k + 1..=lj]
+                .iter()
+                .fold(Pose::IDENTITY, |t, l| t * l.origin);
+            Some((t.translation, t.rotation * joint.axis))
+        }
+    }
+
     fn body_radii_with(&self, offset: &[f64], k: usize, reach: f64) -> Vec<f64> {
         (0..self.dof())
             .map(|j| {
@@ -317,6 +355,33 @@ mod tests {
                 joint("j2", JointKind::Continuous, DVec3::Y, -2.0 * PI, 2.0 * PI),
                 joint("j3", JointKind::Prismatic, DVec3::X, 0.0, 0.2),
             ],
+        }
+    }
+
+    /// The axis of a joint in a link's frame is where forward kinematics puts it, in every
+    /// configuration; links with another joint between have none.
+    #[test]
+    fn joint_axes_in_link_frames() {
+        let c = arm();
+        assert_eq!(c.joint_axis_in(2, 3), None, "prismatic");
+        assert_eq!(c.joint_axis_in(0, 2), None, "j2 lies between");
+        assert_eq!(c.joint_axis_in(1, 4), None, "j3 lies between");
+        let mut poses = vec![Pose::IDENTITY; c.links.len()];
+        for (j, k) in [(0, 0), (0, 1), (1, 1), (1, 2)] {
+            let (p, d) = c.joint_axis_in(j, k).expect("a fixed line");
+            assert!((d.length() - 1.0).abs() < 1e-12);
+            for t in 0..20 {
+                let t = t as f64 / 20.0;
+                c.fk_all(&[3.0 * t - 1.5, 5.0 * t - 2.0, 0.2 * t], &mut poses);
+                let lj = c.joint_link(j).unwrap();
+                let (wp, wd) = (poses[lj].translation, poses[lj].rotation * c.joints[j].axis);
+                let (kp, kd) = (poses[k].transform_point(p), poses[k].rotation * d);
+                assert!((kd - wd).length() < 1e-12, "{j} in {k}: {kd:?} vs {wd:?}");
+                assert!(
+                    (kp - wp).cross(wd).length() < 1e-12,
+                    "{j} in {k}: {kp:?} off the axis"
+                );
+            }
         }
     }
 

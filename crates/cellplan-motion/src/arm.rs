@@ -29,14 +29,24 @@
 //! joint as the gripper is), and a self pair's by the motion of its distal body relative to
 //! the proximal one, over the joints between them only. The segment check steps by these
 //! tighter bounds ([`SegmentMotion::bound_with`]). On the MBM UR5, the upper arm's points lie
-//! within 0.67 m and 0.53 m of the first two axes, where the whole arm's radii are 1.45 m and
-//! 1.31 m; the base/upper-arm pair, which cut most steps short with the latter, allows steps
-//! about twice as long (`bench/motion/README.md`).
+//! within 0.64 m and 0.50 m of the first two axes, where the whole arm's radii are 1.45 m and
+//! 1.31 m. Two joints are bounded tighter still (`body_radii`, `pair_radii`): a body's
+//! own joint, the last before its link, by its reach from that joint's axis, and a self pair's
+//! first joint by the nearer body's reach from its axis — the base reaches 0.11 m from the
+//! first axis, so the base/upper-arm pair, which cuts most steps short, allows longer ones
+//! (`bench/motion/README.md`). Pairs proven apart everywhere are not checked at all
+//! ([`apart_everywhere`]).
 use crate::plan::{Clearance, JointSpace, SegmentMotion, StateValidity, narrow_step};
 use cellplan_geom::{BroadPhase, CollisionWorld, GroupId, PlacedCovers, Pose};
 use cellplan_kin::Chain;
 use std::cell::RefCell;
 use std::ops::Range;
+
+mod apart;
+#[cfg(test)]
+mod tests;
+
+pub use apart::{APART_BUDGET, apart_everywhere, pairs_that_may_touch};
 
 /// Clearances are capped at this (m) by default: larger values only lengthen the steps of a
 /// segment check a little, and the cap lets the distance queries skip everything further.
@@ -132,6 +142,74 @@ fn body_reach(arm: &Arm, i: usize) -> Option<f64> {
         .fold(None, |m: Option<f64>, v| Some(m.map_or(v, |m| m.max(v))))
 }
 
+/// The chain link body `i` hangs on (the tip for a body without one).
+fn body_link(arm: &Arm, i: usize) -> usize {
+    let tip = arm.chain.links.len().saturating_sub(1);
+    arm.body_links.get(i).copied().unwrap_or(tip).min(tip)
+}
+
+/// The number of joints that move body `i`: joints `0..moved_by(arm, i)`.
+fn moved_by(arm: &Arm, i: usize) -> usize {
+    arm.chain.joints_to().get(body_link(arm, i)).copied().unwrap_or(0)
+}
+
+/// Body `i`'s radii: [`Chain::body_radii`] with its reach taken from its cover, and for the
+/// last joint before its link — whose axis stands still in the body's frame
+/// ([`Chain::joint_axis_in`]) — the reach of its cover from that axis, where smaller. A body
+/// turning about an axis moves no farther than its points lie from it: the gripper's bodies,
+/// centred on the wrist's last axis, reach a few centimetres from it, where the bound through
+/// the link's origin counts the whole offset to the flange.
+fn body_radii(arm: &Arm, i: usize) -> Vec<f64> {
+    let link = body_link(arm, i);
+    let mut radii = arm
+        .chain
+        .body_radii(link, body_reach(arm, i).unwrap_or(f64::INFINITY));
+    let last = arm
+        .chain
+        .joints_to()
+        .get(link)
+        .copied()
+        .unwrap_or(0)
+        .checked_sub(1);
+    if let Some(j) = last
+        && let Some(r) = axis_reach(arm, i, j, link)
+        && let Some(slot) = radii.get_mut(j)
+    {
+        *slot = slot.min(r);
+    }
+    radii
+}
+
+/// The radii bounding how fast the distance of a self pair can fall: those of its distal body
+/// (`far`, its [`body_radii`]), except for the first joint between the two, `first`, whose
+/// axis stands still in the frame of the proximal body `near`: turning it turns the distal
+/// body about that axis, or equally the proximal body about it the other way, so the distance
+/// changes no faster than the nearer of the two bodies' reaches from the axis allows. The
+/// upper arm reaches 0.64 m from the UR5's base axis; the base, 0.11 m.
+fn pair_radii(arm: &Arm, near: usize, first: usize, far: &[f64]) -> Vec<f64> {
+    let mut radii = far.to_vec();
+    if let Some(r) = axis_reach(arm, near, first, body_link(arm, near))
+        && let Some(slot) = radii.get_mut(first)
+    {
+        *slot = slot.min(r);
+    }
+    radii
+}
+
+/// The largest distance of body `i`'s points (its cover, in the frame of its link `link`) from
+/// the axis of joint `j` when that axis stands still in the link's frame; `None` when it does
+/// not, or for a body without shapes.
+fn axis_reach(arm: &Arm, i: usize, j: usize, link: usize) -> Option<f64> {
+    let (p, d) = arm.chain.joint_axis_in(j, link)?;
+    let cover = arm.world.body_cover(arm.group, i);
+    (!cover.is_empty()).then(|| {
+        cover
+            .iter()
+            .map(|s| (s.centre - p).cross(d).length() + s.radius)
+            .fold(0.0, f64::max)
+    })
+}
+
 /// The configurations that move the tool point `tcp` (a pose in the chain's tip frame) from
 /// where it is at `q` backwards along its own z axis by `distance` (m), its orientation kept:
 /// the retract before a leg, and reversed the approach after it (a probe, a gripper or a gun
@@ -224,10 +302,10 @@ pub struct ArmValidity<'a> {
     pub own_radii: bool,
     /// Bodies checked against the scene (those moved by some joint), with their joints.
     moving: Vec<(usize, Range<usize>)>,
-    /// Checked self pairs with the joints between them and the body whose radii bound their
-    /// relative motion (the one farther down the chain).
-    pairs: Vec<(usize, usize, Range<usize>, usize)>,
-    /// Each body's radii ([`Chain::body_radii`], its reach taken from its cover).
+    /// Checked self pairs with the joints between them and the radii that bound their
+    /// relative motion ([`pair_radii`]).
+    pairs: Vec<(usize, usize, Range<usize>, Vec<f64>)>,
+    /// Each body's radii ([`body_radii`]).
     body_radii: Vec<Vec<f64>>,
     /// The part that last proved a configuration invalid (asked first next time).
     last_failed: PartHint,
@@ -244,14 +322,8 @@ impl<'a> ArmValidity<'a> {
     /// the `parked` groups. Bodies on links before the first joint never move and are not
     /// checked against the scene (a robot's base stands on its floor).
     pub fn new(arm: Arm<'a>, margin: f64, parked: Vec<(GroupId, Vec<Pose>)>) -> Self {
-        let joints_to = arm.chain.joints_to();
-        let tip = arm.chain.links.len().saturating_sub(1);
-        let moved_by = |i: usize| {
-            let l = arm.body_links.get(i).copied().unwrap_or(tip).min(tip);
-            joints_to.get(l).copied().unwrap_or(0)
-        };
         let moving = (0..arm.body_links.len())
-            .map(|i| (i, 0..moved_by(i)))
+            .map(|i| (i, 0..moved_by(&arm, i)))
             .filter(|(_, r)| !r.is_empty())
             .collect();
         // Pairs that no joint moves relative to each other keep one distance: measured once
@@ -260,22 +332,18 @@ impl<'a> ArmValidity<'a> {
         let mut links = Vec::new();
         let mut poses = Vec::new();
         arm.body_poses(&arm.chain.mid_configuration(), &mut links, &mut poses);
+        let body_radii: Vec<Vec<f64>> = (0..arm.body_links.len()).map(|i| body_radii(&arm, i)).collect();
         let pairs = arm
             .self_pairs
             .iter()
             .map(|&(i, j)| {
-                let (a, b) = (moved_by(i), moved_by(j));
-                (i, j, a.min(b)..a.max(b), if b >= a { j } else { i })
+                let (a, b) = (moved_by(&arm, i), moved_by(&arm, j));
+                let (near, far) = if b >= a { (i, j) } else { (j, i) };
+                let radii = pair_radii(&arm, near, a.min(b), &body_radii[far]);
+                (i, j, a.min(b)..a.max(b), radii)
             })
             .filter(|(i, j, r, _)| {
                 !r.is_empty() || arm.world.pair_distance(arm.group, *i, *j, &poses, 1.0) <= DISTANCE_SLACK
-            })
-            .collect();
-        let body_radii = (0..arm.body_links.len())
-            .map(|i| {
-                let link = arm.body_links[i].min(tip);
-                arm.chain
-                    .body_radii(link, body_reach(&arm, i).unwrap_or(f64::INFINITY))
             })
             .collect();
         ArmValidity {
@@ -407,12 +475,13 @@ impl<'a> ArmValidity<'a> {
         })
     }
 
-    /// How far the points of a part move over a segment: by the radii of `body` (the moving
-    /// body, or a pair's distal one) when [`Self::own_radii`] is on, else the space's.
-    fn part_bound(&self, motion: &SegmentMotion, joints: &Range<usize>, body: usize) -> f64 {
-        match self.body_radii.get(body) {
-            Some(own) if self.own_radii => motion.bound_with(joints, own),
-            _ => motion.bound(joints),
+    /// How far a part's distance can fall over a segment: by its own radii (a moving body's,
+    /// or a pair's) when [`Self::own_radii`] is on, else by the space's.
+    fn part_bound(&self, motion: &SegmentMotion, joints: &Range<usize>, own: &[f64]) -> f64 {
+        if self.own_radii {
+            motion.bound_with(joints, own)
+        } else {
+            motion.bound(joints)
         }
     }
 
@@ -492,7 +561,7 @@ impl StateValidity for ArmValidity<'_> {
         self.posed(q, |bodies, placed| {
             let mut step = limit;
             for (i, joints) in self.moving.iter().rev() {
-                let b = self.part_bound(motion, joints, *i);
+                let b = self.part_bound(motion, joints, self.body_radii.get(*i).map_or(&[], |r| r));
                 let part = self.capped_part(
                     |cap| self.scene_part(*i, bodies, placed, cap),
                     margin,
@@ -502,8 +571,8 @@ impl StateValidity for ArmValidity<'_> {
                 );
                 step = narrow_step(step, part, b, floor)?;
             }
-            for (i, j, joints, distal) in &self.pairs {
-                let b = self.part_bound(motion, joints, *distal);
+            for (i, j, joints, radii) in &self.pairs {
+                let b = self.part_bound(motion, joints, radii);
                 let part = self.capped_part(
                     |cap| self.pair_part(*i, *j, bodies, placed, cap),
                     0.0,

@@ -9,8 +9,10 @@
 //! [`cellplan_geom::pieces`] — the hulls of such links are what touch their neighbours across
 //! the joint, while every piece multiplies the pairs to check, so rigid attachments such as
 //! gripper fingers keep one hull per mesh), the SRDF's `disable_collisions` pairs left out of the self checks (without an SRDF:
-//! every pair of bodies on different links that are not parent and child).
-use crate::arm::{Arm, ArmValidity};
+//! every pair of bodies on different links that are not parent and child). Of the remaining
+//! pairs, those proven apart in every configuration within the joint limits are not asked by
+//! the validity check ([`crate::arm::pairs_that_may_touch`]).
+use crate::arm::{Arm, ArmValidity, pairs_that_may_touch};
 use cellplan_geom::pieces::convex_pieces;
 use cellplan_geom::read::{LimitedReadError, read_limited, show_bytes, utf8_text};
 use cellplan_geom::{CollisionWorld, DQuat, DVec3, GroupBody, GroupId, Mesh, Pose, ShapeSpec};
@@ -416,8 +418,12 @@ pub struct ArmSetup {
     pub body_links: Vec<usize>,
     /// The URDF link each body's shape belongs to.
     pub body_sources: Vec<String>,
-    /// The body pairs checked for self-collision.
+    /// The body pairs to keep apart: every pair on different links but those the SRDF
+    /// disables (what an exact re-check checks).
     pub self_pairs: Vec<(usize, usize)>,
+    /// The pairs of `self_pairs` that the validity check asks: those not proven apart in
+    /// every configuration within the joint limits ([`crate::arm::pairs_that_may_touch`]).
+    pub checked_pairs: Vec<(usize, usize)>,
     /// Where the root stands.
     pub base: Pose,
     /// For each chain joint, its index in the file's joint list.
@@ -505,16 +511,19 @@ impl ArmSetup {
                 self_pairs.push((i, j));
             }
         }
-        Ok(ArmSetup {
+        let mut setup = ArmSetup {
             base: set.robot.base,
             model,
             world,
             group,
             body_links,
             body_sources,
+            checked_pairs: self_pairs.clone(),
             self_pairs,
             order,
-        })
+        };
+        setup.checked_pairs = pairs_that_may_touch(&setup.arm());
+        Ok(setup)
     }
 
     /// Replaces the obstacles of the world.
@@ -552,11 +561,11 @@ impl ArmSetup {
             base: self.base,
             group: self.group,
             body_links: &self.body_links,
-            self_pairs: &self.self_pairs,
+            self_pairs: &self.checked_pairs,
         }
     }
 
-    /// The checked self pairs by URDF link names (each once).
+    /// The self pairs to keep apart (`self_pairs`) by URDF link names (each once).
     pub fn link_pairs(&self) -> Vec<(String, String)> {
         let mut out: Vec<(String, String)> = self
             .self_pairs

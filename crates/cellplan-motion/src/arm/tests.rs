@@ -1,0 +1,164 @@
+//! The arm's motion bounds and its proof of pairs apart, on the MBM UR5 (bench/motion).
+use super::{Arm, apart_everywhere, body_radii, moved_by, pair_radii, pairs_that_may_touch};
+use crate::problem::{ArmSetup, read_problems};
+use cellplan_geom::{DVec3, Pose};
+use rand::{RngExt, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use std::path::Path;
+
+fn ur5() -> ArmSetup {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../bench/motion/mbm-ur5/table_pick.json");
+    ArmSetup::load(&read_problems(&path).unwrap()).unwrap()
+}
+
+fn random_q(arm: &Arm, rng: &mut ChaCha8Rng) -> Vec<f64> {
+    arm.chain
+        .joints
+        .iter()
+        .map(|j| rng.random_range(j.lower..=j.upper))
+        .collect()
+}
+
+fn lerp(a: &[f64], b: &[f64], t: f64) -> Vec<f64> {
+    a.iter().zip(b).map(|(x, y)| x + (y - x) * t).collect()
+}
+
+/// `Σ_k r_k·|b_k − a_k|` over the joints `joints`.
+fn bound(radii: &[f64], a: &[f64], b: &[f64], joints: std::ops::Range<usize>) -> f64 {
+    joints.map(|k| radii[k] * (b[k] - a[k]).abs()).sum()
+}
+
+/// Over random short segments, every hull vertex of every body travels no farther than its
+/// radii allow (the tightened radius of its own joint included), and every self pair's
+/// distance changes no more than the pair's radii allow (the proximal body's reach for the
+/// first joint included). Each bound is also not slack by much for some segment: the test
+/// would notice radii far too large as well as too small.
+#[test]
+fn body_and_pair_radii_bound_the_motion() {
+    let setup = ur5();
+    let arm = setup.arm();
+    let n = arm.body_links.len();
+    let radii: Vec<Vec<f64>> = (0..n).map(|i| body_radii(&arm, i)).collect();
+    let hulls: Vec<Vec<DVec3>> = (0..n)
+        .map(|i| {
+            arm.world
+                .body_hull(arm.group, i)
+                .map_or(Vec::new(), |m| m.vertices)
+        })
+        .collect();
+    let mut rng = ChaCha8Rng::seed_from_u64(11);
+    let (mut links, mut poses) = (Vec::new(), Vec::<Pose>::new());
+    let mut tightest = vec![0.0f64; n];
+    for _ in 0..60 {
+        let a = random_q(&arm, &mut rng);
+        let b: Vec<f64> = a.iter().map(|x| x + rng.random_range(-0.2..0.2)).collect();
+        let steps = 40;
+        let mut travelled = vec![0.0; n];
+        let mut prev: Option<Vec<Pose>> = None;
+        for s in 0..=steps {
+            arm.body_poses(&lerp(&a, &b, s as f64 / steps as f64), &mut links, &mut poses);
+            if let Some(p) = &prev {
+                for i in 0..n {
+                    let step = hulls[i]
+                        .iter()
+                        .map(|v| (poses[i].transform_point(*v) - p[i].transform_point(*v)).length())
+                        .fold(0.0, f64::max);
+                    travelled[i] += step;
+                }
+            }
+            prev = Some(poses.clone());
+        }
+        for i in 0..n {
+            let limit = bound(&radii[i], &a, &b, 0..arm.chain.dof());
+            assert!(
+                travelled[i] <= limit + 1e-9,
+                "body {i}: {} > {limit}",
+                travelled[i]
+            );
+            if limit > 0.0 {
+                tightest[i] = tightest[i].max(travelled[i] / limit);
+            }
+        }
+        // Pairs: the distance at the ends of the segment.
+        let mut ends = Vec::new();
+        for q in [&a, &b] {
+            arm.body_poses(q, &mut links, &mut poses);
+            ends.push(poses.clone());
+        }
+        for &(i, j) in arm.self_pairs {
+            let (ma, mb) = (moved_by(&arm, i), moved_by(&arm, j));
+            let (near, far) = if mb >= ma { (i, j) } else { (j, i) };
+            let first = ma.min(mb);
+            let pr = pair_radii(&arm, near, first, &radii[far]);
+            let limit = bound(&pr, &a, &b, first..ma.max(mb));
+            let d = |p: &[Pose]| arm.world.pair_distance(arm.group, i, j, p, 10.0);
+            let (da, db) = (d(&ends[0]), d(&ends[1]));
+            if da > 0.0 && db > 0.0 {
+                assert!(
+                    (db - da).abs() <= limit + 1e-6,
+                    "pair ({i}, {j}): {da} -> {db}, bound {limit}"
+                );
+            }
+        }
+    }
+    // The gripper's bodies turn about the wrist's last axis: their bound there is their reach
+    // from it, nearly met by some segment.
+    let gripper = (0..n).filter(|&i| arm.body_links[i] == arm.chain.links.len() - 1);
+    for i in gripper {
+        assert!(
+            tightest[i] > 0.5,
+            "body {i}: at most {} of its bound",
+            tightest[i]
+        );
+    }
+}
+
+/// Pairs proven apart are apart in every sampled configuration; pairs seen touching are never
+/// proven apart; and some are proven: the wrist's last link and the force sensor, which only
+/// turns about its own axis in front of it.
+#[test]
+fn pairs_proven_apart_never_touch() {
+    let setup = ur5();
+    let all = Arm {
+        self_pairs: &setup.self_pairs,
+        ..setup.arm()
+    };
+    let may_touch = pairs_that_may_touch(&all);
+    assert_eq!(may_touch, setup.checked_pairs);
+    let apart: Vec<(usize, usize)> = setup
+        .self_pairs
+        .iter()
+        .copied()
+        .filter(|p| !may_touch.contains(p))
+        .collect();
+    let named = |a: &str, b: &str| {
+        apart.iter().any(|&(i, j)| {
+            let (x, y) = (&setup.body_sources[i], &setup.body_sources[j]);
+            (x == a && y == b) || (x == b && y == a)
+        })
+    };
+    assert!(named("wrist_2_link", "fts_robotside"), "{apart:?}");
+    let mut rng = ChaCha8Rng::seed_from_u64(5);
+    let (mut links, mut poses) = (Vec::new(), Vec::<Pose>::new());
+    let mut touched = std::collections::BTreeSet::new();
+    for _ in 0..5000 {
+        let q = random_q(&all, &mut rng);
+        all.body_poses(&q, &mut links, &mut poses);
+        for &(i, j) in all.self_pairs {
+            if all.world.bodies_within(all.group, i, j, &poses, 0.0) {
+                touched.insert((i, j));
+            }
+        }
+    }
+    assert!(
+        touched.len() > 10,
+        "the sampling finds contacts: {}",
+        touched.len()
+    );
+    for p in &apart {
+        assert!(!touched.contains(p), "{p:?} proven apart but touches");
+    }
+    // A touching pair fails the proof within any budget.
+    let &(i, j) = touched.iter().next().unwrap();
+    assert!(!apart_everywhere(&all, i, j, 1_000_000));
+}
