@@ -218,14 +218,33 @@ fn spinner(show: bool, message: &str) -> indicatif::ProgressBar {
 /// Most points `gen tasks` makes.
 const MAX_GENERATED_TASKS: usize = 100_000;
 
-/// `out/<cell name>`, refused when the name would lead outside `out/` (an absolute path, `..`,
-/// a separator): the name comes from the cell file.
-pub(crate) fn default_output_dir(cell: &Cell) -> Result<PathBuf, Failure> {
-    output_dir_named(&cell.name, &cell.path)
+/// The output folder of a plan: `output` when given, else `out/<name>` ([`output_dir_named`]);
+/// refused before any planning when it cannot take files.
+pub(crate) fn plan_output_dir(
+    output: Option<&std::path::Path>,
+    name: &str,
+    cell_path: &std::path::Path,
+) -> Result<PathBuf, Failure> {
+    let dir = match output {
+        Some(d) => d.to_path_buf(),
+        None => output_dir_named(name, cell_path)?,
+    };
+    ensure_writable(&dir)?;
+    Ok(dir)
 }
 
-/// `out/<name>` for the cell file `cell_path` of any process, refused as
-/// [`default_output_dir`] says.
+/// Refuses an output folder that cannot take files (a usage error naming it).
+pub(crate) fn ensure_writable(dir: &std::path::Path) -> Result<(), Failure> {
+    cellplan_model::io::check_writable(dir).map_err(|e| {
+        Failure::Usage(format!(
+            "cannot write into the output folder {}: {e}; give a writable folder with -o",
+            dir.display()
+        ))
+    })
+}
+
+/// `out/<name>` for the cell file `cell_path` of any process, refused when the name would lead
+/// outside `out/` (an absolute path, `..`, a separator): the name comes from the cell file.
 pub(crate) fn output_dir_named(name: &str, cell_path: &std::path::Path) -> Result<PathBuf, Failure> {
     let plain = !name.is_empty()
         && name != "."

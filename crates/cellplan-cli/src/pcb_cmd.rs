@@ -5,7 +5,7 @@ use crate::Failure;
 use crate::plan_cmd::PlanArgs;
 use crate::verify_cmd::print_verdict;
 use cellplan_model::InputError;
-use cellplan_model::io::{check_writable, write_all_atomic};
+use cellplan_model::io::write_all_atomic;
 use cellplan_pcb::PcbCell;
 use cellplan_pcb::cell::{Configuration, KIND, MotionModel};
 use cellplan_pcb::document::PcbPlan;
@@ -170,16 +170,8 @@ pub fn plan(args: &PlanArgs) -> Result<(), Failure> {
     }
     let loaded = load(&args.cell)?;
     let cell = variant(&loaded, args)?;
-    let dir = match &args.output {
-        Some(d) => d.clone(),
-        None => crate::output_dir_named(&cell.name, &cell.path)?,
-    };
-    check_writable(&dir).map_err(|e| {
-        Failure::Usage(format!(
-            "cannot write into the output folder {}: {e}; give a writable folder with -o",
-            dir.display()
-        ))
-    })?;
+    // Before any planning: the output folder must take files.
+    let dir = crate::plan_output_dir(args.output.as_deref(), &cell.name, &cell.path)?;
     let show = !args.quiet && !args.json;
     let pb = crate::spinner(show, &format!("planning {} components", cell.len()));
     let optimizer: Optimizer = args.optimizer.into();

@@ -5,7 +5,7 @@ use cellplan_core::coord::{CoordSettings, Coordination};
 use cellplan_core::document as output;
 use cellplan_core::pipeline::{self, PipelineError, Step};
 use cellplan_core::plan::{Allocation, CoverMethod, MoveModel, PlanSettings, Stage};
-use cellplan_model::io::{check_writable, write_all_atomic};
+use cellplan_model::io::write_all_atomic;
 use cellplan_model::{Cell, InputError};
 use cellplan_verify::VerifySettings;
 use clap::Args;
@@ -159,17 +159,8 @@ pub fn run(args: &PlanArgs) -> Result<(), Failure> {
     let opts = load_options(args.no_cache, &args.cache_dir);
     let pb = spinner(show, "loading the cell");
     let cell = crate::load_cell(&args.cell, &opts)?;
-    let dir = match &args.output {
-        Some(d) => d.clone(),
-        None => crate::default_output_dir(&cell)?,
-    };
     // Before any planning: the output folder must take files.
-    check_writable(&dir).map_err(|e| {
-        Failure::Usage(format!(
-            "cannot write into the output folder {}: {e}; give a writable folder with -o",
-            dir.display()
-        ))
-    })?;
+    let dir = crate::plan_output_dir(args.output.as_deref(), &cell.name, &cell.path)?;
     let load_s = start.elapsed().as_secs_f64();
     let settings = PlanSettings {
         allocation: args.allocation,

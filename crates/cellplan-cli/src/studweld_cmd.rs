@@ -5,7 +5,7 @@ use crate::Failure;
 use crate::compare_cmd::CompareArgs;
 use crate::plan_cmd::PlanArgs;
 use crate::verify_cmd::print_verdict;
-use cellplan_model::io::{check_writable, write_atomic};
+use cellplan_model::io::write_atomic;
 use cellplan_model::{Cell, InputError, LoadOptions};
 use cellplan_studweld::cell::WeldCell;
 use cellplan_studweld::document::{WeldPlan, build};
@@ -78,16 +78,8 @@ pub fn plan(args: &PlanArgs) -> Result<(), Failure> {
     }
     let cell = load(&args.cell)?;
     let w = WeldCell::new(&cell)?;
-    let dir = match &args.output {
-        Some(d) => d.clone(),
-        None => crate::output_dir_named(&cell.name, &cell.path)?,
-    };
-    check_writable(&dir).map_err(|e| {
-        Failure::Usage(format!(
-            "cannot write into the output folder {}: {e}; give a writable folder with -o",
-            dir.display()
-        ))
-    })?;
+    // Before any planning: the output folder must take files.
+    let dir = crate::plan_output_dir(args.output.as_deref(), &cell.name, &cell.path)?;
     let show = !args.quiet && !args.json;
     let pb = crate::spinner(show, &format!("planning {} studs", cell.tasks.len()));
     let settings = LegSettings {

@@ -237,6 +237,15 @@ impl Move<'_> {
                 x[l.q(i, j)] = self.start[j] + s * (self.goal[j] - self.start[j]);
             }
         }
+        self.hold_against_gravity(&mut x);
+        x[l.h()] = h;
+        x
+    }
+
+    /// Sets the torques of `x` to those that hold each midpoint of its grid against gravity
+    /// (within the torque limits).
+    pub fn hold_against_gravity(&self, x: &mut [f64]) {
+        let l = self.layout();
         for i in 0..l.steps {
             let mid: Vec<f64> = (0..l.n)
                 .map(|j| 0.5 * (x[l.q(i, j)] + x[l.q(i + 1, j)]))
@@ -246,8 +255,6 @@ impl Move<'_> {
                 x[l.u(i, j)] = g[j].clamp(-self.u_max[j], self.u_max[j]);
             }
         }
-        x[l.h()] = h;
-        x
     }
 }
 

@@ -7,6 +7,7 @@ use cellplan_studweld::cell::WeldCell;
 use cellplan_studweld::document::WeldPlan;
 use cellplan_studweld::leg::Motion;
 use cellplan_studweld::profile::{Profile, holding, profile};
+use cellplan_studweld::sequence::Sequencer;
 use cellplan_verify::studweld::WeldReport;
 use maud::{DOCTYPE, Markup, PreEscaped, html};
 use std::fmt::Write;
@@ -172,7 +173,7 @@ pub fn html(plan: &WeldPlan, w: &WeldCell, verdict: Option<&WeldReport>) -> Stri
                     h1 { (title) }
                     p class="sub" {
                         "Stud welding (paper 002): " b { (plan.visits.len()) } " welds, "
-                        "sequenced on " b { (if plan.sequencer.name() == "optimal-control" { "optimal-control costs (the paper's new sequencer)" } else { "travel time, then each move optimised (the paper's old sequencer)" }) }
+                        "sequenced on " b { (if plan.sequencer == Sequencer::OptimalControl { "optimal-control costs (the paper's new sequencer)" } else { "travel time, then each move optimised (the paper's old sequencer)" }) }
                         ", " (plan.sequencing.rounds) " lazy round(s)"
                         @if !plan.sequencing.converged { " (the OCP budget ended)" }
                         ", " (plan.sequencing.ocp_solves) " optimal-control problems solved"
@@ -219,13 +220,13 @@ pub fn html(plan: &WeldPlan, w: &WeldCell, verdict: Option<&WeldReport>) -> Stri
                         table id="welds" {
                             tr { th { "#" } th { "stud" } th { "alternative" } th { "gun rotation °" } th { "weld cost" } th { "stud's range" } th { "largest holding torque / limit" } th { "start s" } }
                             @for (k, v) in plan.visits.iter().enumerate() {
-                                @let range = plan.alternatives.iter().find(|a| a.stud == v.stud).and_then(|a| a.weld_cost_range.map(|r| (a.count, r)));
+                                @let spread = plan.alternatives.iter().find(|a| a.stud == v.stud).and_then(|a| a.weld_cost_range.map(|r| (a.count, r)));
                                 @let g = holding(w, &v.q).iter().fold(0.0f64, |m, x| m.max(x.abs()));
                                 tr {
                                     td { (k + 1) } td { (v.stud) } td { (v.alternative) }
                                     td { (format!("{:.0}", v.rotation_rad.to_degrees())) }
                                     td { (format!("{:.1}", v.weld_cost)) }
-                                    td { @if let Some((n, [lo, hi])) = range { (format!("{n} alternatives, {lo:.1}–{hi:.1}")) } }
+                                    td { @if let Some((n, [lo, hi])) = spread { (format!("{n} alternatives, {lo:.1}–{hi:.1}")) } }
                                     td { (format!("{g:.2}")) }
                                     td { (format!("{:.2}", v.start_s)) }
                                 }

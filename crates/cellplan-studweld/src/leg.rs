@@ -172,17 +172,16 @@ fn resample(path: &[Vec<f64>], v: &[f64], steps: usize, profile: fn(f64) -> f64)
     grid
 }
 
-/// The target of the trust regions' first iterate: the grid at rest-to-rest positions along
-/// the path ([`quintic`] in time, waypoints on the grid), so that a trajectory of the dynamics
-/// lies near it; the step giving a mean speed of half the slowest joint's limit
-/// (the quintic peaks at 1.875× the mean); zero torques.
-pub fn rest_to_rest_guess(m: &Move, path: &[Vec<f64>]) -> Vec<f64> {
+/// The grid along `path` (`profile` of time, every waypoint on the grid, the ends exactly the
+/// move's), zero torques, and the step at `slack` × the path's least time at the joints'
+/// speeds.
+fn along(m: &Move, path: &[Vec<f64>], profile: fn(f64) -> f64, slack: f64) -> Vec<f64> {
     let l = m.layout();
     let least: f64 = path
         .windows(2)
         .map(|s| segment_time(&s[0], &s[1], &m.v_max))
         .sum();
-    let grid = resample(path, &m.v_max, l.steps, quintic);
+    let grid = resample(path, &m.v_max, l.steps, profile);
     let mut x = vec![0.0; l.vars()];
     for (i, q) in grid.iter().enumerate() {
         for j in 0..l.n {
@@ -195,8 +194,16 @@ pub fn rest_to_rest_guess(m: &Move, path: &[Vec<f64>]) -> Vec<f64> {
             };
         }
     }
-    x[l.h()] = (2.0 * least / l.steps as f64).clamp(m.h_bounds[0], m.h_bounds[1]);
+    x[l.h()] = (slack * least / l.steps as f64).clamp(m.h_bounds[0], m.h_bounds[1]);
     x
+}
+
+/// The target of the trust regions' first iterate: the grid at rest-to-rest positions along
+/// the path ([`quintic`] in time, waypoints on the grid), so that a trajectory of the dynamics
+/// lies near it; the step giving a mean speed of half the slowest joint's limit
+/// (the quintic peaks at 1.875× the mean); zero torques.
+pub fn rest_to_rest_guess(m: &Move, path: &[Vec<f64>]) -> Vec<f64> {
+    along(m, path, quintic, 2.0)
 }
 
 /// DMOC steps for a move along `path`: the process's, or one per path segment when more.
@@ -222,36 +229,10 @@ pub fn ocp<'a>(w: &'a WeldCell, a: &[f64], b: &[f64]) -> Move<'a> {
 /// The starting point along `path`: positions resampled, the step giving the slowest joint
 /// 1.5× its least time, torques zero or the gravity torques at the midpoints.
 fn guess(m: &Move, path: &[Vec<f64>], gravity: bool) -> Vec<f64> {
-    let l = m.layout();
-    let grid = resample(path, &m.v_max, l.steps, |t| t);
-    let least: f64 = path
-        .windows(2)
-        .map(|s| segment_time(&s[0], &s[1], &m.v_max))
-        .sum();
-    let mut x = vec![0.0; l.vars()];
-    for (i, q) in grid.iter().enumerate() {
-        for j in 0..l.n {
-            x[l.q(i, j)] = if i == 0 {
-                m.start[j]
-            } else if i == l.steps {
-                m.goal[j]
-            } else {
-                q[j].clamp(m.q_bounds[j][0], m.q_bounds[j][1])
-            };
-        }
-    }
+    let mut x = along(m, path, |t| t, 1.5);
     if gravity {
-        for i in 0..l.steps {
-            let mid: Vec<f64> = (0..l.n)
-                .map(|j| 0.5 * (x[l.q(i, j)] + x[l.q(i + 1, j)]))
-                .collect();
-            let g = m.dynamics.gravity_torques(&mid);
-            for j in 0..l.n {
-                x[l.u(i, j)] = g[j].clamp(-m.u_max[j], m.u_max[j]);
-            }
-        }
+        m.hold_against_gravity(&mut x);
     }
-    x[l.h()] = (1.5 * least / l.steps as f64).clamp(m.h_bounds[0], m.h_bounds[1]);
     x
 }
 

@@ -132,8 +132,9 @@ pub const EXACT_STATES: u128 = 4_000_000;
 /// Kicks of the iterated local search per GTSP (beyond [`EXACT_STATES`]).
 pub const ILS_KICKS: usize = 100;
 
-/// Whether to print one line per lazy round to stderr (`CELLPLAN_STUDWELD_VERBOSE`).
-fn verbose() -> bool {
+/// Whether to print the lazy rounds and the trust-region steps to stderr
+/// (`CELLPLAN_STUDWELD_VERBOSE`).
+pub(crate) fn verbose() -> bool {
     std::env::var_os("CELLPLAN_STUDWELD_VERBOSE").is_some()
 }
 
@@ -213,6 +214,13 @@ fn travel_bound(w: &WeldCell, a: &[f64], b: &[f64]) -> f64 {
     cellplan_motion::timing::move_time(a, b, &limits)
 }
 
+/// `f` of every ordered pair of the graph's configurations (rows in parallel).
+fn pairwise(g: &Graph, f: impl Fn(&[f64], &[f64]) -> f64 + Sync) -> Vec<Vec<f64>> {
+    g.q.par_iter()
+        .map(|a| g.q.iter().map(|b| f(a, b)).collect())
+        .collect()
+}
+
 /// Solves the legs of `pairs` (not yet in the cache) in parallel, into the cache.
 pub fn solve_legs(w: &WeldCell, g: &Graph, pairs: &[(usize, usize)], s: &LegSettings, cache: &mut Cache) {
     let mut todo: Vec<(usize, usize)> = pairs
@@ -281,17 +289,11 @@ fn best_of(g: &Graph, cache: &Cache, nodes: Vec<usize>, best: &Option<(f64, Vec<
 /// Sequences on optimal-control costs (lazy), solving the legs it needs into `cache`.
 pub fn optimal_control(w: &WeldCell, g: &Graph, s: &LegSettings, cache: &mut Cache) -> Sequence {
     let n = g.q.len();
-    let est: Vec<Vec<f64>> = (0..n)
-        .into_par_iter()
-        .map(|i| (0..n).map(|j| estimate(w, &g.q[i], &g.q[j])).collect())
-        .collect();
+    let est = pairwise(g, |a, b| estimate(w, a, b));
     // Round 0: the tour on travel-time bounds (straight moves at the joints' limits) with the
     // node costs — its legs, solved, are a complete cycle whose J the loop can only improve on,
     // and the first calibration of the estimates.
-    let bound: Vec<Vec<f64>> = (0..n)
-        .into_par_iter()
-        .map(|i| (0..n).map(|j| travel_bound(w, &g.q[i], &g.q[j])).collect())
-        .collect();
+    let bound = pairwise(g, |a, b| travel_bound(w, a, b));
     let (first, ex) = tour(g, &bound, &g.weld_cost, s.seed);
     let mut exact = ex;
     solve_legs(w, g, &edges(&first), s, cache);
@@ -361,10 +363,7 @@ pub fn optimal_control(w: &WeldCell, g: &Graph, s: &LegSettings, cache: &mut Cac
 /// the tour re-sequenced.
 pub fn travel_time(w: &WeldCell, g: &Graph, s: &LegSettings, cache: &mut Cache) -> Sequence {
     let n = g.q.len();
-    let bound: Vec<Vec<f64>> = (0..n)
-        .into_par_iter()
-        .map(|i| (0..n).map(|j| travel_bound(w, &g.q[i], &g.q[j])).collect())
-        .collect();
+    let bound = pairwise(g, |a, b| travel_bound(w, a, b));
     let service: Vec<f64> = (0..n)
         .map(|i| if i == 0 { 0.0 } else { w.process.weld_time })
         .collect();

@@ -136,13 +136,14 @@ impl Nlp for Shaped<'_, '_> {
 
 /// The outcome of the iteration.
 pub struct Trusted {
-    /// The last accepted trajectory and its J (`None` when no iterate was accepted).
+    /// The last accepted trajectory and its J — the first iterate when no boxed step was
+    /// accepted; `None` when no first iterate was clear.
     pub best: Option<(Dmoc, f64)>,
     /// Interior-point iterations spent.
     pub iterations: usize,
     /// OCPs solved.
     pub solves: usize,
-    /// Accepted iterations.
+    /// Accepted boxed steps (after the first iterate).
     pub accepted: usize,
 }
 
@@ -150,8 +151,8 @@ pub struct Trusted {
 /// point's displacement from the path's grid), lightest first.
 pub const TRACKING: [f64; 4] = [1e3, 1e5, 1e7, 1e9];
 
-/// Runs the trust-region iteration for `m` from `x0` (whose grid points must be clear: the
-/// planner's path resampled).
+/// Runs the trust-region iteration for `m`; `x0` is the grid along a collision-free path
+/// that the first iterate tracks ([`crate::leg::rest_to_rest_guess`]).
 pub fn iterate(w: &WeldCell, m: &Move, x0: &[f64], opt: &nlp::Options, s: &TrustSettings) -> Trusted {
     let l = m.layout();
     let validity = robot_validity(w.cell, w.robot, w.cell.planning.clearance);
@@ -185,7 +186,7 @@ pub fn iterate(w: &WeldCell, m: &Move, x0: &[f64], opt: &nlp::Options, s: &Trust
         out.solves += 1;
         let ok = matches!(sol.status, Status::Solved | Status::SolvedToAcceptableLevel);
         let clear = ok && crate::leg::clear(w, &unpack(m, &sol.x).q);
-        if std::env::var_os("CELLPLAN_STUDWELD_VERBOSE").is_some() {
+        if crate::sequence::verbose() {
             eprintln!("    tracking ρ {rho:.0e}: {:?}, clear {clear}", sol.status);
         }
         if clear {
@@ -198,6 +199,7 @@ pub fn iterate(w: &WeldCell, m: &Move, x0: &[f64], opt: &nlp::Options, s: &Trust
     };
     // The boxes' scale: 1 is the paper's (grid points proven clear); doubled after an accepted
     // iterate, halved after a rejected one (the dense check decides).
+    let verbose = crate::sequence::verbose();
     let mut scale: f64 = 1.0;
     let mut last = Nlp::objective(m, &x);
     out.best = Some((unpack(m, &x), last));
@@ -230,7 +232,6 @@ pub fn iterate(w: &WeldCell, m: &Move, x0: &[f64], opt: &nlp::Options, s: &Trust
             let sol = nlp::ipm::solve_from(&b, &x, opt);
             out.iterations += sol.iterations;
             out.solves += 1;
-            let verbose = std::env::var_os("CELLPLAN_STUDWELD_VERBOSE").is_some();
             if !matches!(sol.status, Status::Solved | Status::SolvedToAcceptableLevel) {
                 if verbose {
                     eprintln!("    trust region ×{scale}: {:?}", sol.status);

@@ -17,7 +17,7 @@ use cellplan_cmm::classify::Method;
 use cellplan_cmm::document::{CmmPlan, Strategy};
 use cellplan_cmm::plan::{Request, document, reuse, run};
 use cellplan_model::InputError;
-use cellplan_model::io::{check_writable, write_all_atomic};
+use cellplan_model::io::write_all_atomic;
 use cellplan_solve::GtspMethod;
 use cellplan_verify::cmm::{CmmReport, CmmViolation, verify_cmm};
 pub use compare::compare;
@@ -142,16 +142,8 @@ pub fn plan(args: &PlanArgs) -> Result<(), Failure> {
         return Err(Failure::Usage("--order is a PCB-assembly option".into()));
     }
     let cell = load(&args.cell)?;
-    let dir = match &args.output {
-        Some(d) => d.clone(),
-        None => crate::output_dir_named(&cell.name, &cell.path)?,
-    };
-    check_writable(&dir).map_err(|e| {
-        Failure::Usage(format!(
-            "cannot write into the output folder {}: {e}; give a writable folder with -o",
-            dir.display()
-        ))
-    })?;
+    // Before any planning: the output folder must take files.
+    let dir = crate::plan_output_dir(args.output.as_deref(), &cell.name, &cell.path)?;
     let show = !args.quiet && !args.json;
     let pb = crate::spinner(show, &format!("planning {} MPs", cell.mps.len()));
     let req = Request {

@@ -176,12 +176,7 @@ pub fn run_reuse(args: &ReuseArgs) -> Result<(), Failure> {
         .output
         .clone()
         .unwrap_or_else(|| args.plan.parent().unwrap_or(Path::new(".")).join("reuse"));
-    check_writable(&dir).map_err(|e| {
-        Failure::Usage(format!(
-            "cannot write into the output folder {}: {e}; give a writable folder with -o",
-            dir.display()
-        ))
-    })?;
+    crate::ensure_writable(&dir)?;
     let (file, _, report_file) = write_plan(&dir, &doc, &cell, &verdict, args.no_report)?;
     if args.json {
         crate::print_json(&ReuseSummary {

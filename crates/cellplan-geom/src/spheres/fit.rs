@@ -553,14 +553,7 @@ mod tests {
     }
 
     fn polytope(hull: &ConvexPolyhedron) -> Polytope {
-        Polytope::new(
-            hull.points(),
-            hull.edges()
-                .iter()
-                .map(|e| [e.vertices[0] as usize, e.vertices[1] as usize]),
-            hull.faces().iter().map(|f| f.normal),
-        )
-        .unwrap()
+        crate::spheres::convex_polytope(hull).unwrap()
     }
 
     proptest! {
