@@ -12,6 +12,22 @@ use std::sync::Arc;
 /// The `[process] kind` of stud-weld cells.
 pub const KIND: &str = "stud-weld";
 
+/// How far (m) the gun's TCP may be from the stud, and (rad) its axis from the stud's normal, in
+/// a weld pose: the alternatives keep only poses within it and the verifier checks it. The
+/// numeric IK stops within 1e-6 m and 1e-6 rad at the flange, so a TCP a lever `L` beyond the
+/// flange misses by up to 1e-6·(1 + L) m; 10 µm and 10 µrad hold that for any gun shorter than
+/// 9 m, and are far below a stud gun's accuracy (tenths of a millimetre).
+pub const WELD_POSE_TOLERANCE: (f64, f64) = (1e-5, 1e-5);
+
+/// Whether `tcp` welds at `position` along `-normal`, within [`WELD_POSE_TOLERANCE`]; the
+/// distance and the angle either way.
+pub fn weld_pose_error(tcp: &Pose, position: DVec3, normal: DVec3) -> (bool, f64, f64) {
+    let off = (tcp.translation - position).length();
+    let tilt = (tcp.rotation * DVec3::Z).angle_between(-normal.normalize());
+    let ok = off <= WELD_POSE_TOLERANCE.0 && !tilt.is_nan() && tilt <= WELD_POSE_TOLERANCE.1;
+    (ok, off, tilt)
+}
+
 /// Most gun rotations about the stud axis (a step of 1° gives 360).
 pub const MAX_ROTATIONS: usize = 360;
 

@@ -22,10 +22,6 @@ use cellplan_studweld::StudWeld;
 use cellplan_studweld::document::WeldPlan;
 use serde::Serialize;
 
-/// Position tolerance (m).
-const POS_TOL: f64 = 1e-6;
-/// Angle tolerance (rad).
-const ANGLE_TOL: f64 = 1e-6;
 /// Relative tolerance of re-derived numbers.
 const REL_TOL: f64 = 1e-6;
 
@@ -211,10 +207,8 @@ fn welds(c: &mut Ctx, plan: &WeldPlan) {
             continue;
         }
         let tcp = c.robot.tcp_pose(&v.q);
-        let off = (tcp.translation - task.position).length();
-        let axis = tcp.rotation * DVec3::Z;
-        let tilt = axis.angle_between(-task.normal.normalize());
-        if off > POS_TOL || tilt.is_nan() || tilt > ANGLE_TOL {
+        let (ok, off, tilt) = cellplan_studweld::process::weld_pose_error(&tcp, task.position, task.normal);
+        if !ok {
             c.fail(
                 WeldViolationKind::Weld,
                 format!(

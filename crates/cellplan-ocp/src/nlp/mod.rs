@@ -24,6 +24,8 @@
 // Index loops over several arrays at once read as the formulas do.
 #![allow(clippy::needless_range_loop)]
 pub mod ipm;
+#[cfg(feature = "ipopt")]
+pub mod ipopt;
 mod iterate;
 mod kkt;
 pub mod ldl;

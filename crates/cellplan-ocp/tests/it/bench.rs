@@ -35,6 +35,37 @@ pub struct Problem {
 }
 
 impl Problem {
+    /// The initial guess the reference solve used: the brief's (`casadi`), or the brief's with
+    /// the torques at zero (`casadi_best`, `--guess-u zero`).
+    pub fn start(&self, reference: &str) -> Vec<f64> {
+        let mut x = self.mv.initial_guess();
+        if reference == "casadi_best" {
+            let l = self.mv.layout();
+            for i in 0..l.steps {
+                for j in 0..l.n {
+                    x[l.u(i, j)] = 0.0;
+                }
+            }
+        }
+        x
+    }
+
+    /// The relative distance of `j` to the nearest known local optimum of problem `name` (the
+    /// reference's, and for the KR 210 problems the others listed in `bench/ocp/README.md`),
+    /// and that optimum.
+    pub fn nearest_optimum(&self, name: &str, j: f64) -> (f64, f64) {
+        let mut known = vec![self.casadi_j];
+        known.extend(match name {
+            "kr210_a" => &[140.74409242326524, 139.440, 98.92193339037054][..],
+            "kr210_b" => &[95.03052964755395, 113.166, 78.08866576533336][..],
+            _ => &[][..],
+        });
+        known
+            .iter()
+            .map(|k| ((j - k).abs() / k, *k))
+            .fold((f64::INFINITY, f64::NAN), |a, b| if b.0 < a.0 { b } else { a })
+    }
+
     /// `name` as in `bench/ocp/NAME.json`; `reference` the suffix of the solution file
     /// (`casadi` or `casadi_best`).
     pub fn load(name: &str, reference: &str) -> Problem {

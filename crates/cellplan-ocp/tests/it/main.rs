@@ -2,4 +2,6 @@
 //! `bench/ocp/` against the CasADi + IPOPT optima recorded there.
 mod bench;
 mod hessian_time;
+#[cfg(feature = "ipopt")]
+mod ipopt_bench;
 mod solve_bench;

@@ -23,19 +23,7 @@ pub fn solve_and_check(name: &str, reference: &str) -> Outcome {
         verbose: std::env::var_os("CELLPLAN_NLP_VERBOSE").is_some(),
         ..Options::default()
     };
-    let x0 = if reference == "casadi_best" {
-        // `--guess-u zero`: the brief's guess with the torques at zero.
-        let mut x = m.initial_guess();
-        let l = m.layout();
-        for i in 0..l.steps {
-            for j in 0..l.n {
-                x[l.u(i, j)] = 0.0;
-            }
-        }
-        x
-    } else {
-        m.initial_guess()
-    };
+    let x0 = p.start(reference);
     let started = Instant::now();
     let s = nlp::ipm::solve_from(m, &x0, &opt);
     let seconds = started.elapsed().as_secs_f64();
@@ -48,23 +36,14 @@ pub fn solve_and_check(name: &str, reference: &str) -> Outcome {
     );
     // The KR 210 problems have several local optima (bench/ocp/README.md, "Reproducibility
     // and local optima"): the answer must be one of them to 1e-4.
-    let mut known = vec![p.casadi_j];
-    known.extend(match name {
-        "kr210_a" => &[140.74409242326524, 139.440, 98.92193339037054][..],
-        "kr210_b" => &[95.03052964755395, 113.166, 78.08866576533336][..],
-        _ => &[][..],
-    });
-    let (rel, matched) = known
-        .iter()
-        .map(|j| ((s.objective - j).abs() / j, *j))
-        .fold((f64::INFINITY, f64::NAN), |a, b| if b.0 < a.0 { b } else { a });
+    let (rel, matched) = p.nearest_optimum(name, s.objective);
     eprintln!(
         "{name} ({reference}): J {:.12} vs CasADi {:.12}, nearest known optimum {matched} (rel {rel:.1e}), {} iterations ({}), {seconds:.3} s ({:.2} s)",
         s.objective, p.casadi_j, s.iterations, p.casadi_iterations, p.casadi_solve_s
     );
     assert!(
         rel < 1e-4,
-        "{name}: J {} is none of the known optima {known:?}",
+        "{name}: J {} is none of the known optima (nearest {matched})",
         s.objective
     );
     let c = m.eq(&s.x);

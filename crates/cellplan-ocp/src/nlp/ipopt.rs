@@ -1,0 +1,400 @@
+//! IPOPT itself (the COIN-OR library, through its C interface) on any [`Nlp`]: the reference
+//! the interior-point solver of [`super::ipm`] is measured against on the same problem with
+//! the same derivatives. Opt-in (`--features ipopt`): it links the system's `libipopt`
+//! (Debian: `apt-get install coinor-libipopt-dev`, IPOPT 3.11 with MUMPS); the default build
+//! needs nothing outside Rust.
+//!
+//! The trait's triplets list only the nonzeros of the point they are evaluated at, while IPOPT
+//! fixes the sparsity structure once: the structure is the union of the entries at the start
+//! and at three points near it with every multiplier nonzero (each derivative of the DMOC
+//! transcription that can be nonzero is nonzero there), and an entry outside it later ends the
+//! solve with [`Status::NumericalFailure`] rather than being dropped.
+use super::{Nlp, Status, Triplets};
+use std::collections::BTreeMap;
+use std::ffi::{CString, c_char, c_int, c_void};
+
+type Bool = c_int;
+type Index = c_int;
+type EvalF = extern "C" fn(Index, *mut f64, Bool, *mut f64, *mut c_void) -> Bool;
+type EvalGradF = extern "C" fn(Index, *mut f64, Bool, *mut f64, *mut c_void) -> Bool;
+type EvalG = extern "C" fn(Index, *mut f64, Bool, Index, *mut f64, *mut c_void) -> Bool;
+type EvalJacG =
+    extern "C" fn(Index, *mut f64, Bool, Index, Index, *mut Index, *mut Index, *mut f64, *mut c_void) -> Bool;
+type EvalH = extern "C" fn(
+    Index,
+    *mut f64,
+    Bool,
+    f64,
+    Index,
+    *mut f64,
+    Bool,
+    Index,
+    *mut Index,
+    *mut Index,
+    *mut f64,
+    *mut c_void,
+) -> Bool;
+type Intermediate =
+    extern "C" fn(Index, Index, f64, f64, f64, f64, f64, f64, f64, f64, Index, *mut c_void) -> Bool;
+
+#[link(name = "ipopt")]
+unsafe extern "C" {
+    fn CreateIpoptProblem(
+        n: Index,
+        x_l: *mut f64,
+        x_u: *mut f64,
+        m: Index,
+        g_l: *mut f64,
+        g_u: *mut f64,
+        nele_jac: Index,
+        nele_hess: Index,
+        index_style: Index,
+        eval_f: EvalF,
+        eval_g: EvalG,
+        eval_grad_f: EvalGradF,
+        eval_jac_g: EvalJacG,
+        eval_h: EvalH,
+    ) -> *mut c_void;
+    fn FreeIpoptProblem(p: *mut c_void);
+    fn AddIpoptStrOption(p: *mut c_void, key: *const c_char, val: *const c_char) -> Bool;
+    fn AddIpoptNumOption(p: *mut c_void, key: *const c_char, val: f64) -> Bool;
+    fn AddIpoptIntOption(p: *mut c_void, key: *const c_char, val: c_int) -> Bool;
+    fn SetIntermediateCallback(p: *mut c_void, cb: Intermediate) -> Bool;
+    #[allow(clippy::too_many_arguments)]
+    fn IpoptSolve(
+        p: *mut c_void,
+        x: *mut f64,
+        g: *mut f64,
+        obj: *mut f64,
+        mult_g: *mut f64,
+        mult_x_l: *mut f64,
+        mult_x_u: *mut f64,
+        user: *mut c_void,
+    ) -> c_int;
+}
+
+/// What IPOPT is told (its option names; the rest stay IPOPT's defaults).
+#[derive(Clone, Debug)]
+pub struct IpoptOptions {
+    /// `tol`.
+    pub tol: f64,
+    /// `max_iter`.
+    pub max_iter: usize,
+    /// `bound_relax_factor` (IPOPT's default is 1e-8; 0 keeps every bound exactly, as the
+    /// CasADi reference runs in `bench/ocp` do).
+    pub bound_relax_factor: f64,
+    /// `print_level` (0 silent).
+    pub print_level: i32,
+}
+
+impl Default for IpoptOptions {
+    fn default() -> Self {
+        IpoptOptions {
+            tol: 1e-10,
+            max_iter: 3000,
+            bound_relax_factor: 0.0,
+            print_level: 0,
+        }
+    }
+}
+
+/// IPOPT's outcome.
+#[derive(Clone, Debug)]
+pub struct IpoptSolution {
+    /// IPOPT's return code mapped to the solver's statuses (an entry outside the fixed
+    /// structure, an evaluation error and IPOPT's internal failures are `NumericalFailure`).
+    pub status: Status,
+    /// IPOPT's `ApplicationReturnStatus` as it gave it.
+    pub code: i32,
+    /// The final point.
+    pub x: Vec<f64>,
+    /// `f(x)`.
+    pub objective: f64,
+    /// Iterations (the last `iter_count` IPOPT reported, restoration included).
+    pub iterations: usize,
+}
+
+/// A sparsity structure fixed from sample evaluations: `(row, col)` → position.
+struct Structure {
+    index: BTreeMap<(usize, usize), usize>,
+    rows: Vec<Index>,
+    cols: Vec<Index>,
+}
+
+impl Structure {
+    fn new(samples: impl IntoIterator<Item = Triplets>) -> Structure {
+        let mut index = BTreeMap::new();
+        for t in samples {
+            for (r, c, _) in t {
+                let next = index.len();
+                index.entry((r, c)).or_insert(next);
+            }
+        }
+        let mut rows = vec![0; index.len()];
+        let mut cols = vec![0; index.len()];
+        for (&(r, c), &k) in &index {
+            rows[k] = r as Index;
+            cols[k] = c as Index;
+        }
+        Structure { index, rows, cols }
+    }
+
+    /// Adds `t` into `values` (zeroed first); false when an entry is outside the structure.
+    fn scatter(&self, t: &Triplets, values: &mut [f64]) -> bool {
+        values.fill(0.0);
+        for &(r, c, v) in t {
+            match self.index.get(&(r, c)) {
+                Some(&k) => values[k] += v,
+                None => return false,
+            }
+        }
+        true
+    }
+}
+
+/// The problem and the bookkeeping the callbacks share.
+struct Session<'a> {
+    nlp: &'a dyn Nlp,
+    m_eq: usize,
+    jac: Structure,
+    hess: Structure,
+    iterations: usize,
+    outside_structure: bool,
+}
+
+/// # Safety (all callbacks)
+/// IPOPT passes back the `user` pointer given to `IpoptSolve` (a live `Session`) and arrays of
+/// the sizes the problem was created with.
+fn session<'s>(user: *mut c_void) -> &'s mut Session<'s> {
+    unsafe { &mut *(user as *mut Session) }
+}
+
+fn slice<'s>(p: *mut f64, len: usize) -> &'s mut [f64] {
+    if len == 0 {
+        return &mut [];
+    }
+    unsafe { std::slice::from_raw_parts_mut(p, len) }
+}
+
+extern "C" fn eval_f(n: Index, x: *mut f64, _new: Bool, obj: *mut f64, user: *mut c_void) -> Bool {
+    let s = session(user);
+    let x = slice(x, n as usize);
+    let f = s.nlp.objective(x);
+    unsafe { *obj = f };
+    f.is_finite() as Bool
+}
+
+extern "C" fn eval_grad_f(n: Index, x: *mut f64, _new: Bool, grad: *mut f64, user: *mut c_void) -> Bool {
+    let s = session(user);
+    let x = slice(x, n as usize);
+    let g = s.nlp.gradient(x);
+    slice(grad, n as usize).copy_from_slice(&g);
+    g.iter().all(|v| v.is_finite()) as Bool
+}
+
+extern "C" fn eval_g(n: Index, x: *mut f64, _new: Bool, m: Index, g: *mut f64, user: *mut c_void) -> Bool {
+    let s = session(user);
+    let x = slice(x, n as usize);
+    let out = slice(g, m as usize);
+    let c = s.nlp.eq(x);
+    let d = s.nlp.ineq(x);
+    out[..s.m_eq].copy_from_slice(&c);
+    out[s.m_eq..].copy_from_slice(&d);
+    out.iter().all(|v| v.is_finite()) as Bool
+}
+
+extern "C" fn eval_jac_g(
+    n: Index,
+    x: *mut f64,
+    _new: Bool,
+    _m: Index,
+    nele: Index,
+    rows: *mut Index,
+    cols: *mut Index,
+    values: *mut f64,
+    user: *mut c_void,
+) -> Bool {
+    let s = session(user);
+    if values.is_null() {
+        unsafe {
+            std::ptr::copy_nonoverlapping(s.jac.rows.as_ptr(), rows, nele as usize);
+            std::ptr::copy_nonoverlapping(s.jac.cols.as_ptr(), cols, nele as usize);
+        }
+        return 1;
+    }
+    let x = slice(x, n as usize);
+    let t = stacked_jacobian(s.nlp, x, s.m_eq);
+    let ok = s.jac.scatter(&t, slice(values, nele as usize));
+    s.outside_structure |= !ok;
+    ok as Bool
+}
+
+extern "C" fn eval_h(
+    n: Index,
+    x: *mut f64,
+    _new_x: Bool,
+    obj_factor: f64,
+    m: Index,
+    lambda: *mut f64,
+    _new_lambda: Bool,
+    nele: Index,
+    rows: *mut Index,
+    cols: *mut Index,
+    values: *mut f64,
+    user: *mut c_void,
+) -> Bool {
+    let s = session(user);
+    if values.is_null() {
+        unsafe {
+            std::ptr::copy_nonoverlapping(s.hess.rows.as_ptr(), rows, nele as usize);
+            std::ptr::copy_nonoverlapping(s.hess.cols.as_ptr(), cols, nele as usize);
+        }
+        return 1;
+    }
+    let x = slice(x, n as usize);
+    let lambda = slice(lambda, m as usize);
+    let (eq, ineq) = lambda.split_at(s.m_eq);
+    let t = s.nlp.hessian(x, obj_factor, eq, ineq);
+    let ok = s.hess.scatter(&t, slice(values, nele as usize));
+    s.outside_structure |= !ok;
+    ok as Bool
+}
+
+extern "C" fn intermediate(
+    _mode: Index,
+    iter: Index,
+    _obj: f64,
+    _inf_pr: f64,
+    _inf_du: f64,
+    _mu: f64,
+    _d_norm: f64,
+    _reg: f64,
+    _alpha_du: f64,
+    _alpha_pr: f64,
+    _ls: Index,
+    user: *mut c_void,
+) -> Bool {
+    session(user).iterations = iter.max(0) as usize;
+    1
+}
+
+/// The Jacobian of `[c; d]` (the inequalities' rows after the equalities').
+fn stacked_jacobian(nlp: &dyn Nlp, x: &[f64], m_eq: usize) -> Triplets {
+    let mut t = nlp.eq_jacobian(x);
+    t.extend(nlp.ineq_jacobian(x).into_iter().map(|(r, c, v)| (r + m_eq, c, v)));
+    t
+}
+
+/// Points near `x0` (a deterministic spread of 1e-3 relative) where the derivatives take
+/// their generic nonzeros.
+fn nearby(x0: &[f64], k: usize) -> Vec<f64> {
+    x0.iter()
+        .enumerate()
+        .map(|(i, v)| {
+            let wiggle = ((i * 7 + k * 13) % 11) as f64 / 11.0 - 0.45;
+            v + 1e-3 * wiggle * v.abs().max(1.0)
+        })
+        .collect()
+}
+
+fn cstr(s: &str) -> CString {
+    CString::new(s).unwrap_or_default()
+}
+
+/// Solves `nlp` from `x0` with IPOPT (exact Hessian, the options given).
+pub fn solve(nlp: &dyn Nlp, x0: &[f64], opt: &IpoptOptions) -> IpoptSolution {
+    let (n, m_eq, m_in) = (nlp.num_vars(), nlp.num_eq(), nlp.num_ineq());
+    let fail = |status| IpoptSolution {
+        status,
+        code: i32::MIN,
+        x: x0.to_vec(),
+        objective: f64::NAN,
+        iterations: 0,
+    };
+    if x0.len() != n {
+        return fail(Status::InvalidProblem);
+    }
+    let (mut xl, mut xu) = nlp.bounds();
+    let (dl, du) = nlp.ineq_bounds();
+    let big = 1e20;
+    let clip = |v: &mut f64| *v = v.clamp(-big, big);
+    xl.iter_mut().chain(xu.iter_mut()).for_each(clip);
+    let mut gl: Vec<f64> = std::iter::repeat_n(0.0, m_eq).chain(dl).collect();
+    let mut gu: Vec<f64> = std::iter::repeat_n(0.0, m_eq).chain(du).collect();
+    gl.iter_mut().chain(gu.iter_mut()).for_each(clip);
+    let points: Vec<Vec<f64>> = std::iter::once(x0.to_vec()).chain((1..=3).map(|k| nearby(x0, k))).collect();
+    let ones_eq = vec![1.0; m_eq];
+    let ones_in = vec![1.0; m_in];
+    let jac = Structure::new(points.iter().map(|x| stacked_jacobian(nlp, x, m_eq)));
+    let hess = Structure::new(points.iter().map(|x| nlp.hessian(x, 1.0, &ones_eq, &ones_in)));
+    let mut session = Session {
+        nlp,
+        m_eq,
+        iterations: 0,
+        outside_structure: false,
+        jac,
+        hess,
+    };
+    let mut x = x0.to_vec();
+    let mut objective = f64::NAN;
+    let code = unsafe {
+        let p = CreateIpoptProblem(
+            n as Index,
+            xl.as_mut_ptr(),
+            xu.as_mut_ptr(),
+            (m_eq + m_in) as Index,
+            gl.as_mut_ptr(),
+            gu.as_mut_ptr(),
+            session.jac.rows.len() as Index,
+            session.hess.rows.len() as Index,
+            0,
+            eval_f,
+            eval_g,
+            eval_grad_f,
+            eval_jac_g,
+            eval_h,
+        );
+        if p.is_null() {
+            return fail(Status::InvalidProblem);
+        }
+        AddIpoptNumOption(p, cstr("tol").as_ptr(), opt.tol);
+        AddIpoptIntOption(p, cstr("max_iter").as_ptr(), opt.max_iter.min(i32::MAX as usize) as c_int);
+        AddIpoptNumOption(p, cstr("bound_relax_factor").as_ptr(), opt.bound_relax_factor);
+        AddIpoptIntOption(p, cstr("print_level").as_ptr(), opt.print_level);
+        AddIpoptStrOption(p, cstr("hessian_approximation").as_ptr(), cstr("exact").as_ptr());
+        AddIpoptStrOption(p, cstr("sb").as_ptr(), cstr("yes").as_ptr());
+        SetIntermediateCallback(p, intermediate);
+        let code = IpoptSolve(
+            p,
+            x.as_mut_ptr(),
+            std::ptr::null_mut(),
+            &mut objective,
+            std::ptr::null_mut(),
+            std::ptr::null_mut(),
+            std::ptr::null_mut(),
+            &mut session as *mut Session as *mut c_void,
+        );
+        FreeIpoptProblem(p);
+        code
+    };
+    let status = if session.outside_structure {
+        Status::NumericalFailure
+    } else {
+        match code {
+            0 => Status::Solved,
+            1 => Status::SolvedToAcceptableLevel,
+            2 => Status::LocallyInfeasible,
+            -1 => Status::MaxIterations,
+            -2 => Status::RestorationFailed,
+            -11 | -12 => Status::InvalidProblem,
+            _ => Status::NumericalFailure,
+        }
+    };
+    IpoptSolution {
+        status,
+        code,
+        x,
+        objective,
+        iterations: session.iterations,
+    }
+}
