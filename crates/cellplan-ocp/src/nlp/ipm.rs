@@ -24,6 +24,10 @@ pub struct Options {
     /// Run the feasibility restoration phase when the line search fails (off inside the
     /// restoration phase itself).
     pub restoration: bool,
+    /// The equalities' multipliers start at the least-squares estimate (IPOPT §3.6) unless
+    /// it is larger than this; 0 starts them at zero (IPOPT `constr_mult_init_max`; the
+    /// restoration phase uses 0, as IPOPT's does).
+    pub constr_mult_init_max: f64,
 }
 
 impl Default for Options {
@@ -38,6 +42,7 @@ impl Default for Options {
             scaling_max_gradient: 100.0,
             verbose: false,
             restoration: true,
+            constr_mult_init_max: 1000.0,
         }
     }
 }
@@ -366,6 +371,14 @@ pub(crate) fn solve_with<P: Nlp + ?Sized>(
             .collect(),
     };
     let kkt = Kkt::new(n, m, nlp.kkt_order(), p.fixed.clone());
+    let mut it = it;
+    if m > 0
+        && opt.constr_mult_init_max > 0.0
+        && let Some(y) = least_squares_multipliers(&p, &kkt, &it)
+        && norm_inf(&y) <= opt.constr_mult_init_max
+    {
+        it.yc = y;
+    }
     let mut state = Driver {
         p: &p,
         kkt,
@@ -375,6 +388,37 @@ pub(crate) fn solve_with<P: Nlp + ?Sized>(
     };
     let (status, it) = state.run(it, opt.mu_init, early);
     state.finish(status, it)
+}
+
+/// IPOPT's least-squares estimate of the equalities' multipliers at the start (§3.6 of
+/// Wächter & Biegler): `[I, J_cᵀ; J_c, 0] (w, y) = (−(∇f − z_L + z_U), 0)`, the inequalities'
+/// multipliers left at zero. `None` when that system does not have the inertia of a
+/// least-squares problem (J_c rank-deficient).
+fn least_squares_multipliers<P: Nlp + ?Sized>(p: &Scaled<P>, kkt: &Kkt, it: &Iterate) -> Option<Vec<f64>> {
+    let (n, m) = (p.n, p.m);
+    let grad = p.gradient(&it.x);
+    let identity: Triplets = (0..n).map(|i| (i, i, 1.0)).collect();
+    let jac_c = p.jac_c(&it.x);
+    let none: Triplets = Vec::new();
+    let zeros_x = vec![0.0; n];
+    let zeros_s = vec![0.0; p.md];
+    let values = super::kkt::KktValues {
+        hess: &identity,
+        jac_c: &jac_c,
+        jac_d: &none,
+        sigma_x: &zeros_x,
+        sigma_s: &zeros_s,
+    };
+    let fact = kkt.factor_exact(&values)?;
+    let mut rhs = vec![0.0; n + m];
+    for i in 0..n {
+        if !p.fixed[i] {
+            rhs[i] = -(grad[i] - it.zl[i] + it.zu[i]);
+        }
+    }
+    let sol = kkt.solve(&fact, &rhs, 3);
+    let y = sol[n..].to_vec();
+    y.iter().all(|v| v.is_finite()).then_some(y)
 }
 
 /// The iteration's machinery, shared with the restoration phase.

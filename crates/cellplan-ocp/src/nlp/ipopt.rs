@@ -4,13 +4,10 @@
 //! (Debian: `apt-get install coinor-libipopt-dev`, IPOPT 3.11 with MUMPS); the default build
 //! needs nothing outside Rust.
 //!
-//! The trait's triplets list only the nonzeros of the point they are evaluated at, while IPOPT
-//! fixes the sparsity structure once: the structure is the union of the entries at the start
-//! and at three points near it with every multiplier nonzero (each derivative of the DMOC
-//! transcription that can be nonzero is nonzero there), and an entry outside it later ends the
-//! solve with [`Status::NumericalFailure`] rather than being dropped.
-use super::{Nlp, Status, Triplets};
-use std::collections::BTreeMap;
+//! IPOPT fixes the sparsity structure once ([`Structure::of`]); an entry outside it later ends
+//! the solve with [`Status::NumericalFailure`] rather than being dropped.
+use super::structure::{Structure, stacked_jacobian};
+use super::{Nlp, Status};
 use std::ffi::{CString, c_char, c_int, c_void};
 
 type Bool = c_int;
@@ -114,44 +111,6 @@ pub struct IpoptSolution {
     pub iterations: usize,
 }
 
-/// A sparsity structure fixed from sample evaluations: `(row, col)` → position.
-struct Structure {
-    index: BTreeMap<(usize, usize), usize>,
-    rows: Vec<Index>,
-    cols: Vec<Index>,
-}
-
-impl Structure {
-    fn new(samples: impl IntoIterator<Item = Triplets>) -> Structure {
-        let mut index = BTreeMap::new();
-        for t in samples {
-            for (r, c, _) in t {
-                let next = index.len();
-                index.entry((r, c)).or_insert(next);
-            }
-        }
-        let mut rows = vec![0; index.len()];
-        let mut cols = vec![0; index.len()];
-        for (&(r, c), &k) in &index {
-            rows[k] = r as Index;
-            cols[k] = c as Index;
-        }
-        Structure { index, rows, cols }
-    }
-
-    /// Adds `t` into `values` (zeroed first); false when an entry is outside the structure.
-    fn scatter(&self, t: &Triplets, values: &mut [f64]) -> bool {
-        values.fill(0.0);
-        for &(r, c, v) in t {
-            match self.index.get(&(r, c)) {
-                Some(&k) => values[k] += v,
-                None => return false,
-            }
-        }
-        true
-    }
-}
-
 /// The problem and the bookkeeping the callbacks share.
 struct Session<'a> {
     nlp: &'a dyn Nlp,
@@ -217,8 +176,8 @@ extern "C" fn eval_jac_g(
     let s = session(user);
     if values.is_null() {
         unsafe {
-            std::ptr::copy_nonoverlapping(s.jac.rows.as_ptr(), rows, nele as usize);
-            std::ptr::copy_nonoverlapping(s.jac.cols.as_ptr(), cols, nele as usize);
+            std::ptr::copy_nonoverlapping(s.jac.rows_i32.as_ptr(), rows, nele as usize);
+            std::ptr::copy_nonoverlapping(s.jac.cols_i32.as_ptr(), cols, nele as usize);
         }
         return 1;
     }
@@ -246,8 +205,8 @@ extern "C" fn eval_h(
     let s = session(user);
     if values.is_null() {
         unsafe {
-            std::ptr::copy_nonoverlapping(s.hess.rows.as_ptr(), rows, nele as usize);
-            std::ptr::copy_nonoverlapping(s.hess.cols.as_ptr(), cols, nele as usize);
+            std::ptr::copy_nonoverlapping(s.hess.rows_i32.as_ptr(), rows, nele as usize);
+            std::ptr::copy_nonoverlapping(s.hess.cols_i32.as_ptr(), cols, nele as usize);
         }
         return 1;
     }
@@ -278,25 +237,6 @@ extern "C" fn intermediate(
     1
 }
 
-/// The Jacobian of `[c; d]` (the inequalities' rows after the equalities').
-fn stacked_jacobian(nlp: &dyn Nlp, x: &[f64], m_eq: usize) -> Triplets {
-    let mut t = nlp.eq_jacobian(x);
-    t.extend(nlp.ineq_jacobian(x).into_iter().map(|(r, c, v)| (r + m_eq, c, v)));
-    t
-}
-
-/// Points near `x0` (a deterministic spread of 1e-3 relative) where the derivatives take
-/// their generic nonzeros.
-fn nearby(x0: &[f64], k: usize) -> Vec<f64> {
-    x0.iter()
-        .enumerate()
-        .map(|(i, v)| {
-            let wiggle = ((i * 7 + k * 13) % 11) as f64 / 11.0 - 0.45;
-            v + 1e-3 * wiggle * v.abs().max(1.0)
-        })
-        .collect()
-}
-
 fn cstr(s: &str) -> CString {
     CString::new(s).unwrap_or_default()
 }
@@ -322,11 +262,7 @@ pub fn solve(nlp: &dyn Nlp, x0: &[f64], opt: &IpoptOptions) -> IpoptSolution {
     let mut gl: Vec<f64> = std::iter::repeat_n(0.0, m_eq).chain(dl).collect();
     let mut gu: Vec<f64> = std::iter::repeat_n(0.0, m_eq).chain(du).collect();
     gl.iter_mut().chain(gu.iter_mut()).for_each(clip);
-    let points: Vec<Vec<f64>> = std::iter::once(x0.to_vec()).chain((1..=3).map(|k| nearby(x0, k))).collect();
-    let ones_eq = vec![1.0; m_eq];
-    let ones_in = vec![1.0; m_in];
-    let jac = Structure::new(points.iter().map(|x| stacked_jacobian(nlp, x, m_eq)));
-    let hess = Structure::new(points.iter().map(|x| nlp.hessian(x, 1.0, &ones_eq, &ones_in)));
+    let (jac, hess) = Structure::of(nlp, x0);
     let mut session = Session {
         nlp,
         m_eq,
@@ -345,8 +281,8 @@ pub fn solve(nlp: &dyn Nlp, x0: &[f64], opt: &IpoptOptions) -> IpoptSolution {
             (m_eq + m_in) as Index,
             gl.as_mut_ptr(),
             gu.as_mut_ptr(),
-            session.jac.rows.len() as Index,
-            session.hess.rows.len() as Index,
+            session.jac.len() as Index,
+            session.hess.len() as Index,
             0,
             eval_f,
             eval_g,
@@ -358,7 +294,11 @@ pub fn solve(nlp: &dyn Nlp, x0: &[f64], opt: &IpoptOptions) -> IpoptSolution {
             return fail(Status::InvalidProblem);
         }
         AddIpoptNumOption(p, cstr("tol").as_ptr(), opt.tol);
-        AddIpoptIntOption(p, cstr("max_iter").as_ptr(), opt.max_iter.min(i32::MAX as usize) as c_int);
+        AddIpoptIntOption(
+            p,
+            cstr("max_iter").as_ptr(),
+            opt.max_iter.min(i32::MAX as usize) as c_int,
+        );
         AddIpoptNumOption(p, cstr("bound_relax_factor").as_ptr(), opt.bound_relax_factor);
         AddIpoptIntOption(p, cstr("print_level").as_ptr(), opt.print_level);
         AddIpoptStrOption(p, cstr("hessian_approximation").as_ptr(), cstr("exact").as_ptr());

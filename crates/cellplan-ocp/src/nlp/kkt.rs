@@ -165,6 +165,13 @@ impl Kkt {
         )
     }
 
+    /// Factors without regularisation; `None` unless the inertia is the right one (n
+    /// positive, m negative, no zero pivot).
+    pub fn factor_exact(&self, v: &KktValues) -> Option<Factored> {
+        let (f, inertia) = self.factor(v, 0.0, 0.0);
+        (inertia.zero == 0 && (inertia.positive, inertia.negative) == (self.n, self.m)).then_some(f)
+    }
+
     /// Factors with IPOPT's inertia correction: δ_w = δ_c = 0 first; a zero pivot brings
     /// δ_c = 1e-8 μ^¼; a wrong inertia raises δ_w (from 1e-4, or a third of the last one, by
     /// ×100 or ×8). `None` when δ_w passes 1e40.

@@ -30,6 +30,7 @@ mod iterate;
 mod kkt;
 pub mod ldl;
 mod restoration;
+pub mod structure;
 #[cfg(test)]
 mod tests;
 

@@ -151,6 +151,7 @@ impl<P: Nlp + ?Sized> Driver<'_, '_, P> {
         let opt = Options {
             mu_init: mu_r,
             restoration: false,
+            constr_mult_init_max: 0.0,
             max_iter: self.opt.max_iter.saturating_sub(self.iterations),
             verbose: self.opt.verbose,
             ..self.opt.clone()

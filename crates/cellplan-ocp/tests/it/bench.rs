@@ -7,8 +7,14 @@ use serde_json::Value;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
+/// The repository's root: the first folder up from the crate that holds `bench/ocp` (this file
+/// is also compiled into `bench/peers/ocp_ripopt`).
 pub fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
+    let here = Path::new(env!("CARGO_MANIFEST_DIR"));
+    here.ancestors()
+        .find(|d| d.join("bench/ocp").is_dir())
+        .unwrap_or(here)
+        .to_path_buf()
 }
 
 fn read(rel: &str) -> Value {

@@ -66,7 +66,11 @@ fn ipopt_vs_ipm() {
         ));
         // Both solve the problems IPOPT solves, to a known optimum.
         if theirs.status == Status::Solved {
-            assert!(theirs_rel < 1e-4, "{name}: IPOPT's J {} is no known optimum", theirs.objective);
+            assert!(
+                theirs_rel < 1e-4,
+                "{name}: IPOPT's J {} is no known optimum",
+                theirs.objective
+            );
         }
     }
     eprintln!(
