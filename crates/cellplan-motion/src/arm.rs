@@ -210,6 +210,46 @@ fn axis_reach(arm: &Arm, i: usize, j: usize, link: usize) -> Option<f64> {
     })
 }
 
+/// Paper 002 §2.4's joint weights at `q`: for each joint `j`, `w_j(q) = max_p ‖∂p/∂q_j‖₁` over
+/// the points `p` of the bodies joint `j` moves — bounded from above over their sphere covers,
+/// which contain them: `‖a_j × (c − o_j)‖₁ + √3·r` for a sphere `(c, r)` and a turning joint
+/// with unit axis `a_j` through `o_j` (`‖a_j × δ‖₁ ≤ √3 |δ|`), `‖a_j‖₁` for a sliding one. 0 for a
+/// joint that moves no body. Unlike [`joint_radii`], which hold in every configuration, these
+/// hold at `q` only (to first order nearby).
+pub fn point_speed_weights(arm: &Arm, q: &[f64]) -> Vec<f64> {
+    let chain = arm.chain;
+    let mut links = Vec::new();
+    let mut bodies = Vec::new();
+    arm.body_poses(q, &mut links, &mut bodies);
+    let moved: Vec<usize> = (0..arm.body_links.len()).map(|i| moved_by(arm, i)).collect();
+    (0..chain.dof())
+        .map(|j| {
+            let (Some(joint), Some(k)) = (chain.joints.get(j), chain.joint_link(j)) else {
+                return 0.0;
+            };
+            let frame = arm.base * links.get(k).copied().unwrap_or(Pose::IDENTITY);
+            let a = (frame.rotation * joint.axis).normalize_or_zero();
+            let o = frame.translation;
+            let l1 = |v: cellplan_geom::DVec3| v.x.abs() + v.y.abs() + v.z.abs();
+            let mut w: f64 = 0.0;
+            for (i, pose) in bodies.iter().enumerate() {
+                if moved.get(i).is_none_or(|&m| j >= m) {
+                    continue;
+                }
+                for s in arm.world.body_cover(arm.group, i) {
+                    let v = if joint.is_rotational() {
+                        l1(a.cross(pose.transform_point(s.centre) - o)) + 3f64.sqrt() * s.radius
+                    } else {
+                        l1(a)
+                    };
+                    w = w.max(v);
+                }
+            }
+            w
+        })
+        .collect()
+}
+
 /// The configurations that move the tool point `tcp` (a pose in the chain's tip frame) from
 /// where it is at `q` backwards along its own z axis by `distance` (m), its orientation kept:
 /// the retract before a leg, and reversed the approach after it (a probe, a gripper or a gun

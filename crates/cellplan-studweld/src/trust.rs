@@ -6,12 +6,13 @@
 //! min_gain`] (relative) or after [`TrustSettings::iterations`].
 //!
 //! Here `φ` is the clearance of `q_i^k` in the leg planner's validity test (the distance of the
-//! bodies to the scene less the cell's clearance, half the smallest self distance), and `w_j`
-//! is the joint's radius — an upper bound, valid in every configuration, on the distance of any
-//! body point from joint j's axis — in place of the paper's `max_p ‖∂p/∂q_j‖₁` at `q_i^k`. Since
-//! no point moves farther than `Σ_j w_j |Δq_j| ≤ n max_j w_j |Δq_j|`, at `s = 1` (the paper's
-//! box) every grid point of the new trajectory is proven clear (not only to first order); the
-//! pieces between grid points are checked by the motion core's segment check.
+//! bodies to the scene less the cell's clearance, half the smallest self distance), and `w_j` is
+//! the paper's `max_p ‖∂p/∂q_j‖₁` at `q_i^k` over the robot's points
+//! ([`cellplan_motion::arm::point_speed_weights`], bounded from above over the bodies' sphere
+//! covers). A point then moves by at most `Σ_j w_j |Δq_j| ≤ n max_j w_j |Δq_j|` to first order,
+//! so at `s = 1` (the paper's box) the new grid points keep their clearance to first order, as
+//! the paper says; it is the dense check of every new trajectory (grid points and the pieces
+//! between them, by the motion core's conservative segment check) that proves it.
 //!
 //! Two things the paper leaves open, measured on `examples/studweld-kr210`:
 //! - **The first iterate.** A path is not a trajectory: with its grid pinned in boxes of a few
@@ -28,6 +29,7 @@
 use crate::cell::WeldCell;
 use crate::leg::{Dmoc, unpack};
 use cellplan_core::motion::{joint_radii, robot_validity};
+use cellplan_motion::arm::point_speed_weights;
 use cellplan_ocp::nlp::{self, Nlp, Status, Triplets};
 use cellplan_ocp::problem::Move;
 
@@ -157,6 +159,7 @@ pub fn iterate(w: &WeldCell, m: &Move, x0: &[f64], opt: &nlp::Options, s: &Trust
     let l = m.layout();
     let validity = robot_validity(w.cell, w.robot, w.cell.planning.clearance);
     let radii = joint_radii(w.cell, w.robot);
+    let arm = w.robot.arm(&w.cell.world);
     let (base_lo, base_hi) = m.bounds();
     let mut out = Trusted {
         best: None,
@@ -204,21 +207,22 @@ pub fn iterate(w: &WeldCell, m: &Move, x0: &[f64], opt: &nlp::Options, s: &Trust
     let mut last = Nlp::objective(m, &x);
     out.best = Some((unpack(m, &x), last));
     while out.accepted < s.iterations {
-        // φ(q_i^k) − d_c per grid point.
-        let room: Vec<f64> = (0..=l.steps)
+        // φ(q_i^k) − d_c and the weights w(q_i^k) per grid point.
+        let (room, weights): (Vec<f64>, Vec<Vec<f64>>) = (0..=l.steps)
             .map(|i| {
                 let q: Vec<f64> = (0..l.n).map(|j| x[l.q(i, j)]).collect();
                 let (scene, own) = validity.scene_and_self_clearance(&q);
-                (scene.min(0.5 * own) - s.extra_clearance).max(0.0)
+                let room = (scene.min(0.5 * own) - s.extra_clearance).max(0.0);
+                (room, point_speed_weights(&arm, &q))
             })
-            .collect();
+            .unzip();
         let mut accepted = false;
         for _ in 0..=s.backtracks {
             let (mut lo, mut hi) = (base_lo.clone(), base_hi.clone());
             for i in 1..l.steps {
                 for j in 0..l.n {
                     let k = l.q(i, j);
-                    let half = scale * room[i] / (l.n as f64 * radii[j].max(1e-9));
+                    let half = scale * room[i] / (l.n as f64 * weights[i][j].max(1e-9));
                     lo[k] = (x[k] - half).max(base_lo[k]).min(x[k]);
                     hi[k] = (x[k] + half).min(base_hi[k]).max(x[k]);
                 }

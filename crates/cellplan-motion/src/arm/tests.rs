@@ -162,3 +162,58 @@ fn pairs_proven_apart_never_touch() {
     let &(i, j) = touched.iter().next().unwrap();
     assert!(!apart_everywhere(&all, i, j, 1_000_000));
 }
+
+/// Paper 002's weights `w_j(q) = max_p ‖∂p/∂q_j‖₁`: at random configurations, no hull vertex
+/// of a body that joint `j` moves is faster (central differences) than `w_j`, and `w_j` exceeds
+/// the fastest vertex by no more than the covers' slack (√3 times the largest sphere radius).
+#[test]
+fn point_speed_weights_bound_the_vertices_speeds_and_are_tight() {
+    let setup = ur5();
+    let arm = setup.arm();
+    let n = arm.body_links.len();
+    let hulls: Vec<Vec<DVec3>> = (0..n)
+        .map(|i| {
+            arm.world
+                .body_hull(arm.group, i)
+                .map_or(Vec::new(), |m| m.vertices)
+        })
+        .collect();
+    let largest = (0..n)
+        .flat_map(|i| arm.world.body_cover(arm.group, i).iter().map(|s| s.radius))
+        .fold(0.0f64, f64::max);
+    let mut rng = ChaCha8Rng::seed_from_u64(5);
+    let (mut links, mut lo, mut hi) = (Vec::new(), Vec::<Pose>::new(), Vec::<Pose>::new());
+    let eps = 1e-6;
+    for _ in 0..30 {
+        let q = random_q(&arm, &mut rng);
+        let w = super::point_speed_weights(&arm, &q);
+        assert_eq!(w.len(), arm.chain.dof());
+        for j in 0..arm.chain.dof() {
+            let (mut a, mut b) = (q.clone(), q.clone());
+            a[j] -= eps;
+            b[j] += eps;
+            arm.body_poses(&a, &mut links, &mut lo);
+            arm.body_poses(&b, &mut links, &mut hi);
+            let fastest = (0..n)
+                .filter(|&i| j < moved_by(&arm, i))
+                .flat_map(|i| {
+                    let (lo, hi) = (lo[i], hi[i]);
+                    hulls[i].iter().map(move |v| {
+                        let d = (hi.transform_point(*v) - lo.transform_point(*v)) / (2.0 * eps);
+                        d.x.abs() + d.y.abs() + d.z.abs()
+                    })
+                })
+                .fold(0.0f64, f64::max);
+            assert!(
+                fastest <= w[j] + 1e-6,
+                "joint {j}: a vertex moves at {fastest}, w {}",
+                w[j]
+            );
+            assert!(
+                w[j] <= fastest + 3f64.sqrt() * largest + 1e-6,
+                "joint {j}: w {} far above the fastest vertex {fastest}",
+                w[j]
+            );
+        }
+    }
+}
