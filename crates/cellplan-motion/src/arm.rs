@@ -214,7 +214,8 @@ fn axis_reach(arm: &Arm, i: usize, j: usize, link: usize) -> Option<f64> {
 /// the points `p` of the bodies joint `j` moves — bounded from above over their sphere covers,
 /// which contain them: `‖a_j × (c − o_j)‖₁ + √3·r` for a sphere `(c, r)` and a turning joint
 /// with unit axis `a_j` through `o_j` (`‖a_j × δ‖₁ ≤ √3 |δ|`), `‖a_j‖₁` for a sliding one. 0 for a
-/// joint that moves no body. Unlike [`joint_radii`], which hold in every configuration, these
+/// joint that moves no body. Each sphere holds some body point within `r` of its centre, so the
+/// bound exceeds the exact maximum by at most `2√3` times the largest radius. Unlike [`joint_radii`], which hold in every configuration, these
 /// hold at `q` only (to first order nearby).
 pub fn point_speed_weights(arm: &Arm, q: &[f64]) -> Vec<f64> {
     let chain = arm.chain;

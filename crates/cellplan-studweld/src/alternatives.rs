@@ -1,6 +1,6 @@
 //! The alternatives of each stud (paper 002 §2.1, Table 1): every inverse-kinematics branch of
-//! every gun rotation about the stud axis that welds within the pose tolerance
-//! ([`crate::process::WELD_POSE_TOLERANCE`]), is collision-free (the leg planner's own
+//! every gun rotation about the stud axis whose reached pose welds within the pose tolerance
+//! ([`crate::process::WELD_POSE_TOLERANCE`], the process's `pose_check`), is collision-free (the leg planner's own
 //! validity test at the cell's clearance) and whose holding torques are within the limits;
 //! each with its node cost, holding the pose for the weld time under gravity.
 use crate::cell::WeldCell;
@@ -107,12 +107,6 @@ pub fn alternatives(w: &WeldCell) -> Alternatives {
                 }
                 let mut kept: Vec<Vec<f64>> = Vec::new();
                 for c in r.candidates {
-                    // The pose the joints reach must weld within the tolerance the verifier
-                    // checks (a numeric IK solution misses the asked pose a little).
-                    if !crate::process::weld_pose_error(&c.tcp, task.position, task.normal).0 {
-                        furthest = furthest.max(Some(Rejection::NoIk));
-                        continue;
-                    }
                     if !holds(w, &c.q) {
                         too_heavy = true;
                         continue;

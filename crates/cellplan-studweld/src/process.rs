@@ -219,8 +219,18 @@ impl Process for StudWeld {
             .collect()
     }
 
-    fn pose_check(&self, _task: &Task, _tcp: &Pose) -> Result<(), ProcessReason> {
-        Ok(())
+    /// The pose the joints reach must weld within [`WELD_POSE_TOLERANCE`], which the verifier
+    /// checks (a numeric IK solution misses the asked pose a little).
+    fn pose_check(&self, task: &Task, tcp: &Pose) -> Result<(), ProcessReason> {
+        if weld_pose_error(tcp, task.position, task.normal).0 {
+            Ok(())
+        } else {
+            Err(ProcessReason {
+                rank: 0,
+                code: "weld-pose",
+                text: "the pose the joints reach is farther from the stud than the weld-pose tolerance",
+            })
+        }
     }
 
     fn reached_check(&self, _world: &CollisionWorld, _task: &Task, _tcp: &Pose) -> Result<(), ProcessReason> {

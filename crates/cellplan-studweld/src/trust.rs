@@ -200,7 +200,7 @@ pub fn iterate(w: &WeldCell, m: &Move, x0: &[f64], opt: &nlp::Options, s: &Trust
     let Some(mut x) = x else {
         return out;
     };
-    // The boxes' scale: 1 is the paper's (grid points proven clear); doubled after an accepted
+    // The boxes' scale: 1 is the paper's (grid points clear to first order); doubled after an accepted
     // iterate, halved after a rejected one (the dense check decides).
     let verbose = crate::sequence::verbose();
     let mut scale: f64 = 1.0;

@@ -3,7 +3,8 @@
 //! - the document is of this cell and its process parameters; every stud is welded once or
 //!   listed unweldable;
 //! - every weld: the TCP (forward kinematics of the robot with its gun) on the stud within
-//!   1 µm, the gun's axis along the inward normal within 1 µrad, the joints within their limits,
+//!   10 µm, the gun's axis along the inward normal within 10 µrad
+//!   (`cellplan_studweld::process::WELD_POSE_TOLERANCE`), the joints within their limits,
 //!   the pose collision-free at the cell's clearance, the gravity torques within the limits, the
 //!   pose held from `start_s` to `end_s` = weld time, and its node cost re-derived;
 //! - every move ([`legs`]): joins the welds (home at both ends), satisfies the discrete

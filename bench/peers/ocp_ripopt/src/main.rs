@@ -7,8 +7,8 @@
 #[allow(dead_code)]
 mod bench;
 
-use cellplan_ocp::nlp::structure::{Structure, stacked_jacobian};
-use cellplan_ocp::nlp::{self, Nlp, Options};
+use cellplan_ocp::nlp::Nlp;
+use cellplan_ocp::nlp::structure::{Structure, stacked_bounds, stacked_constraints, stacked_jacobian};
 use ripopt::{NlpProblem, SolverOptions};
 use std::time::Instant;
 
@@ -34,12 +34,9 @@ impl NlpProblem for Adapter<'_> {
         x_u.copy_from_slice(&u);
     }
     fn constraint_bounds(&self, g_l: &mut [f64], g_u: &mut [f64]) {
-        let m = self.nlp.num_eq();
-        let (l, u) = self.nlp.ineq_bounds();
-        g_l[..m].fill(0.0);
-        g_u[..m].fill(0.0);
-        g_l[m..].copy_from_slice(&l);
-        g_u[m..].copy_from_slice(&u);
+        let (l, u) = stacked_bounds(self.nlp);
+        g_l.copy_from_slice(&l);
+        g_u.copy_from_slice(&u);
     }
     fn initial_point(&self, x0: &mut [f64]) {
         x0.copy_from_slice(&self.x0);
@@ -53,9 +50,7 @@ impl NlpProblem for Adapter<'_> {
         grad.iter().all(|v| v.is_finite())
     }
     fn constraints(&self, x: &[f64], _new_x: bool, g: &mut [f64]) -> bool {
-        let m = self.nlp.num_eq();
-        g[..m].copy_from_slice(&self.nlp.eq(x));
-        g[m..].copy_from_slice(&self.nlp.ineq(x));
+        g.copy_from_slice(&stacked_constraints(self.nlp, x));
         g.iter().all(|v| v.is_finite())
     }
     fn jacobian_structure(&self) -> (Vec<usize>, Vec<usize>) {
@@ -92,28 +87,11 @@ fn main() {
     println!(
         "| problem | ours: status J (rel. to nearest known optimum) | iterations | s | ripopt: status J (rel.) | iterations | s | time ratio ours/ripopt |\n|---|---|---|---|---|---|---|---|"
     );
-    for (name, reference) in [
-        ("ur10_a", "casadi"),
-        ("ur10_b", "casadi"),
-        ("ur10_c", "casadi"),
-        ("ur10_fast", "casadi"),
-        ("kr210_a", "casadi"),
-        ("kr210_a", "casadi_best"),
-        ("kr210_b", "casadi"),
-        ("kr210_b", "casadi_best"),
-    ] {
+    for (name, reference) in bench::CASES {
         let p = bench::Problem::load(name, reference);
         let x0 = p.start(reference);
         let t = Instant::now();
-        let ours = nlp::ipm::solve_from(
-            &p.mv,
-            &x0,
-            &Options {
-                tol: 1e-10,
-                max_iter: 1000,
-                ..Options::default()
-            },
-        );
+        let ours = bench::solve_ours(&p, &x0);
         let ours_s = t.elapsed().as_secs_f64();
         let (jac, hess) = Structure::of(&p.mv, &x0);
         let a = Adapter {

@@ -6,7 +6,7 @@
 //!
 //! IPOPT fixes the sparsity structure once ([`Structure::of`]); an entry outside it later ends
 //! the solve with [`Status::NumericalFailure`] rather than being dropped.
-use super::structure::{Structure, stacked_jacobian};
+use super::structure::{Structure, stacked_bounds, stacked_constraints, stacked_jacobian};
 use super::{Nlp, Status};
 use std::ffi::{CString, c_char, c_int, c_void};
 
@@ -153,12 +153,8 @@ extern "C" fn eval_grad_f(n: Index, x: *mut f64, _new: Bool, grad: *mut f64, use
 
 extern "C" fn eval_g(n: Index, x: *mut f64, _new: Bool, m: Index, g: *mut f64, user: *mut c_void) -> Bool {
     let s = session(user);
-    let x = slice(x, n as usize);
     let out = slice(g, m as usize);
-    let c = s.nlp.eq(x);
-    let d = s.nlp.ineq(x);
-    out[..s.m_eq].copy_from_slice(&c);
-    out[s.m_eq..].copy_from_slice(&d);
+    out.copy_from_slice(&stacked_constraints(s.nlp, slice(x, n as usize)));
     out.iter().all(|v| v.is_finite()) as Bool
 }
 
@@ -241,8 +237,12 @@ fn cstr(s: &str) -> CString {
     CString::new(s).unwrap_or_default()
 }
 
-/// Solves `nlp` from `x0` with IPOPT (exact Hessian, the options given).
+/// IPOPT 3.11 with MUMPS is not thread-safe: one solve at a time in this process.
+static ONE_AT_A_TIME: std::sync::Mutex<()> = std::sync::Mutex::new(());
+
+/// Solves `nlp` from `x0` with IPOPT (exact Hessian, the options given); one solve at a time.
 pub fn solve(nlp: &dyn Nlp, x0: &[f64], opt: &IpoptOptions) -> IpoptSolution {
+    let _one = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
     let (n, m_eq, m_in) = (nlp.num_vars(), nlp.num_eq(), nlp.num_ineq());
     let fail = |status| IpoptSolution {
         status,
@@ -255,12 +255,11 @@ pub fn solve(nlp: &dyn Nlp, x0: &[f64], opt: &IpoptOptions) -> IpoptSolution {
         return fail(Status::InvalidProblem);
     }
     let (mut xl, mut xu) = nlp.bounds();
-    let (dl, du) = nlp.ineq_bounds();
+    let (mut gl, mut gu) = stacked_bounds(nlp);
+    // IPOPT reads ±1e19 and beyond as no bound.
     let big = 1e20;
     let clip = |v: &mut f64| *v = v.clamp(-big, big);
     xl.iter_mut().chain(xu.iter_mut()).for_each(clip);
-    let mut gl: Vec<f64> = std::iter::repeat_n(0.0, m_eq).chain(dl).collect();
-    let mut gu: Vec<f64> = std::iter::repeat_n(0.0, m_eq).chain(du).collect();
     gl.iter_mut().chain(gu.iter_mut()).for_each(clip);
     let (jac, hess) = Structure::of(nlp, x0);
     let mut session = Session {

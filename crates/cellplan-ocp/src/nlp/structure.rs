@@ -78,6 +78,22 @@ impl Structure {
     }
 }
 
+/// `g = [c; d]`, the form IPOPT's and ripopt's interfaces take.
+pub fn stacked_constraints(nlp: &dyn Nlp, x: &[f64]) -> Vec<f64> {
+    let mut g = nlp.eq(x);
+    g.extend(nlp.ineq(x));
+    g
+}
+
+/// The bounds `(g_L, g_U)` of [`stacked_constraints`]: 0 for the equalities, then `d_L`, `d_U`.
+pub fn stacked_bounds(nlp: &dyn Nlp) -> (Vec<f64>, Vec<f64>) {
+    let m = nlp.num_eq();
+    let (dl, du) = nlp.ineq_bounds();
+    let lo = std::iter::repeat_n(0.0, m).chain(dl).collect();
+    let hi = std::iter::repeat_n(0.0, m).chain(du).collect();
+    (lo, hi)
+}
+
 /// The Jacobian of `[c; d]` (the inequalities' rows after the equalities').
 pub fn stacked_jacobian(nlp: &dyn Nlp, x: &[f64], m_eq: usize) -> Triplets {
     let mut t = nlp.eq_jacobian(x);

@@ -30,6 +30,32 @@ fn floats(v: &Value) -> Vec<f64> {
         .collect()
 }
 
+/// The bench problems with the reference each is solved against (`bench/ocp/README.md`).
+pub const CASES: [(&str, &str); 8] = [
+    ("ur10_a", "casadi"),
+    ("ur10_b", "casadi"),
+    ("ur10_c", "casadi"),
+    ("ur10_fast", "casadi"),
+    ("kr210_a", "casadi"),
+    ("kr210_a", "casadi_best"),
+    ("kr210_b", "casadi"),
+    ("kr210_b", "casadi_best"),
+];
+
+/// cellplan's solver as the bench runs it (`tol` 1e-10, at most 1000 iterations) from `x0`.
+pub fn solve_ours(p: &Problem, x0: &[f64]) -> cellplan_ocp::nlp::Solution {
+    cellplan_ocp::nlp::ipm::solve_from(
+        &p.mv,
+        x0,
+        &cellplan_ocp::nlp::Options {
+            tol: 1e-10,
+            max_iter: 1000,
+            verbose: std::env::var_os("CELLPLAN_NLP_VERBOSE").is_some(),
+            ..cellplan_ocp::nlp::Options::default()
+        },
+    )
+}
+
 /// One bench problem: the move (its robot's dynamics live for the whole test run) and the
 /// reference.
 pub struct Problem {

@@ -3,9 +3,9 @@
 //! the same start, the same tolerance.
 //!
 //! `cargo test -p cellplan-ocp --release --features ipopt --test it -- --ignored --nocapture ipopt_vs_ipm`
-use crate::bench::Problem;
+use crate::bench::{CASES, Problem, solve_ours};
 use cellplan_ocp::nlp::ipopt::{self, IpoptOptions};
-use cellplan_ocp::nlp::{self, Nlp, Options, Status};
+use cellplan_ocp::nlp::{Nlp, Status};
 use std::time::Instant;
 
 #[test]
@@ -23,28 +23,11 @@ fn ipopt_reaches_the_casadi_optimum_on_ur10_a() {
 #[ignore = "heavier: cargo test -p cellplan-ocp --release --features ipopt --test it -- --ignored --nocapture ipopt_vs_ipm"]
 fn ipopt_vs_ipm() {
     let mut rows = Vec::new();
-    for (name, reference) in [
-        ("ur10_a", "casadi"),
-        ("ur10_b", "casadi"),
-        ("ur10_c", "casadi"),
-        ("ur10_fast", "casadi"),
-        ("kr210_a", "casadi"),
-        ("kr210_a", "casadi_best"),
-        ("kr210_b", "casadi"),
-        ("kr210_b", "casadi_best"),
-    ] {
+    for (name, reference) in CASES {
         let p = Problem::load(name, reference);
         let x0 = p.start(reference);
         let t = Instant::now();
-        let ours = nlp::ipm::solve_from(
-            &p.mv,
-            &x0,
-            &Options {
-                tol: 1e-10,
-                max_iter: 1000,
-                ..Options::default()
-            },
-        );
+        let ours = solve_ours(&p, &x0);
         let ours_s = t.elapsed().as_secs_f64();
         let t = Instant::now();
         let theirs = ipopt::solve(&p.mv, &x0, &IpoptOptions::default());

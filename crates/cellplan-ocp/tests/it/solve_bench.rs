@@ -3,8 +3,8 @@
 //!
 //! `ur10_a` runs in the normal suite; the rest are ignored (heavier), run them with
 //! `cargo test -p cellplan-ocp --release --test it -- --ignored --nocapture solve_bench`.
-use crate::bench::Problem;
-use cellplan_ocp::nlp::{self, Nlp, Options, Status};
+use crate::bench::{CASES, Problem, solve_ours};
+use cellplan_ocp::nlp::{Nlp, Status};
 use std::time::Instant;
 
 pub struct Outcome {
@@ -17,15 +17,9 @@ pub struct Outcome {
 pub fn solve_and_check(name: &str, reference: &str) -> Outcome {
     let p = Problem::load(name, reference);
     let m = &p.mv;
-    let opt = Options {
-        tol: 1e-10,
-        max_iter: 1000,
-        verbose: std::env::var_os("CELLPLAN_NLP_VERBOSE").is_some(),
-        ..Options::default()
-    };
     let x0 = p.start(reference);
     let started = Instant::now();
-    let s = nlp::ipm::solve_from(m, &x0, &opt);
+    let s = solve_ours(&p, &x0);
     let seconds = started.elapsed().as_secs_f64();
     assert_eq!(
         s.status,
@@ -77,16 +71,7 @@ fn ur10_a_reaches_the_casadi_optimum() {
 fn solve_bench_all() {
     let mut rows = Vec::new();
     let mut failed: Vec<String> = Vec::new();
-    for (name, reference) in [
-        ("ur10_a", "casadi"),
-        ("ur10_b", "casadi"),
-        ("ur10_c", "casadi"),
-        ("ur10_fast", "casadi"),
-        ("kr210_a", "casadi"),
-        ("kr210_a", "casadi_best"),
-        ("kr210_b", "casadi"),
-        ("kr210_b", "casadi_best"),
-    ] {
+    for (name, reference) in CASES {
         // Every problem runs; the failures are listed at the end.
         match std::panic::catch_unwind(|| solve_and_check(name, reference)) {
             Ok(o) => rows.push(format!(
