@@ -19,6 +19,17 @@ fn random_q(arm: &Arm, rng: &mut ChaCha8Rng) -> Vec<f64> {
         .collect()
 }
 
+/// Each body's hull vertices in its own frame (none for a body without shapes).
+fn hull_vertices(arm: &Arm) -> Vec<Vec<DVec3>> {
+    (0..arm.body_links.len())
+        .map(|i| {
+            arm.world
+                .body_hull(arm.group, i)
+                .map_or(Vec::new(), |m| m.vertices)
+        })
+        .collect()
+}
+
 fn lerp(a: &[f64], b: &[f64], t: f64) -> Vec<f64> {
     a.iter().zip(b).map(|(x, y)| x + (y - x) * t).collect()
 }
@@ -39,13 +50,7 @@ fn body_and_pair_radii_bound_the_motion() {
     let arm = setup.arm();
     let n = arm.body_links.len();
     let radii: Vec<Vec<f64>> = (0..n).map(|i| body_radii(&arm, i)).collect();
-    let hulls: Vec<Vec<DVec3>> = (0..n)
-        .map(|i| {
-            arm.world
-                .body_hull(arm.group, i)
-                .map_or(Vec::new(), |m| m.vertices)
-        })
-        .collect();
+    let hulls = hull_vertices(&arm);
     let mut rng = ChaCha8Rng::seed_from_u64(11);
     let (mut links, mut poses) = (Vec::new(), Vec::<Pose>::new());
     let mut tightest = vec![0.0f64; n];
@@ -172,13 +177,7 @@ fn point_speed_weights_bound_the_vertices_speeds_and_are_tight() {
     let setup = ur5();
     let arm = setup.arm();
     let n = arm.body_links.len();
-    let hulls: Vec<Vec<DVec3>> = (0..n)
-        .map(|i| {
-            arm.world
-                .body_hull(arm.group, i)
-                .map_or(Vec::new(), |m| m.vertices)
-        })
-        .collect();
+    let hulls = hull_vertices(&arm);
     let largest = (0..n)
         .flat_map(|i| arm.world.body_cover(arm.group, i).iter().map(|s| s.radius))
         .fold(0.0f64, f64::max);

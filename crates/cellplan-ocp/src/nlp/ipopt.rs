@@ -7,7 +7,7 @@
 //! IPOPT fixes the sparsity structure once ([`Structure::of`]); an entry outside it later ends
 //! the solve with [`Status::NumericalFailure`] rather than being dropped.
 use super::structure::{Structure, stacked_bounds, stacked_constraints, stacked_jacobian};
-use super::{Nlp, Status};
+use super::{Nlp, Status, Triplets};
 use std::ffi::{CString, c_char, c_int, c_void};
 
 type Bool = c_int;
@@ -128,8 +128,10 @@ fn session<'s>(user: *mut c_void) -> &'s mut Session<'s> {
     unsafe { &mut *(user as *mut Session) }
 }
 
+/// `len` numbers at `p`; empty for a null pointer (IPOPT passes null `x` and multipliers when
+/// it asks for a structure).
 fn slice<'s>(p: *mut f64, len: usize) -> &'s mut [f64] {
-    if len == 0 {
+    if len == 0 || p.is_null() {
         return &mut [];
     }
     unsafe { std::slice::from_raw_parts_mut(p, len) }
@@ -170,18 +172,11 @@ extern "C" fn eval_jac_g(
     user: *mut c_void,
 ) -> Bool {
     let s = session(user);
-    if values.is_null() {
-        unsafe {
-            std::ptr::copy_nonoverlapping(s.jac.rows_i32.as_ptr(), rows, nele as usize);
-            std::ptr::copy_nonoverlapping(s.jac.cols_i32.as_ptr(), cols, nele as usize);
-        }
-        return 1;
-    }
     let x = slice(x, n as usize);
-    let t = stacked_jacobian(s.nlp, x, s.m_eq);
-    let ok = s.jac.scatter(&t, slice(values, nele as usize));
-    s.outside_structure |= !ok;
-    ok as Bool
+    let (nlp, m_eq) = (s.nlp, s.m_eq);
+    answer(&s.jac, nele, rows, cols, values, &mut s.outside_structure, || {
+        stacked_jacobian(nlp, x, m_eq)
+    })
 }
 
 extern "C" fn eval_h(
@@ -199,19 +194,43 @@ extern "C" fn eval_h(
     user: *mut c_void,
 ) -> Bool {
     let s = session(user);
-    if values.is_null() {
-        unsafe {
-            std::ptr::copy_nonoverlapping(s.hess.rows_i32.as_ptr(), rows, nele as usize);
-            std::ptr::copy_nonoverlapping(s.hess.cols_i32.as_ptr(), cols, nele as usize);
-        }
-        return 1;
-    }
     let x = slice(x, n as usize);
     let lambda = slice(lambda, m as usize);
     let (eq, ineq) = lambda.split_at(s.m_eq);
-    let t = s.nlp.hessian(x, obj_factor, eq, ineq);
-    let ok = s.hess.scatter(&t, slice(values, nele as usize));
-    s.outside_structure |= !ok;
+    let nlp = s.nlp;
+    answer(
+        &s.hess,
+        nele,
+        rows,
+        cols,
+        values,
+        &mut s.outside_structure,
+        || nlp.hessian(x, obj_factor, eq, ineq),
+    )
+}
+
+/// One of IPOPT's two-way calls for a sparse matrix with structure `st`: the positions when
+/// `values` is null (`x` and the multipliers may then be null too, and are not read), else the
+/// values of `triplets()`; an entry outside the structure sets `outside` and fails the call.
+fn answer(
+    st: &Structure,
+    nele: Index,
+    rows: *mut Index,
+    cols: *mut Index,
+    values: *mut f64,
+    outside: &mut bool,
+    triplets: impl FnOnce() -> Triplets,
+) -> Bool {
+    let len = (nele.max(0) as usize).min(st.len());
+    if values.is_null() {
+        unsafe {
+            std::ptr::copy_nonoverlapping(st.rows_i32.as_ptr(), rows, len);
+            std::ptr::copy_nonoverlapping(st.cols_i32.as_ptr(), cols, len);
+        }
+        return 1;
+    }
+    let ok = st.scatter(&triplets(), slice(values, len));
+    *outside |= !ok;
     ok as Bool
 }
 
