@@ -215,8 +215,9 @@ fn axis_reach(arm: &Arm, i: usize, j: usize, link: usize) -> Option<f64> {
 /// which contain them: `‖a_j × (c − o_j)‖₁ + √3·r` for a sphere `(c, r)` and a turning joint
 /// with unit axis `a_j` through `o_j` (`‖a_j × δ‖₁ ≤ √3 |δ|`), `‖a_j‖₁` for a sliding one. 0 for a
 /// joint that moves no body. Each sphere holds some body point within `r` of its centre, so the
-/// bound exceeds the exact maximum by at most `2√3` times the largest radius. Unlike [`joint_radii`], which hold in every configuration, these
-/// hold at `q` only (to first order nearby).
+/// bound exceeds the exact maximum by at most `2√3` times the largest radius. Unlike
+/// [`joint_radii`], which hold in every configuration, these hold at `q` only (to first order
+/// nearby).
 pub fn point_speed_weights(arm: &Arm, q: &[f64]) -> Vec<f64> {
     let chain = arm.chain;
     let mut links = Vec::new();
@@ -232,21 +233,18 @@ pub fn point_speed_weights(arm: &Arm, q: &[f64]) -> Vec<f64> {
             let a = (frame.rotation * joint.axis).normalize_or_zero();
             let o = frame.translation;
             let l1 = |v: cellplan_geom::DVec3| v.x.abs() + v.y.abs() + v.z.abs();
-            let mut w: f64 = 0.0;
-            for (i, pose) in bodies.iter().enumerate() {
-                if moved.get(i).is_none_or(|&m| j >= m) {
-                    continue;
-                }
-                for s in arm.world.body_cover(arm.group, i) {
-                    let v = if joint.is_rotational() {
-                        l1(a.cross(pose.transform_point(s.centre) - o)) + 3f64.sqrt() * s.radius
-                    } else {
-                        l1(a)
-                    };
-                    w = w.max(v);
-                }
+            // Every sphere of every body joint `j` moves.
+            let mut spheres = bodies
+                .iter()
+                .enumerate()
+                .filter(|(i, _)| moved.get(*i).is_some_and(|&m| j < m))
+                .flat_map(|(i, pose)| arm.world.body_cover(arm.group, i).iter().map(move |s| (pose, s)));
+            if !joint.is_rotational() {
+                return if spheres.next().is_some() { l1(a) } else { 0.0 };
             }
-            w
+            spheres
+                .map(|(pose, s)| l1(a.cross(pose.transform_point(s.centre) - o)) + 3f64.sqrt() * s.radius)
+                .fold(0.0, f64::max)
         })
         .collect()
 }

@@ -1,8 +1,8 @@
 //! The alternatives of each stud (paper 002 §2.1, Table 1): every inverse-kinematics branch of
 //! every gun rotation about the stud axis whose reached pose welds within the pose tolerance
-//! ([`crate::process::WELD_POSE_TOLERANCE`], the process's `pose_check`), is collision-free (the leg planner's own
-//! validity test at the cell's clearance) and whose holding torques are within the limits;
-//! each with its node cost, holding the pose for the weld time under gravity.
+//! ([`crate::process::WELD_POSE_TOLERANCE`], the process's `pose_check`), is collision-free
+//! (the leg planner's own validity test at the cell's clearance) and whose holding torques are
+//! within the limits; each with its node cost, holding the pose for the weld time under gravity.
 use crate::cell::WeldCell;
 use cellplan_core::candidates::{reach, wrap};
 use cellplan_core::motion::robot_validity;

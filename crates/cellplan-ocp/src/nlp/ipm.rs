@@ -356,7 +356,7 @@ pub(crate) fn solve_with<P: Nlp + ?Sized>(
         return fail(Status::NumericalFailure);
     };
     let s: Vec<f64> = (0..md).map(|r| push_inside(e0.d[r], p.dl[r], p.du[r])).collect();
-    let it = Iterate {
+    let mut it = Iterate {
         x,
         s,
         yc: vec![0.0; m],
@@ -371,7 +371,6 @@ pub(crate) fn solve_with<P: Nlp + ?Sized>(
             .collect(),
     };
     let kkt = Kkt::new(n, m, nlp.kkt_order(), p.fixed.clone());
-    let mut it = it;
     if m > 0
         && opt.constr_mult_init_max > 0.0
         && let Some(y) = least_squares_multipliers(&p, &kkt, &it)

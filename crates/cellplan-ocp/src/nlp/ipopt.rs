@@ -196,8 +196,8 @@ extern "C" fn eval_h(
     let s = session(user);
     let x = slice(x, n as usize);
     let lambda = slice(lambda, m as usize);
-    let (eq, ineq) = lambda.split_at(s.m_eq);
-    let nlp = s.nlp;
+    let (nlp, m_eq) = (s.nlp, s.m_eq);
+    // Split only when the values are asked: a structure call may pass no multipliers.
     answer(
         &s.hess,
         nele,
@@ -205,7 +205,10 @@ extern "C" fn eval_h(
         cols,
         values,
         &mut s.outside_structure,
-        || nlp.hessian(x, obj_factor, eq, ineq),
+        || {
+            let (eq, ineq) = lambda.split_at(m_eq);
+            nlp.hessian(x, obj_factor, eq, ineq)
+        },
     )
 }
 
