@@ -335,7 +335,7 @@ fn render(doc: &output::Plan, working: &str) -> String {
     );
     if let Some(p) = &doc.stats.passage_search {
         s += &format!(
-            "passage orders: {} conflict boxes ({} exact distances), {} search nodes, {}\n",
+            "passage orders: {} conflict boxes ({} exact distances), {} search nodes, {}{}\n",
             p.boxes,
             p.distances,
             p.nodes,
@@ -343,6 +343,11 @@ fn render(doc: &output::Plan, working: &str) -> String {
                 "the shortest schedule the boxes allow"
             } else {
                 "node budget reached: the best schedule found"
+            },
+            match p.reversed {
+                0 => String::new(),
+                1 => "; 1 tour runs the other way round".to_string(),
+                n => format!("; {n} tours run the other way round"),
             }
         );
     }

@@ -127,13 +127,15 @@ const BLOCKING_WEIGHT: f64 = 0.5;
 
 /// Per task and robot, the seconds `coordinated` says the robot's measurement there blocked
 /// the others, weighted (0 for pairs it did not see).
-fn blocking_penalty(cell: &Cell, outcome: &Outcome, coordinated: &Coordinated) -> Vec<Vec<f64>> {
+fn blocking_penalty(cell: &Cell, coordinated: &Coordinated) -> Vec<Vec<f64>> {
     let mut pen = vec![vec![0.0; cell.robots.len()]; cell.tasks.len()];
-    for (r, result) in outcome.robots.iter().enumerate() {
+    // The coordinated programs: their visits are those the blocking counts, in the order
+    // (the direction) coordination ran them.
+    for (r, program) in coordinated.programs.iter().enumerate() {
         let Some(block) = coordinated.blocking.get(r) else {
             continue;
         };
-        for (v, visit) in result.program.visits.iter().enumerate() {
+        for (v, visit) in program.visits.iter().enumerate() {
             pen[visit.task.0][r] = BLOCKING_WEIGHT * block.get(v).copied().unwrap_or(0.0);
         }
     }
@@ -162,7 +164,7 @@ pub fn coordinate(
     let lap = Instant::now();
     let first = coordinate_outcome(cell, table, &outcome, coord)?;
     let again = PlanSettings {
-        task_penalty: blocking_penalty(cell, &outcome, &first),
+        task_penalty: blocking_penalty(cell, &first),
         ..settings.clone()
     };
     let mut runs = vec![(outcome, settings, first)];

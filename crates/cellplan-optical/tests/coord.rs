@@ -166,12 +166,15 @@ fn robots_keep_more_than_the_coordination_distance_from_the_homes() {
     assert!(samples > 100);
 }
 
+/// `best` is no worse than the baselines, to its tie rule: a cycle within a millisecond with a
+/// smaller Δt counts as shorter (and `best` runs the fixed-priority competitor on the tours
+/// in their canonical directions, the baseline on the tours as planned).
 #[test]
 fn best_is_no_worse_than_the_baselines_here() {
     let cycle = |s: Coordination| document(s).0.cycle_time_s;
     let best = cycle(Coordination::Best);
     for s in [Coordination::DelayStartup, Coordination::FixedPriority] {
-        assert!(best <= cycle(s) + 1e-9, "best {best} vs {} {}", s, cycle(s));
+        assert!(best <= cycle(s) + 1e-3, "best {best} vs {} {}", s, cycle(s));
     }
 }
 
@@ -386,4 +389,132 @@ fn a_stop_splits_a_segment_on_the_same_joint_path() {
     let mut same = program.clone();
     assert!(!same.stop_at(timed, 0.5 * (arrive + depart), &limits).unwrap());
     assert_eq!(same, program);
+}
+
+/// A tour run the other way round is the same joint path backwards on the clock: at position
+/// `len − s` it is where the tour is at `s`, it takes as long, and reversing it twice gives
+/// the tour back.
+#[test]
+fn a_reversed_tour_is_the_same_path_backwards() {
+    let f = fixture();
+    let (_, none) = document(Coordination::None);
+    for (p, t) in none.programs.iter().zip(&none.timed) {
+        let limits = cellplan_core::plan::graph::limits_of(&f.cell.robots[p.robot]);
+        let back = p.reversed(&limits).unwrap();
+        assert_eq!(back.reversed(&limits).unwrap(), *p);
+        assert_eq!(
+            back.visits.iter().map(|v| v.task).collect::<Vec<_>>(),
+            p.visits.iter().rev().map(|v| v.task).collect::<Vec<_>>()
+        );
+        let tb = back.timed(&limits).unwrap();
+        let len = t.end();
+        assert!((tb.end() - len).abs() < 1e-9, "{} vs {len}", tb.end());
+        let mut s = 0.0;
+        while s <= len {
+            let (x, y) = (t.trajectory.position(s), tb.trajectory.position(len - s));
+            for (a, b) in x.iter().zip(&y) {
+                assert!((a - b).abs() < 1e-7, "at {s}: {x:?} vs {y:?}");
+            }
+            s += 0.01;
+        }
+    }
+}
+
+/// The diagram of a pair with one tour reversed is the pair's diagram mirrored along that
+/// robot's positions (what `best`'s choice of directions relies on): every pair of positions
+/// at which the reversed tour comes closer than the clearance to the other lies in a mirrored
+/// box, and the mirrored boxes are the boxes built for the reversed tour, to rounding.
+#[test]
+fn the_diagram_of_a_reversed_tour_is_the_mirrored_diagram() {
+    let f = fixture();
+    let (_, none) = document(Coordination::None);
+    let settings = coord::CoordSettings::default();
+    let boxes = coord::conflict_boxes(&f.cell, &f.table, &none.programs, &settings).unwrap();
+    let len = none.timed[1].end();
+    let mirrored: Vec<coord::ConflictBox> = boxes
+        .iter()
+        .map(|b| coord::ConflictBox {
+            b: (len - b.b.1, len - b.b.0),
+            open: [b.open[0], b.open[1], b.open[3], b.open[2]],
+            ..b.clone()
+        })
+        .collect();
+    let limits = cellplan_core::plan::graph::limits_of(&f.cell.robots[1]);
+    let programs = vec![
+        none.programs[0].clone(),
+        none.programs[1].reversed(&limits).unwrap(),
+    ];
+    let direct = coord::conflict_boxes(&f.cell, &f.table, &programs, &settings).unwrap();
+    let key = |b: &coord::ConflictBox| {
+        let r = |x: f64| (x * 1e6).round() as i64;
+        (r(b.a.0), r(b.a.1), r(b.b.0), r(b.b.1), b.open)
+    };
+    let mut x: Vec<_> = mirrored.iter().map(key).collect();
+    let mut y: Vec<_> = direct.iter().map(key).collect();
+    x.sort();
+    y.sort();
+    assert_eq!(x, y);
+    // And they cover every contact of the reversed tour.
+    let timed: Vec<_> = programs.iter().map(|p| p.timed(&limits).unwrap()).collect();
+    let margin = f.cell.planning.clearance + coord::REPLAY_SLACK;
+    let (ra, rb) = (&f.cell.robots[0], &f.cell.robots[1]);
+    let ta = &none.timed[0];
+    let tb = &timed[1];
+    let (mut sa_, mut sb_) = (Default::default(), Default::default());
+    let mut close = 0;
+    let mut sa = 0.0;
+    while sa <= ta.end() {
+        ra.body_poses(&ta.trajectory.position(sa), &mut sa_);
+        let mut sb = 0.0;
+        while sb <= tb.end() {
+            rb.body_poses(&tb.trajectory.position(sb), &mut sb_);
+            let d = f
+                .cell
+                .world
+                .group_group_distance(ra.group, &sa_.bodies, rb.group, &sb_.bodies, 1.0);
+            if d <= margin {
+                close += 1;
+                let inside = mirrored.iter().any(|x| {
+                    x.a.0 - 1e-9 <= sa && sa <= x.a.1 + 1e-9 && x.b.0 - 1e-9 <= sb && sb <= x.b.1 + 1e-9
+                });
+                assert!(inside, "({sa}, {sb}) at {d} m is in no mirrored box");
+            }
+            sb += 0.05;
+        }
+        sa += 0.05;
+    }
+    assert!(close > 0);
+}
+
+/// `best` chooses each tour's direction: given robot R2's tour the other way round, it ends
+/// at the same cycle time as from the tour as planned (directions count from a canonical one,
+/// not from the way the sequencer wrote the tour), and either plan verifies — with the tours,
+/// the tracks before coordination and the conflicts before it in the directions run.
+#[test]
+fn best_chooses_the_tour_directions() {
+    let f = fixture();
+    let settings = coord::CoordSettings::default();
+    let limits = cellplan_core::plan::graph::limits_of(&f.cell.robots[1]);
+    let mut turned = f.outcome.clone();
+    turned.robots[1].program = f.outcome.robots[1].program.reversed(&limits).unwrap();
+    let mut cycles = Vec::new();
+    for outcome in [&f.outcome, &turned] {
+        let c = coord::coordinate_outcome(&f.cell, &f.table, outcome, &settings).unwrap();
+        let doc = cellplan_core::document::build(&f.cell, &f.table, outcome, &c, &f.settings, 0.0, 0.0);
+        let report = verify(&f.cell, &doc, &VerifySettings::default());
+        assert!(report.ok, "{:#?}", report.violations);
+        // Reversed tours come only from the schedule (not from the fixed-priority
+        // competitor, nor when nothing conflicts), which the document then reports.
+        let flipped = c.reversed.iter().filter(|&&r| r).count();
+        assert_eq!(doc.stats.passage_search.map_or(0, |s| s.reversed), flipped);
+        // The tour run is the one given, or that one reversed.
+        let given: Vec<_> = outcome.robots[1].program.visits.iter().map(|v| v.task).collect();
+        let mut run: Vec<_> = c.programs[1].visits.iter().map(|v| v.task).collect();
+        if c.reversed.get(1).copied().unwrap_or(false) {
+            run.reverse();
+        }
+        assert_eq!(run, given);
+        cycles.push(doc.cycle_time_s);
+    }
+    assert!((cycles[0] - cycles[1]).abs() < 1e-9, "{cycles:?}");
 }

@@ -51,6 +51,7 @@ struct Piece {
 }
 
 /// A robot's path as positions: its program without waits on the clock.
+#[derive(Clone)]
 pub(crate) struct RobotPath {
     /// The robot (cell index).
     pub robot: usize,

@@ -19,7 +19,9 @@
 //!     diagram (`diagram`: boxes of positions along the two paths that cover every contact,
 //!     found by distance-bounded subdivision) and the order in which the two pass each box,
 //!     chosen by branch and bound for the shortest makespan (`schedule`; waits at any rest
-//!     before a box, a node budget, exact within it); then each wait cut as far as the exact
+//!     before a box, a node budget, exact within it), together with the direction each robot
+//!     runs its tour in (a tour is a cycle from home: either way it takes as long, but it
+//!     meets its neighbours at other times); then each wait cut as far as the exact
 //!     search on the clock allows. Where no order exists (a robot's home in another's way)
 //!     it falls back on prioritised resolution: every priority order (all up to 4 robots,
 //!     else a few), at each conflict the shortest wait or another measuring pose.
@@ -32,7 +34,7 @@ pub mod timeline;
 
 pub use diagram::ConflictBox;
 pub use ours::conflict_boxes;
-use ours::{baselines_if_shorter, best, rank_of, scheduled};
+use ours::{against_canonical, baselines_if_shorter, best, rank_of, scheduled};
 pub use program::{Activity, Program, Timed, VisitPose, Wait, WaitReason};
 pub use timeline::{Conflict, Scenario, Timeline};
 
@@ -156,6 +158,10 @@ pub struct Coordinated {
     /// Per robot, per visit (`best` only; else empty): seconds of the other robots' paths that
     /// conflict with the robot measuring there (see `diagram::blocking`).
     pub blocking: Vec<Vec<f64>>,
+    /// Per robot, whether coordination runs its tour the other way round (`best`; else
+    /// empty). The programs, `before` and the uncoordinated cycle are those of the tours in
+    /// the directions chosen.
+    pub reversed: Vec<bool>,
     /// Wall seconds.
     pub compute_s: f64,
 }
@@ -273,12 +279,47 @@ pub fn coordinate(
             (progs, res, priority)
         }
         Coordination::Best => {
+            // Tours in their canonical directions; `reversed` then says which run against the
+            // planned ones.
+            let against = against_canonical(&programs);
+            let programs: Vec<Program> = programs
+                .iter()
+                .zip(&against)
+                .map(|(p, &a)| {
+                    if a {
+                        p.reversed(&ctx.limits[p.robot])
+                    } else {
+                        Ok(p.clone())
+                    }
+                })
+                .collect::<Result<_, _>>()?;
             let first = match scheduled(&ctx, &programs)? {
                 Some(done) => done,
                 None => best(&ctx, programs.clone())?,
             };
-            baselines_if_shorter(&ctx, &programs, first, &cell_order)?
+            let (progs, mut res, priority) = baselines_if_shorter(&ctx, &programs, first, &cell_order)?;
+            res.reversed = (0..programs.len())
+                .map(|i| against[i] != res.reversed.get(i).copied().unwrap_or(false))
+                .collect();
+            if let Some(s) = &mut res.search {
+                s.reversed = res.reversed.iter().filter(|&&r| r).count();
+            }
+            (progs, res, priority)
         }
+    };
+    // Tours `best` runs the other way round: what they meet uncoordinated.
+    let before = if res.reversed.iter().any(|&r| r) {
+        let bare: Vec<Timed> = programs
+            .iter()
+            .map(|p| {
+                let mut p = p.clone();
+                p.waits.clear();
+                ctx.timed(&p)
+            })
+            .collect::<Result<_, _>>()?;
+        ctx.timeline(&bare).conflicts()
+    } else {
+        before
     };
     let timed: Vec<Timed> = programs.iter().map(|p| ctx.timed(p)).collect::<Result<_, _>>()?;
     // Whatever the strategy claims, the result is searched once more.
@@ -317,6 +358,7 @@ pub fn coordinate(
         uncoordinated_cycle,
         search: res.search,
         blocking: res.blocking,
+        reversed: res.reversed,
         compute_s: started.elapsed().as_secs_f64(),
     })
 }
@@ -345,6 +387,8 @@ pub(crate) struct Resolution {
     pub search: Option<crate::document::PassageSearch>,
     /// See [`Coordinated::blocking`].
     pub blocking: Vec<Vec<f64>>,
+    /// See [`Coordinated::reversed`] (empty: none).
+    pub reversed: Vec<bool>,
 }
 
 /// Most conflicts one strategy resolves before giving up (each resolution moves a conflict

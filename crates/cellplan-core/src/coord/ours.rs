@@ -101,21 +101,24 @@ pub(super) fn best(ctx: &Ctx, programs: Vec<Program>) -> Result<Resolved, PlanEr
 }
 
 /// Ours: the coordination diagram of every robot pair, and the passage orders through its
-/// conflict boxes with the shortest makespan (`schedule`); every wait at a rest. `None` when
-/// no order exists (then `best` falls back on prioritised resolution).
+/// conflict boxes with the shortest makespan (`schedule`); every wait at a rest; each robot's
+/// tour in the direction that goes with them ([`directions`]). `None` when no order exists
+/// (then `best` falls back on prioritised resolution).
 ///
 /// Waits are at rests only; when no order exists because a robot has no rest where it could let
 /// another pass (it must leave one box before the other robot has passed and reach the next
 /// before it has), the robots of an infeasible core of boxes get a stop in the middle of each
 /// stretch of path between two of the core's boxes that has none (the segment is split: the
 /// same joint path, one more stop), and the diagram is built again, up to [`STOP_ROUNDS`]
-/// times.
+/// times (the tours keep their planned directions then).
 pub(super) fn scheduled(ctx: &Ctx, programs: &[Program]) -> Result<Option<Resolved>, PlanError> {
     let mut programs = programs.to_vec();
     let mut round = 0;
     let mut parts = Vec::new();
     let mut distances = 0;
-    let (paths, boxes, s) = loop {
+    let mut searched = 0;
+    let m = programs.len();
+    loop {
         let paths: Vec<diagram::RobotPath> = programs
             .iter()
             .map(|p| diagram::RobotPath::new(ctx, p))
@@ -124,8 +127,51 @@ pub(super) fn scheduled(ctx: &Ctx, programs: &[Program]) -> Result<Option<Resolv
         distances += work.distances;
         let tracks: Vec<schedule::Track> = paths.iter().map(|p| p.track()).collect();
         let (nodes, min_wait) = (ctx.settings.schedule_nodes, ctx.settings.min_wait);
-        if let Some(s) = schedule::schedule(&tracks, &boxes, nodes, min_wait) {
-            break (paths, boxes, s);
+        let found = if round == 0 {
+            let (found, spent) = directions(ctx, &programs, &paths, &boxes)?;
+            searched += spent;
+            found
+        } else {
+            let s = schedule::schedule(&tracks, &boxes, nodes, min_wait);
+            searched += s.as_ref().map_or(nodes, |s| s.nodes);
+            s.map(|s| vec![(vec![false; m], s, boxes.clone())])
+                .unwrap_or_default()
+        };
+        // Each combination of directions found, finished (waits cut on the exact clock); the
+        // shortest cycle (then Δt) wins, ties to the earlier.
+        let mut kept: Option<((f64, f64), Resolved)> = None;
+        for (flip, s, boxes) in found {
+            let mut progs = Vec::with_capacity(m);
+            let mut ps = Vec::with_capacity(m);
+            for (i, (p, path)) in programs.iter().zip(&paths).enumerate() {
+                if flip[i] {
+                    let r = p.reversed(&ctx.limits[p.robot])?;
+                    ps.push(diagram::RobotPath::new(ctx, &r)?);
+                    progs.push(r);
+                } else {
+                    progs.push(p.clone());
+                    ps.push(path.clone());
+                }
+            }
+            let search = crate::document::PassageSearch {
+                boxes: boxes.len(),
+                distances,
+                nodes: searched,
+                proven: s.proven,
+                reversed: flip.iter().filter(|&&r| r).count(),
+            };
+            let done = finish(ctx, progs, &ps, &boxes, &s, search, flip)?;
+            let timed: Vec<Timed> = done.0.iter().map(|p| ctx.timed(p)).collect::<Result<_, _>>()?;
+            let key = cycle_and_delta(&timed);
+            let shorter = kept
+                .as_ref()
+                .is_none_or(|(k, _)| key.0 < k.0 - 1e-3 || (key.0 <= k.0 + 1e-3 && key.1 < k.1 - 1e-3));
+            if shorter {
+                kept = Some((key, done));
+            }
+        }
+        if let Some((_, done)) = kept {
+            return Ok(Some(done));
         }
         if round == STOP_ROUNDS {
             return Ok(None);
@@ -138,7 +184,6 @@ pub(super) fn scheduled(ctx: &Ctx, programs: &[Program]) -> Result<Option<Resolv
             return Ok(None);
         }
         // The pairs of robots whose paths changed are built again.
-        let m = programs.len();
         let mut i = 0;
         for a in 0..m {
             for b in a + 1..m {
@@ -148,10 +193,22 @@ pub(super) fn scheduled(ctx: &Ctx, programs: &[Program]) -> Result<Option<Resolv
                 i += 1;
             }
         }
-    };
-    let mut out = programs;
+    }
+}
+
+/// The programs of `s` (a schedule of `paths` through `boxes`) with its waits, each cut as far
+/// as the exact search on the clock allows, and the counts.
+fn finish(
+    ctx: &Ctx,
+    mut out: Vec<Program>,
+    paths: &[diagram::RobotPath],
+    boxes: &[ConflictBox],
+    s: &schedule::Schedule,
+    search: crate::document::PassageSearch,
+    reversed: Vec<bool>,
+) -> Result<Resolved, PlanError> {
     let mut res = Resolution::default();
-    for ((prog, path), waits) in out.iter_mut().zip(&paths).zip(&s.waits) {
+    for ((prog, path), waits) in out.iter_mut().zip(paths).zip(&s.waits) {
         prog.waits.clear();
         for (rest, &(d, by)) in path.rests.iter().zip(waits) {
             if d > 0.0 {
@@ -162,25 +219,164 @@ pub(super) fn scheduled(ctx: &Ctx, programs: &[Program]) -> Result<Option<Resolv
                     reason: WaitReason::GiveWay,
                     for_robot: by,
                 });
-                res.waits += 1;
             }
         }
     }
     res.resolved = s.decisions;
-    res.blocking = diagram::blocking(&paths, &boxes);
-    res.search = Some(crate::document::PassageSearch {
-        boxes: boxes.len(),
-        distances,
-        nodes: s.nodes,
-        proven: s.proven,
-    });
+    res.blocking = diagram::blocking(paths, boxes);
+    res.search = Some(search);
+    res.reversed = reversed;
     debug_assert!({
         let timed: Vec<Timed> = out.iter().map(|p| ctx.timed(p)).collect::<Result<_, _>>()?;
         (cycle_and_delta(&timed).0 - s.makespan).abs() < 1e-6
     });
     shrink_waits(ctx, &mut out)?;
     res.waits = out.iter().map(|p| p.waits.len()).sum();
-    Ok(Some((out, res, Vec::new())))
+    Ok((out, res, Vec::new()))
+}
+
+/// Up to this many robots, [`directions`] tries every combination of tour directions;
+/// beyond, it flips one robot at a time.
+const ALL_DIRECTIONS_UP_TO: usize = 5;
+
+/// Rounds of single flips [`directions`] makes beyond [`ALL_DIRECTIONS_UP_TO`] robots.
+const FLIP_ROUNDS: usize = 2;
+
+/// How many of the best combinations of directions are finished (waits cut on the exact
+/// clock) and compared by the cycle they then give: the boxes are conservative, and the
+/// shortest schedule through them need not be the shortest once cut.
+const DIRECTIONS_FINISHED: usize = 2;
+
+/// A combination of tour directions (per robot, whether its tour runs the other way round),
+/// the schedule of passage orders found for it, and its (mirrored) boxes.
+type Directed = (Vec<bool>, schedule::Schedule, Vec<ConflictBox>);
+
+/// The directions each robot may run its tour in, chosen with the passage orders.
+///
+/// A robot's tour is a cycle from home to home: run the other way round it measures the same
+/// MPs on the same legs in the same time, but it is in the space it shares with a neighbour at
+/// other times. The diagram of a pair with one tour reversed is the pair's diagram mirrored
+/// along that robot's positions (`s ↦ len − s`: every segment is timed from rest to rest and
+/// takes as long either way), so the boxes are built once and each combination costs one
+/// search over passage orders. Reversing every robot is the same schedule run backwards in
+/// time, so the first robot keeps its direction. (`best` hands the tours over in their
+/// canonical directions, see [`against_canonical`].) Combinations are tried all (up
+/// to [`ALL_DIRECTIONS_UP_TO`] robots) or one flip at a time (a flip kept when it shortens the
+/// schedule, [`FLIP_ROUNDS`] rounds); ties go to fewer flips, then to the earlier combination.
+///
+/// Returns the [`DIRECTIONS_FINISHED`] best combinations by makespan (flips relative to
+/// `programs`; empty when no combination has a schedule) and the nodes searched.
+fn directions(
+    ctx: &Ctx,
+    programs: &[Program],
+    paths: &[diagram::RobotPath],
+    boxes: &[ConflictBox],
+) -> Result<(Vec<Directed>, usize), PlanError> {
+    let m = programs.len();
+    let (nodes, min_wait) = (ctx.settings.schedule_nodes, ctx.settings.min_wait);
+    let mut back: Vec<Option<diagram::RobotPath>> = (0..m).map(|_| None).collect();
+    let index: Vec<usize> = {
+        let mut v = vec![usize::MAX; paths.iter().map(|p| p.robot + 1).max().unwrap_or(0)];
+        for (i, p) in paths.iter().enumerate() {
+            v[p.robot] = i;
+        }
+        v
+    };
+    let mut spent = 0;
+    let mut try_turn = |flip: &[bool]| -> Result<Option<Directed>, PlanError> {
+        let flip = flip.to_vec();
+        for (i, &f) in flip.iter().enumerate() {
+            if f && back[i].is_none() {
+                let p = programs[i].reversed(&ctx.limits[programs[i].robot])?;
+                back[i] = Some(diagram::RobotPath::new(ctx, &p)?);
+            }
+        }
+        let mirrored: Vec<ConflictBox> = boxes
+            .iter()
+            .map(|b| {
+                let (ia, ib) = (index[b.robots.0], index[b.robots.1]);
+                let mut mb = b.clone();
+                if flip[ia] {
+                    mb.a = (paths[ia].len - b.a.1, paths[ia].len - b.a.0);
+                    mb.open.swap(0, 1);
+                }
+                if flip[ib] {
+                    mb.b = (paths[ib].len - b.b.1, paths[ib].len - b.b.0);
+                    mb.open.swap(2, 3);
+                }
+                mb
+            })
+            .collect();
+        let tracks: Vec<schedule::Track> = (0..m)
+            .map(|i| match (&back[i], flip[i]) {
+                (Some(p), true) => p.track(),
+                _ => paths[i].track(),
+            })
+            .collect();
+        let s = schedule::schedule(&tracks, &mirrored, nodes, min_wait);
+        spent += s.as_ref().map_or(nodes, |s| s.nodes);
+        Ok(s.map(|s| (flip, s, mirrored)))
+    };
+    let mut found: Vec<Directed> = Vec::new();
+    // Kept sorted by makespan (stable: ties stay in the order tried).
+    let keep = |d: Directed, found: &mut Vec<Directed>| {
+        let at = found.partition_point(|x| x.1.makespan <= d.1.makespan + 1e-3);
+        found.insert(at, d);
+        found.truncate(DIRECTIONS_FINISHED);
+    };
+    if m <= ALL_DIRECTIONS_UP_TO {
+        // By number of turns, then mask.
+        let mut masks: Vec<usize> = (0..1usize << m.saturating_sub(1)).collect();
+        masks.sort_by_key(|&k| (k.count_ones(), k));
+        for k in masks {
+            let turn: Vec<bool> = (0..m).map(|i| i > 0 && (k >> (i - 1)) & 1 == 1).collect();
+            if let Some(d) = try_turn(&turn)? {
+                keep(d, &mut found);
+            }
+        }
+    } else {
+        let mut turn = vec![false; m];
+        let mut now = try_turn(&turn)?.map(|d| {
+            let span = d.1.makespan;
+            keep(d, &mut found);
+            span
+        });
+        for _ in 0..FLIP_ROUNDS {
+            let mut changed = false;
+            for i in 1..m {
+                turn[i] = !turn[i];
+                match try_turn(&turn)? {
+                    Some(d) if now.is_none_or(|n| d.1.makespan < n - 1e-3) => {
+                        now = Some(d.1.makespan);
+                        keep(d, &mut found);
+                        changed = true;
+                    }
+                    Some(d) => {
+                        keep(d, &mut found);
+                        turn[i] = !turn[i];
+                    }
+                    None => turn[i] = !turn[i],
+                }
+            }
+            if !changed {
+                break;
+            }
+        }
+    }
+    Ok((found, spent))
+}
+
+/// Per program, whether it runs against its tour's canonical direction (the first MP after
+/// the last in the cell's order): `best` turns such tours round before it starts, so that what
+/// it finds does not depend on which way the sequencer happened to write a tour.
+pub(super) fn against_canonical(programs: &[Program]) -> Vec<bool> {
+    programs
+        .iter()
+        .map(|p| match (p.visits.first(), p.visits.last()) {
+            (Some(a), Some(b)) => a.task.0 > b.task.0,
+            _ => false,
+        })
+        .collect()
 }
 
 /// How many times `scheduled` adds stops before it gives up on passage orders.

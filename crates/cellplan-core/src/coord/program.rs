@@ -300,6 +300,29 @@ impl Program {
         Ok(true)
     }
 
+    /// The same tour the other way round: the visits in reverse order, each leg's joint path
+    /// reversed, no waits. Every segment is timed from rest to rest, which takes as long
+    /// either way, so the program's duration does not change.
+    pub fn reversed(&self, limits: &Limits) -> Result<Program, PlanError> {
+        let legs = self
+            .legs
+            .iter()
+            .rev()
+            .map(|l| {
+                let mut w = l.waypoints.clone();
+                w.reverse();
+                ProgramLeg::new(w, l.straight, limits)
+            })
+            .collect::<Result<_, _>>()?;
+        Ok(Program {
+            robot: self.robot,
+            home: self.home.clone(),
+            legs,
+            visits: self.visits.iter().rev().cloned().collect(),
+            waits: Vec::new(),
+        })
+    }
+
     /// The wait at a waypoint, if any.
     pub fn wait_at(&self, leg: usize, waypoint: usize) -> Option<&Wait> {
         self.waits.iter().find(|w| w.leg == leg && w.waypoint == waypoint)

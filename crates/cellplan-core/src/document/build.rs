@@ -205,7 +205,7 @@ fn coordination_out(cell: &Cell, outcome: &Outcome, coordinated: &Coordinated) -
             .iter()
             .map(|&r| cell.robots[r].name.clone())
             .collect(),
-        uncoordinated_probe: uncoordinated_probe(cell, outcome),
+        uncoordinated_probe: uncoordinated_probe(cell, outcome, &coordinated.reversed),
     }
 }
 
@@ -283,14 +283,22 @@ fn compute_times(
     compute
 }
 
-/// The probe tracks of the programs before coordination (see [`ProbeTrack`]).
-fn uncoordinated_probe(cell: &Cell, outcome: &Outcome) -> Vec<ProbeTrack> {
+/// The probe tracks of the programs before coordination (see [`ProbeTrack`]), each tour in
+/// the direction coordination chose (`reversed`, per robot; empty: as planned).
+fn uncoordinated_probe(cell: &Cell, outcome: &Outcome, reversed: &[bool]) -> Vec<ProbeTrack> {
     let round = |v: f64| (v * 1e4).round() / 1e4;
     cell.robots
         .iter()
         .zip(&outcome.robots)
-        .map(|(robot, res)| {
-            let xyz = match res.program.timed(&plan::graph::limits_of(robot)) {
+        .enumerate()
+        .map(|(r, (robot, res))| {
+            let limits = plan::graph::limits_of(robot);
+            let program = if reversed.get(r).copied().unwrap_or(false) {
+                res.program.reversed(&limits)
+            } else {
+                Ok(res.program.clone())
+            };
+            let xyz = match program.and_then(|p| p.timed(&limits)) {
                 Ok(timed) => {
                     let end = timed.trajectory.duration();
                     let steps = (end / PROBE_TRACK_DT).ceil() as usize;

@@ -394,11 +394,15 @@ pub struct PassageSearch {
     pub boxes: usize,
     /// Exact robot–robot distances the diagrams asked.
     pub distances: usize,
-    /// Nodes of the branch and bound.
+    /// Nodes of the branch and bound, over every combination of tour directions tried.
     pub nodes: usize,
-    /// Whether it ended within its node budget (the schedule is then the shortest the boxes
-    /// allow; else the best found).
+    /// Whether the search for the tour directions chosen ended within its node budget (the
+    /// schedule is then the shortest the boxes allow for them; else the best found).
     pub proven: bool,
+    /// Robots whose tours the search runs the other way round (the direction of each tour
+    /// is chosen with the passage orders).
+    #[serde(default)]
+    pub reversed: usize,
 }
 
 /// Wall-clock seconds per stage.
