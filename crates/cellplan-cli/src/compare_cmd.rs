@@ -258,7 +258,7 @@ fn html(report: &Report) -> String {
                     }
                     CompareRow {
                         cells,
-                        ours: r.allocation == "zones+feedback",
+                        ours: r.allocation == "ours",
                     }
                 })
                 .collect();
@@ -298,7 +298,7 @@ fn html(report: &Report) -> String {
                         f2(m.compute_mean_s),
                         f2(m.coordination_compute_mean_s),
                     ],
-                    ours: m.allocation == "zones+feedback",
+                    ours: m.allocation == "ours",
                 })
                 .collect();
             let bars = report
@@ -340,9 +340,10 @@ fn html(report: &Report) -> String {
 }
 
 /// Ours, whole, as `cellplan plan` decides it ([`pipeline::coordinate`]): `best` coordination
-/// of the zones allocation, planned again knowing what its measurements blocked the other
-/// robots, the shorter coordinated cycle kept (compute: the first zones planning and
-/// everything the pipeline did after it).
+/// of the zones allocation, of the zones allocation planned again knowing what its
+/// measurements blocked the other robots, and of the nearest-robot allocation, the shortest
+/// coordinated cycle kept (compute: the first zones planning and everything the pipeline did
+/// after it).
 fn ours(
     cell: &Cell,
     table: &CandidateTable,
@@ -351,7 +352,7 @@ fn ours(
     seed: u64,
 ) -> Row {
     let label = |row: Row| Row {
-        allocation: "zones+feedback".into(),
+        allocation: "ours".into(),
         ..row
     };
     let Some((outcome, settings, plan_s, mut cache)) = zones else {

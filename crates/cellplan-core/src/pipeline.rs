@@ -2,7 +2,8 @@
 //! planned legs, timing, coordination, the document and its verification — and the one place
 //! that decides what "ours" is: `best` coordination on the zones allocation, planned and
 //! coordinated twice (the second time each robot's time counts what its measurements blocked
-//! the others in the first), the shorter coordinated cycle kept.
+//! the others in the first), and on the nearest-robot allocation the zones start from; the
+//! shortest coordinated cycle kept.
 //! `cellplan compare` takes its "ours" row from here as well.
 use crate::candidates::{self, CandidateTable};
 use crate::check::{cap_error, graph_size_error, idle_robot_error};
@@ -19,10 +20,10 @@ pub enum Step {
     Candidates,
     /// A planning stage.
     Plan(Stage),
-    /// Coordination (with `zones_too` when ours plans and coordinates the zones allocation a
-    /// second time).
+    /// Coordination (with `zones_too` when ours plans and coordinates two more plans: the
+    /// zones allocation a second time, and the nearest-robot allocation).
     Coordination {
-        /// Whether the proximity allocation is coordinated too.
+        /// Whether ours' two more plans are made and coordinated too.
         zones_too: bool,
     },
     /// The verifier.
@@ -116,7 +117,8 @@ pub fn run<R>(
 }
 
 /// Whether ours runs: `best` on the zones allocation, which then plans and coordinates the
-/// zones allocation a second time, knowing what its measurements blocked the other robots.
+/// zones allocation a second time, knowing what its measurements blocked the other robots,
+/// and the nearest-robot allocation.
 pub fn ours_tries_zones(settings: &PlanSettings, coord: &CoordSettings) -> bool {
     coord.strategy == Coordination::Best && settings.allocation == Allocation::Zones
 }
@@ -145,8 +147,9 @@ fn blocking_penalty(cell: &Cell, coordinated: &Coordinated) -> Vec<Vec<f64>> {
 /// What `cellplan plan` runs: `outcome` (planned with `settings`) coordinated with `coord`.
 /// With `best` and the zones allocation (ours), the zones allocation is planned again with
 /// what the first plan's measurements blocked the other robots
-/// ([`PlanSettings::task_penalty`]) and coordinated too; the shorter coordinated cycle (then
-/// Δt, then the first) wins, with the coordination compute of both. Returns the winning run,
+/// ([`PlanSettings::task_penalty`]) and coordinated too, and so is the nearest-robot
+/// allocation; the shortest coordinated cycle (then Δt, then the earlier) wins, with the
+/// coordination compute of all. Returns the winning run,
 /// its settings and its coordination. `cache` holds what earlier runs on the cell planned (see
 /// [`plan::PlanCache`]).
 pub fn coordinate(
@@ -167,15 +170,38 @@ pub fn coordinate(
         task_penalty: blocking_penalty(cell, &first),
         ..settings.clone()
     };
+    // The nearest-robot allocation the zones start from, planned and coordinated as it is:
+    // where neighbours share much space, uneven but separate work can end sooner than
+    // balanced work that meets.
+    let nearest = PlanSettings {
+        allocation: plan::Allocation::Proximity,
+        task_penalty: Vec::new(),
+        ..settings.clone()
+    };
     let mut runs = vec![(outcome, settings, first)];
-    // Past the deadline the second try is skipped, and the plan says the clock cut it.
-    if again.deadline.is_some_and(|d| Instant::now() >= d) {
-        runs[0].0.time_limit_hit = true;
-    // A plan that fails the second time only loses the second try.
-    } else if let Ok(o) = plan::plan_cached(cell, table, &again, &|_| {}, cache)
-        && let Ok(c) = coordinate_outcome(cell, table, &o, coord)
-    {
-        runs.push((o, again, c));
+    for more in [again, nearest] {
+        // Past the deadline the other tries are skipped, and the plan says the clock cut it.
+        if more.deadline.is_some_and(|d| Instant::now() >= d) {
+            runs[0].0.time_limit_hit = true;
+            break;
+        }
+        // A plan that fails only loses its try.
+        let Ok(o) = plan::plan_cached(cell, table, &more, &|_| {}, cache) else {
+            continue;
+        };
+        // Coordination only adds waits: a plan whose robots end no sooner than the best cycle
+        // so far even without them cannot win, and is not coordinated.
+        let free = o.robots.iter().map(|r| r.program.duration()).fold(0.0, f64::max);
+        let so_far = runs
+            .iter()
+            .map(|r| cycle_and_delta(&r.2.timed).0)
+            .fold(f64::INFINITY, f64::min);
+        if free >= so_far {
+            continue;
+        }
+        if let Ok(c) = coordinate_outcome(cell, table, &o, coord) {
+            runs.push((o, more, c));
+        }
     }
     let spent = lap.elapsed().as_secs_f64();
     let key = |r: &(Outcome, PlanSettings, Coordinated)| cycle_and_delta(&r.2.timed);

@@ -518,3 +518,32 @@ fn best_chooses_the_tour_directions() {
     }
     assert!((cycles[0] - cycles[1]).abs() < 1e-9, "{cycles:?}");
 }
+
+/// Ours (`pipeline::coordinate` with `best` on the zones allocation) keeps the shortest of its
+/// plans: never longer than the zones plan coordinated alone, whichever of its plans wins (the
+/// zones again with the blocking penalties, or the nearest robots), and the plan verifies with
+/// the settings of the plan that won.
+#[test]
+fn ours_keeps_the_shortest_of_its_plans() {
+    use cellplan_core::plan::{self, Allocation, PlanCache, PlanSettings};
+    let f = fixture();
+    let coord_settings = coord::CoordSettings::default();
+    let zones = PlanSettings {
+        allocation: Allocation::Zones,
+        ..f.settings.clone()
+    };
+    let mut cache = PlanCache::default();
+    let outcome = plan::plan_cached(&f.cell, &f.table, &zones, &|_| {}, &mut cache).unwrap();
+    let alone = coord::coordinate_outcome(&f.cell, &f.table, &outcome, &coord_settings).unwrap();
+    let (o, s, c) =
+        cellplan_core::pipeline::coordinate(&f.cell, &f.table, outcome, zones, &coord_settings, &mut cache)
+            .unwrap();
+    assert!(matches!(s.allocation, Allocation::Zones | Allocation::Proximity));
+    if s.allocation == Allocation::Proximity {
+        assert!(s.task_penalty.is_empty());
+    }
+    let doc = cellplan_core::document::build(&f.cell, &f.table, &o, &c, &s, 0.0, 0.0);
+    let report = verify(&f.cell, &doc, &VerifySettings::default());
+    assert!(report.ok, "{:#?}", report.violations);
+    assert!(doc.cycle_time_s <= coord::cycle_and_delta(&alone.timed).0 + 1e-9);
+}

@@ -315,5 +315,5 @@ fn compare_writes_its_table_and_bar_chart_as_html() {
     // A bar per robot of every solved strategy (one robot here), a table row per strategy.
     assert_eq!(page.matches("class=\"bar\"").count(), solved);
     assert_eq!(page.matches("<tr><td").count(), rows.len());
-    assert!(page.contains("<b>zones+feedback + best</b>"));
+    assert!(page.contains("<b>ours + best</b>"));
 }
