@@ -303,18 +303,22 @@ impl PairDiagram<'_> {
     /// The body pairs of the two placed robots whose sphere covers (body spheres first) come
     /// within `need`: every other pair is farther than `need` (the covers hold the meshes).
     fn close_pairs(&self, xa: &Placed, xb: &Placed, need: f64) -> Vec<(usize, usize)> {
+        // Squared distances against squared reaches (all terms are non-negative): no square
+        // root per sphere pair.
+        let within = |c: DVec3, r: f64, d: DVec3, q: f64| {
+            let reach = need + r + q;
+            (c - d).length_squared() <= reach * reach
+        };
         let mut out = Vec::new();
         for (i, (ca, ra)) in xa.spheres.iter().enumerate() {
             for (j, (cb, rb)) in xb.spheres.iter().enumerate() {
-                if (*ca - *cb).length() - ra - rb > need {
+                if !within(*ca, *ra, *cb, *rb) {
                     continue;
                 }
                 let (bi, bj) = (xa.bodies[i], xb.bodies[j]);
-                let close = xa.covers[bi].iter().any(|(c, r)| {
-                    xb.covers[bj]
-                        .iter()
-                        .any(|(d, q)| (*c - *d).length() - r - q <= need)
-                });
+                let close = xa.covers[bi]
+                    .iter()
+                    .any(|(c, r)| xb.covers[bj].iter().any(|(d, q)| within(*c, *r, *d, *q)));
                 if close {
                     out.push((bi, bj));
                 }
