@@ -72,6 +72,36 @@ fn every_strategy_gives_a_verified_conflict_free_plan() {
     }
 }
 
+/// The pairs of positions (every 50 ms of each program: `ta` of R1, `tb` of R2 of the
+/// crossing cell) at which the two robots come closer than the coordination's distance, with
+/// that distance.
+fn contacts(ta: &coord::Timed, tb: &coord::Timed) -> Vec<(f64, f64, f64)> {
+    let f = fixture();
+    let margin = f.cell.planning.clearance + coord::REPLAY_SLACK;
+    let (ra, rb) = (&f.cell.robots[0], &f.cell.robots[1]);
+    let (mut sa_, mut sb_) = (Default::default(), Default::default());
+    let mut out = Vec::new();
+    let step = 0.05;
+    let mut sa = 0.0;
+    while sa <= ta.end() {
+        ra.body_poses(&ta.trajectory.position(sa), &mut sa_);
+        let mut sb = 0.0;
+        while sb <= tb.end() {
+            rb.body_poses(&tb.trajectory.position(sb), &mut sb_);
+            let d = f
+                .cell
+                .world
+                .group_group_distance(ra.group, &sa_.bodies, rb.group, &sb_.bodies, 1.0);
+            if d <= margin {
+                out.push((sa, sb, d));
+            }
+            sb += step;
+        }
+        sa += step;
+    }
+    out
+}
+
 /// The coordination diagram misses no contact: on a grid of position pairs (every 50 ms of
 /// each program) every pair of configurations closer than the clearance lies in a box of that
 /// robot pair, and so does every conflict the search on the clock found (both robots at the
@@ -95,31 +125,12 @@ fn the_coordination_diagram_covers_every_contact() {
     for c in &none.after {
         assert!(inside(c.robots.0, c.robots.1, c.start, c.start), "{c:?}");
     }
-    let margin = f.cell.planning.clearance + coord::REPLAY_SLACK;
-    let (ra, rb) = (&f.cell.robots[0], &f.cell.robots[1]);
     let (ta, tb) = (&none.timed[0], &none.timed[1]);
-    let (mut sa_, mut sb_) = (Default::default(), Default::default());
-    let mut close = 0;
-    let step = 0.05;
-    let mut sa = 0.0;
-    while sa <= ta.end() {
-        ra.body_poses(&ta.trajectory.position(sa), &mut sa_);
-        let mut sb = 0.0;
-        while sb <= tb.end() {
-            rb.body_poses(&tb.trajectory.position(sb), &mut sb_);
-            let d = f
-                .cell
-                .world
-                .group_group_distance(ra.group, &sa_.bodies, rb.group, &sb_.bodies, 1.0);
-            if d <= margin {
-                close += 1;
-                assert!(inside(0, 1, sa, sb), "({sa}, {sb}) at {d} m is in no box");
-            }
-            sb += step;
-        }
-        sa += step;
+    let close = contacts(ta, tb);
+    for &(sa, sb, d) in &close {
+        assert!(inside(0, 1, sa, sb), "({sa}, {sb}) at {d} m is in no box");
     }
-    assert!(close > 0);
+    assert!(!close.is_empty());
     let area: f64 = boxes.iter().map(|x| (x.a.1 - x.a.0) * (x.b.1 - x.b.0)).sum();
     assert!(area < 0.5 * ta.end() * tb.end(), "{area}");
 }
@@ -455,35 +466,14 @@ fn the_diagram_of_a_reversed_tour_is_the_mirrored_diagram() {
     y.sort();
     assert_eq!(x, y);
     // And they cover every contact of the reversed tour.
-    let timed: Vec<_> = programs.iter().map(|p| p.timed(&limits).unwrap()).collect();
-    let margin = f.cell.planning.clearance + coord::REPLAY_SLACK;
-    let (ra, rb) = (&f.cell.robots[0], &f.cell.robots[1]);
-    let ta = &none.timed[0];
-    let tb = &timed[1];
-    let (mut sa_, mut sb_) = (Default::default(), Default::default());
-    let mut close = 0;
-    let mut sa = 0.0;
-    while sa <= ta.end() {
-        ra.body_poses(&ta.trajectory.position(sa), &mut sa_);
-        let mut sb = 0.0;
-        while sb <= tb.end() {
-            rb.body_poses(&tb.trajectory.position(sb), &mut sb_);
-            let d = f
-                .cell
-                .world
-                .group_group_distance(ra.group, &sa_.bodies, rb.group, &sb_.bodies, 1.0);
-            if d <= margin {
-                close += 1;
-                let inside = mirrored.iter().any(|x| {
-                    x.a.0 - 1e-9 <= sa && sa <= x.a.1 + 1e-9 && x.b.0 - 1e-9 <= sb && sb <= x.b.1 + 1e-9
-                });
-                assert!(inside, "({sa}, {sb}) at {d} m is in no mirrored box");
-            }
-            sb += 0.05;
-        }
-        sa += 0.05;
+    let close = contacts(&none.timed[0], &programs[1].timed(&limits).unwrap());
+    for &(sa, sb, d) in &close {
+        let inside = mirrored
+            .iter()
+            .any(|x| x.a.0 - 1e-9 <= sa && sa <= x.a.1 + 1e-9 && x.b.0 - 1e-9 <= sb && sb <= x.b.1 + 1e-9);
+        assert!(inside, "({sa}, {sb}) at {d} m is in no mirrored box");
     }
-    assert!(close > 0);
+    assert!(!close.is_empty());
 }
 
 /// `best` chooses each tour's direction: given robot R2's tour the other way round, it ends
