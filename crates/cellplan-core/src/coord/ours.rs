@@ -127,15 +127,16 @@ pub(super) fn scheduled(ctx: &Ctx, programs: &[Program]) -> Result<Option<Resolv
         distances += work.distances;
         let tracks: Vec<schedule::Track> = paths.iter().map(|p| p.track()).collect();
         let (nodes, min_wait) = (ctx.settings.schedule_nodes, ctx.settings.min_wait);
-        let found = if round == 0 {
-            let (found, spent) = directions(ctx, &programs, &paths, &boxes)?;
+        // The reversed programs and their paths `directions` made (none after round 0).
+        let (found, back) = if round == 0 {
+            let (found, back, spent) = directions(ctx, &programs, &paths, &boxes)?;
             searched += spent;
-            found
+            (found, back)
         } else {
             let s = schedule::schedule(&tracks, &boxes, nodes, min_wait);
             searched += s.as_ref().map_or(nodes, |s| s.nodes);
-            s.map(|s| vec![(vec![false; m], s, boxes.clone())])
-                .unwrap_or_default()
+            let found = s.map(|s| vec![(vec![false; m], s, boxes.clone())]);
+            (found.unwrap_or_default(), Vec::new())
         };
         // Each combination of directions found, finished (waits cut on the exact clock); the
         // shortest cycle (then Δt) wins, ties to the earlier.
@@ -144,13 +145,15 @@ pub(super) fn scheduled(ctx: &Ctx, programs: &[Program]) -> Result<Option<Resolv
             let mut progs = Vec::with_capacity(m);
             let mut ps = Vec::with_capacity(m);
             for (i, (p, path)) in programs.iter().zip(&paths).enumerate() {
-                if flip[i] {
-                    let r = p.reversed(&ctx.limits[p.robot])?;
-                    ps.push(diagram::RobotPath::new(ctx, &r)?);
-                    progs.push(r);
-                } else {
-                    progs.push(p.clone());
-                    ps.push(path.clone());
+                match back.get(i) {
+                    Some(Some((r, rpath))) if flip[i] => {
+                        progs.push(r.clone());
+                        ps.push(rpath.clone());
+                    }
+                    _ => {
+                        progs.push(p.clone());
+                        ps.push(path.clone());
+                    }
                 }
             }
             let search = crate::document::PassageSearch {
@@ -265,16 +268,18 @@ type Directed = (Vec<bool>, schedule::Schedule, Vec<ConflictBox>);
 /// schedule, [`FLIP_ROUNDS`] rounds); ties go to fewer flips, then to the earlier combination.
 ///
 /// Returns the [`DIRECTIONS_FINISHED`] best combinations by makespan (flips relative to
-/// `programs`; empty when no combination has a schedule) and the nodes searched.
+/// `programs`; empty when no combination has a schedule), per robot its reversed program and
+/// path (made for every robot some combination reversed), and the nodes searched.
+#[allow(clippy::type_complexity)]
 fn directions(
     ctx: &Ctx,
     programs: &[Program],
     paths: &[diagram::RobotPath],
     boxes: &[ConflictBox],
-) -> Result<(Vec<Directed>, usize), PlanError> {
+) -> Result<(Vec<Directed>, Vec<Option<(Program, diagram::RobotPath)>>, usize), PlanError> {
     let m = programs.len();
     let (nodes, min_wait) = (ctx.settings.schedule_nodes, ctx.settings.min_wait);
-    let mut back: Vec<Option<diagram::RobotPath>> = (0..m).map(|_| None).collect();
+    let mut back: Vec<Option<(Program, diagram::RobotPath)>> = (0..m).map(|_| None).collect();
     let index: Vec<usize> = {
         let mut v = vec![usize::MAX; paths.iter().map(|p| p.robot + 1).max().unwrap_or(0)];
         for (i, p) in paths.iter().enumerate() {
@@ -288,7 +293,8 @@ fn directions(
         for (i, &f) in flip.iter().enumerate() {
             if f && back[i].is_none() {
                 let p = programs[i].reversed(&ctx.limits[programs[i].robot])?;
-                back[i] = Some(diagram::RobotPath::new(ctx, &p)?);
+                let path = diagram::RobotPath::new(ctx, &p)?;
+                back[i] = Some((p, path));
             }
         }
         let mirrored: Vec<ConflictBox> = boxes
@@ -309,7 +315,7 @@ fn directions(
             .collect();
         let tracks: Vec<schedule::Track> = (0..m)
             .map(|i| match (&back[i], flip[i]) {
-                (Some(p), true) => p.track(),
+                (Some((_, p)), true) => p.track(),
                 _ => paths[i].track(),
             })
             .collect();
@@ -363,7 +369,7 @@ fn directions(
             }
         }
     }
-    Ok((found, spent))
+    Ok((found, back, spent))
 }
 
 /// Per program, whether it runs against its tour's canonical direction (the first MP after
