@@ -14,6 +14,7 @@ use crate::problem::CostMatrix;
 
 pub use crate::error::{MinMaxError, RoutesError, VehicleError};
 
+mod bound;
 mod construct;
 mod generate;
 mod ils;
@@ -21,6 +22,7 @@ mod route;
 #[cfg(test)]
 mod tests;
 
+pub use bound::lower_bound;
 pub use generate::generate;
 
 /// One vehicle (robot).
@@ -368,63 +370,4 @@ pub(crate) fn violation(p: &MinMaxProblem, times: &[f64]) -> f64 {
             (hi - lo - g).max(0.0)
         }
     }
-}
-
-/// A lower bound of the makespan of every solution of `p` (ignoring the balance limit).
-///
-/// Every task is entered once, by an arc into one of its nodes from a node of another task or
-/// the depot, and then served; every route that does something ends with an arc home. So a
-/// vehicle's route time is at least the sum, over the tasks only it can do, of their service
-/// and cheapest entry (plus its cheapest return), and the longest route is at least the
-/// average of the total, where each task counts its cheapest entry over the vehicles able to
-/// do it. The bound is the larger of the two.
-pub fn lower_bound(p: &MinMaxProblem) -> f64 {
-    let m = p.vehicles.len();
-    if m == 0 || p.tasks == 0 {
-        return 0.0;
-    }
-    // entry[v][t]: the cheapest arc into a node of t from outside t's nodes, for vehicle v.
-    let mut entry = vec![vec![f64::INFINITY; p.tasks]; m];
-    let mut ret = vec![f64::INFINITY; m];
-    for (v, veh) in p.vehicles.iter().enumerate() {
-        let n = veh.costs.n();
-        let mut owner = vec![usize::MAX; n];
-        for (t, alts) in veh.alternatives.iter().enumerate() {
-            for &a in alts {
-                owner[a] = t;
-            }
-        }
-        // Nodes that can precede a task: the depot and every node of some task.
-        let sources: Vec<usize> = (0..n)
-            .filter(|&u| u == veh.depot || owner[u] != usize::MAX)
-            .collect();
-        for (t, alts) in veh.alternatives.iter().enumerate() {
-            for &a in alts {
-                for &u in &sources {
-                    if owner[u] != t {
-                        entry[v][t] = entry[v][t].min(veh.costs.get(u, a));
-                    }
-                }
-                ret[v] = ret[v].min(veh.costs.get(a, veh.depot));
-            }
-        }
-    }
-    let mut best: f64 = 0.0;
-    let mut total = 0.0;
-    for (t, service) in p.service.iter().enumerate() {
-        let who = p.capable(t);
-        let cheapest = who.iter().map(|&v| entry[v][t]).fold(f64::INFINITY, f64::min);
-        total += service + cheapest;
-    }
-    total += (0..m).map(|v| ret[v]).fold(f64::INFINITY, f64::min);
-    best = best.max(total / m as f64);
-    for v in 0..m {
-        let own: Vec<usize> = (0..p.tasks).filter(|&t| p.capable(t) == [v]).collect();
-        if own.is_empty() {
-            continue;
-        }
-        let mine: f64 = own.iter().map(|&t| p.service[t] + entry[v][t]).sum::<f64>() + ret[v];
-        best = best.max(mine);
-    }
-    best
 }

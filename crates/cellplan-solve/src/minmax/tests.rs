@@ -274,6 +274,26 @@ fn lower_bound_is_below_every_solution_and_tight_on_one_task() {
 }
 
 #[test]
+fn lower_bound_is_below_the_optimum_of_small_problems() {
+    let mut closest: f64 = 0.0;
+    for seed in 0..40 {
+        let mut p = generate(2, 1 + seed as usize % 6, (1, 2), seed);
+        if seed % 3 == 0 {
+            p = tight(p);
+        }
+        let lb = lower_bound(&p);
+        let opt = brute_force(&p);
+        assert!(
+            lb > 0.0 && lb <= opt + 1e-9,
+            "seed {seed}: bound {lb} above the optimum {opt}"
+        );
+        closest = closest.max(lb / opt);
+    }
+    // Not vacuous: on some instance the bound comes within a fifth of the optimum.
+    assert!(closest > 0.8, "best bound/optimum {closest}");
+}
+
+#[test]
 fn assignment_within_caps_moves_tasks_along_augmenting_paths() {
     // Task 0 either vehicle, task 1 only vehicle 0: task 0 must move to vehicle 1.
     let can = |v: usize, t: usize| t == 0 || v == 0;

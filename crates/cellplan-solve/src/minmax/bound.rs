@@ -1,0 +1,333 @@
+//! Lower bounds of the makespan of a [`MinMaxProblem`], each a proof: no solution, whatever its
+//! allocation, orders and nodes, ends sooner.
+//!
+//! Say `k` vehicles do something. Their routes are `k` cycles through the depot that visit
+//! every task once, so their times add up to the service of every task plus the legs, and the
+//! longest is at least the `k`-th of that sum. Two bounds of the legs follow:
+//!
+//! - **Entries** ([`entry_bound`]): every task is entered once; the `k` tasks entered first are
+//!   entered from the depot and the `k` tasks left last are left for it, each `k` distinct.
+//! - **Trees** ([`tree_bound`], Held and Karp's bound carried to `k` routes): the routes, seen
+//!   as one graph on the tasks and the depot, are connected, have `n + k` edges, degree 2 at
+//!   every task and `2k` at the depot. Such a graph costs at least a spanning tree plus the `k`
+//!   cheapest further edges; with node prices `π` added to the edges at their ends and the
+//!   degrees' worth taken off again, every choice of `π` gives a bound, and a subgradient
+//!   ascent on `π` (a fixed number of steps: the result depends only on the problem) finds
+//!   good ones. A leg costs at least the cheaper direction between the two tasks over the
+//!   vehicles able to do both (no vehicle: no such leg).
+//!
+//! The bound is the largest of these (each the smallest over the numbers `k` of vehicles the
+//! caps allow) and of [`own_bound`]: a vehicle's route is at least the tasks only it can do.
+use super::MinMaxProblem;
+
+/// Most tasks for which [`tree_bound`] runs (its matrix holds `n²` numbers).
+const TREE_MAX_TASKS: usize = 4_000;
+
+/// Work budget of the subgradient ascent per number of vehicles, in edge evaluations (each
+/// step costs about `(n + 1)²`); at least [`TREE_MIN_STEPS`] and at most [`TREE_MAX_STEPS`]
+/// steps.
+const TREE_WORK: usize = 40_000_000;
+const TREE_MIN_STEPS: usize = 20;
+const TREE_MAX_STEPS: usize = 400;
+
+/// A lower bound of the makespan of every solution of `p` (ignoring the balance limit).
+pub fn lower_bound(p: &MinMaxProblem) -> f64 {
+    if p.vehicles.is_empty() || p.tasks == 0 {
+        return 0.0;
+    }
+    let legs = Legs::new(p);
+    let fewest = fewest_vehicles(p);
+    let most = p.vehicles.len().min(p.tasks);
+    let mut best = own_bound(p, &legs);
+    if fewest <= most {
+        let service: f64 = p.service.iter().sum();
+        let shared = (fewest..=most)
+            .map(|k| {
+                let trees = legs.tree.as_ref().map_or(0.0, |t| tree_bound(t, k));
+                let legs_k = entry_bound(p, &legs, k).max(trees);
+                (service + legs_k) / k as f64
+            })
+            .fold(f64::INFINITY, f64::min);
+        if shared.is_finite() {
+            best = best.max(shared);
+        }
+    }
+    best
+}
+
+/// The fewest vehicles whose caps hold every task.
+fn fewest_vehicles(p: &MinMaxProblem) -> usize {
+    let mut caps: Vec<usize> = p.vehicles.iter().map(|v| v.cap).collect();
+    caps.sort_unstable_by(|a, b| b.cmp(a));
+    let mut held = 0;
+    for (i, c) in caps.iter().enumerate() {
+        held += c;
+        if held >= p.tasks {
+            return i + 1;
+        }
+    }
+    usize::MAX
+}
+
+/// Per vehicle and task, the cheapest legs that can enter and leave the task's nodes, and the
+/// tasks' symmetric leg matrix for [`tree_bound`].
+struct Legs {
+    /// `from_task[v][t]`: the cheapest arc into a node of `t` from a node of another task.
+    from_task: Vec<Vec<f64>>,
+    /// `from_depot[v][t]`: the cheapest arc from the depot into a node of `t`.
+    from_depot: Vec<Vec<f64>>,
+    /// `home[v][t]`: the cheapest arc from a node of `t` to the depot.
+    home: Vec<Vec<f64>>,
+    /// Absent beyond [`TREE_MAX_TASKS`].
+    tree: Option<Tree>,
+}
+
+/// The tasks and the depot (node `n`) as one symmetric graph: an edge's cost is the cheapest leg
+/// between its ends, either way, over the vehicles able to do both (infinite when none is).
+struct Tree {
+    n: usize,
+    cost: Vec<f64>,
+}
+
+impl Tree {
+    fn get(&self, i: usize, j: usize) -> f64 {
+        self.cost[i * (self.n + 1) + j]
+    }
+}
+
+impl Legs {
+    fn new(p: &MinMaxProblem) -> Legs {
+        let (m, n) = (p.vehicles.len(), p.tasks);
+        let mut legs = Legs {
+            from_task: vec![vec![f64::INFINITY; n]; m],
+            from_depot: vec![vec![f64::INFINITY; n]; m],
+            home: vec![vec![f64::INFINITY; n]; m],
+            tree: (n <= TREE_MAX_TASKS).then(|| Tree {
+                n,
+                cost: vec![f64::INFINITY; (n + 1) * (n + 1)],
+            }),
+        };
+        for (v, veh) in p.vehicles.iter().enumerate() {
+            let tasks: Vec<usize> = (0..n).filter(|&t| p.can_do(v, t)).collect();
+            for &t in &tasks {
+                for &a in &veh.alternatives[t] {
+                    legs.from_depot[v][t] = legs.from_depot[v][t].min(veh.costs.get(veh.depot, a));
+                    legs.home[v][t] = legs.home[v][t].min(veh.costs.get(a, veh.depot));
+                }
+                for &s in &tasks {
+                    if s == t {
+                        continue;
+                    }
+                    let mut c = f64::INFINITY;
+                    for &u in &veh.alternatives[s] {
+                        for &a in &veh.alternatives[t] {
+                            c = c.min(veh.costs.get(u, a));
+                        }
+                    }
+                    legs.from_task[v][t] = legs.from_task[v][t].min(c);
+                    if let Some(tree) = &mut legs.tree {
+                        let w = n + 1;
+                        tree.cost[s * w + t] = tree.cost[s * w + t].min(c);
+                        tree.cost[t * w + s] = tree.cost[t * w + s].min(c);
+                    }
+                }
+                if let Some(tree) = &mut legs.tree {
+                    let w = n + 1;
+                    let c = legs.from_depot[v][t].min(legs.home[v][t]);
+                    tree.cost[n * w + t] = tree.cost[n * w + t].min(c);
+                    tree.cost[t * w + n] = tree.cost[t * w + n].min(c);
+                }
+            }
+        }
+        legs
+    }
+}
+
+/// Sum of the `k` smallest of `values`.
+fn smallest_sum(values: &[f64], k: usize) -> f64 {
+    let mut v = values.to_vec();
+    v.sort_by(f64::total_cmp);
+    v.iter().take(k).sum()
+}
+
+/// The legs of `k` routes by their entries: every task's cheapest entry (over the vehicles
+/// able to do it, from the depot or another task), the `k` smallest extra costs of entering a
+/// task from the depot instead, and the `k` smallest costs of going home from a task.
+fn entry_bound(p: &MinMaxProblem, legs: &Legs, k: usize) -> f64 {
+    let mut base = 0.0;
+    let mut extra = Vec::with_capacity(p.tasks);
+    let mut home = Vec::with_capacity(p.tasks);
+    for t in 0..p.tasks {
+        let who = p.capable(t);
+        let cheapest = |of: &[Vec<f64>]| who.iter().map(|&v| of[v][t]).fold(f64::INFINITY, f64::min);
+        let depot = cheapest(&legs.from_depot);
+        let entry = cheapest(&legs.from_task).min(depot);
+        base += entry;
+        extra.push(depot - entry);
+        home.push(cheapest(&legs.home));
+    }
+    base + smallest_sum(&extra, k) + smallest_sum(&home, k)
+}
+
+/// The legs of `k` routes by Held and Karp's trees (see the module).
+fn tree_bound(tree: &Tree, k: usize) -> f64 {
+    let n = tree.n;
+    let nodes = n + 1;
+    let want = |i: usize| if i == n { 2.0 * k as f64 } else { 2.0 };
+    let steps = (TREE_WORK / (nodes * nodes)).clamp(TREE_MIN_STEPS, TREE_MAX_STEPS);
+    let mut price = vec![0.0; nodes];
+    let mut last = vec![0.0; nodes];
+    let mut best = f64::NEG_INFINITY;
+    let mut step = 0.0;
+    let mut stale = 0;
+    for i in 0..steps {
+        let (value, degree) = priced_tree(tree, &price, k);
+        let value = value - (0..nodes).map(|j| want(j) * price[j]).sum::<f64>();
+        if !value.is_finite() {
+            return 0.0;
+        }
+        if value > best + 1e-12 {
+            best = value;
+            stale = 0;
+        } else {
+            stale += 1;
+        }
+        if i == 0 {
+            // First step: a hundredth of the average edge of the tree per unit of degree.
+            step = 0.01 * value.abs().max(1e-9) / nodes as f64;
+        } else if stale >= nodes.div_ceil(4).max(4) {
+            step *= 0.5;
+            stale = 0;
+        }
+        let g: Vec<f64> = (0..nodes).map(|j| degree[j] as f64 - want(j)).collect();
+        if g.iter().all(|x| *x == 0.0) {
+            break; // the tree is k routes: the bound is their cost
+        }
+        for ((p, g), l) in price.iter_mut().zip(&g).zip(&mut last) {
+            *p += step * (0.7 * g + 0.3 * *l);
+            *l = *g;
+        }
+    }
+    best.max(0.0)
+}
+
+/// The cheapest spanning tree plus `k` further edges (each edge at most twice among them) under
+/// `price`, and each node's degree in it. The value includes the prices on the edges.
+fn priced_tree(tree: &Tree, price: &[f64], k: usize) -> (f64, Vec<usize>) {
+    let nodes = tree.n + 1;
+    let c = |i: usize, j: usize| tree.get(i, j) + price[i] + price[j];
+    // Prim from the depot.
+    let mut inside = vec![false; nodes];
+    let mut near = vec![f64::INFINITY; nodes];
+    let mut parent = vec![usize::MAX; nodes];
+    let mut degree = vec![0usize; nodes];
+    let mut value = 0.0;
+    let root = tree.n;
+    near[root] = 0.0;
+    for _ in 0..nodes {
+        let mut pick = usize::MAX;
+        for j in 0..nodes {
+            if !inside[j] && (pick == usize::MAX || near[j] < near[pick]) {
+                pick = j;
+            }
+        }
+        if !near[pick].is_finite() {
+            return (f64::INFINITY, degree);
+        }
+        inside[pick] = true;
+        value += near[pick];
+        if parent[pick] != usize::MAX {
+            degree[pick] += 1;
+            degree[parent[pick]] += 1;
+        }
+        for j in 0..nodes {
+            if !inside[j] {
+                let w = c(pick, j);
+                if w < near[j] {
+                    near[j] = w;
+                    parent[j] = pick;
+                }
+            }
+        }
+    }
+    // The k cheapest further edges, each edge usable twice (a route of one task runs its depot
+    // edge both ways); ties to the lower pair of nodes.
+    let mut extra: Vec<(f64, usize, usize)> = Vec::with_capacity(k + 2);
+    for i in 0..nodes {
+        for j in (i + 1)..nodes {
+            let w = c(i, j);
+            if !w.is_finite() {
+                continue;
+            }
+            for _ in 0..2 {
+                if extra.len() < k || w < extra[extra.len() - 1].0 {
+                    let at = extra.partition_point(|e| e.0 <= w);
+                    extra.insert(at, (w, i, j));
+                    extra.truncate(k);
+                }
+            }
+        }
+    }
+    if extra.len() < k {
+        return (f64::INFINITY, degree);
+    }
+    for &(w, i, j) in &extra {
+        value += w;
+        degree[i] += 1;
+        degree[j] += 1;
+    }
+    (value, degree)
+}
+
+/// The bound of each vehicle alone: its route is at least the sum, over the tasks only it can
+/// do, of their service and cheapest entry (from the depot or another task), plus its cheapest
+/// way home (from any task it can do: the last need not be one of them).
+fn own_bound(p: &MinMaxProblem, legs: &Legs) -> f64 {
+    let mut best: f64 = 0.0;
+    for v in 0..p.vehicles.len() {
+        let own: Vec<usize> = (0..p.tasks).filter(|&t| p.capable(t) == [v]).collect();
+        if own.is_empty() {
+            continue;
+        }
+        let entries: f64 = own
+            .iter()
+            .map(|&t| p.service[t] + legs.from_task[v][t].min(legs.from_depot[v][t]))
+            .sum();
+        let home = legs.home[v].iter().copied().fold(f64::INFINITY, f64::min);
+        best = best.max(entries + home);
+    }
+    best
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::minmax::{MinMaxMethod, MinMaxParams, generate, solve};
+
+    #[test]
+    fn trees_bound_the_moves_tighter_than_entries_and_below_a_solution() {
+        let mut tighter = 0;
+        for seed in 0..5 {
+            let p = generate(3, 30, (1, 3), seed);
+            let legs = Legs::new(&p);
+            let tree = legs.tree.as_ref().expect("30 tasks have a tree");
+            let sol = solve(
+                &p,
+                &MinMaxParams {
+                    method: MinMaxMethod::Ils,
+                    seed,
+                    max_iterations: Some(30),
+                    ..MinMaxParams::default()
+                },
+            );
+            let service: f64 = p.service.iter().sum();
+            let moves: f64 = (0..3).map(|v| p.route_time(v, &sol.routes.tours[v])).sum::<f64>() - service;
+            let used = sol.routes.tours.iter().filter(|t| !t.is_empty()).count();
+            let trees = tree_bound(tree, used);
+            assert!(trees <= moves + 1e-9, "seed {seed}: trees {trees} above the solution's moves {moves}");
+            tighter += usize::from(trees > entry_bound(&p, &legs, used) + 1e-9);
+            assert!(lower_bound(&p) <= sol.makespan + 1e-9);
+        }
+        assert!(tighter >= 3, "the trees beat the entries on {tighter} of 5");
+    }
+}
