@@ -156,6 +156,7 @@ fn route(p: &Gtsp, method: Method, limit: Duration, seed: u64) -> Result<(f64, b
                 time_limit: limit,
                 seed,
                 max_iterations: None,
+                max_stall: None,
                 method: if method == Method::Ga {
                     gtsp::GtspMethod::Ga
                 } else {

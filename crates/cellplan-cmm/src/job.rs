@@ -263,6 +263,7 @@ fn tour_from_depot(costs: CostMatrix, s: &JobSettings) -> Vec<usize> {
         method: s.order,
         seed: s.mrnc.seed,
         max_iterations: Some(s.order_iterations),
+        max_stall: None,
         time_limit: Duration::from_secs(3600),
     };
     solve_gtsp(&tsp, &params)

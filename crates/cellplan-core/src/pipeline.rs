@@ -117,8 +117,7 @@ pub fn run<R>(
 }
 
 /// Whether ours runs: `best` on the zones allocation, which then plans and coordinates the
-/// zones allocation a second time, knowing what its measurements blocked the other robots,
-/// and the nearest-robot allocation.
+/// other plans of [`coordinate`].
 pub fn ours_tries_zones(settings: &PlanSettings, coord: &CoordSettings) -> bool {
     coord.strategy == Coordination::Best && settings.allocation == Allocation::Zones
 }
@@ -144,14 +143,61 @@ fn blocking_penalty(cell: &Cell, coordinated: &Coordinated) -> Vec<Vec<f64>> {
     pen
 }
 
+/// The line of the robots: the principal axis of their bases in the floor plane (`None` for
+/// fewer than two robots or bases on one spot).
+pub fn robot_line(cell: &Cell) -> Option<[f64; 2]> {
+    let bases: Vec<(f64, f64)> = cell
+        .robots
+        .iter()
+        .map(|r| (r.base.translation.x, r.base.translation.y))
+        .collect();
+    if bases.len() < 2 {
+        return None;
+    }
+    let n = bases.len() as f64;
+    let (mx, my) = bases
+        .iter()
+        .fold((0.0, 0.0), |(a, b), (x, y)| (a + x / n, b + y / n));
+    let (mut sxx, mut sxy, mut syy) = (0.0, 0.0, 0.0);
+    for (x, y) in &bases {
+        sxx += (x - mx) * (x - mx);
+        sxy += (x - mx) * (y - my);
+        syy += (y - my) * (y - my);
+    }
+    if sxx + syy <= 1e-12 {
+        return None;
+    }
+    // The eigenvector of the larger eigenvalue of the 2×2 scatter matrix.
+    let angle = 0.5 * (2.0 * sxy).atan2(sxx - syy);
+    Some([angle.cos(), angle.sin()])
+}
+
+/// Per task and robot, the seconds per task the robot's program in `o` took beyond its
+/// lower-bound time (its legs' real times over their lower bounds), spread over its tasks.
+fn slowness_penalty(cell: &Cell, o: &plan::Outcome) -> Vec<Vec<f64>> {
+    let per_task: Vec<f64> = o
+        .robots
+        .iter()
+        .zip(&o.graphs)
+        .map(|(r, g)| {
+            let bound = plan::sequence::order_cost(g, &Default::default(), &r.sequence.nodes);
+            (r.program.duration() - bound).max(0.0) / r.program.visits.len().max(1) as f64
+        })
+        .collect();
+    vec![per_task; cell.tasks.len()]
+}
+
 /// What `cellplan plan` runs: `outcome` (planned with `settings`) coordinated with `coord`.
-/// With `best` and the zones allocation (ours), the zones allocation is planned again with
-/// what the first plan's measurements blocked the other robots
-/// ([`PlanSettings::task_penalty`]) and coordinated too, and so is the nearest-robot
-/// allocation; the shortest coordinated cycle (then Δt, then the earlier) wins, with the
-/// coordination compute of all. Returns the winning run,
-/// its settings and its coordination. `cache` holds what earlier runs on the cell planned (see
-/// [`plan::PlanCache`]).
+/// With `best` and the zones allocation (ours), more plans are made and coordinated: the
+/// zones as strips across the line of the robots, each robot sweeping its strip
+/// ([`PlanSettings::sweep`]; where the robots have a line), and the strips once more with each
+/// robot's estimates raised by how much slower than their lower bounds its legs were
+/// ([`PlanSettings::task_penalty`]); the nearest-robot allocation; and the zones allocation
+/// again with what the first plan's measurements blocked the other robots. A plan whose robots
+/// end no sooner than the best cycle so far even uncoordinated is not coordinated. The shortest
+/// coordinated cycle (then Δt, then the earlier) wins, with the coordination compute of all.
+/// Returns the winning run, its settings and its coordination. `cache` holds what earlier runs
+/// on the cell planned (see [`plan::PlanCache`]).
 pub fn coordinate(
     cell: &Cell,
     table: &CandidateTable,
@@ -178,8 +224,23 @@ pub fn coordinate(
         task_penalty: Vec::new(),
         ..settings.clone()
     };
+    // Strips across the line of the robots, every robot sweeping its strip along the line
+    // (Åblad et al. separate the robots' workspaces; sweeping the same way keeps neighbours a
+    // strip apart, and coordination still chooses each tour's direction).
+    let sweep = robot_line(cell).map(|line| PlanSettings {
+        sweep: Some(line),
+        task_penalty: Vec::new(),
+        ..settings.clone()
+    });
     let mut runs = vec![(outcome, settings, first)];
-    for more in [again, nearest] {
+    // The strips first: where they pay, the others are then often beaten before coordination.
+    let mut tries: Vec<PlanSettings> = [sweep, Some(nearest), Some(again)]
+        .into_iter()
+        .flatten()
+        .collect();
+    let mut next = 0;
+    while let Some(more) = tries.get(next).cloned() {
+        next += 1;
         // Past the deadline the other tries are skipped, and the plan says the clock cut it.
         if more.deadline.is_some_and(|d| Instant::now() >= d) {
             runs[0].0.time_limit_hit = true;
@@ -189,6 +250,17 @@ pub fn coordinate(
         let Ok(o) = plan::plan_cached(cell, table, &more, &|_| {}, cache) else {
             continue;
         };
+        // The strips once more, each robot's estimates raised by what its legs took beyond
+        // their lower bounds in this plan.
+        if more.sweep.is_some() && more.task_penalty.is_empty() {
+            tries.insert(
+                next,
+                PlanSettings {
+                    task_penalty: slowness_penalty(cell, &o),
+                    ..more.clone()
+                },
+            );
+        }
         // Coordination only adds waits: a plan whose robots end no sooner than the best cycle
         // so far even without them cannot win, and is not coordinated.
         let free = o.robots.iter().map(|r| r.program.duration()).fold(0.0, f64::max);

@@ -186,7 +186,7 @@ fn zones_never_make_the_busiest_robot_busier_than_proximity() {
             .iter()
             .zip(&outcome.allocated.tasks)
             .map(|(g, tasks)| {
-                let order = plan::sequence::best_order(g, tasks, &Default::default(), 0);
+                let order = plan::sequence::best_order(g, tasks, &Default::default(), 0, &[]);
                 plan::sequence::order_cost(g, &Default::default(), &order)
             })
             .fold(0.0, f64::max);
@@ -203,4 +203,57 @@ fn zones_never_make_the_busiest_robot_busier_than_proximity() {
     let doc = build(&f.cell, &f.table, &outcome, &s);
     check_plan(&f.cell, &doc);
     verified(&f.cell, &doc);
+}
+
+#[test]
+fn strips_cut_the_mps_along_the_line_of_the_robots_and_each_robot_sweeps_its_strip() {
+    let cell = load(&small_cell(20), &LoadOptions::default()).unwrap();
+    let table = generate(&cell);
+    let line = cellplan_core::pipeline::robot_line(&cell).expect("two robots make a line");
+    let s = PlanSettings {
+        sweep: Some(line),
+        ..settings(Allocation::Zones)
+    };
+    let outcome = plan::plan(&cell, &table, &s, &|_| {}).unwrap();
+    let key = plan::sweep_keys(&cell, Some(line));
+    let place = |r: usize| {
+        let b = cell.robots[r].base.translation;
+        b.x * line[0] + b.y * line[1]
+    };
+    let mut robots: Vec<usize> = (0..cell.robots.len()).collect();
+    robots.sort_by(|&a, &b| place(a).total_cmp(&place(b)));
+    let tasks_of = |r: usize| -> Vec<usize> { outcome.allocated.tasks[r].iter().map(|t| t.0).collect() };
+    let shared = |t: usize| table.robots_for(TaskId(t)).len() == cell.robots.len();
+    for pair in robots.windows(2) {
+        let (a, b) = (tasks_of(pair[0]), tasks_of(pair[1]));
+        assert!(!a.is_empty() && !b.is_empty(), "every robot has a strip");
+        // Of the MPs both can measure, the first robot's all lie before the second's.
+        let last_a = a
+            .iter()
+            .filter(|&&t| shared(t))
+            .map(|&t| key[t])
+            .fold(f64::MIN, f64::max);
+        let first_b = b
+            .iter()
+            .filter(|&&t| shared(t))
+            .map(|&t| key[t])
+            .fold(f64::MAX, f64::min);
+        assert!(last_a <= first_b, "strips overlap: {last_a} > {first_b}");
+    }
+    // Each robot measures its strip in three groups of rising place, one after the other.
+    for (r, rr) in outcome.robots.iter().enumerate() {
+        let mut mine = tasks_of(r);
+        mine.sort_by(|&x, &y| key[x].total_cmp(&key[y]).then(x.cmp(&y)));
+        let group =
+            |t: usize| mine.iter().position(|&x| x == t).unwrap() * plan::sequence::SWEEP_GROUPS / mine.len();
+        let groups: Vec<usize> = rr.program.visits.iter().map(|v| group(v.task.0)).collect();
+        assert!(
+            groups.windows(2).all(|w| w[0] <= w[1]),
+            "robot {r} goes back: {groups:?}"
+        );
+    }
+    // The plan holds up.
+    let doc = build(&cell, &table, &outcome, &s);
+    check_plan(&cell, &doc);
+    verified(&cell, &doc);
 }

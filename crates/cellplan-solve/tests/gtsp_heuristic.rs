@@ -17,6 +17,7 @@ fn params(iters: usize, seed: u64) -> GtspParams {
         time_limit: Duration::from_secs(3600),
         seed,
         max_iterations: Some(iters),
+        max_stall: None,
         method: GtspMethod::Ils,
     }
 }
@@ -31,6 +32,29 @@ fn gtsp_berlin52_reaches_optimum() {
     assert_eq!(sol.cost, g.tour_cost(&sol.tour));
     assert_eq!(sol.iterations, 3000);
     assert_eq!(sol.cost, optima["berlin52"]);
+}
+
+#[test]
+fn gtsp_stops_after_kicks_that_do_not_improve() {
+    let inst = read_tsplib(bench("tsplib/berlin52.tsp")).unwrap();
+    let g = Gtsp::tsp(inst.costs);
+    let stalled = GtspParams {
+        max_stall: Some(20),
+        ..params(3000, 1)
+    };
+    let a = solve_gtsp(&g, &stalled);
+    g.check(&a.tour).unwrap();
+    // It stopped on the stall, well before the kick budget, and found no worse a tour than its
+    // own first 20 kicks would have...
+    assert!(
+        a.iterations >= 20 && a.iterations < 3000,
+        "{} kicks",
+        a.iterations
+    );
+    let first = solve_gtsp(&g, &params(20, 1));
+    assert!(a.cost <= first.cost);
+    // ... and, stopping on work done, it is deterministic.
+    assert_eq!(solve_gtsp(&g, &stalled), a);
 }
 
 #[test]

@@ -92,6 +92,9 @@ pub fn allocate(
     let mut tasks: Vec<Vec<TaskId>> = vec![Vec::new(); m];
     let mut local_sets = (0, 0);
     match settings.allocation {
+        Allocation::Zones if settings.sweep.is_some() => {
+            strips(cell, graphs, &capable, settings, &mut tasks)?;
+        }
         Allocation::Proximity | Allocation::Zones => {
             // Exclusive tasks first (they have no choice), then the shared ones.
             let mut order: Vec<usize> = (0..cell.tasks.len())
@@ -173,7 +176,7 @@ impl Tour {
     fn new(graph: &RobotGraph, tasks: &[TaskId], seed: u64) -> Tour {
         // Long tours get fewer kicks: the work per kick grows with the tour.
         let kicks = (ZONE_TOUR_WORK / (tasks.len() + 1)).clamp(20, ZONE_TOUR_ITERATIONS);
-        let nodes = super::sequence::best_order_with(graph, tasks, &Default::default(), seed, kicks);
+        let nodes = super::sequence::best_order_with(graph, tasks, &Default::default(), seed, kicks, &[]);
         let time = super::sequence::order_cost(graph, &Default::default(), &nodes);
         Tour { nodes, time }
     }
@@ -357,6 +360,177 @@ fn zones(
             tours[to] = Tour::new(&graphs[to], &tasks[to], seed);
         }
     }
+}
+
+/// [`Allocation::Zones`] along [`PlanSettings::sweep`]: strips across the line of the robots.
+/// The MPs sorted by their place along the line are cut into one run per robot, in the
+/// robots' order along it, so that the largest measuring time of a run is least (a dynamic
+/// programme, each run at most φ MPs; an MP its run's robot cannot measure counts twice, and
+/// goes to the robot of the nearest run that can). Then, while the busiest robot finishes sooner by giving the MP at
+/// an end of its run to the neighbour on that side (lower-bound tours, as the zones search
+/// edits them), it does: runs stay runs.
+fn strips(
+    cell: &Cell,
+    graphs: &[RobotGraph],
+    capable: &[Vec<usize>],
+    settings: &PlanSettings,
+    tasks: &mut [Vec<TaskId>],
+) -> Result<(), PlanError> {
+    let m = graphs.len();
+    let cap = cell.planning.task_cap;
+    let key = super::sweep_keys(cell, settings.sweep);
+    let [dx, dy] = settings.sweep.unwrap_or([1.0, 0.0]);
+    let place = |p: DVec3| p.x * dx + p.y * dy;
+    let mut robots: Vec<usize> = (0..m).collect();
+    robots.sort_by(|&a, &b| {
+        place(cell.robots[a].base.translation)
+            .total_cmp(&place(cell.robots[b].base.translation))
+            .then(a.cmp(&b))
+    });
+    let mut order: Vec<usize> = (0..cell.tasks.len())
+        .filter(|&t| !capable[t].is_empty())
+        .collect();
+    order.sort_by(|&a, &b| key[a].total_cmp(&key[b]).then(a.cmp(&b)));
+    let n = order.len();
+    // An MP the run's robot cannot measure weighs twice (it goes to a robot of a nearby run).
+    let dwell: Vec<f64> = order.iter().map(|&t| super::dwell(cell, TaskId(t))).collect();
+    // prefix[j][i]: the weight of order[..i] for robots[j].
+    let mut prefix = vec![vec![0.0; n + 1]; m];
+    for (j, &r) in robots.iter().enumerate() {
+        for (i, &t) in order.iter().enumerate() {
+            let w = if capable[t].contains(&r) {
+                dwell[i]
+            } else {
+                2.0 * dwell[i]
+            };
+            prefix[j][i + 1] = prefix[j][i] + w;
+        }
+    }
+    // best[j][b]: the least largest weight of runs of robots[..=j] covering order[..b], and
+    // where robots[j]'s run starts (the earliest on ties).
+    let mut best = vec![vec![(f64::INFINITY, 0usize); n + 1]; m];
+    for b in 0..=n.min(cap) {
+        best[0][b] = (prefix[0][b], 0);
+    }
+    for j in 1..m {
+        for b in 0..=n {
+            for a in b.saturating_sub(cap)..=b {
+                if !best[j - 1][a].0.is_finite() {
+                    continue;
+                }
+                let v = best[j - 1][a].0.max(prefix[j][b] - prefix[j][a]);
+                if v < best[j][b].0 {
+                    best[j][b] = (v, a);
+                }
+            }
+        }
+    }
+    if !best[m - 1][n].0.is_finite() {
+        // Cutting every φ MPs would fit: only caps below the MPs per robot get here.
+        return Err(cap_error(cell, order[n - 1], cap));
+    }
+    let mut run_of = vec![0usize; n];
+    let mut b = n;
+    for j in (0..m).rev() {
+        let a = if j == 0 { 0 } else { best[j][b].1 };
+        for slot in &mut run_of[a..b] {
+            *slot = j;
+        }
+        b = a;
+    }
+    for (i, &t) in order.iter().enumerate() {
+        let r = robots[run_of[i]];
+        if capable[t].contains(&r) {
+            tasks[r].push(TaskId(t));
+        }
+    }
+    for (i, &t) in order.iter().enumerate() {
+        if capable[t].contains(&robots[run_of[i]]) {
+            continue;
+        }
+        // The robot of the nearest run that can measure it and has room; then the fewer tasks.
+        let mut who: Vec<usize> = (0..m).filter(|&j| capable[t].contains(&robots[j])).collect();
+        who.sort_by_key(|&j| (j.abs_diff(run_of[i]), tasks[robots[j]].len(), j));
+        let r = who
+            .into_iter()
+            .map(|j| robots[j])
+            .find(|&r| tasks[r].len() < cap)
+            .ok_or_else(|| cap_error(cell, t, cap))?;
+        tasks[r].push(TaskId(t));
+    }
+    for list in tasks.iter_mut() {
+        list.sort();
+    }
+    // Balance the ends of the runs on the lower-bound tours and the task penalties.
+    let pen = |t: TaskId, r: usize| {
+        settings
+            .task_penalty
+            .get(t.0)
+            .and_then(|p| p.get(r))
+            .copied()
+            .unwrap_or(0.0)
+    };
+    let load = |r: usize, tasks: &[TaskId]| tasks.iter().map(|&t| pen(t, r)).sum::<f64>();
+    let seed = settings.seed;
+    let mut tours: Vec<Tour> = (0..m).map(|r| Tour::new(&graphs[r], &tasks[r], seed)).collect();
+    let mut since = 0;
+    let mut work = 0usize;
+    for _ in 0..4 * n {
+        if work > ZONE_SEARCH_WORK {
+            break;
+        }
+        let times: Vec<f64> = (0..m).map(|r| tours[r].time + load(r, &tasks[r])).collect();
+        // The busiest robot (the first on ties) gives an end of its run away, or nobody does.
+        let from = (0..m)
+            .max_by(|&a, &b| times[a].total_cmp(&times[b]).then(b.cmp(&a)))
+            .expect("robots");
+        let j = robots
+            .iter()
+            .position(|&r| r == from)
+            .expect("every robot has a place");
+        let by_key = |a: &TaskId, b: &TaskId| key[a.0].total_cmp(&key[b.0]).then(a.0.cmp(&b.0));
+        let ends = [
+            (j.checked_sub(1), tasks[from].iter().copied().min_by(by_key)),
+            (
+                (j + 1 < m).then_some(j + 1),
+                tasks[from].iter().copied().max_by(by_key),
+            ),
+        ];
+        let mut pick = None;
+        for (side, t) in ends {
+            let (Some(side), Some(t)) = (side, t) else {
+                continue;
+            };
+            let to = robots[side];
+            if !capable[t.0].contains(&to) || tasks[to].len() >= cap {
+                continue;
+            }
+            work +=
+                (tours[to].nodes.len() + 1) * graphs[to].alternatives[t.0].len() + tours[from].nodes.len();
+            let gone = tours[from].without(&graphs[from], t) + load(from, &tasks[from]) - pen(t, from);
+            let came = tours[to].with(&graphs[to], t) + load(to, &tasks[to]) + pen(t, to);
+            // Only while it lowers the larger of the two robots' times.
+            if came.max(gone) < times[from].max(times[to]) - 1e-6 {
+                pick = Some((from, to, t));
+                break;
+            }
+        }
+        let Some((from, to, t)) = pick else {
+            break;
+        };
+        tasks[from].retain(|&x| x != t);
+        tasks[to].push(t);
+        tasks[to].sort();
+        tours[from].remove(&graphs[from], t);
+        tours[to].insert(&graphs[to], t);
+        since += 1;
+        if since >= ZONE_REOPTIMISE_EVERY {
+            since = 0;
+            tours[from] = Tour::new(&graphs[from], &tasks[from], seed);
+            tours[to] = Tour::new(&graphs[to], &tasks[to], seed);
+        }
+    }
+    Ok(())
 }
 
 fn cap_error(cell: &Cell, t: usize, cap: usize) -> PlanError {

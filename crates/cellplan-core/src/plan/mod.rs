@@ -75,6 +75,13 @@ pub struct PlanSettings {
     /// (empty: none): what its measurement there cost the other robots in an earlier
     /// coordination (see [`crate::coord::Coordinated::blocking`]).
     pub task_penalty: Vec<Vec<f64>>,
+    /// A direction in the floor plane (unit `[x, y]`) along which the robots stand (`None`:
+    /// none). With it, the zones allocation draws strips across it instead (see
+    /// [`allocate`]), and each robot's order visits its tasks in [`sequence::SWEEP_GROUPS`]
+    /// groups of rising place along it, one group after the other, wherever some order can
+    /// (see [`sequence::best_order`]): every robot sweeping the same way, neighbours stay
+    /// about a strip apart.
+    pub sweep: Option<[f64; 2]>,
 }
 
 impl PlanSettings {
@@ -116,6 +123,7 @@ impl Default for PlanSettings {
             roadmap: true,
             sample_dt: 0.02,
             task_penalty: Vec::new(),
+            sweep: None,
             deadline: None,
         }
     }
@@ -332,6 +340,18 @@ pub fn plan(
     progress: &(dyn Fn(Stage) + Sync),
 ) -> Result<Outcome, PlanError> {
     plan_cached(cell, table, settings, progress, &mut PlanCache::default())
+}
+
+/// Each task's place along `sweep` (its position projected on the direction), or none.
+pub fn sweep_keys(cell: &Cell, sweep: Option<[f64; 2]>) -> Vec<f64> {
+    match sweep {
+        None => Vec::new(),
+        Some([x, y]) => cell
+            .tasks
+            .iter()
+            .map(|t| t.position.x * x + t.position.y * y)
+            .collect(),
+    }
 }
 
 /// What runs of [`plan_cached`] on one cell share: the robot graphs (they depend on the cell,
@@ -615,8 +635,13 @@ fn sequence_all(
             .zip(tasks)
             .zip(planned.par_iter())
             .map(|(((robot, graph), tasks), planned)| {
-                let order =
-                    sequence::best_order(graph, tasks, planned, sequence::order_seed(settings, robot));
+                let order = sequence::best_order(
+                    graph,
+                    tasks,
+                    planned,
+                    sequence::order_seed(settings, robot),
+                    &sweep_keys(cell, settings.sweep),
+                );
                 let time = sequence::order_cost(graph, planned, &order);
                 (order, time)
             })

@@ -370,6 +370,7 @@ mod tests {
             time_limit: Duration::from_secs(3600),
             seed,
             max_iterations: Some(generations),
+            max_stall: None,
             method: GtspMethod::Ga,
         };
         let sol = solve(p, &params);

@@ -44,10 +44,15 @@ pub(super) fn run(inst: &Inst, params: &GtspParams, deadline: Instant) -> (State
     let mut best_cost = cur_cost;
     let accept = ACCEPT;
     let mut iterations = 0;
+    let mut stall = 0;
     loop {
         if params.max_iterations.is_some_and(|n| iterations >= n) {
             break;
         }
+        if params.max_stall.is_some_and(|n| stall >= n) {
+            break;
+        }
+        stall += 1;
         if Instant::now() >= deadline {
             break;
         }
@@ -84,6 +89,7 @@ pub(super) fn run(inst: &Inst, params: &GtspParams, deadline: Instant) -> (State
             if cost < best_cost - super::EPS {
                 best.clone_from(&cur);
                 best_cost = cost;
+                stall = 0;
             }
         }
     }

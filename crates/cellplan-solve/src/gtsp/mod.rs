@@ -44,6 +44,9 @@ pub struct GtspParams {
     /// Stop after this many kicks (ILS) or generations (GA); the result then depends only on the
     /// instance and the seed.
     pub max_iterations: Option<usize>,
+    /// ILS: stop after this many kicks in a row that did not improve the best tour (the result
+    /// still depends only on the instance and the seed).
+    pub max_stall: Option<usize>,
     /// The heuristic (default [`GtspMethod::Ils`]).
     pub method: GtspMethod,
 }
@@ -54,6 +57,7 @@ impl Default for GtspParams {
             time_limit: Duration::from_secs(1),
             seed: 0,
             max_iterations: None,
+            max_stall: None,
             method: GtspMethod::Ils,
         }
     }
@@ -305,6 +309,7 @@ pub(crate) mod tests {
             time_limit: Duration::from_secs(3600),
             seed,
             max_iterations: Some(iters),
+            max_stall: None,
             method: GtspMethod::Ils,
         };
         let sol = solve(p, &params);

@@ -324,7 +324,10 @@ mod tests {
             let moves: f64 = (0..3).map(|v| p.route_time(v, &sol.routes.tours[v])).sum::<f64>() - service;
             let used = sol.routes.tours.iter().filter(|t| !t.is_empty()).count();
             let trees = tree_bound(tree, used);
-            assert!(trees <= moves + 1e-9, "seed {seed}: trees {trees} above the solution's moves {moves}");
+            assert!(
+                trees <= moves + 1e-9,
+                "seed {seed}: trees {trees} above the solution's moves {moves}"
+            );
             tighter += usize::from(trees > entry_bound(&p, &legs, used) + 1e-9);
             assert!(lower_bound(&p) <= sol.makespan + 1e-9);
         }

@@ -87,6 +87,7 @@ pub(crate) fn optimise(p: &MinMaxProblem, v: usize, tour: &[Visit], seed: u64, i
             time_limit: Duration::from_secs(3600),
             seed,
             max_iterations: Some(iters),
+            max_stall: None,
             method: gtsp::GtspMethod::Ils,
         },
     );
