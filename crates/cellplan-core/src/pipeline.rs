@@ -143,33 +143,9 @@ fn blocking_penalty(cell: &Cell, coordinated: &Coordinated) -> Vec<Vec<f64>> {
     pen
 }
 
-/// The line of the robots: the principal axis of their bases in the floor plane (`None` for
-/// fewer than two robots or bases on one spot).
+/// The line of the robots along which ours draws strips: see [`plan::robot_rows`].
 pub fn robot_line(cell: &Cell) -> Option<[f64; 2]> {
-    let bases: Vec<(f64, f64)> = cell
-        .robots
-        .iter()
-        .map(|r| (r.base.translation.x, r.base.translation.y))
-        .collect();
-    if bases.len() < 2 {
-        return None;
-    }
-    let n = bases.len() as f64;
-    let (mx, my) = bases
-        .iter()
-        .fold((0.0, 0.0), |(a, b), (x, y)| (a + x / n, b + y / n));
-    let (mut sxx, mut sxy, mut syy) = (0.0, 0.0, 0.0);
-    for (x, y) in &bases {
-        sxx += (x - mx) * (x - mx);
-        sxy += (x - mx) * (y - my);
-        syy += (y - my) * (y - my);
-    }
-    if sxx + syy <= 1e-12 {
-        return None;
-    }
-    // The eigenvector of the larger eigenvalue of the 2×2 scatter matrix.
-    let angle = 0.5 * (2.0 * sxy).atan2(sxx - syy);
-    Some([angle.cos(), angle.sin()])
+    plan::robot_rows(cell).map(|(line, _)| line)
 }
 
 /// Per task and robot, the seconds per task the robot's program in `o` took beyond its

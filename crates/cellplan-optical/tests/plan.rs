@@ -257,3 +257,32 @@ fn strips_cut_the_mps_along_the_line_of_the_robots_and_each_robot_sweeps_its_str
     check_plan(&cell, &doc);
     verified(&cell, &doc);
 }
+
+#[test]
+fn robots_facing_each_other_make_two_rows_along_the_part() {
+    // facing-4r-roof: two robots on each side of the car, facing across it.
+    let cell = load(
+        &repo_root().join("bench/cells/facing-4r-roof/cell.toml"),
+        &LoadOptions::default(),
+    )
+    .unwrap();
+    let (line, rows) = plan::robot_rows(&cell).expect("four robots");
+    assert_eq!(rows.len(), 2, "{rows:?}");
+    for row in &rows {
+        assert_eq!(row.len(), 2);
+        // The robots of a row stand on one side of the car (same x).
+        let x: Vec<f64> = row.iter().map(|&r| cell.robots[r].base.translation.x).collect();
+        assert!((x[0] - x[1]).abs() < 1e-9, "{x:?}");
+    }
+    // The line runs along the car (y), not across it.
+    assert!(line[1].abs() > 0.99, "{line:?}");
+    // The README cell: one row of four along the car.
+    let readme = load(
+        &repo_root().join("examples/autobody-4r/cell.toml"),
+        &LoadOptions::default(),
+    )
+    .unwrap();
+    let (line, rows) = plan::robot_rows(&readme).unwrap();
+    assert_eq!(rows, vec![vec![0, 1, 2, 3]]);
+    assert!(line[1].abs() > 0.99, "{line:?}");
+}
