@@ -208,7 +208,9 @@ pub fn coordinate(
         task_penalty: Vec::new(),
         ..settings.clone()
     });
-    let mut runs = vec![(outcome, settings, first)];
+    // Only the best run so far is kept (the shortest cycle, then Δt, then the earlier): the
+    // others' plans and coordinations are dropped as soon as they lose.
+    let mut best = (outcome, settings, first);
     // The strips first: where they pay, the others are then often beaten before coordination.
     let mut tries: Vec<PlanSettings> = [sweep, Some(nearest), Some(again)]
         .into_iter()
@@ -219,7 +221,7 @@ pub fn coordinate(
         next += 1;
         // Past the deadline the other tries are skipped, and the plan says the clock cut it.
         if more.deadline.is_some_and(|d| Instant::now() >= d) {
-            runs[0].0.time_limit_hit = true;
+            best.0.time_limit_hit = true;
             break;
         }
         // A plan that fails only loses its try.
@@ -240,26 +242,17 @@ pub fn coordinate(
         // Coordination only adds waits: a plan whose robots end no sooner than the best cycle
         // so far even without them cannot win, and is not coordinated.
         let free = o.robots.iter().map(|r| r.program.duration()).fold(0.0, f64::max);
-        let so_far = runs
-            .iter()
-            .map(|r| cycle_and_delta(&r.2.timed).0)
-            .fold(f64::INFINITY, f64::min);
-        if free >= so_far {
+        if free >= cycle_and_delta(&best.2.timed).0 {
             continue;
         }
-        if let Ok(c) = coordinate_outcome(cell, table, &o, coord) {
-            runs.push((o, more, c));
+        if let Ok(c) = coordinate_outcome(cell, table, &o, coord)
+            && cycle_and_delta(&c.timed) < cycle_and_delta(&best.2.timed)
+        {
+            best = (o, more, c);
         }
     }
     let spent = lap.elapsed().as_secs_f64();
-    let key = |r: &(Outcome, PlanSettings, Coordinated)| cycle_and_delta(&r.2.timed);
-    let mut win = 0;
-    for i in 1..runs.len() {
-        if key(&runs[i]) < key(&runs[win]) {
-            win = i;
-        }
-    }
-    let (o, s, c) = runs.swap_remove(win);
+    let (o, s, c) = best;
     Ok((
         o,
         s,
