@@ -143,6 +143,9 @@ fn blocking_penalty(cell: &Cell, coordinated: &Coordinated) -> Vec<Vec<f64>> {
     pen
 }
 
+/// Ours plans the balanced (min-max) allocation too on cells of at most this many MPs × robots.
+const BALANCED_MAX_PAIRS: usize = 100;
+
 /// The line of the robots along which ours draws strips: see [`plan::robot_rows`].
 pub fn robot_line(cell: &Cell) -> Option<[f64; 2]> {
     plan::robot_rows(cell).map(|(line, _)| line)
@@ -168,8 +171,9 @@ fn slowness_penalty(cell: &Cell, o: &plan::Outcome) -> Vec<Vec<f64>> {
 /// zones as strips across the line of the robots, each robot sweeping its strip
 /// ([`PlanSettings::sweep`]; where the robots have a line), and the strips once more with each
 /// robot's estimates raised by how much slower than their lower bounds its legs were
-/// ([`PlanSettings::task_penalty`]); the nearest-robot allocation; and the zones allocation
-/// again with what the first plan's measurements blocked the other robots. A plan whose robots
+/// ([`PlanSettings::task_penalty`]); the nearest-robot allocation; the zones allocation
+/// again with what the first plan's measurements blocked the other robots; and, on cells of at
+/// most [`BALANCED_MAX_PAIRS`] MPs × robots, the balanced allocation. A plan whose robots
 /// end no sooner than the best cycle so far even uncoordinated is not coordinated. The shortest
 /// coordinated cycle (then Δt, then the earlier) wins, with the coordination compute of all.
 /// Returns the winning run, its settings and its coordination. `cache` holds what earlier runs
@@ -208,11 +212,18 @@ pub fn coordinate(
         task_penalty: Vec::new(),
         ..settings.clone()
     });
+    // On small cells the min-max allocation too: its search is cheap there, and with few
+    // robots meeting little, balanced work often ends first.
+    let balanced = (cell.tasks.len() * cell.robots.len() <= BALANCED_MAX_PAIRS).then(|| PlanSettings {
+        allocation: plan::Allocation::Balanced,
+        task_penalty: Vec::new(),
+        ..settings.clone()
+    });
     // Only the best run so far is kept (the shortest cycle, then Δt, then the earlier): the
     // others' plans and coordinations are dropped as soon as they lose.
     let mut best = (outcome, settings, first);
     // The strips first: where they pay, the others are then often beaten before coordination.
-    let mut tries: Vec<PlanSettings> = [sweep, Some(nearest), Some(again)]
+    let mut tries: Vec<PlanSettings> = [sweep, Some(nearest), Some(again), balanced]
         .into_iter()
         .flatten()
         .collect();

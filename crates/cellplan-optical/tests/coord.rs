@@ -528,8 +528,11 @@ fn ours_keeps_the_shortest_of_its_plans() {
     let (o, s, c) =
         cellplan_core::pipeline::coordinate(&f.cell, &f.table, outcome, zones, &coord_settings, &mut cache)
             .unwrap();
-    assert!(matches!(s.allocation, Allocation::Zones | Allocation::Proximity));
-    if s.allocation == Allocation::Proximity {
+    assert!(matches!(
+        s.allocation,
+        Allocation::Zones | Allocation::Proximity | Allocation::Balanced
+    ));
+    if s.allocation != Allocation::Zones {
         assert!(s.task_penalty.is_empty());
     }
     let doc = cellplan_core::document::build(&f.cell, &f.table, &o, &c, &s, 0.0, 0.0);
