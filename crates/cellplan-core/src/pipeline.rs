@@ -144,7 +144,7 @@ fn blocking_penalty(cell: &Cell, coordinated: &Coordinated) -> Vec<Vec<f64>> {
 }
 
 /// Ours plans the balanced (min-max) allocation too on cells of at most this many MPs × robots.
-const BALANCED_MAX_PAIRS: usize = 100;
+pub const BALANCED_MAX_PAIRS: usize = 100;
 
 /// The line of the robots along which ours draws strips: see [`plan::robot_rows`].
 pub fn robot_line(cell: &Cell) -> Option<[f64; 2]> {
