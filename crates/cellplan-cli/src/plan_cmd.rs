@@ -194,7 +194,7 @@ pub fn run(args: &PlanArgs) -> Result<(), Failure> {
                 Step::Plan(Stage::Sequencing) => "sequencing and planning collision-free legs".into(),
                 Step::Plan(Stage::Timing) => "timing the trajectories".into(),
                 Step::Coordination { zones_too: true } => {
-                    "coordinating the robots on one clock (and two more plans: the zones again, the nearest robots)".into()
+                    "coordinating the robots on one clock (and ours' other plans: strips, the nearest robots, the zones again)".into()
                 }
                 Step::Coordination { zones_too: false } => "coordinating the robots on one clock".into(),
                 Step::Verification => "verifying the plan".into(),

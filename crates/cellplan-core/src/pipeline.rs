@@ -1,9 +1,9 @@
 //! The pipeline as `cellplan plan` runs it — candidates, allocation, sequencing with lazily
 //! planned legs, timing, coordination, the document and its verification — and the one place
-//! that decides what "ours" is: `best` coordination on the zones allocation, planned and
-//! coordinated twice (the second time each robot's time counts what its measurements blocked
-//! the others in the first), and on the nearest-robot allocation the zones start from; the
-//! shortest coordinated cycle kept.
+//! that decides what "ours" is: `best` coordination on the zones allocation and on the other
+//! plans of [`coordinate`] (strips per row of robots, swept, twice; the nearest-robot
+//! allocation; the zones again knowing what their measurements blocked; the balanced
+//! allocation on small cells); the shortest coordinated cycle kept.
 //! `cellplan compare` takes its "ours" row from here as well.
 use crate::candidates::{self, CandidateTable};
 use crate::check::{cap_error, graph_size_error, idle_robot_error};
@@ -20,10 +20,10 @@ pub enum Step {
     Candidates,
     /// A planning stage.
     Plan(Stage),
-    /// Coordination (with `zones_too` when ours plans and coordinates two more plans: the
-    /// zones allocation a second time, and the nearest-robot allocation).
+    /// Coordination (with `zones_too` when ours plans and coordinates the other plans of
+    /// [`coordinate`] too).
     Coordination {
-        /// Whether ours' two more plans are made and coordinated too.
+        /// Whether ours' other plans are made and coordinated too.
         zones_too: bool,
     },
     /// The verifier.
