@@ -342,18 +342,32 @@ fn zones(
             }
             continue;
         };
-        tasks[from].retain(|x| x.0 != t);
-        tasks[to].push(TaskId(t));
-        tasks[to].sort();
-        tours[from].remove(&graphs[from], TaskId(t));
-        tours[to].insert(&graphs[to], TaskId(t));
-        since += 1;
+        hand_over(graphs, tasks, &mut tours, (from, to, TaskId(t)), &mut since, seed);
         edited = true;
-        if since >= ZONE_REOPTIMISE_EVERY {
-            since = 0;
-            tours[from] = Tour::new(&graphs[from], &tasks[from], seed);
-            tours[to] = Tour::new(&graphs[to], &tasks[to], seed);
-        }
+    }
+}
+
+/// Moves task `t` from robot `from` to robot `to`: the two tours edited (cheapest removal and
+/// insertion), and both re-optimised every [`ZONE_REOPTIMISE_EVERY`] moves (`since` counts
+/// them).
+fn hand_over(
+    graphs: &[RobotGraph],
+    tasks: &mut [Vec<TaskId>],
+    tours: &mut [Tour],
+    (from, to, t): (usize, usize, TaskId),
+    since: &mut usize,
+    seed: u64,
+) {
+    tasks[from].retain(|&x| x != t);
+    tasks[to].push(t);
+    tasks[to].sort();
+    tours[from].remove(&graphs[from], t);
+    tours[to].insert(&graphs[to], t);
+    *since += 1;
+    if *since >= ZONE_REOPTIMISE_EVERY {
+        *since = 0;
+        tours[from] = Tour::new(&graphs[from], &tasks[from], seed);
+        tours[to] = Tour::new(&graphs[to], &tasks[to], seed);
     }
 }
 

@@ -371,15 +371,13 @@ pub fn robot_rows(cell: &Cell) -> Option<([f64; 2], Vec<Vec<usize>>)> {
             cell.robots[r].base.translation.y,
         )
     };
-    // The scatter of the bases about their rows' centres (about the centre of all when every
-    // row is one robot).
-    let groups: Vec<Vec<usize>> = if rows.iter().all(|row| row.len() == 1) {
-        vec![(0..cell.robots.len()).collect()]
-    } else {
-        rows.clone()
-    };
+    // Rows of one robot each are one row: the scatter is then about the centre of all bases.
+    if rows.iter().all(|row| row.len() == 1) {
+        rows = vec![(0..cell.robots.len()).collect()];
+    }
+    let groups = &rows;
     let (mut sxx, mut sxy, mut syy) = (0.0, 0.0, 0.0);
-    for g in &groups {
+    for g in groups {
         let centre = g.iter().map(|&r| base(r)).sum::<glam::DVec2>() / g.len() as f64;
         for &r in g {
             let d = base(r) - centre;
@@ -393,9 +391,6 @@ pub fn robot_rows(cell: &Cell) -> Option<([f64; 2], Vec<Vec<usize>>)> {
     }
     // The eigenvector of the larger eigenvalue of the 2×2 scatter matrix.
     let angle = 0.5 * (2.0 * sxy).atan2(sxx - syy);
-    if rows.iter().all(|row| row.len() == 1) {
-        rows = vec![(0..cell.robots.len()).collect()];
-    }
     Some(([angle.cos(), angle.sin()], rows))
 }
 

@@ -5,7 +5,7 @@
 //! every task once, so their times add up to the service of every task plus the legs, and the
 //! longest is at least the `k`-th of that sum. Two bounds of the legs follow:
 //!
-//! - **Entries** ([`entry_bound`]): every task is entered once; the `k` tasks entered first are
+//! - **Entries** ([`Entries`]): every task is entered once; the `k` tasks entered first are
 //!   entered from the depot and the `k` tasks left last are left for it, each `k` distinct.
 //! - **Trees** ([`tree_bound`], Held and Karp's bound carried to `k` routes): the routes, seen
 //!   as one graph on the tasks and the depot, are connected, have `n + k` edges, degree 2 at
@@ -41,11 +41,11 @@ pub fn lower_bound(p: &MinMaxProblem) -> f64 {
     let mut best = own_bound(p, &legs);
     if fewest <= most {
         let service: f64 = p.service.iter().sum();
+        let entries = Entries::new(p, &legs);
         let shared = (fewest..=most)
             .map(|k| {
                 let trees = legs.tree.as_ref().map_or(0.0, |t| tree_bound(t, k));
-                let legs_k = entry_bound(p, &legs, k).max(trees);
-                (service + legs_k) / k as f64
+                (service + entries.bound(k).max(trees)) / k as f64
             })
             .fold(f64::INFINITY, f64::min);
         if shared.is_finite() {
@@ -143,30 +143,44 @@ impl Legs {
     }
 }
 
-/// Sum of the `k` smallest of `values`.
-fn smallest_sum(values: &[f64], k: usize) -> f64 {
-    let mut v = values.to_vec();
-    v.sort_by(f64::total_cmp);
-    v.iter().take(k).sum()
+/// The legs of routes by their entries (see [`Entries::bound`]), per task over the vehicles
+/// able to do it.
+struct Entries {
+    /// The sum over tasks of the cheapest entry, from the depot or another task.
+    base: f64,
+    /// Per task, the extra cost of entering it from the depot instead, ascending.
+    extra: Vec<f64>,
+    /// Per task, the cheapest way home from it, ascending.
+    home: Vec<f64>,
 }
 
-/// The legs of `k` routes by their entries: every task's cheapest entry (over the vehicles
-/// able to do it, from the depot or another task), the `k` smallest extra costs of entering a
-/// task from the depot instead, and the `k` smallest costs of going home from a task.
-fn entry_bound(p: &MinMaxProblem, legs: &Legs, k: usize) -> f64 {
-    let mut base = 0.0;
-    let mut extra = Vec::with_capacity(p.tasks);
-    let mut home = Vec::with_capacity(p.tasks);
-    for t in 0..p.tasks {
-        let who = p.capable(t);
-        let cheapest = |of: &[Vec<f64>]| who.iter().map(|&v| of[v][t]).fold(f64::INFINITY, f64::min);
-        let depot = cheapest(&legs.from_depot);
-        let entry = cheapest(&legs.from_task).min(depot);
-        base += entry;
-        extra.push(depot - entry);
-        home.push(cheapest(&legs.home));
+impl Entries {
+    fn new(p: &MinMaxProblem, legs: &Legs) -> Entries {
+        let mut e = Entries {
+            base: 0.0,
+            extra: Vec::with_capacity(p.tasks),
+            home: Vec::with_capacity(p.tasks),
+        };
+        for t in 0..p.tasks {
+            let who = p.capable(t);
+            let cheapest = |of: &[Vec<f64>]| who.iter().map(|&v| of[v][t]).fold(f64::INFINITY, f64::min);
+            let depot = cheapest(&legs.from_depot);
+            let entry = cheapest(&legs.from_task).min(depot);
+            e.base += entry;
+            e.extra.push(depot - entry);
+            e.home.push(cheapest(&legs.home));
+        }
+        e.extra.sort_by(f64::total_cmp);
+        e.home.sort_by(f64::total_cmp);
+        e
     }
-    base + smallest_sum(&extra, k) + smallest_sum(&home, k)
+
+    /// The legs of `k` routes: every task's cheapest entry, the `k` smallest extra costs of
+    /// entering a task from the depot instead, and the `k` smallest costs of going home from a
+    /// task.
+    fn bound(&self, k: usize) -> f64 {
+        self.base + self.extra.iter().take(k).sum::<f64>() + self.home.iter().take(k).sum::<f64>()
+    }
 }
 
 /// The legs of `k` routes by Held and Karp's trees (see the module).
@@ -328,7 +342,7 @@ mod tests {
                 trees <= moves + 1e-9,
                 "seed {seed}: trees {trees} above the solution's moves {moves}"
             );
-            tighter += usize::from(trees > entry_bound(&p, &legs, used) + 1e-9);
+            tighter += usize::from(trees > Entries::new(&p, &legs).bound(used) + 1e-9);
             assert!(lower_bound(&p) <= sol.makespan + 1e-9);
         }
         assert!(tighter >= 3, "the trees beat the entries on {tighter} of 5");

@@ -1,6 +1,6 @@
 //! [`crate::plan::Allocation::Zones`] along [`PlanSettings::sweep`]: strips per row of robots.
 use super::super::graph::RobotGraph;
-use super::{Tour, ZONE_REOPTIMISE_EVERY, ZONE_SEARCH_WORK, cap_error, load, penalty};
+use super::{Tour, ZONE_SEARCH_WORK, cap_error, hand_over, load, penalty};
 use crate::plan::{PlanError, PlanSettings};
 use cellplan_model::Cell;
 use cellplan_model::tasks::TaskId;
@@ -133,17 +133,7 @@ pub(super) fn strips(
         let Some((from, to, t)) = pick else {
             break;
         };
-        tasks[from].retain(|&x| x != t);
-        tasks[to].push(t);
-        tasks[to].sort();
-        tours[from].remove(&graphs[from], t);
-        tours[to].insert(&graphs[to], t);
-        since += 1;
-        if since >= ZONE_REOPTIMISE_EVERY {
-            since = 0;
-            tours[from] = Tour::new(&graphs[from], &tasks[from], seed);
-            tours[to] = Tour::new(&graphs[to], &tasks[to], seed);
-        }
+        hand_over(graphs, tasks, &mut tours, (from, to, t), &mut since, seed);
     }
     Ok(())
 }
