@@ -14,7 +14,8 @@
 //! - [`Trajectory`] is a sequence of [`Piece`]s of constant joint acceleration, so position,
 //!   velocity and acceleration are exact at every time.
 //! - [`time_path_exact`] times a piecewise-linear joint path (a planner's output) so that it is
-//!   followed exactly, stopping at every corner; [`time_path_blended`] replaces the corners by
+//!   followed exactly, stopping at every corner ([`segment_time`] is one segment of it);
+//!   [`time_path_blended`] replaces the corners by
 //!   parabolic blends within a per-joint deviation bound and is never slower.
 //! - [`check_limits`] and [`check_position_limits`] verify a trajectory exactly, piece by piece.
 
@@ -27,5 +28,5 @@ mod trajectory;
 pub use check::{LimitViolation, check_limits, check_position_limits};
 pub use error::TimingError;
 pub use limits::{Limits, joint_min_time, move_time, move_time_instant, move_trajectory};
-pub use path::{Blend, BlendedPath, TimedPath, time_path_blended, time_path_exact};
+pub use path::{Blend, BlendedPath, TimedPath, segment_time, time_path_blended, time_path_exact};
 pub use trajectory::{Piece, Trajectory};

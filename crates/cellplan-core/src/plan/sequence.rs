@@ -437,7 +437,8 @@ fn polish_leg(
 }
 
 /// `waypoints` shortcut with the full iteration count (seeded by `seed`, every change checked
-/// at the process clearance) and timed under the robot's limits: the path and its time.
+/// at the process clearance, each change kept only when it shortens the time stopping at every
+/// waypoint) and timed under the robot's limits: the path and its time.
 fn shortcut_and_time(
     cell: &Cell,
     robot: &Robot,
@@ -453,7 +454,7 @@ fn shortcut_and_time(
         shortcut_iterations: settings.final_shortcut_iterations,
         ..settings.motion.clone()
     };
-    cellplan_motion::plan::shortcut(&space, &validity, &mut waypoints, &motion);
+    cellplan_motion::plan::shortcut_timed(&space, &validity, &mut waypoints, &motion, &graph.limits);
     let duration = time_path_exact(&waypoints, &graph.limits)?.trajectory.duration();
     Ok((waypoints, duration))
 }

@@ -1,5 +1,6 @@
 //! Path post-processing: shortcuts and redundant waypoints.
 use super::{JointSpace, PlanSettings, StateValidity, check_segment};
+use crate::timing::{Limits, segment_time};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
@@ -38,6 +39,34 @@ pub fn shortcut(
     )
 }
 
+/// [`shortcut`] for a path that is timed stopping at every waypoint: shortens its time under
+/// `limits` (each segment from rest to rest, [`segment_time`]) instead of its length. A
+/// shortcut that cuts a corner with two new waypoints adds a stop, and is kept only when the
+/// time saved on the way pays for it; half of the shortcuts are drawn from a waypoint (the
+/// start of a segment) and half to one (the end of a segment), so that corners are also
+/// removed, not only cut. Never lengthens the path's time; the path stays valid. Same
+/// settings, work and determinism as [`shortcut`].
+pub fn shortcut_timed(
+    space: &JointSpace,
+    validity: &dyn StateValidity,
+    waypoints: &mut Vec<Vec<f64>>,
+    settings: &PlanSettings,
+    limits: &Limits,
+) -> usize {
+    let cost = |a: &[f64], b: &[f64]| segment_time(a, b, limits);
+    shortcut_by(
+        space,
+        validity,
+        waypoints,
+        (settings.seed, settings.shortcut_iterations),
+        settings.min_clearance,
+        Some(&cost),
+    )
+}
+
+/// A segment's cost: its time (rest to rest) when shortcutting for time.
+type SegmentCost<'a> = &'a dyn Fn(&[f64], &[f64]) -> f64;
+
 /// [`shortcut`] with its settings spelled out.
 pub(crate) fn shortcut_with(
     space: &JointSpace,
@@ -47,9 +76,33 @@ pub(crate) fn shortcut_with(
     iterations: usize,
     min_clearance: f64,
 ) -> usize {
+    shortcut_by(
+        space,
+        validity,
+        waypoints,
+        (seed, iterations),
+        min_clearance,
+        None,
+    )
+}
+
+/// The shortcut loop: by length in the space's metric, or by `timed` segment costs.
+fn shortcut_by(
+    space: &JointSpace,
+    validity: &dyn StateValidity,
+    waypoints: &mut Vec<Vec<f64>>,
+    (seed, iterations): (u64, usize),
+    min_clearance: f64,
+    timed: Option<SegmentCost<'_>>,
+) -> usize {
+    let seg = |a: &[f64], b: &[f64]| match timed {
+        Some(cost) => cost(a, b),
+        None => space.distance(a, b),
+    };
+    let total = |w: &[Vec<f64>]| w.windows(2).map(|p| seg(&p[0], &p[1])).sum::<f64>();
     let mut calls = 0;
     waypoints.dedup_by(|b, a| space.distance(a, b) == 0.0);
-    calls += remove_redundant(space, validity, waypoints, min_clearance);
+    calls += remove_redundant(space, validity, waypoints, min_clearance, &seg);
     let mut rng = ChaCha8Rng::seed_from_u64(seed ^ 0x5348_4f52_5443_5554);
     let (mut p1, mut p2) = (Vec::new(), Vec::new());
     let mut misses = 0;
@@ -67,13 +120,30 @@ pub(crate) fn shortcut_with(
         if i == j {
             continue;
         }
-        let (t1, t2): (f64, f64) = (rng.random_range(0.0..1.0), rng.random_range(0.0..1.0));
+        let (mut t1, mut t2): (f64, f64) = (rng.random_range(0.0..1.0), rng.random_range(0.0..1.0));
+        if timed.is_some() {
+            // A third from a waypoint and a third to one: a shortcut that removes corners adds
+            // no stop.
+            if rng.random_bool(0.5) {
+                t1 = 0.0;
+            } else {
+                t2 = 1.0;
+            }
+        }
         space.interpolate(&waypoints[i], &waypoints[i + 1], t1, &mut p1);
         space.interpolate(&waypoints[j], &waypoints[j + 1], t2, &mut p2);
-        let old = space.distance(&p1, &waypoints[i + 1])
-            + path_length(space, &waypoints[i + 1..=j])
-            + space.distance(&waypoints[j], &p2);
-        if space.distance(&p1, &p2) >= old - 1e-9 {
+        let (old, new) = match timed {
+            // Rest to rest: the pieces before p1 and after p2 are crossed on their own.
+            Some(_) => (
+                total(&waypoints[i..=j + 1]),
+                seg(&waypoints[i], &p1) + seg(&p1, &p2) + seg(&p2, &waypoints[j + 1]),
+            ),
+            None => (
+                seg(&p1, &waypoints[i + 1]) + total(&waypoints[i + 1..=j]) + seg(&waypoints[j], &p2),
+                seg(&p1, &p2),
+            ),
+        };
+        if new >= old - 1e-9 {
             misses += 1;
             continue;
         }
@@ -81,8 +151,8 @@ pub(crate) fn shortcut_with(
         calls += check.calls;
         // A shortcut that gains little counts as a miss too: the path is near its local
         // optimum, and every further shortcut costs a whole segment check.
-        let gain = old - space.distance(&p1, &p2);
-        misses = if check.valid && gain >= MIN_GAIN * path_length(space, waypoints) {
+        let gain = old - new;
+        misses = if check.valid && gain >= MIN_GAIN * total(waypoints) {
             0
         } else {
             misses + 1
@@ -97,20 +167,27 @@ pub(crate) fn shortcut_with(
             waypoints.dedup_by(|b, a| space.distance(a, b) <= 1e-12);
         }
     }
-    calls += remove_redundant(space, validity, waypoints, min_clearance);
+    calls += remove_redundant(space, validity, waypoints, min_clearance, &seg);
     calls
 }
 
-/// Drops every waypoint whose neighbours see each other directly; returns the calls made.
+/// Drops every waypoint whose neighbours see each other directly (and whose removal does not
+/// cost more by `seg`); returns the calls made.
 fn remove_redundant(
     space: &JointSpace,
     validity: &dyn StateValidity,
     waypoints: &mut Vec<Vec<f64>>,
     min_clearance: f64,
+    seg: &dyn Fn(&[f64], &[f64]) -> f64,
 ) -> usize {
     let mut calls = 0;
     let mut i = 0;
     while i + 2 < waypoints.len() {
+        let (a, m, b) = (&waypoints[i], &waypoints[i + 1], &waypoints[i + 2]);
+        if seg(a, b) > seg(a, m) + seg(m, b) + 1e-12 {
+            i += 1;
+            continue;
+        }
         let check = check_segment(space, validity, &waypoints[i], &waypoints[i + 2], min_clearance);
         calls += check.calls;
         if check.valid {

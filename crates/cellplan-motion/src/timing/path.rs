@@ -106,6 +106,48 @@ pub fn time_path_exact(path: &[Vec<f64>], limits: &Limits) -> Result<TimedPath, 
     })
 }
 
+/// The time of the straight joint segment from `a` to `b`, from rest to rest, as
+/// [`time_path_exact`] crosses it: along the line at the largest speed and acceleration no
+/// joint exceeds, a trapezoid (or a triangle when the line is too short to cruise). At least
+/// [`move_time`](super::move_time) of the two points. Cost: O(dof), no allocation. Panics if
+/// `a`, `b` and `limits` differ in length.
+///
+/// ```
+/// use cellplan_motion::timing::{Limits, segment_time, time_path_exact};
+/// let l = Limits::new(vec![1.0, 2.0], vec![2.0, 1.0]).unwrap();
+/// let (a, b) = (vec![0.0, 0.0], vec![2.0, -1.0]);
+/// let exact = time_path_exact(&[a.clone(), b.clone()], &l).unwrap();
+/// assert!((segment_time(&a, &b, &l) - exact.trajectory.duration()).abs() < 1e-12);
+/// ```
+pub fn segment_time(a: &[f64], b: &[f64], limits: &Limits) -> f64 {
+    assert!(
+        a.len() == b.len() && a.len() == limits.dof(),
+        "segment_time: joint counts differ"
+    );
+    let len = dist(a, b);
+    if len <= SAME_POINT {
+        return 0.0;
+    }
+    // Along the line joint j moves at s'·|u_j|: the line's limits are the tightest joint's.
+    let (mut vmax, mut amax) = (f64::INFINITY, f64::INFINITY);
+    for ((x, y), (&v, &acc)) in a
+        .iter()
+        .zip(b)
+        .zip(limits.velocity.iter().zip(&limits.acceleration))
+    {
+        let u = (y - x).abs() / len;
+        if u > 0.0 {
+            vmax = vmax.min(v / u);
+            amax = amax.min(acc / u);
+        }
+    }
+    if len * amax >= vmax * vmax {
+        len / vmax + vmax / amax
+    } else {
+        2.0 * (len / amax).sqrt()
+    }
+}
+
 /// Times a piecewise-linear joint path with parabolic blends at its corners: near
 /// time-optimal, never slower than [`time_path_exact`], within `max_deviation` of the polyline.
 ///

@@ -301,6 +301,40 @@ fn shortcut_never_lengthens_and_stays_valid() {
     }
 }
 
+#[test]
+fn timed_shortcut_never_slows_the_path_and_stays_valid() {
+    use crate::timing::{Limits, time_path_exact};
+    let space = square(2, 10.0);
+    let v = wall();
+    // A slow joint 1: time and length disagree about where to cut.
+    let limits = Limits::new(vec![2.0, 0.5], vec![4.0, 1.0]).unwrap();
+    let time = |p: &[Vec<f64>]| time_path_exact(p, &limits).unwrap().trajectory.duration();
+    let mut faster = 0;
+    for seed in 0..20 {
+        let raw = RrtConnect::default()
+            .plan(&space, &v, &[1.0, 1.0], &[9.0, 1.0], &settings(seed))
+            .unwrap();
+        let mut path = raw.waypoints.clone();
+        let mut last = time(&path);
+        for round in 0..3 {
+            let s = PlanSettings {
+                shortcut_iterations: 20,
+                ..settings(seed * 10 + round)
+            };
+            shortcut_timed(&space, &v, &mut path, &s, &limits);
+            let now = time(&path);
+            assert!(now <= last + 1e-9, "seed {seed}: {now} > {last}");
+            assert!(brute_force_valid(&v, &path, 1e-3), "seed {seed}");
+            assert_eq!(path.first(), raw.waypoints.first());
+            assert_eq!(path.last(), raw.waypoints.last());
+            last = now;
+        }
+        faster += usize::from(last < time(&raw.waypoints) - 1e-9);
+    }
+    // The planner's raw paths zigzag: most get faster.
+    assert!(faster >= 15, "{faster} of 20 faster");
+}
+
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(300))]
 
