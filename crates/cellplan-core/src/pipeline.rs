@@ -3,7 +3,8 @@
 //! that decides what "ours" is: `best` coordination on the zones allocation and on the other
 //! plans of [`coordinate`] (strips per row of robots, swept, twice; the nearest-robot
 //! allocation; the zones again knowing what their measurements blocked; the balanced
-//! allocation on small cells); the shortest coordinated cycle kept.
+//! allocation on small cells); the shortest coordinated cycle kept, then balanced on its real
+//! times ([`plan::rebalance`]).
 //! `cellplan compare` takes its "ours" row from here as well.
 use crate::candidates::{self, CandidateTable};
 use crate::check::{cap_error, graph_size_error, idle_robot_error};
@@ -175,7 +176,9 @@ fn slowness_penalty(cell: &Cell, o: &plan::Outcome) -> Vec<Vec<f64>> {
 /// again with what the first plan's measurements blocked the other robots; and, on cells of at
 /// most [`BALANCED_MAX_PAIRS`] MPs × robots, the balanced allocation. A plan whose robots
 /// end no sooner than the best cycle so far even uncoordinated is not coordinated. The shortest
-/// coordinated cycle (then Δt, then the earlier) wins, with the coordination compute of all.
+/// coordinated cycle (then Δt, then the earlier) wins; then [`plan::rebalance::rebalance`]
+/// hands tasks from the robot that ends last to others, one at a time, each hand-over kept
+/// when its plan, coordinated, ends sooner still. The coordination compute of all is counted.
 /// Returns the winning run, its settings and its coordination. `cache` holds what earlier runs
 /// on the cell planned (see [`plan::PlanCache`]).
 pub fn coordinate(
@@ -260,6 +263,20 @@ pub fn coordinate(
             && cycle_and_delta(&c.timed) < cycle_and_delta(&best.2.timed)
         {
             best = (o, more, c);
+        }
+    }
+    // The best plan balanced on its real times (one task at a time from the robot that ends
+    // last, see [`plan::rebalance`]), each hand-over judged by its coordinated cycle.
+    if best.1.deadline.is_none_or(|d| Instant::now() < d) {
+        let score = cycle_and_delta(&best.2.timed).0;
+        let mut judge = |o: &Outcome| {
+            let c = coordinate_outcome(cell, table, o, coord).ok()?;
+            Some((cycle_and_delta(&c.timed).0, c))
+        };
+        if let Ok(Some((o, s, c))) =
+            plan::rebalance::rebalance(cell, table, (&best.0, score), &best.1, cache, &mut judge)
+        {
+            best = (o, s, c);
         }
     }
     let spent = lap.elapsed().as_secs_f64();

@@ -286,3 +286,58 @@ fn robots_facing_each_other_make_two_rows_along_the_part() {
     assert_eq!(rows, vec![vec![0, 1, 2, 3]]);
     assert!(line[1].abs() > 0.99, "{line:?}");
 }
+
+#[test]
+fn rebalancing_hands_tasks_from_the_robot_ending_last_until_the_robots_end_sooner() {
+    use plan::rebalance::{REBALANCE_PLANS, makespan, rebalance};
+    let cell = load(
+        &repo_root().join("examples/autobody-4r/cell.toml"),
+        &LoadOptions::default(),
+    )
+    .unwrap();
+    let table = generate(&cell);
+    // The nearest-robot allocation ignores how long each robot works (5 to 14 MPs here).
+    let s = settings(Allocation::Proximity);
+    let mut cache = plan::PlanCache::default();
+    let base = plan::plan_cached(&cell, &table, &s, &|_| {}, &mut cache).unwrap();
+    let before = makespan(&base);
+    let mut judged = 0;
+    let mut judge = |o: &plan::Outcome| {
+        judged += 1;
+        Some((makespan(o), ()))
+    };
+    let (o, fixed, ()) = rebalance(&cell, &table, (&base, before), &s, &mut cache, &mut judge)
+        .unwrap()
+        .expect("the nearest robots are unbalanced here");
+    assert!(judged >= 1);
+    assert!(makespan(&o) < before - 1e-6, "{} !< {before}", makespan(&o));
+    // The plan is the fixed allocation it was made with: every task once, within the caps,
+    // each with a robot able to do it, a few hand-overs away from the start.
+    assert_eq!(Some(&o.allocated.tasks), fixed.tasks.as_ref());
+    let mut all: Vec<usize> = o.allocated.tasks.iter().flatten().map(|t| t.0).collect();
+    all.sort();
+    assert_eq!(all, (0..cell.tasks.len()).collect::<Vec<_>>());
+    let moved: usize = o
+        .allocated
+        .tasks
+        .iter()
+        .zip(&base.allocated.tasks)
+        .map(|(a, b)| a.iter().filter(|t| !b.contains(t)).count())
+        .sum();
+    assert!((1..=REBALANCE_PLANS).contains(&moved), "{moved} tasks moved");
+    for (r, tasks) in o.allocated.tasks.iter().enumerate() {
+        assert!(tasks.len() <= cell.planning.task_cap);
+        for &t in tasks {
+            assert!(table.robots_for(t).iter().any(|x| x.0 == r));
+        }
+        // Each robot measures exactly its tasks.
+        let mut visited: Vec<usize> = o.robots[r].program.visits.iter().map(|v| v.task.0).collect();
+        let mut mine: Vec<usize> = tasks.iter().map(|t| t.0).collect();
+        visited.sort();
+        mine.sort();
+        assert_eq!(visited, mine);
+    }
+    let doc = build(&cell, &table, &o, &fixed);
+    check_plan(&cell, &doc);
+    verified(&cell, &doc);
+}

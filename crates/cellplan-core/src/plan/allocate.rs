@@ -90,6 +90,13 @@ pub fn allocate(
         .collect();
     let problem = min_max_problem(cell, graphs, &capable)?;
     let lower_bound = minmax::lower_bound(&problem.0);
+    if let Some(fixed) = &settings.tasks {
+        return Ok(Allocated {
+            tasks: fixed.clone(),
+            local_sets: (0, 0),
+            lower_bound,
+        });
+    }
     let cap = cell.planning.task_cap;
     let mut tasks: Vec<Vec<TaskId>> = vec![Vec::new(); m];
     let mut local_sets = (0, 0);

@@ -8,6 +8,7 @@
 //! 5. [`crate::document`]: the Plan document.
 pub mod allocate;
 pub mod graph;
+pub mod rebalance;
 pub mod sequence;
 
 pub use allocate::{Allocation, CoverMethod};
@@ -82,6 +83,10 @@ pub struct PlanSettings {
     /// (see [`sequence::best_order`]): every robot sweeping the same way, neighbours stay
     /// about a strip apart.
     pub sweep: Option<[f64; 2]>,
+    /// A fixed allocation, per robot its tasks (`None`: the allocation strategy decides). The
+    /// caller keeps it within the caps and to robots able to do each task; see
+    /// [`rebalance::rebalance`].
+    pub tasks: Option<Vec<Vec<TaskId>>>,
 }
 
 impl PlanSettings {
@@ -124,6 +129,7 @@ impl Default for PlanSettings {
             sample_dt: 0.02,
             task_penalty: Vec::new(),
             sweep: None,
+            tasks: None,
             deadline: None,
         }
     }

@@ -1,0 +1,192 @@
+//! Balancing a plan on its real times: the allocations draw their lines on lower-bound move
+//! times, but a robot's legs can be much slower than their bounds (detours around the part,
+//! stops at every corner), so the robot that ends last is often not the one the allocation
+//! expected. [`rebalance`] hands one task at a time from the robot that ends last to the robot
+//! that can take it at the least cost, plans the robots again with that allocation (the legs
+//! already planned are reused: see [`super::PlanCache`]) and keeps the change when the robots
+//! end sooner. Spensieri et al. (2016) iterate routing and scheduling the same way, one level
+//! down.
+use super::{Outcome, PlanCache, PlanError, PlanSettings, dwell, plan_cached};
+use crate::candidates::CandidateTable;
+use cellplan_model::Cell;
+use cellplan_model::tasks::TaskId;
+use std::time::Instant;
+
+/// Plans [`rebalance`] makes at most (work, not time: the result does not depend on the
+/// machine).
+pub const REBALANCE_PLANS: usize = 6;
+
+/// Plans [`rebalance`] hands its judge at most (a coordination each: the costly part).
+pub const REBALANCE_JUDGED: usize = 3;
+
+/// One hand-over: the task, from which robot, to which, and the ends it is expected to give
+/// the two (s).
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Move {
+    task: TaskId,
+    from: usize,
+    to: usize,
+    expected: f64,
+}
+
+/// When each robot of `o` ends without coordination (s).
+pub fn ends(o: &Outcome) -> Vec<f64> {
+    o.robots.iter().map(|r| r.program.duration()).collect()
+}
+
+/// The latest of [`ends`].
+pub fn makespan(o: &Outcome) -> f64 {
+    ends(o).into_iter().fold(0.0, f64::max)
+}
+
+/// The hand-overs from the robot of `o` that ends last, best expected first: each of its tasks
+/// to each other robot able to do it with room under the cap. A robot's real legs are slower
+/// than their bounds by its own factor (its legs' time over their bounds), so the task's
+/// removal saves its two legs and dwell, less the bound of the leg that replaces them times the
+/// factor, and its cheapest insertion (on bounds) into the other robot's tour costs the dwell
+/// plus the insertion times that robot's factor. Only hand-overs expected to end both robots
+/// sooner than the last one ends now are returned.
+fn moves(cell: &Cell, o: &Outcome) -> Vec<Move> {
+    let end = ends(o);
+    let Some(from) = (0..end.len()).max_by(|&a, &b| end[a].total_cmp(&end[b]).then(b.cmp(&a))) else {
+        return Vec::new();
+    };
+    // Per robot: its tour as graph nodes (home at both ends) and its slowness factor.
+    let tour = |r: usize| -> Vec<usize> {
+        let mut t = vec![0];
+        t.extend(&o.robots[r].sequence.nodes);
+        t.push(0);
+        t
+    };
+    let slowness = |r: usize| -> f64 {
+        let g = &o.graphs[r];
+        let t = tour(r);
+        let bound: f64 = t.windows(2).map(|w| g.costs.get(w[0], w[1])).sum();
+        let real = o.robots[r].program.motion();
+        if bound > 1e-9 {
+            (real / bound).max(1.0)
+        } else {
+            1.0
+        }
+    };
+    let (long_tour, long_slow) = (tour(from), slowness(from));
+    let g = &o.graphs[from];
+    let legs = &o.robots[from].sequence.legs;
+    let mut out = Vec::new();
+    for (i, w) in long_tour.windows(3).enumerate() {
+        let (prev, node, next) = (w[0], w[1], w[2]);
+        let Some((task, _)) = g.node_task[node] else {
+            continue;
+        };
+        let saved =
+            legs[i].duration + legs[i + 1].duration + dwell(cell, task) - long_slow * g.costs.get(prev, next);
+        let from_end = end[from] - saved;
+        for to in 0..end.len() {
+            let h = &o.graphs[to];
+            let nodes = &h.alternatives[task.0];
+            if to == from || nodes.is_empty() || o.robots[to].sequence.nodes.len() >= cell.planning.task_cap {
+                continue;
+            }
+            let t = tour(to);
+            let insertion = t
+                .windows(2)
+                .flat_map(|p| {
+                    nodes
+                        .iter()
+                        .map(move |&n| h.costs.get(p[0], n) + h.costs.get(n, p[1]) - h.costs.get(p[0], p[1]))
+                })
+                .fold(f64::INFINITY, f64::min);
+            let to_end = end[to] + dwell(cell, task) + slowness(to) * insertion;
+            let expected = from_end.max(to_end);
+            if expected < end[from] - 1e-6 {
+                out.push(Move {
+                    task,
+                    from,
+                    to,
+                    expected,
+                });
+            }
+        }
+    }
+    out.sort_by(|a, b| {
+        a.expected
+            .total_cmp(&b.expected)
+            .then(a.task.0.cmp(&b.task.0))
+            .then(a.to.cmp(&b.to))
+    });
+    out
+}
+
+/// `base` (planned with `settings`; `base_score` is what `judge` said of it) balanced on its
+/// real times. Up to [`REBALANCE_PLANS`] times, the best expected hand-over not tried yet (one
+/// task of the robot ending last to another robot, ranked by the ends it is expected to give
+/// the two) is planned with the allocation fixed ([`PlanSettings::tasks`]). A plan whose robots
+/// end sooner than the current plan's, and sooner than the best score (the judge's score is
+/// never below that end: a coordinated cycle), goes to `judge` — at most [`REBALANCE_JUDGED`]
+/// plans; the first it scores below the best is kept and the next hand-overs start from it.
+/// Returns the best plan found with its settings and what the judge made of it, or `None` when
+/// no hand-over beat `base_score` (or `base` leaves tasks unreached: it is not rebalanced
+/// then). Plans that fail only lose their try; past the deadline the search stops.
+pub fn rebalance<J>(
+    cell: &Cell,
+    table: &CandidateTable,
+    (base, base_score): (&Outcome, f64),
+    settings: &PlanSettings,
+    cache: &mut PlanCache,
+    judge: &mut dyn FnMut(&Outcome) -> Option<(f64, J)>,
+) -> Result<Option<(Outcome, PlanSettings, J)>, PlanError> {
+    if !base.unreached.is_empty() || cell.robots.len() < 2 {
+        return Ok(None);
+    }
+    let mut best: Option<(Outcome, PlanSettings, J)> = None;
+    let mut score = base_score;
+    let mut tried: Vec<Vec<Vec<TaskId>>> = vec![base.allocated.tasks.clone()];
+    let (mut plans, mut judged) = (0, 0);
+    'rounds: while plans < REBALANCE_PLANS && judged < REBALANCE_JUDGED {
+        let current = best.as_ref().map_or(base, |b| &b.0);
+        let (bar, from_tasks, hand_overs) = (
+            makespan(current),
+            current.allocated.tasks.clone(),
+            moves(cell, current),
+        );
+        for mv in hand_overs {
+            if plans >= REBALANCE_PLANS
+                || judged >= REBALANCE_JUDGED
+                || settings.deadline.is_some_and(|d| Instant::now() >= d)
+            {
+                break 'rounds;
+            }
+            let mut tasks = from_tasks.clone();
+            tasks[mv.from].retain(|&t| t != mv.task);
+            tasks[mv.to].push(mv.task);
+            if tried.contains(&tasks) {
+                continue;
+            }
+            tried.push(tasks.clone());
+            plans += 1;
+            let next = PlanSettings {
+                tasks: Some(tasks),
+                ..settings.clone()
+            };
+            let Ok(o) = plan_cached(cell, table, &next, &|_| {}, cache) else {
+                continue;
+            };
+            // The robots must end sooner without coordination, and the judge's score (a
+            // coordinated cycle, never below that) must beat the best so far.
+            if !o.unreached.is_empty() || makespan(&o) >= bar - 1e-6 || makespan(&o) >= score - 1e-6 {
+                continue;
+            }
+            judged += 1;
+            if let Some((sc, j)) = judge(&o)
+                && sc < score - 1e-6
+            {
+                score = sc;
+                best = Some((o, next, j));
+                continue 'rounds;
+            }
+        }
+        // No hand-over of the robot ending last helped.
+        break;
+    }
+    Ok(best)
+}
