@@ -238,8 +238,13 @@ pub fn coordinate(
             best.0.time_limit_hit = true;
             break;
         }
-        // A plan that fails only loses its try.
-        let Ok(o) = plan::plan_cached(cell, table, &more, &|_| {}, cache) else {
+        // The balanced allocation is planned afresh, as it is on its own (legs the other plans
+        // timed would steer its lazy sequencing elsewhere): ours is then never longer than it
+        // with `best`. A plan that fails only loses its try.
+        let mut own = plan::PlanCache::default();
+        let fresh = more.allocation == Allocation::Balanced;
+        let Ok(o) = plan::plan_cached(cell, table, &more, &|_| {}, if fresh { &mut own } else { cache })
+        else {
             continue;
         };
         // The strips once more, each robot's estimates raised by what its legs took beyond
@@ -268,13 +273,14 @@ pub fn coordinate(
     // The best plan balanced on its real times (one task at a time from the robot that ends
     // last, see [`plan::rebalance`]), each hand-over judged by its coordinated cycle.
     if best.1.deadline.is_none_or(|d| Instant::now() < d) {
-        let score = cycle_and_delta(&best.2.timed).0;
+        let ends = |c: &Coordinated| c.timed.iter().map(|t| t.end()).collect::<Vec<f64>>();
+        let (score, base_ends) = (cycle_and_delta(&best.2.timed).0, ends(&best.2));
         let mut judge = |o: &Outcome| {
             let c = coordinate_outcome(cell, table, o, coord).ok()?;
-            Some((cycle_and_delta(&c.timed).0, c))
+            Some((cycle_and_delta(&c.timed).0, ends(&c), c))
         };
-        if let Ok(Some((o, s, c))) =
-            plan::rebalance::rebalance(cell, table, (&best.0, score), &best.1, cache, &mut judge)
+        let base = (&best.0, score, base_ends.as_slice());
+        if let Ok(Some((o, s, c))) = plan::rebalance::rebalance(cell, table, base, &best.1, cache, &mut judge)
         {
             best = (o, s, c);
         }

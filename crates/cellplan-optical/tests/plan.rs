@@ -289,7 +289,7 @@ fn robots_facing_each_other_make_two_rows_along_the_part() {
 
 #[test]
 fn rebalancing_hands_tasks_from_the_robot_ending_last_until_the_robots_end_sooner() {
-    use plan::rebalance::{REBALANCE_PLANS, makespan, rebalance};
+    use plan::rebalance::{REBALANCE_PLANS, ends, makespan, rebalance};
     let cell = load(
         &repo_root().join("examples/autobody-4r/cell.toml"),
         &LoadOptions::default(),
@@ -304,11 +304,18 @@ fn rebalancing_hands_tasks_from_the_robot_ending_last_until_the_robots_end_soone
     let mut judged = 0;
     let mut judge = |o: &plan::Outcome| {
         judged += 1;
-        Some((makespan(o), ()))
+        Some((makespan(o), ends(o), ()))
     };
-    let (o, fixed, ()) = rebalance(&cell, &table, (&base, before), &s, &mut cache, &mut judge)
-        .unwrap()
-        .expect("the nearest robots are unbalanced here");
+    let (o, fixed, ()) = rebalance(
+        &cell,
+        &table,
+        (&base, before, &ends(&base)),
+        &s,
+        &mut cache,
+        &mut judge,
+    )
+    .unwrap()
+    .expect("the nearest robots are unbalanced here");
     assert!(judged >= 1);
     assert!(makespan(&o) < before - 1e-6, "{} !< {before}", makespan(&o));
     // The plan is the fixed allocation it was made with: every task once, within the caps,

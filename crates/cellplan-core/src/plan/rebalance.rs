@@ -29,6 +29,10 @@ struct Move {
     expected: f64,
 }
 
+/// What a judge says of a plan: its score (s; a cycle, never below the robots' latest end
+/// without coordination), each robot's end under it (s), and what it made.
+pub type Judged<J> = (f64, Vec<f64>, J);
+
 /// When each robot of `o` ends without coordination (s).
 pub fn ends(o: &Outcome) -> Vec<f64> {
     o.robots.iter().map(|r| r.program.duration()).collect()
@@ -39,15 +43,16 @@ pub fn makespan(o: &Outcome) -> f64 {
     ends(o).into_iter().fold(0.0, f64::max)
 }
 
-/// The hand-overs from the robot of `o` that ends last, best expected first: each of its tasks
+/// The hand-overs from the robot of `o` that ends last by `end` (each robot's end as judged:
+/// coordinated, waits included), best expected first: each of its tasks
 /// to each other robot able to do it with room under the cap. A robot's real legs are slower
 /// than their bounds by its own factor (its legs' time over their bounds), so the task's
 /// removal saves its two legs and dwell, less the bound of the leg that replaces them times the
 /// factor, and its cheapest insertion (on bounds) into the other robot's tour costs the dwell
 /// plus the insertion times that robot's factor. Only hand-overs expected to end both robots
 /// sooner than the last one ends now are returned.
-fn moves(cell: &Cell, o: &Outcome) -> Vec<Move> {
-    let end = ends(o);
+fn moves(cell: &Cell, o: &Outcome, end: &[f64]) -> Vec<Move> {
+    let free = ends(o);
     let Some(from) = (0..end.len()).max_by(|&a, &b| end[a].total_cmp(&end[b]).then(b.cmp(&a))) else {
         return Vec::new();
     };
@@ -80,7 +85,7 @@ fn moves(cell: &Cell, o: &Outcome) -> Vec<Move> {
         };
         let saved =
             legs[i].duration + legs[i + 1].duration + dwell(cell, task) - long_slow * g.costs.get(prev, next);
-        let from_end = end[from] - saved;
+        let from_end = free[from] - saved;
         for to in 0..end.len() {
             let h = &o.graphs[to];
             let nodes = &h.alternatives[task.0];
@@ -96,7 +101,7 @@ fn moves(cell: &Cell, o: &Outcome) -> Vec<Move> {
                         .map(move |&n| h.costs.get(p[0], n) + h.costs.get(n, p[1]) - h.costs.get(p[0], p[1]))
                 })
                 .fold(f64::INFINITY, f64::min);
-            let to_end = end[to] + dwell(cell, task) + slowness(to) * insertion;
+            let to_end = free[to] + dwell(cell, task) + slowness(to) * insertion;
             let expected = from_end.max(to_end);
             if expected < end[from] - 1e-6 {
                 out.push(Move {
@@ -117,37 +122,36 @@ fn moves(cell: &Cell, o: &Outcome) -> Vec<Move> {
     out
 }
 
-/// `base` (planned with `settings`; `base_score` is what `judge` said of it) balanced on its
-/// real times. Up to [`REBALANCE_PLANS`] times, the best expected hand-over not tried yet (one
-/// task of the robot ending last to another robot, ranked by the ends it is expected to give
-/// the two) is planned with the allocation fixed ([`PlanSettings::tasks`]). A plan whose robots
-/// end sooner than the current plan's, and sooner than the best score (the judge's score is
-/// never below that end: a coordinated cycle), goes to `judge` — at most [`REBALANCE_JUDGED`]
-/// plans; the first it scores below the best is kept and the next hand-overs start from it.
+/// `base` (planned with `settings`; `judge` said `base_score` and `base_ends` of it) balanced
+/// on its real times. Up to [`REBALANCE_PLANS`] times, the best expected hand-over not tried
+/// yet (one task of the robot that ends last as judged to another robot, ranked by the ends it
+/// is expected to give the two) is planned with the allocation fixed ([`PlanSettings::tasks`]).
+/// A plan whose robots end, without coordination, sooner than the best score (the judge's
+/// score is never below that end) goes to `judge` — at most [`REBALANCE_JUDGED`] plans; the
+/// first it scores below the best is kept and the next hand-overs start from it and its ends.
 /// Returns the best plan found with its settings and what the judge made of it, or `None` when
 /// no hand-over beat `base_score` (or `base` leaves tasks unreached: it is not rebalanced
 /// then). Plans that fail only lose their try; past the deadline the search stops.
 pub fn rebalance<J>(
     cell: &Cell,
     table: &CandidateTable,
-    (base, base_score): (&Outcome, f64),
+    (base, base_score, base_ends): (&Outcome, f64, &[f64]),
     settings: &PlanSettings,
     cache: &mut PlanCache,
-    judge: &mut dyn FnMut(&Outcome) -> Option<(f64, J)>,
+    judge: &mut dyn FnMut(&Outcome) -> Option<Judged<J>>,
 ) -> Result<Option<(Outcome, PlanSettings, J)>, PlanError> {
     if !base.unreached.is_empty() || cell.robots.len() < 2 {
         return Ok(None);
     }
     let mut best: Option<(Outcome, PlanSettings, J)> = None;
-    let mut score = base_score;
+    let (mut score, mut judged_ends) = (base_score, base_ends.to_vec());
     let mut tried: Vec<Vec<Vec<TaskId>>> = vec![base.allocated.tasks.clone()];
     let (mut plans, mut judged) = (0, 0);
     'rounds: while plans < REBALANCE_PLANS && judged < REBALANCE_JUDGED {
         let current = best.as_ref().map_or(base, |b| &b.0);
-        let (bar, from_tasks, hand_overs) = (
-            makespan(current),
+        let (from_tasks, hand_overs) = (
             current.allocated.tasks.clone(),
-            moves(cell, current),
+            moves(cell, current, &judged_ends),
         );
         for mv in hand_overs {
             if plans >= REBALANCE_PLANS
@@ -171,16 +175,15 @@ pub fn rebalance<J>(
             let Ok(o) = plan_cached(cell, table, &next, &|_| {}, cache) else {
                 continue;
             };
-            // The robots must end sooner without coordination, and the judge's score (a
-            // coordinated cycle, never below that) must beat the best so far.
-            if !o.unreached.is_empty() || makespan(&o) >= bar - 1e-6 || makespan(&o) >= score - 1e-6 {
+            // The judge's score is never below the robots' latest end without coordination.
+            if !o.unreached.is_empty() || makespan(&o) >= score - 1e-6 {
                 continue;
             }
             judged += 1;
-            if let Some((sc, j)) = judge(&o)
+            if let Some((sc, e, j)) = judge(&o)
                 && sc < score - 1e-6
             {
-                score = sc;
+                (score, judged_ends) = (sc, e);
                 best = Some((o, next, j));
                 continue 'rounds;
             }
