@@ -86,7 +86,7 @@ fn moves(cell: &Cell, o: &Outcome, end: &[f64]) -> Vec<Move> {
         let saved =
             legs[i].duration + legs[i + 1].duration + dwell(cell, task) - long_slow * g.costs.get(prev, next);
         let from_end = free[from] - saved;
-        for to in 0..end.len() {
+        for (to, &to_free) in free.iter().enumerate() {
             let h = &o.graphs[to];
             let nodes = &h.alternatives[task.0];
             if to == from || nodes.is_empty() || o.robots[to].sequence.nodes.len() >= cell.planning.task_cap {
@@ -101,7 +101,7 @@ fn moves(cell: &Cell, o: &Outcome, end: &[f64]) -> Vec<Move> {
                         .map(move |&n| h.costs.get(p[0], n) + h.costs.get(n, p[1]) - h.costs.get(p[0], p[1]))
                 })
                 .fold(f64::INFINITY, f64::min);
-            let to_end = free[to] + dwell(cell, task) + slowness(to) * insertion;
+            let to_end = to_free + dwell(cell, task) + slowness(to) * insertion;
             let expected = from_end.max(to_end);
             if expected < end[from] - 1e-6 {
                 out.push(Move {
