@@ -258,14 +258,15 @@ fn strips_cut_the_mps_along_the_line_of_the_robots_and_each_robot_sweeps_its_str
     verified(&cell, &doc);
 }
 
+/// A cell of the repository (path from its root), loaded.
+fn repo_cell(rel: &str) -> cellplan_model::Cell {
+    load(&repo_root().join(rel), &LoadOptions::default()).unwrap()
+}
+
 #[test]
 fn robots_facing_each_other_make_two_rows_along_the_part() {
     // facing-4r-roof: two robots on each side of the car, facing across it.
-    let cell = load(
-        &repo_root().join("bench/cells/facing-4r-roof/cell.toml"),
-        &LoadOptions::default(),
-    )
-    .unwrap();
+    let cell = repo_cell("bench/cells/facing-4r-roof/cell.toml");
     let (line, rows) = plan::robot_rows(&cell).expect("four robots");
     assert_eq!(rows.len(), 2, "{rows:?}");
     for row in &rows {
@@ -277,11 +278,7 @@ fn robots_facing_each_other_make_two_rows_along_the_part() {
     // The line runs along the car (y), not across it.
     assert!(line[1].abs() > 0.99, "{line:?}");
     // The README cell: one row of four along the car.
-    let readme = load(
-        &repo_root().join("examples/autobody-4r/cell.toml"),
-        &LoadOptions::default(),
-    )
-    .unwrap();
+    let readme = repo_cell("examples/autobody-4r/cell.toml");
     let (line, rows) = plan::robot_rows(&readme).unwrap();
     assert_eq!(rows, vec![vec![0, 1, 2, 3]]);
     assert!(line[1].abs() > 0.99, "{line:?}");
@@ -290,11 +287,7 @@ fn robots_facing_each_other_make_two_rows_along_the_part() {
 #[test]
 fn rebalancing_hands_tasks_from_the_robot_ending_last_until_the_robots_end_sooner() {
     use plan::rebalance::{REBALANCE_PLANS, ends, makespan, rebalance};
-    let cell = load(
-        &repo_root().join("examples/autobody-4r/cell.toml"),
-        &LoadOptions::default(),
-    )
-    .unwrap();
+    let cell = repo_cell("examples/autobody-4r/cell.toml");
     let table = generate(&cell);
     // The nearest-robot allocation ignores how long each robot works (5 to 14 MPs here).
     let s = settings(Allocation::Proximity);
