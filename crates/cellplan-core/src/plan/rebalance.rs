@@ -57,34 +57,38 @@ fn moves(cell: &Cell, o: &Outcome, end: &[f64]) -> Vec<Move> {
         return Vec::new();
     };
     // Per robot: its tour as graph nodes (home at both ends) and its slowness factor.
-    let tour = |r: usize| -> Vec<usize> {
-        let mut t = vec![0];
-        t.extend(&o.robots[r].sequence.nodes);
-        t.push(0);
-        t
-    };
-    let slowness = |r: usize| -> f64 {
-        let g = &o.graphs[r];
-        let t = tour(r);
-        let bound: f64 = t.windows(2).map(|w| g.costs.get(w[0], w[1])).sum();
-        let real = o.robots[r].program.motion();
-        if bound > 1e-9 {
-            (real / bound).max(1.0)
-        } else {
-            1.0
-        }
-    };
-    let (long_tour, long_slow) = (tour(from), slowness(from));
+    let tours: Vec<Vec<usize>> = o
+        .robots
+        .iter()
+        .map(|r| {
+            let mut t = vec![0];
+            t.extend(&r.sequence.nodes);
+            t.push(0);
+            t
+        })
+        .collect();
+    let slowness: Vec<f64> = (0..o.robots.len())
+        .map(|r| {
+            let g = &o.graphs[r];
+            let bound: f64 = tours[r].windows(2).map(|w| g.costs.get(w[0], w[1])).sum();
+            let real = o.robots[r].program.motion();
+            if bound > 1e-9 {
+                (real / bound).max(1.0)
+            } else {
+                1.0
+            }
+        })
+        .collect();
     let g = &o.graphs[from];
     let legs = &o.robots[from].sequence.legs;
     let mut out = Vec::new();
-    for (i, w) in long_tour.windows(3).enumerate() {
+    for (i, w) in tours[from].windows(3).enumerate() {
         let (prev, node, next) = (w[0], w[1], w[2]);
         let Some((task, _)) = g.node_task[node] else {
             continue;
         };
-        let saved =
-            legs[i].duration + legs[i + 1].duration + dwell(cell, task) - long_slow * g.costs.get(prev, next);
+        let saved = legs[i].duration + legs[i + 1].duration + dwell(cell, task)
+            - slowness[from] * g.costs.get(prev, next);
         let from_end = free[from] - saved;
         for (to, &to_free) in free.iter().enumerate() {
             let h = &o.graphs[to];
@@ -92,8 +96,7 @@ fn moves(cell: &Cell, o: &Outcome, end: &[f64]) -> Vec<Move> {
             if to == from || nodes.is_empty() || o.robots[to].sequence.nodes.len() >= cell.planning.task_cap {
                 continue;
             }
-            let t = tour(to);
-            let insertion = t
+            let insertion = tours[to]
                 .windows(2)
                 .flat_map(|p| {
                     nodes
@@ -101,7 +104,7 @@ fn moves(cell: &Cell, o: &Outcome, end: &[f64]) -> Vec<Move> {
                         .map(move |&n| h.costs.get(p[0], n) + h.costs.get(n, p[1]) - h.costs.get(p[0], p[1]))
                 })
                 .fold(f64::INFINITY, f64::min);
-            let to_end = to_free + dwell(cell, task) + slowness(to) * insertion;
+            let to_end = to_free + dwell(cell, task) + slowness[to] * insertion;
             let expected = from_end.max(to_end);
             if expected < end[from] - 1e-6 {
                 out.push(Move {

@@ -122,8 +122,8 @@ fn shortcut_by(
         }
         let (mut t1, mut t2): (f64, f64) = (rng.random_range(0.0..1.0), rng.random_range(0.0..1.0));
         if timed.is_some() {
-            // A third from a waypoint and a third to one: a shortcut that removes corners adds
-            // no stop.
+            // Half from a waypoint and half to one: a shortcut that removes corners adds no
+            // stop.
             if rng.random_bool(0.5) {
                 t1 = 0.0;
             } else {

@@ -128,19 +128,7 @@ pub fn segment_time(a: &[f64], b: &[f64], limits: &Limits) -> f64 {
     if len <= SAME_POINT {
         return 0.0;
     }
-    // Along the line joint j moves at s'·|u_j|: the line's limits are the tightest joint's.
-    let (mut vmax, mut amax) = (f64::INFINITY, f64::INFINITY);
-    for ((x, y), (&v, &acc)) in a
-        .iter()
-        .zip(b)
-        .zip(limits.velocity.iter().zip(&limits.acceleration))
-    {
-        let u = (y - x).abs() / len;
-        if u > 0.0 {
-            vmax = vmax.min(v / u);
-            amax = amax.min(acc / u);
-        }
-    }
+    let (vmax, amax) = line_limits(a.iter().zip(b).map(|(x, y)| (y - x).abs() / len), limits);
     if len * amax >= vmax * vmax {
         len / vmax + vmax / amax
     } else {
@@ -311,6 +299,20 @@ struct Built {
     blends: Vec<Blend>,
 }
 
+/// The largest speed and acceleration along a line whose unit direction has the components
+/// `|u_j|` (joint order) that no joint exceeds: joint `j` moves at `s'·|u_j|`, so the tightest
+/// joint sets them (infinite for a line no joint moves along).
+fn line_limits(u: impl Iterator<Item = f64>, limits: &Limits) -> (f64, f64) {
+    let (mut v, mut a) = (f64::INFINITY, f64::INFINITY);
+    for ((u, &vj), &aj) in u.zip(&limits.velocity).zip(&limits.acceleration) {
+        if u > 0.0 {
+            v = v.min(vj / u);
+            a = a.min(aj / u);
+        }
+    }
+    (v, a)
+}
+
 fn dist(a: &[f64], b: &[f64]) -> f64 {
     a.iter()
         .zip(b)
@@ -380,16 +382,7 @@ impl Clean {
                 .unwrap_or(path.len() - 1);
         }
         for s in &mut segments {
-            let (mut v, mut a) = (f64::INFINITY, f64::INFINITY);
-            for j in 0..dof {
-                let u = s.dir[j].abs();
-                if u > 0.0 {
-                    v = v.min(limits.velocity[j] / u);
-                    a = a.min(limits.acceleration[j] / u);
-                }
-            }
-            s.vmax = v;
-            s.amax = a;
+            (s.vmax, s.amax) = line_limits(s.dir.iter().map(|u| u.abs()), limits);
         }
         let mut beta = vec![0.0; m + 1];
         for (k, b) in beta.iter_mut().enumerate().take(m).skip(1) {
