@@ -272,18 +272,20 @@ pub fn coordinate(
     }
     // The best plan balanced on its real times (one task at a time from the robot that ends
     // last, see [`plan::rebalance`]), each hand-over judged by its coordinated cycle.
-    if best.1.deadline.is_none_or(|d| Instant::now() < d) {
-        let ends = |c: &Coordinated| c.timed.iter().map(|t| t.end()).collect::<Vec<f64>>();
-        let (score, base_ends) = (cycle_and_delta(&best.2.timed).0, ends(&best.2));
-        let mut judge = |o: &Outcome| {
-            let c = coordinate_outcome(cell, table, o, coord).ok()?;
-            Some((cycle_and_delta(&c.timed).0, ends(&c), c))
-        };
-        let base = (&best.0, score, base_ends.as_slice());
-        if let Ok(Some((o, s, c))) = plan::rebalance::rebalance(cell, table, base, &best.1, cache, &mut judge)
-        {
-            best = (o, s, c);
+    let ends = |c: &Coordinated| c.timed.iter().map(|t| t.end()).collect::<Vec<f64>>();
+    let (score, base_ends) = (cycle_and_delta(&best.2.timed).0, ends(&best.2));
+    let mut judge = |o: &Outcome| {
+        let c = coordinate_outcome(cell, table, o, coord).ok()?;
+        Some((cycle_and_delta(&c.timed).0, ends(&c), c))
+    };
+    let base = (&best.0, score, base_ends.as_slice());
+    if let Ok((found, clock_cut)) = plan::rebalance::rebalance(cell, table, base, &best.1, cache, &mut judge)
+    {
+        if let Some(found) = found {
+            best = found;
         }
+        // The clock stopped the hand-overs: the plan says so.
+        best.0.time_limit_hit |= clock_cut;
     }
     let spent = lap.elapsed().as_secs_f64();
     let (o, s, c) = best;

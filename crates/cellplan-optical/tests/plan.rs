@@ -294,11 +294,27 @@ fn rebalancing_hands_tasks_from_the_robot_ending_last_until_the_robots_end_soone
     let mut cache = plan::PlanCache::default();
     let base = plan::plan_cached(&cell, &table, &s, &|_| {}, &mut cache).unwrap();
     let before = makespan(&base);
-    let mut judged = 0;
+    let judged = std::cell::Cell::new(0);
     let mut judge = |o: &plan::Outcome| {
-        judged += 1;
+        judged.set(judged.get() + 1);
         Some((makespan(o), ends(o), ()))
     };
+    // Past the deadline no hand-over is planned, and the search says the clock cut it.
+    let late = PlanSettings {
+        deadline: Some(std::time::Instant::now()),
+        ..s.clone()
+    };
+    let cut = rebalance(
+        &cell,
+        &table,
+        (&base, before, &ends(&base)),
+        &late,
+        &mut cache,
+        &mut judge,
+    )
+    .unwrap();
+    assert!(cut.0.is_none() && cut.1, "the clock cut must show");
+    assert_eq!(judged.get(), 0);
     let (o, fixed, ()) = rebalance(
         &cell,
         &table,
@@ -308,8 +324,9 @@ fn rebalancing_hands_tasks_from_the_robot_ending_last_until_the_robots_end_soone
         &mut judge,
     )
     .unwrap()
+    .0
     .expect("the nearest robots are unbalanced here");
-    assert!(judged >= 1);
+    assert!(judged.get() >= 1);
     assert!(makespan(&o) < before - 1e-6, "{} !< {before}", makespan(&o));
     // The plan is the fixed allocation it was made with: every task once, within the caps,
     // each with a robot able to do it, a few hand-overs away from the start.

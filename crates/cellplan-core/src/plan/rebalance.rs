@@ -33,6 +33,10 @@ struct Move {
 /// without coordination), each robot's end under it (s), and what it made.
 pub type Judged<J> = (f64, Vec<f64>, J);
 
+/// A rebalanced plan: the plan, the settings it was made with (its fixed allocation) and what
+/// the judge made of it.
+pub type Rebalanced<J> = (Outcome, PlanSettings, J);
+
 /// When each robot of `o` ends without coordination (s).
 pub fn ends(o: &Outcome) -> Vec<f64> {
     o.robots.iter().map(|r| r.program.duration()).collect()
@@ -134,7 +138,8 @@ fn moves(cell: &Cell, o: &Outcome, end: &[f64]) -> Vec<Move> {
 /// first it scores below the best is kept and the next hand-overs start from it and its ends.
 /// Returns the best plan found with its settings and what the judge made of it, or `None` when
 /// no hand-over beat `base_score` (or `base` leaves tasks unreached: it is not rebalanced
-/// then). Plans that fail only lose their try; past the deadline the search stops.
+/// then), and whether the deadline stopped the search with hand-overs left to try (the plan
+/// then depends on the machine's speed). Plans that fail only lose their try.
 pub fn rebalance<J>(
     cell: &Cell,
     table: &CandidateTable,
@@ -142,11 +147,11 @@ pub fn rebalance<J>(
     settings: &PlanSettings,
     cache: &mut PlanCache,
     judge: &mut dyn FnMut(&Outcome) -> Option<Judged<J>>,
-) -> Result<Option<(Outcome, PlanSettings, J)>, PlanError> {
+) -> Result<(Option<Rebalanced<J>>, bool), PlanError> {
     if !base.unreached.is_empty() || cell.robots.len() < 2 {
-        return Ok(None);
+        return Ok((None, false));
     }
-    let mut best: Option<(Outcome, PlanSettings, J)> = None;
+    let mut best: Option<Rebalanced<J>> = None;
     let (mut score, mut judged_ends) = (base_score, base_ends.to_vec());
     let mut tried: Vec<Vec<Vec<TaskId>>> = vec![base.allocated.tasks.clone()];
     let (mut plans, mut judged) = (0, 0);
@@ -157,11 +162,11 @@ pub fn rebalance<J>(
             moves(cell, current, &judged_ends),
         );
         for mv in hand_overs {
-            if plans >= REBALANCE_PLANS
-                || judged >= REBALANCE_JUDGED
-                || settings.deadline.is_some_and(|d| Instant::now() >= d)
-            {
+            if plans >= REBALANCE_PLANS || judged >= REBALANCE_JUDGED {
                 break 'rounds;
+            }
+            if settings.deadline.is_some_and(|d| Instant::now() >= d) {
+                return Ok((best, true));
             }
             let mut tasks = from_tasks.clone();
             tasks[mv.from].retain(|&t| t != mv.task);
@@ -194,5 +199,5 @@ pub fn rebalance<J>(
         // No hand-over of the robot ending last helped.
         break;
     }
-    Ok(best)
+    Ok((best, false))
 }
