@@ -8,7 +8,10 @@
 //! `cellplan compare` takes its "ours" row from here as well.
 use crate::candidates::{self, CandidateTable};
 use crate::check::{cap_error, graph_size_error, idle_robot_error};
-use crate::coord::{CoordSettings, Coordinated, Coordination, coordinate_outcome, cycle_and_delta};
+use crate::coord::{
+    CoordSettings, Coordinated, Coordination, DiagramCache, coordinate_outcome, coordinate_outcome_cached,
+    cycle_and_delta,
+};
 use crate::document::{self, Plan};
 use crate::plan::{self, Allocation, Outcome, PlanError, PlanSettings, Stage};
 use cellplan_model::{Cell, InputError};
@@ -194,11 +197,8 @@ pub fn coordinate(
         return Ok((outcome, settings, c));
     }
     let lap = Instant::now();
-    let first = coordinate_outcome(cell, table, &outcome, coord)?;
-    let again = PlanSettings {
-        task_penalty: blocking_penalty(cell, &first),
-        ..settings.clone()
-    };
+    // Pair diagrams shared by the coordinations below (many robots keep their paths).
+    let diagrams = DiagramCache::default();
     // The nearest-robot allocation the zones start from, planned and coordinated as it is:
     // where neighbours share much space, uneven but separate work can end sooner than
     // balanced work that meets.
@@ -222,60 +222,133 @@ pub fn coordinate(
         task_penalty: Vec::new(),
         ..settings.clone()
     });
-    // Only the best run so far is kept (the shortest cycle, then Δt, then the earlier): the
-    // others' plans and coordinations are dropped as soon as they lose.
-    let mut best = (outcome, settings, first);
     // The strips first: where they pay, the others are then often beaten before coordination.
-    let mut tries: Vec<PlanSettings> = [sweep, Some(nearest), Some(again), balanced]
-        .into_iter()
-        .flatten()
-        .collect();
+    // `None` stands for the zones allocation again with what the first plan's measurements
+    // blocked the other robots (known once the first plan is coordinated).
+    let mut tries: Vec<Option<PlanSettings>> = [
+        sweep.map(Some),
+        Some(Some(nearest)),
+        Some(None),
+        balanced.map(Some),
+    ]
+    .into_iter()
+    .flatten()
+    .collect();
+    // Only the best run so far is kept (the shortest cycle, then Δt, then the earlier): the
+    // others' plans and coordinations are dropped as soon as they lose. Each plan is
+    // coordinated while the next is planned (the plans share `cache`, the coordinations
+    // nothing but the diagrams: the result is that of one after the other).
+    let mut best: Option<(Outcome, PlanSettings, Coordinated)> = None;
+    let mut pending = Some((outcome, settings.clone()));
+    let mut again: Option<Vec<Vec<f64>>> = None;
     let mut next = 0;
-    while let Some(more) = tries.get(next).cloned() {
-        next += 1;
+    let mut cut = false;
+    let cycle_of = |b: &Option<(Outcome, PlanSettings, Coordinated)>| {
+        b.as_ref()
+            .map_or(f64::INFINITY, |b| cycle_and_delta(&b.2.timed).0)
+    };
+    loop {
         // Past the deadline the other tries are skipped, and the plan says the clock cut it.
-        if more.deadline.is_some_and(|d| Instant::now() >= d) {
-            best.0.time_limit_hit = true;
-            break;
-        }
-        // The balanced allocation is planned afresh, as it is on its own (legs the other plans
-        // timed would steer its lazy sequencing elsewhere): ours is then never longer than it
-        // with `best`. A plan that fails only loses its try.
-        let mut own = plan::PlanCache::default();
-        let fresh = more.allocation == Allocation::Balanced;
-        let Ok(o) = plan::plan_cached(cell, table, &more, &|_| {}, if fresh { &mut own } else { cache })
-        else {
-            continue;
+        let more = match tries.get(next) {
+            _ if cut => None,
+            Some(t)
+                if t.as_ref()
+                    .unwrap_or(&settings)
+                    .deadline
+                    .is_some_and(|d| Instant::now() >= d) =>
+            {
+                cut = true;
+                None
+            }
+            Some(Some(t)) => Some(t.clone()),
+            Some(None) => again.clone().map(|pen| PlanSettings {
+                task_penalty: pen,
+                ..settings.clone()
+            }),
+            None => None,
         };
-        // The strips once more, each robot's estimates raised by what its legs took beyond
-        // their lower bounds in this plan.
-        if more.sweep.is_some() && more.task_penalty.is_empty() {
-            tries.insert(
-                next,
-                PlanSettings {
-                    task_penalty: slowness_penalty(cell, &o),
-                    ..more.clone()
-                },
-            );
+        if pending.is_none() && more.is_none() {
+            if next < tries.len() && !cut {
+                // The try could not be made (the first coordination failed): the next.
+                next += 1;
+                continue;
+            }
+            break;
         }
         // Coordination only adds waits: a plan whose robots end no sooner than the best cycle
         // so far even without them cannot win, and is not coordinated.
-        let free = o.robots.iter().map(|r| r.program.duration()).fold(0.0, f64::max);
-        if free >= cycle_and_delta(&best.2.timed).0 {
-            continue;
+        let bar = cycle_of(&best);
+        let first = best.is_none();
+        let (judged, planned) = rayon::join(
+            || {
+                let (o, _) = pending.as_ref()?;
+                let free = o.robots.iter().map(|r| r.program.duration()).fold(0.0, f64::max);
+                (free < bar).then(|| coordinate_outcome_cached(cell, table, o, coord, &diagrams))
+            },
+            || {
+                // The balanced allocation is planned afresh, as it is on its own (legs the
+                // other plans timed would steer its lazy sequencing elsewhere): ours is then
+                // never longer than it with `best`. A plan that fails only loses its try.
+                let more = more.as_ref()?;
+                let mut own = plan::PlanCache::default();
+                let fresh = more.allocation == Allocation::Balanced;
+                plan::plan_cached(
+                    cell,
+                    table,
+                    more,
+                    &|_| {},
+                    if fresh { &mut own } else { &mut *cache },
+                )
+                .ok()
+            },
+        );
+        if let Some((o, s)) = pending.take() {
+            match judged {
+                // The first plan's coordination is the run's: its failure is the run's.
+                Some(Err(e)) if first => return Err(e),
+                Some(Ok(c)) if first => {
+                    again = Some(blocking_penalty(cell, &c));
+                    best = Some((o, s, c));
+                }
+                Some(Ok(c))
+                    if best
+                        .as_ref()
+                        .is_some_and(|b| cycle_and_delta(&c.timed) < cycle_and_delta(&b.2.timed)) =>
+                {
+                    best = Some((o, s, c));
+                }
+                _ => {}
+            }
         }
-        if let Ok(c) = coordinate_outcome(cell, table, &o, coord)
-            && cycle_and_delta(&c.timed) < cycle_and_delta(&best.2.timed)
-        {
-            best = (o, more, c);
+        if let Some(more) = more {
+            next += 1;
+            if let Some(o) = planned {
+                // The strips once more, each robot's estimates raised by what its legs took
+                // beyond their lower bounds in this plan.
+                if more.sweep.is_some() && more.task_penalty.is_empty() {
+                    tries.insert(
+                        next,
+                        Some(PlanSettings {
+                            task_penalty: slowness_penalty(cell, &o),
+                            ..more.clone()
+                        }),
+                    );
+                }
+                pending = Some((o, more));
+            }
         }
+    }
+    // (Never `None`: the first plan is coordinated, or the run has failed with its error.)
+    let mut best = best.ok_or(PlanError::NoPriorityOrder)?;
+    if cut {
+        best.0.time_limit_hit = true;
     }
     // The best plan balanced on its real times (one task at a time from the robot that ends
     // last, see [`plan::rebalance`]), each hand-over judged by its coordinated cycle.
     let ends = |c: &Coordinated| c.timed.iter().map(|t| t.end()).collect::<Vec<f64>>();
     let (score, base_ends) = (cycle_and_delta(&best.2.timed).0, ends(&best.2));
     let mut judge = |o: &Outcome| {
-        let c = coordinate_outcome(cell, table, o, coord).ok()?;
+        let c = coordinate_outcome_cached(cell, table, o, coord, &diagrams).ok()?;
         Some((cycle_and_delta(&c.timed).0, ends(&c), c))
     };
     let base = (&best.0, score, base_ends.as_slice());

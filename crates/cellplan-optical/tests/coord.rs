@@ -135,6 +135,98 @@ fn the_coordination_diagram_covers_every_contact() {
     assert!(area < 0.5 * ta.end() * tb.end(), "{area}");
 }
 
+/// The diagram as a certificate on the clock: with waits anywhere in the two programs, every
+/// time (every 10 ms) at which the robots come closer than the coordination's distance lies in
+/// a window the cover gives for the pair, and the windows are not the whole clock. (The exact
+/// search on the clock looks only there.)
+#[test]
+fn the_diagrams_windows_on_the_clock_hold_every_contact() {
+    let f = fixture();
+    let (_, none) = document(Coordination::None);
+    let settings = coord::CoordSettings::default();
+    let boxes = coord::conflict_boxes(&f.cell, &f.table, &none.programs, &settings).unwrap();
+    let cover = coord::Cover::new(2, &boxes);
+    let margin = f.cell.planning.clearance + coord::REPLAY_SLACK;
+    let (ra, rb) = (&f.cell.robots[0], &f.cell.robots[1]);
+    let limits: Vec<_> = f
+        .cell
+        .robots
+        .iter()
+        .map(cellplan_core::plan::graph::limits_of)
+        .collect();
+    let wait = |leg: usize, duration: f64| coord::Wait {
+        leg,
+        waypoint: 0,
+        duration,
+        reason: coord::WaitReason::GiveWay,
+        for_robot: None,
+    };
+    let (mut contacts, mut covered, mut total) = (0, 0.0, 0.0);
+    // Waits of either robot, at its start and between measurements.
+    for (wa, wb) in [
+        (vec![], vec![]),
+        (vec![(0, 1.5)], vec![]),
+        (vec![], vec![(2, 0.8), (5, 2.0)]),
+        (vec![(3, 0.6)], vec![(0, 0.3)]),
+    ] {
+        let (mut pa, mut pb) = (none.programs[0].clone(), none.programs[1].clone());
+        for (leg, d) in wa {
+            pa.set_wait(wait(leg, d));
+        }
+        for (leg, d) in wb {
+            pb.set_wait(wait(leg, d));
+        }
+        let (ta, tb) = (pa.timed(&limits[0]).unwrap(), pb.timed(&limits[1]).unwrap());
+        let horizon = ta.end().max(tb.end());
+        let windows = cover.windows(0, &ta, 1, &tb, 0.0, horizon).unwrap();
+        covered += windows.iter().map(|w| w.1 - w.0).sum::<f64>();
+        total += horizon;
+        let (mut sa, mut sb) = (Default::default(), Default::default());
+        let mut t = 0.0;
+        while t <= horizon {
+            ra.body_poses(&ta.trajectory.position(t), &mut sa);
+            rb.body_poses(&tb.trajectory.position(t), &mut sb);
+            let d = f
+                .cell
+                .world
+                .group_group_distance(ra.group, &sa.bodies, rb.group, &sb.bodies, 1.0);
+            if d <= margin {
+                contacts += 1;
+                assert!(
+                    windows.iter().any(|w| w.0 - 1e-9 <= t && t <= w.1 + 1e-9),
+                    "contact at {t} s ({d} m) in no window: {windows:?}"
+                );
+            }
+            t += 0.01;
+        }
+    }
+    assert!(contacts > 0, "the robots of the crossing cell meet somewhere");
+    assert!(covered < 0.5 * total, "windows {covered} s of {total} s");
+}
+
+/// Coordinating from diagrams kept by an earlier coordination of the same programs gives the
+/// same programs, counts and search, and builds nothing new.
+#[test]
+fn coordination_from_kept_diagrams_is_the_same() {
+    let f = fixture();
+    let settings = coord::CoordSettings::default();
+    let alone = coord::coordinate_outcome(&f.cell, &f.table, &f.outcome, &settings).unwrap();
+    let cache = coord::DiagramCache::default();
+    let first = coord::coordinate_outcome_cached(&f.cell, &f.table, &f.outcome, &settings, &cache).unwrap();
+    let held = cache.len();
+    assert!(held >= 1);
+    let again = coord::coordinate_outcome_cached(&f.cell, &f.table, &f.outcome, &settings, &cache).unwrap();
+    assert_eq!(cache.len(), held, "nothing built again");
+    for c in [&first, &again] {
+        assert_eq!(c.programs, alone.programs);
+        assert_eq!(c.search, alone.search);
+        assert_eq!(
+            (c.resolved, c.waits, c.reversed.clone()),
+            (alone.resolved, alone.waits, alone.reversed.clone())
+        );
+    }
+}
+
 /// Every robot's motion keeps the coordination's distance, and `HOME_STEP_SLACK` more, from
 /// every other robot standing at home (sampled along the uncoordinated timelines): a robot at
 /// home is never in another's way, with room for the timeline's conservative steps.

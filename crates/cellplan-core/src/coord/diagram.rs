@@ -64,6 +64,9 @@ pub(crate) struct RobotPath {
     pieces: Vec<Piece>,
     /// The program on the clock, without its waits.
     pub timed: Timed,
+    /// The path exactly (robot, every waypoint, segment time, measuring pose and dwell, as
+    /// bits): equal signatures, equal paths, equal diagrams (see [`DiagramCache`]).
+    signature: Vec<u64>,
 }
 
 impl RobotPath {
@@ -104,6 +107,21 @@ impl RobotPath {
                 moving: matches!(s.what, Activity::Move { .. }),
             })
             .collect();
+        let mut signature = vec![program.robot as u64];
+        signature.extend(bare.home.iter().map(|x| x.to_bits()));
+        for leg in &bare.legs {
+            signature.push(leg.waypoints.len() as u64);
+            signature.extend(
+                leg.waypoints
+                    .iter()
+                    .flatten()
+                    .chain(&leg.segments)
+                    .map(|x| x.to_bits()),
+            );
+        }
+        for v in &bare.visits {
+            signature.extend(v.q.iter().chain([&v.dwell]).map(|x| x.to_bits()));
+        }
         Ok(RobotPath {
             robot: program.robot,
             len: timed.end(),
@@ -111,6 +129,7 @@ impl RobotPath {
             visits: timed.visits.clone(),
             pieces,
             timed,
+            signature,
         })
     }
 
@@ -179,6 +198,8 @@ struct Placed {
     /// World bounding sphere of each body with shapes, and which body it is.
     spheres: Vec<(DVec3, f64)>,
     bodies: Vec<usize>,
+    /// Per body, the index of its sphere in `spheres` (`usize::MAX`: no shapes).
+    sphere_of: Vec<usize>,
     /// Each body's sphere cover in the world (empty for a body without shapes).
     covers: Vec<Vec<(DVec3, f64)>>,
 }
@@ -220,8 +241,9 @@ fn covers(ctx: &Ctx, robot: &Robot) -> Vec<Vec<(DVec3, f64)>> {
 enum Rect {
     Free,
     Conflict,
-    HalveA,
-    HalveB,
+    /// Halve along the first robot; the body pairs not proven apart over the whole rectangle.
+    HalveA(Vec<(usize, usize)>),
+    HalveB(Vec<(usize, usize)>),
 }
 
 struct PairDiagram<'a> {
@@ -259,12 +281,16 @@ impl PairDiagram<'_> {
         let q = path.at(s);
         robot.body_poses(&q, &mut self.scratch);
         let local = if first { &self.sa } else { &self.sb };
-        let (spheres, bodies) = local
+        let (spheres, bodies): (Vec<(DVec3, f64)>, Vec<usize>) = local
             .iter()
             .zip(&self.scratch.bodies)
             .enumerate()
             .filter_map(|(i, (s, p))| s.map(|(c, r)| ((p.transform_point(c), r), i)))
             .unzip();
+        let mut sphere_of = vec![usize::MAX; self.scratch.bodies.len()];
+        for (k, &b) in bodies.iter().enumerate() {
+            sphere_of[b] = k;
+        }
         let covers = if first { &self.ca } else { &self.cb }
             .iter()
             .zip(&self.scratch.bodies)
@@ -275,6 +301,7 @@ impl PairDiagram<'_> {
             poses: self.scratch.bodies.clone(),
             spheres,
             bodies,
+            sphere_of,
             covers,
         }
     }
@@ -300,31 +327,42 @@ impl PairDiagram<'_> {
         }
     }
 
-    /// The body pairs of the two placed robots whose sphere covers (body spheres first) come
-    /// within `need`: every other pair is farther than `need` (the covers hold the meshes).
-    fn close_pairs(&self, xa: &Placed, xb: &Placed, need: f64) -> Vec<(usize, usize)> {
+    /// The body pairs of the two placed robots (of `among`, or of all) whose sphere covers
+    /// (body spheres first) come within `need`: every other pair is farther than `need` (the
+    /// covers hold the meshes).
+    fn close_pairs(
+        &self,
+        xa: &Placed,
+        xb: &Placed,
+        need: f64,
+        among: Option<&[(usize, usize)]>,
+    ) -> Vec<(usize, usize)> {
         // Squared distances against squared reaches (all terms are non-negative): no square
         // root per sphere pair.
         let within = |c: DVec3, r: f64, d: DVec3, q: f64| {
             let reach = need + r + q;
             (c - d).length_squared() <= reach * reach
         };
-        let mut out = Vec::new();
-        for (i, (ca, ra)) in xa.spheres.iter().enumerate() {
-            for (j, (cb, rb)) in xb.spheres.iter().enumerate() {
-                if !within(*ca, *ra, *cb, *rb) {
-                    continue;
-                }
-                let (bi, bj) = (xa.bodies[i], xb.bodies[j]);
-                let close = xa.covers[bi]
+        let close = |i: usize, j: usize| {
+            let ((ca, ra), (cb, rb)) = (xa.spheres[i], xb.spheres[j]);
+            let (bi, bj) = (xa.bodies[i], xb.bodies[j]);
+            within(ca, ra, cb, rb)
+                && xa.covers[bi]
                     .iter()
-                    .any(|(c, r)| xb.covers[bj].iter().any(|(d, q)| within(*c, *r, *d, *q)));
-                if close {
-                    out.push((bi, bj));
-                }
-            }
+                    .any(|(c, r)| xb.covers[bj].iter().any(|(d, q)| within(*c, *r, *d, *q)))
+        };
+        match among {
+            Some(pairs) => pairs
+                .iter()
+                .copied()
+                .filter(|&(bi, bj)| close(xa.sphere_of[bi], xb.sphere_of[bj]))
+                .collect(),
+            None => (0..xa.spheres.len())
+                .flat_map(|i| (0..xb.spheres.len()).map(move |j| (i, j)))
+                .filter(|&(i, j)| close(i, j))
+                .map(|(i, j)| (xa.bodies[i], xb.bodies[j]))
+                .collect(),
         }
-        out
     }
 
     /// Whether the two placed robots are farther apart than `need`, exactly (up to the convex
@@ -362,8 +400,9 @@ impl PairDiagram<'_> {
     /// What rectangle `[a0, a1] × [b0, b1]` (inside pieces of the two paths) is: free (the
     /// sphere covers, or the exact distance, exceed the clearance plus both robots' reach over
     /// it), to be halved (along the robot that moves more), or — once nothing is left to halve
-    /// — in conflict.
-    fn judge(&mut self, a: (f64, f64, bool), b: (f64, f64, bool)) -> Rect {
+    /// — in conflict. Only the body pairs `among` are looked at (`None`: all): a rectangle
+    /// inside one where a pair was proven apart has that pair apart too.
+    fn judge(&mut self, a: (f64, f64, bool), b: (f64, f64, bool), among: Option<&[(usize, usize)]>) -> Rect {
         self.work.cells += 1;
         let (pa, pb) = (self.pa, self.pb);
         let xa = self.place(pa, true, 0.5 * (a.0 + a.1));
@@ -377,7 +416,7 @@ impl PairDiagram<'_> {
         // distance only where nothing is left to halve (halving is cheaper than GJK, and
         // the covers decide most rectangles once small), and only for the body pairs whose
         // covers come close.
-        let close = self.close_pairs(&xa, &xb, need);
+        let close = self.close_pairs(&xa, &xb, need, among);
         if close.is_empty() {
             return Rect::Free;
         }
@@ -389,15 +428,15 @@ impl PairDiagram<'_> {
             };
         }
         if split_a && (!split_b || ra >= rb) {
-            Rect::HalveA
+            Rect::HalveA(close)
         } else {
-            Rect::HalveB
+            Rect::HalveB(close)
         }
     }
 
     /// Rectangle `[a0, a1] × [b0, b1]` inside pieces of the two paths: free, or halved, or
     /// recorded as in conflict.
-    fn cell(&mut self, a: (f64, f64, bool), b: (f64, f64, bool)) {
+    fn cell(&mut self, a: (f64, f64, bool), b: (f64, f64, bool), among: Option<&[(usize, usize)]>) {
         // Inside what is already in conflict: nothing to learn.
         if self
             .found
@@ -406,7 +445,7 @@ impl PairDiagram<'_> {
         {
             return;
         }
-        match self.judge(a, b) {
+        match self.judge(a, b, among) {
             Rect::Free => {}
             Rect::Conflict => {
                 let robots = (self.pa.robot, self.pb.robot);
@@ -419,24 +458,37 @@ impl PairDiagram<'_> {
                 f.a = (f.a.0.min(a.0), f.a.1.max(a.1));
                 f.b = (f.b.0.min(b.0), f.b.1.max(b.1));
             }
-            Rect::HalveA => self.halve_a(a, b),
-            Rect::HalveB => self.halve_b(a, b),
+            Rect::HalveA(close) => {
+                let m = 0.5 * (a.0 + a.1);
+                self.cell((a.0, m, a.2), b, Some(&close));
+                self.cell((m, a.1, a.2), b, Some(&close));
+            }
+            Rect::HalveB(close) => {
+                let m = 0.5 * (b.0 + b.1);
+                self.cell(a, (b.0, m, b.2), Some(&close));
+                self.cell(a, (m, b.1, b.2), Some(&close));
+            }
         }
     }
 
     /// Whether rectangle `[a0, a1] × [b0, b1]` is certified free (as [`Self::cell`] decides,
     /// halving until it is or a smallest rectangle is not).
-    fn certify(&mut self, a: (f64, f64, bool), b: (f64, f64, bool)) -> bool {
-        match self.judge(a, b) {
+    fn certify(
+        &mut self,
+        a: (f64, f64, bool),
+        b: (f64, f64, bool),
+        among: Option<&[(usize, usize)]>,
+    ) -> bool {
+        match self.judge(a, b, among) {
             Rect::Free => true,
             Rect::Conflict => false,
-            Rect::HalveA => {
+            Rect::HalveA(close) => {
                 let m = 0.5 * (a.0 + a.1);
-                self.certify((a.0, m, a.2), b) && self.certify((m, a.1, a.2), b)
+                self.certify((a.0, m, a.2), b, Some(&close)) && self.certify((m, a.1, a.2), b, Some(&close))
             }
-            Rect::HalveB => {
+            Rect::HalveB(close) => {
                 let m = 0.5 * (b.0 + b.1);
-                self.certify(a, (b.0, m, b.2)) && self.certify(a, (m, b.1, b.2))
+                self.certify(a, (b.0, m, b.2), Some(&close)) && self.certify(a, (m, b.1, b.2), Some(&close))
             }
         }
     }
@@ -455,32 +507,24 @@ impl PairDiagram<'_> {
         let (la, lb) = (self.pa.len, self.pb.len);
         if x.moving {
             if f.a.0 <= x.from + AT {
-                f.open[0] = x.from <= AT || self.certify((x.from, x.from, false), (f.b.0, f.b.1, y.moving));
+                f.open[0] =
+                    x.from <= AT || self.certify((x.from, x.from, false), (f.b.0, f.b.1, y.moving), None);
             }
             if f.a.1 >= x.to - AT {
-                f.open[1] = x.to >= la - AT || self.certify((x.to, x.to, false), (f.b.0, f.b.1, y.moving));
+                f.open[1] =
+                    x.to >= la - AT || self.certify((x.to, x.to, false), (f.b.0, f.b.1, y.moving), None);
             }
         }
         if y.moving {
             if f.b.0 <= y.from + AT {
-                f.open[2] = y.from <= AT || self.certify((f.a.0, f.a.1, x.moving), (y.from, y.from, false));
+                f.open[2] =
+                    y.from <= AT || self.certify((f.a.0, f.a.1, x.moving), (y.from, y.from, false), None);
             }
             if f.b.1 >= y.to - AT {
-                f.open[3] = y.to >= lb - AT || self.certify((f.a.0, f.a.1, x.moving), (y.to, y.to, false));
+                f.open[3] =
+                    y.to >= lb - AT || self.certify((f.a.0, f.a.1, x.moving), (y.to, y.to, false), None);
             }
         }
-    }
-
-    fn halve_a(&mut self, a: (f64, f64, bool), b: (f64, f64, bool)) {
-        let m = 0.5 * (a.0 + a.1);
-        self.cell((a.0, m, a.2), b);
-        self.cell((m, a.1, a.2), b);
-    }
-
-    fn halve_b(&mut self, a: (f64, f64, bool), b: (f64, f64, bool)) {
-        let m = 0.5 * (b.0 + b.1);
-        self.cell(a, (b.0, m, b.2));
-        self.cell(a, (m, b.1, b.2));
     }
 }
 
@@ -513,7 +557,7 @@ fn pair_boxes(ctx: &Ctx, pa: &RobotPath, pb: &RobotPath) -> (Vec<ConflictBox>, D
             if !sx.may_meet(sy, margin) {
                 continue;
             }
-            d.cell((x.from, x.to, x.moving), (y.from, y.to, y.moving));
+            d.cell((x.from, x.to, x.moving), (y.from, y.to, y.moving), None);
             if let Some(mut f) = d.found.take() {
                 d.open_ends(&mut f, x, y);
                 boxes.push(f);
@@ -551,12 +595,51 @@ pub(crate) fn diagrams(ctx: &Ctx, paths: &[RobotPath]) -> (Vec<ConflictBox>, Dia
     diagrams_reusing(ctx, paths, &mut parts)
 }
 
+/// Boxes of one robot pair, and what they cost.
+type Built = (Vec<ConflictBox>, DiagramWork);
+
+/// The signatures of a robot pair's two paths.
+type PairKey = (Vec<u64>, Vec<u64>);
+
 /// Boxes of one robot pair, and what they cost (see [`diagrams_reusing`]).
-pub(crate) type PairBoxes = Option<(Vec<ConflictBox>, DiagramWork)>;
+pub(crate) type PairBoxes = Option<Built>;
+
+/// The boxes of robot pairs already built on a cell, by the two paths' signatures: the
+/// plans ours makes of one cell share many robots' paths (a hand-over changes two robots),
+/// and a pair's diagram depends on nothing else (the cell, its clearance and the robots'
+/// paths). A pair found here is not built again; its work is counted as when it was built, so
+/// counts and results are those of a run without the cache.
+#[derive(Default)]
+pub struct DiagramCache {
+    pairs: std::sync::Mutex<HashMap<PairKey, Built>>,
+}
+
+impl DiagramCache {
+    /// Robot pairs' diagrams held.
+    pub fn len(&self) -> usize {
+        self.pairs.lock().unwrap_or_else(|e| e.into_inner()).len()
+    }
+
+    /// Whether none is held.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    fn get(&self, a: &RobotPath, b: &RobotPath) -> PairBoxes {
+        let pairs = self.pairs.lock().unwrap_or_else(|e| e.into_inner());
+        pairs.get(&(a.signature.clone(), b.signature.clone())).cloned()
+    }
+
+    fn put(&self, a: &RobotPath, b: &RobotPath, part: &(Vec<ConflictBox>, DiagramWork)) {
+        let mut pairs = self.pairs.lock().unwrap_or_else(|e| e.into_inner());
+        pairs.insert((a.signature.clone(), b.signature.clone()), part.clone());
+    }
+}
 
 /// As [`diagrams`], keeping each pair's boxes in `parts` (pairs `(a, b)`, `a < b`, in order);
 /// a pair whose entry is already there is not built again (clear the entries of pairs whose
-/// paths changed). The work counts what was built this time.
+/// paths changed), nor one the context's [`DiagramCache`] holds. The work counts the pairs
+/// whose entries were empty (built now, or as built before when the cache had them).
 pub(crate) fn diagrams_reusing(
     ctx: &Ctx,
     paths: &[RobotPath],
@@ -566,6 +649,13 @@ pub(crate) fn diagrams_reusing(
         .flat_map(|a| (a + 1..paths.len()).map(move |b| (a, b)))
         .collect();
     parts.resize(pairs.len(), None);
+    // What this call provides (built, or found in the cache): its work is counted.
+    let fresh: Vec<usize> = (0..pairs.len()).filter(|&i| parts[i].is_none()).collect();
+    if let Some(cache) = ctx.diagrams {
+        for &i in &fresh {
+            parts[i] = cache.get(&paths[pairs[i].0], &paths[pairs[i].1]);
+        }
+    }
     let todo: Vec<usize> = (0..pairs.len()).filter(|&i| parts[i].is_none()).collect();
     let built: Vec<(Vec<ConflictBox>, DiagramWork)> = todo
         .par_iter()
@@ -573,9 +663,14 @@ pub(crate) fn diagrams_reusing(
         .collect();
     let mut work = DiagramWork::default();
     for (i, part) in todo.into_iter().zip(built) {
+        if let Some(cache) = ctx.diagrams {
+            cache.put(&paths[pairs[i].0], &paths[pairs[i].1], &part);
+        }
+        parts[i] = Some(part);
+    }
+    for part in fresh.iter().filter_map(|&i| parts[i].as_ref()) {
         work.cells += part.1.cells;
         work.distances += part.1.distances;
-        parts[i] = Some(part);
     }
     let boxes = parts.iter().flatten().flat_map(|p| p.0.iter().cloned()).collect();
     (boxes, work)

@@ -25,6 +25,7 @@
 //!     search on the clock allows. Where no order exists (a robot's home in another's way)
 //!     it falls back on prioritised resolution: every priority order (all up to 4 robots,
 //!     else a few), at each conflict the shortest wait or another measuring pose.
+mod cover;
 mod diagram;
 mod ours;
 mod perturb;
@@ -32,7 +33,8 @@ pub mod program;
 mod schedule;
 pub mod timeline;
 
-pub use diagram::ConflictBox;
+pub use cover::Cover;
+pub use diagram::{ConflictBox, DiagramCache};
 pub use ours::conflict_boxes;
 use ours::{against_canonical, baselines_if_shorter, best, rank_of, scheduled};
 pub use program::{Activity, Program, Timed, VisitPose, Wait, WaitReason};
@@ -177,10 +179,17 @@ pub(crate) struct Ctx<'a> {
     /// Per robot, its validity checker at the cell's clearance (the others parked at home),
     /// as candidates are checked.
     pub validity: Vec<crate::motion::RobotValidity<'a>>,
+    /// Pair diagrams built by earlier coordinations of the cell, if kept.
+    pub diagrams: Option<&'a DiagramCache>,
 }
 
 impl<'a> Ctx<'a> {
-    pub fn new(cell: &'a Cell, table: &'a CandidateTable, settings: &'a CoordSettings) -> Self {
+    pub fn new(
+        cell: &'a Cell,
+        table: &'a CandidateTable,
+        settings: &'a CoordSettings,
+        diagrams: Option<&'a DiagramCache>,
+    ) -> Self {
         Ctx {
             cell,
             table,
@@ -197,6 +206,7 @@ impl<'a> Ctx<'a> {
                 .iter()
                 .map(|r| crate::motion::robot_validity(cell, r, cell.planning.clearance))
                 .collect(),
+            diagrams,
         }
     }
 
@@ -219,7 +229,10 @@ impl<'a> Ctx<'a> {
         Timeline::new(self.cell, movers, self.margin)
     }
 
-    /// Whether robot `x` (timed as `tx`) keeps clear of `others` in `[from, until]`.
+    /// Whether robot `x` (timed as `tx`) keeps clear of `others` in `[from, until]`: the exact
+    /// search on the clock, only in the windows where `cover` (when it holds for the pair)
+    /// says the two may meet.
+    #[allow(clippy::too_many_arguments)]
     pub fn clear(
         &self,
         x: usize,
@@ -228,14 +241,53 @@ impl<'a> Ctx<'a> {
         others: &[usize],
         from: f64,
         until: f64,
+        cover: Option<&Cover>,
     ) -> bool {
         let mx = self.mover(x, tx);
         others.iter().filter(|&&o| o != x).all(|&o| {
             let mo = self.mover(o, &timed[o]);
-            timeline::PairProbe::new(self.cell, &mx, &mo)
-                .first_contact(from, until, self.margin)
-                .is_none()
+            let windows = cover
+                .and_then(|c| c.windows(x, tx, o, &timed[o], from, until))
+                .unwrap_or_else(|| vec![(from, until)]);
+            let mut probe = timeline::PairProbe::new(self.cell, &mx, &mo);
+            windows
+                .into_iter()
+                .all(|(lo, hi)| probe.first_contact(lo, hi, self.margin).is_none())
         })
+    }
+
+    /// The earliest contact of any pair of robots at or after `from`: (time, robot, robot) —
+    /// as [`Timeline::first_conflict`], searching only the windows where `cover` (when it
+    /// holds for the pair) says the two may meet.
+    pub fn first_conflict(
+        &self,
+        timed: &[Timed],
+        from: f64,
+        cover: Option<&Cover>,
+    ) -> Option<(f64, usize, usize)> {
+        let Some(cover) = cover else {
+            return self.timeline(timed).first_conflict(from);
+        };
+        let mut best: Option<(f64, usize, usize)> = None;
+        for a in 0..timed.len() {
+            for b in a + 1..timed.len() {
+                let limit = best.map_or(f64::INFINITY, |x| x.0);
+                let windows = cover
+                    .windows(a, &timed[a], b, &timed[b], from, limit)
+                    .unwrap_or_else(|| vec![(from, limit)]);
+                let (ma, mb) = (self.mover(a, &timed[a]), self.mover(b, &timed[b]));
+                let mut probe = timeline::PairProbe::new(self.cell, &ma, &mb);
+                let found = windows
+                    .into_iter()
+                    .find_map(|(lo, hi)| probe.first_contact(lo, hi, self.margin));
+                if let Some(t) = found
+                    && best.is_none_or(|x| t < x.0)
+                {
+                    best = Some((t, a, b));
+                }
+            }
+        }
+        best
     }
 }
 
@@ -254,8 +306,20 @@ pub fn coordinate(
     programs: Vec<Program>,
     settings: &CoordSettings,
 ) -> Result<Coordinated, PlanError> {
+    coordinate_with(cell, table, programs, settings, None)
+}
+
+/// As [`coordinate`], `best` taking the pair diagrams `diagrams` holds from earlier
+/// coordinations of the cell and keeping those it builds there (the result is the same).
+fn coordinate_with(
+    cell: &Cell,
+    table: &CandidateTable,
+    programs: Vec<Program>,
+    settings: &CoordSettings,
+    diagrams: Option<&DiagramCache>,
+) -> Result<Coordinated, PlanError> {
     let started = Instant::now();
-    let ctx = Ctx::new(cell, table, settings);
+    let ctx = Ctx::new(cell, table, settings, diagrams);
     let timed: Vec<Timed> = programs.iter().map(|p| ctx.timed(p)).collect::<Result<_, _>>()?;
     let before = ctx.timeline(&timed).conflicts();
     let uncoordinated_cycle = cycle_and_delta(&timed).0;
@@ -270,7 +334,7 @@ pub fn coordinate(
                 _ => Mode::Perturb,
             };
             let mut progs = programs;
-            let res = resolve(&ctx, &mut progs, &rank_of(&cell_order), mode, None)?;
+            let res = resolve(&ctx, &mut progs, &rank_of(&cell_order), mode, None, None)?;
             let priority = if mode == Mode::Perturb {
                 Vec::new()
             } else {
@@ -293,11 +357,15 @@ pub fn coordinate(
                     }
                 })
                 .collect::<Result<_, _>>()?;
-            let first = match scheduled(&ctx, &programs)? {
+            // The diagram of the tours as they are certifies where they cannot meet, for the
+            // resolutions below (the exact search then looks only where they may).
+            let (found, cover) = scheduled(&ctx, &programs)?;
+            let first = match found {
                 Some(done) => done,
-                None => best(&ctx, programs.clone())?,
+                None => best(&ctx, programs.clone(), cover.as_ref())?,
             };
-            let (progs, mut res, priority) = baselines_if_shorter(&ctx, &programs, first, &cell_order)?;
+            let (progs, mut res, priority) =
+                baselines_if_shorter(&ctx, &programs, first, &cell_order, cover.as_ref())?;
             res.reversed = (0..programs.len())
                 .map(|i| against[i] != res.reversed.get(i).copied().unwrap_or(false))
                 .collect();
@@ -374,6 +442,19 @@ pub fn coordinate_outcome(
     coordinate(cell, table, programs, settings)
 }
 
+/// As [`coordinate_outcome`], with the pair diagrams of earlier coordinations of the cell
+/// (see [`DiagramCache`]; the result is the same as without).
+pub fn coordinate_outcome_cached(
+    cell: &Cell,
+    table: &CandidateTable,
+    outcome: &crate::plan::Outcome,
+    settings: &CoordSettings,
+    diagrams: &DiagramCache,
+) -> Result<Coordinated, PlanError> {
+    let programs = outcome.robots.iter().map(|r| r.program.clone()).collect();
+    coordinate_with(cell, table, programs, settings, Some(diagrams))
+}
+
 /// Counts of a resolution.
 #[derive(Clone, Debug, Default)]
 pub(crate) struct Resolution {
@@ -434,6 +515,7 @@ pub(crate) fn resolve(
     rank: &[usize],
     mode: Mode,
     bar: Option<f64>,
+    mut cover: Option<Cover>,
 ) -> Result<Resolution, PlanError> {
     let mut timed: Vec<Timed> = programs.iter().map(|p| ctx.timed(p)).collect::<Result<_, _>>()?;
     let m = programs.len();
@@ -447,7 +529,7 @@ pub(crate) fn resolve(
     // Waits only lengthen programs: with waits alone, programs that already end after the
     // bar cannot beat it; the run stops there and says where it ended.
     debug_assert!(bar.is_none() || matches!(mode, Mode::GiveWay | Mode::DelayStartup));
-    while let Some((t, a, b)) = ctx.timeline(&timed).first_conflict(from) {
+    while let Some((t, a, b)) = ctx.first_conflict(&timed, from, cover.as_ref()) {
         let end = timed.iter().map(Timed::end).fold(0.0, f64::max);
         if bar.is_some_and(|bar| end > bar) {
             res.outrun = Some(end);
@@ -485,7 +567,18 @@ pub(crate) fn resolve(
                 None
             } else {
                 let mut p = programs[x].clone();
-                if add_wait(ctx, &mut p, &timed, x, &others, t, other, reason, search)? {
+                if add_wait(
+                    ctx,
+                    &mut p,
+                    &timed,
+                    x,
+                    &others,
+                    t,
+                    other,
+                    reason,
+                    search,
+                    cover.as_ref(),
+                )? {
                     let tp = ctx.timed(&p)?;
                     Some((p, tp))
                 } else {
@@ -503,6 +596,10 @@ pub(crate) fn resolve(
                 (waited, &mut res.waits)
             };
             if let Some((p, tp)) = change {
+                // Other poses: the robot's path is no longer the one the cover was built on.
+                if take_repose && let Some(c) = &mut cover {
+                    c.invalidate(x);
+                }
                 programs[x] = p;
                 timed[x] = tp;
                 *counter += 1;
@@ -536,6 +633,7 @@ pub(crate) fn add_wait(
     other: usize,
     reason: WaitReason,
     search: WaitSearch,
+    cover: Option<&Cover>,
 ) -> Result<bool, PlanError> {
     let tx = &timed[x];
     // Home already at `t`: it can stay out longer instead (wait before going home), until the
@@ -582,7 +680,7 @@ pub(crate) fn add_wait(
                 for_robot: Some(other),
             });
             let tp = ctx.timed(&p)?;
-            Ok(ctx.clear(x, &tp, timed, others, arrive, act_end + delta))
+            Ok(ctx.clear(x, &tp, timed, others, arrive, act_end + delta, cover))
         };
         let found = match search {
             WaitSearch::Startup(step) => {

@@ -16,6 +16,7 @@ pub(super) fn baselines_if_shorter(
     programs: &[Program],
     found: Resolved,
     cell_order: &[usize],
+    cover: Option<&Cover>,
 ) -> Result<Resolved, PlanError> {
     let score = |progs: &[Program]| -> Result<(f64, f64), PlanError> {
         let timed: Vec<Timed> = progs.iter().map(|p| ctx.timed(p)).collect::<Result<_, _>>()?;
@@ -25,7 +26,7 @@ pub(super) fn baselines_if_shorter(
     for mode in [Mode::GiveWay] {
         let mut progs = programs.to_vec();
         let bar = Some(kept.0.0 + 1e-9);
-        let Ok(res) = resolve(ctx, &mut progs, &rank_of(cell_order), mode, bar) else {
+        let Ok(res) = resolve(ctx, &mut progs, &rank_of(cell_order), mode, bar, cover.cloned()) else {
             continue;
         };
         if res.outrun.is_some() {
@@ -53,11 +54,11 @@ type Scheduled = (f64, f64, Vec<Program>, Resolution);
 /// stops as soon as its programs end after the bar, and ranks by that end (a lower bound of
 /// its own finish). The two best orders by that ranking are still run with other poses allowed,
 /// without the bar, since another pose can end sooner than a wait.
-pub(super) fn best(ctx: &Ctx, programs: Vec<Program>) -> Result<Resolved, PlanError> {
+pub(super) fn best(ctx: &Ctx, programs: Vec<Program>, cover: Option<&Cover>) -> Result<Resolved, PlanError> {
     let orders = priority_orders(&programs);
     let run = |order: &Vec<usize>, mode: Mode, bar: Option<f64>| -> Option<Scheduled> {
         let mut p = programs.clone();
-        let res = resolve(ctx, &mut p, &rank_of(order), mode, bar).ok()?;
+        let res = resolve(ctx, &mut p, &rank_of(order), mode, bar, cover.cloned()).ok()?;
         if let Some(end) = res.outrun {
             return Some((end, f64::INFINITY, Vec::new(), res));
         }
@@ -111,19 +112,27 @@ pub(super) fn best(ctx: &Ctx, programs: Vec<Program>) -> Result<Resolved, PlanEr
 /// stretch of path between two of the core's boxes that has none (the segment is split: the
 /// same joint path, one more stop), and the diagram is built again, up to [`STOP_ROUNDS`]
 /// times (the tours keep their planned directions then).
-pub(super) fn scheduled(ctx: &Ctx, programs: &[Program]) -> Result<Option<Resolved>, PlanError> {
+pub(super) fn scheduled(
+    ctx: &Ctx,
+    programs: &[Program],
+) -> Result<(Option<Resolved>, Option<Cover>), PlanError> {
     let mut programs = programs.to_vec();
     let mut round = 0;
     let mut parts = Vec::new();
     let mut distances = 0;
     let mut searched = 0;
     let m = programs.len();
+    // The diagram of the programs as given (round 0), for the resolutions that follow.
+    let mut cover = None;
     loop {
         let paths: Vec<diagram::RobotPath> = programs
             .iter()
             .map(|p| diagram::RobotPath::new(ctx, p))
             .collect::<Result<_, _>>()?;
         let (boxes, work) = diagram::diagrams_reusing(ctx, &paths, &mut parts);
+        if round == 0 {
+            cover = Some(Cover::new(m, &boxes));
+        }
         distances += work.distances;
         let tracks: Vec<schedule::Track> = paths.iter().map(|p| p.track()).collect();
         let (nodes, min_wait) = (ctx.settings.schedule_nodes, ctx.settings.min_wait);
@@ -138,34 +147,39 @@ pub(super) fn scheduled(ctx: &Ctx, programs: &[Program]) -> Result<Option<Resolv
             let found = s.map(|s| vec![(vec![false; m], s, boxes.clone())]);
             (found.unwrap_or_default(), Vec::new())
         };
-        // Each combination of directions found, finished (waits cut on the exact clock); the
-        // shortest cycle (then Δt) wins, ties to the earlier.
-        let mut kept: Option<((f64, f64), Resolved)> = None;
-        for (flip, s, boxes) in found {
-            let mut progs = Vec::with_capacity(m);
-            let mut ps = Vec::with_capacity(m);
-            for (i, (p, path)) in programs.iter().zip(&paths).enumerate() {
-                match back.get(i) {
-                    Some(Some((r, rpath))) if flip[i] => {
-                        progs.push(r.clone());
-                        ps.push(rpath.clone());
-                    }
-                    _ => {
-                        progs.push(p.clone());
-                        ps.push(path.clone());
+        // Each combination of directions found, finished (waits cut on the exact clock; in
+        // parallel, each on its own); the shortest cycle (then Δt) wins, ties to the earlier.
+        let finished: Vec<((f64, f64), Resolved)> = found
+            .into_par_iter()
+            .map(|(flip, s, boxes)| -> Result<((f64, f64), Resolved), PlanError> {
+                let mut progs = Vec::with_capacity(m);
+                let mut ps = Vec::with_capacity(m);
+                for (i, (p, path)) in programs.iter().zip(&paths).enumerate() {
+                    match back.get(i) {
+                        Some(Some((r, rpath))) if flip[i] => {
+                            progs.push(r.clone());
+                            ps.push(rpath.clone());
+                        }
+                        _ => {
+                            progs.push(p.clone());
+                            ps.push(path.clone());
+                        }
                     }
                 }
-            }
-            let search = crate::document::PassageSearch {
-                boxes: boxes.len(),
-                distances,
-                nodes: searched,
-                proven: s.proven,
-                reversed: flip.iter().filter(|&&r| r).count(),
-            };
-            let done = finish(ctx, progs, &ps, &boxes, &s, search, flip)?;
-            let timed: Vec<Timed> = done.0.iter().map(|p| ctx.timed(p)).collect::<Result<_, _>>()?;
-            let key = cycle_and_delta(&timed);
+                let search = crate::document::PassageSearch {
+                    boxes: boxes.len(),
+                    distances,
+                    nodes: searched,
+                    proven: s.proven,
+                    reversed: flip.iter().filter(|&&r| r).count(),
+                };
+                let done = finish(ctx, progs, &ps, &boxes, &s, search, flip)?;
+                let timed: Vec<Timed> = done.0.iter().map(|p| ctx.timed(p)).collect::<Result<_, _>>()?;
+                Ok((cycle_and_delta(&timed), done))
+            })
+            .collect::<Result<_, _>>()?;
+        let mut kept: Option<((f64, f64), Resolved)> = None;
+        for (key, done) in finished {
             let shorter = kept
                 .as_ref()
                 .is_none_or(|(k, _)| key.0 < k.0 - 1e-3 || (key.0 <= k.0 + 1e-3 && key.1 < k.1 - 1e-3));
@@ -174,17 +188,17 @@ pub(super) fn scheduled(ctx: &Ctx, programs: &[Program]) -> Result<Option<Resolv
             }
         }
         if let Some((_, done)) = kept {
-            return Ok(Some(done));
+            return Ok((Some(done), cover));
         }
         if round == STOP_ROUNDS {
-            return Ok(None);
+            return Ok((None, cover));
         }
         round += 1;
         let core = schedule::infeasible_core(&tracks, &boxes, nodes, min_wait);
         let core: Vec<&ConflictBox> = core.iter().map(|&i| &boxes[i]).collect();
         let changed = add_stops(ctx, &mut programs, &paths, &core)?;
         if changed.iter().all(|&c| !c) {
-            return Ok(None);
+            return Ok((None, cover));
         }
         // The pairs of robots whose paths changed are built again.
         let mut i = 0;
@@ -233,7 +247,8 @@ fn finish(
         let timed: Vec<Timed> = out.iter().map(|p| ctx.timed(p)).collect::<Result<_, _>>()?;
         (cycle_and_delta(&timed).0 - s.makespan).abs() < 1e-6
     });
-    shrink_waits(ctx, &mut out)?;
+    let cover = Cover::new(out.len(), boxes);
+    shrink_waits(ctx, &mut out, &cover)?;
     res.waits = out.iter().map(|p| p.waits.len()).sum();
     Ok((out, res, Vec::new()))
 }
@@ -466,7 +481,7 @@ pub fn conflict_boxes(
     programs: &[Program],
     settings: &CoordSettings,
 ) -> Result<Vec<ConflictBox>, PlanError> {
-    let ctx = Ctx::new(cell, table, settings);
+    let ctx = Ctx::new(cell, table, settings, None);
     let paths: Vec<diagram::RobotPath> = programs
         .iter()
         .map(|p| diagram::RobotPath::new(&ctx, p))
@@ -477,7 +492,7 @@ pub fn conflict_boxes(
 /// The boxes of the diagram are larger than the contacts they cover, so the schedule's waits
 /// are longer than needed: each wait, earliest first, is cut as far as the exact contact
 /// search on the clock allows (to 10 ms; to nothing, or at least [`CoordSettings::min_wait`]).
-fn shrink_waits(ctx: &Ctx, programs: &mut [Program]) -> Result<(), PlanError> {
+fn shrink_waits(ctx: &Ctx, programs: &mut [Program], cover: &Cover) -> Result<(), PlanError> {
     let mut timed: Vec<Timed> = programs.iter().map(|p| ctx.timed(p)).collect::<Result<_, _>>()?;
     let mut order: Vec<(f64, usize, usize)> = timed
         .iter()
@@ -503,7 +518,7 @@ fn shrink_waits(ctx: &Ctx, programs: &mut [Program]) -> Result<(), PlanError> {
                 ..w.clone()
             });
             let tp = ctx.timed(&p)?;
-            let ok = ctx.clear(r, &tp, &timed, &others, start, f64::INFINITY);
+            let ok = ctx.clear(r, &tp, &timed, &others, start, f64::INFINITY, Some(cover));
             Ok(ok.then_some((p, tp)))
         };
         let min = ctx.settings.min_wait;

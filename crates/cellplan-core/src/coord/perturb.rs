@@ -215,7 +215,7 @@ pub(crate) fn repose(
             let tp = ctx.timed(&p)?;
             let until = tp.visits.get(last + 1).map_or(tp.end(), |v| v.1);
             Ok(ctx
-                .clear(x, &tp, timed, others, from, until)
+                .clear(x, &tp, timed, others, from, until, None)
                 .then(|| (tp.end(), ci, p, tp)))
         })
         .collect::<Result<_, _>>()?;
