@@ -358,3 +358,49 @@ fn rebalancing_hands_tasks_from_the_robot_ending_last_until_the_robots_end_soone
     check_plan(&cell, &doc);
     verified(&cell, &doc);
 }
+
+/// A plan made from another with one task handed over (`plan_keeping`): the robots whose tasks
+/// did not change keep their programs from the first plan (so their paths, and coordination
+/// reuses the diagrams of their pairs) unless sequenced again they got shorter ones; the two
+/// robots of the hand-over measure their new tasks; the plan verifies.
+#[test]
+fn a_hand_over_keeps_the_other_robots_programs() {
+    let cell = repo_cell("examples/autobody-4r/cell.toml");
+    let table = generate(&cell);
+    let s = settings(Allocation::Proximity);
+    let mut cache = plan::PlanCache::default();
+    let base = plan::plan_cached(&cell, &table, &s, &|_| {}, &mut cache).unwrap();
+    // The first task of some robot that another robot with room under the cap can do.
+    let mut tasks = base.allocated.tasks.clone();
+    let m = cell.robots.len();
+    let (from, to, t) = (0..m)
+        .flat_map(|a| (0..m).map(move |b| (a, b)))
+        .filter(|&(a, b)| a != b && tasks[b].len() < cell.planning.task_cap)
+        .find_map(|(a, b)| {
+            let t = tasks[a]
+                .iter()
+                .find(|&&t| table.robots_for(t).iter().any(|x| x.0 == b))?;
+            Some((a, b, *t))
+        })
+        .expect("neighbours share tasks");
+    tasks[from].retain(|&x| x != t);
+    tasks[to].push(t);
+    let fixed = PlanSettings {
+        tasks: Some(tasks.clone()),
+        ..s.clone()
+    };
+    let o = plan::plan_keeping(&cell, &table, &fixed, &|_| {}, &mut cache, Some(&base)).unwrap();
+    assert_eq!(o.allocated.tasks, tasks);
+    for r in (0..m).filter(|&r| r != from && r != to) {
+        let (now, was) = (&o.robots[r].program, &base.robots[r].program);
+        assert!(now.duration() <= was.duration() + 1e-9, "robot {r}");
+        if now.duration() >= was.duration() - 1e-9 {
+            assert_eq!(now, was, "robot {r}");
+        }
+    }
+    assert!(o.robots[to].program.visits.iter().any(|v| v.task == t));
+    assert!(o.robots[from].program.visits.iter().all(|v| v.task != t));
+    let doc = build(&cell, &table, &o, &fixed);
+    check_plan(&cell, &doc);
+    verified(&cell, &doc);
+}

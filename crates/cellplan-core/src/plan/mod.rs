@@ -9,10 +9,12 @@
 pub mod allocate;
 pub mod graph;
 pub mod rebalance;
+mod rows;
 pub mod sequence;
 
 pub use allocate::{Allocation, CoverMethod};
 pub use graph::MoveModel;
+pub use rows::{robot_rows, sweep_keys};
 
 use crate::candidates::CandidateTable;
 use crate::coord::Program;
@@ -348,70 +350,6 @@ pub fn plan(
     plan_cached(cell, table, settings, progress, &mut PlanCache::default())
 }
 
-/// The robots in rows, and the line the rows run along (`None` for fewer than two robots or
-/// bases on one spot). Robots facing the same way (their bases' x axes in the floor plane
-/// within 45°, in cell order) make a row, as robots on one side of a part do; the line is the
-/// principal axis of the bases about their rows' centres (rows facing each other across a part
-/// run along it), or, when every row is one robot, of all the bases.
-pub fn robot_rows(cell: &Cell) -> Option<([f64; 2], Vec<Vec<usize>>)> {
-    if cell.robots.len() < 2 {
-        return None;
-    }
-    let facing = |r: usize| {
-        let x = cell.robots[r].base.rotation * glam::DVec3::X;
-        glam::DVec2::new(x.x, x.y).normalize_or_zero()
-    };
-    let mut rows: Vec<Vec<usize>> = Vec::new();
-    for r in 0..cell.robots.len() {
-        match rows
-            .iter_mut()
-            .find(|row| facing(row[0]).dot(facing(r)) > std::f64::consts::FRAC_1_SQRT_2)
-        {
-            Some(row) => row.push(r),
-            None => rows.push(vec![r]),
-        }
-    }
-    let base = |r: usize| {
-        glam::DVec2::new(
-            cell.robots[r].base.translation.x,
-            cell.robots[r].base.translation.y,
-        )
-    };
-    // Rows of one robot each are one row: the scatter is then about the centre of all bases.
-    if rows.iter().all(|row| row.len() == 1) {
-        rows = vec![(0..cell.robots.len()).collect()];
-    }
-    let groups = &rows;
-    let (mut sxx, mut sxy, mut syy) = (0.0, 0.0, 0.0);
-    for g in groups {
-        let centre = g.iter().map(|&r| base(r)).sum::<glam::DVec2>() / g.len() as f64;
-        for &r in g {
-            let d = base(r) - centre;
-            sxx += d.x * d.x;
-            sxy += d.x * d.y;
-            syy += d.y * d.y;
-        }
-    }
-    if sxx + syy <= 1e-12 {
-        return None;
-    }
-    // The eigenvector of the larger eigenvalue of the 2×2 scatter matrix.
-    let angle = 0.5 * (2.0 * sxy).atan2(sxx - syy);
-    Some(([angle.cos(), angle.sin()], rows))
-}
-
-/// Each task's place along `sweep` (its position projected on the direction), or none.
-pub fn sweep_keys(cell: &Cell, sweep: Option<[f64; 2]>) -> Vec<f64> {
-    match sweep {
-        None => Vec::new(),
-        Some([x, y]) => cell
-            .tasks
-            .iter()
-            .map(|t| t.position.x * x + t.position.y * y)
-            .collect(),
-    }
-}
-
 /// What runs of [`plan_cached`] on one cell share: the robot graphs (they depend on the cell,
 /// the move model, `alternatives` and `roomy` only) and every leg planned so far. Each leg is
 /// a function of its robot, its two nodes and the settings, so a later run with the same
@@ -429,6 +367,23 @@ pub fn plan_cached(
     settings: &PlanSettings,
     progress: &(dyn Fn(Stage) + Sync),
     cache: &mut PlanCache,
+) -> Result<Outcome, PlanError> {
+    plan_keeping(cell, table, settings, progress, cache, None)
+}
+
+/// [`plan_cached`], where every robot whose tasks are those it has in `prior` (a plan of the
+/// same cell and settings but the allocation) keeps its sequence and program from `prior`
+/// unless sequencing it again (with the legs planned since) gives a shorter program: a
+/// robot's program depends on its tasks only (its legs keep clear of the others parked at
+/// home). Robots that keep their programs keep their paths, and coordination reuses their
+/// pairs' diagrams (see [`crate::coord::DiagramCache`]).
+pub fn plan_keeping(
+    cell: &Cell,
+    table: &CandidateTable,
+    settings: &PlanSettings,
+    progress: &(dyn Fn(Stage) + Sync),
+    cache: &mut PlanCache,
+    prior: Option<&Outcome>,
 ) -> Result<Outcome, PlanError> {
     let started = Instant::now();
     let deadline = settings.deadline.unwrap_or(settings.deadline_from(started));
@@ -480,6 +435,18 @@ pub fn plan_cached(
     let mut planned: Vec<sequence::Planned> = std::mem::take(&mut cache.planned);
     planned.resize_with(cell.robots.len(), Default::default);
     let mut counts = vec![(0usize, 0usize, 0usize); cell.robots.len()];
+    // The robots that may keep what they have in `prior` (same tasks).
+    let kept_of = |tasks: &[Vec<TaskId>]| -> Vec<Option<&RobotResult>> {
+        (0..cell.robots.len())
+            .map(|r| {
+                prior.and_then(|p| {
+                    (p.allocated.tasks.get(r) == tasks.get(r))
+                        .then(|| p.robots.get(r))
+                        .flatten()
+                })
+            })
+            .collect()
+    };
     let mut sequences = sequence_all(
         cell,
         &graphs,
@@ -575,13 +542,22 @@ pub fn plan_cached(
         .zip(&cell.robots)
         .zip(&graphs)
         .for_each(|((seq, robot), graph)| sequence::polish(cell, robot, graph, seq, settings));
+    // On the final allocation (the balanced one may have changed it, dropped tasks moved).
+    let kept = kept_of(&allocated.tasks);
     tick(Stage::Sequencing, &mut compute);
 
     progress(Stage::Timing);
     let mut robots = Vec::with_capacity(sequences.len());
-    for ((sequence, graph), robot) in sequences.into_iter().zip(&graphs).zip(&cell.robots) {
-        let program = Program::from_sequence(cell, table, robot, graph, &sequence)?;
-        robots.push(RobotResult { sequence, program });
+    for (((sequence, graph), robot), kept) in sequences.into_iter().zip(&graphs).zip(&cell.robots).zip(kept) {
+        let new = RobotResult {
+            program: Program::from_sequence(cell, table, robot, graph, &sequence)?,
+            sequence,
+        };
+        let result = match kept {
+            Some(k) if k.program.duration() <= new.program.duration() + 1e-9 => k.clone(),
+            _ => new,
+        };
+        robots.push(result);
     }
     tick(Stage::Timing, &mut compute);
     Ok(Outcome {

@@ -3,10 +3,11 @@
 //! stops at every corner), so the robot that ends last is often not the one the allocation
 //! expected. [`rebalance`] hands one task at a time from the robot that ends last to the robot
 //! that can take it at the least cost, plans the robots again with that allocation (the legs
-//! already planned are reused: see [`super::PlanCache`]) and keeps the change when the robots
-//! end sooner. Spensieri et al. (2016) iterate routing and scheduling the same way, one level
+//! already planned are reused: see [`super::PlanCache`]; a robot whose tasks did not change
+//! keeps its program unless the new one is shorter) and keeps the change when the robots end
+//! sooner. Spensieri et al. (2016) iterate routing and scheduling the same way, one level
 //! down.
-use super::{Outcome, PlanCache, PlanError, PlanSettings, dwell, plan_cached};
+use super::{Outcome, PlanCache, PlanError, PlanSettings, dwell, plan_keeping};
 use crate::candidates::CandidateTable;
 use cellplan_model::Cell;
 use cellplan_model::tasks::TaskId;
@@ -180,7 +181,9 @@ pub fn rebalance<J>(
                 tasks: Some(tasks),
                 ..settings.clone()
             };
-            let Ok(o) = plan_cached(cell, table, &next, &|_| {}, cache) else {
+            // The robots whose tasks did not change keep their programs unless the new ones
+            // are shorter (and so, mostly, the diagrams of their pairs).
+            let Ok(o) = plan_keeping(cell, table, &next, &|_| {}, cache, Some(current)) else {
                 continue;
             };
             // The judge's score is never below the robots' latest end without coordination.
