@@ -161,7 +161,7 @@ fn slowness_penalty(cell: &Cell, o: &plan::Outcome) -> Vec<Vec<f64>> {
     let per_task: Vec<f64> = o
         .robots
         .iter()
-        .zip(&o.graphs)
+        .zip(o.graphs.iter())
         .map(|(r, g)| {
             let bound = plan::sequence::order_cost(g, &Default::default(), &r.sequence.nodes);
             (r.program.duration() - bound).max(0.0) / r.program.visits.len().max(1) as f64

@@ -24,6 +24,7 @@ use cellplan_motion::plan::PlanSettings as MotionSettings;
 use cellplan_solve::CostMatrix;
 use graph::RobotGraph;
 use rayon::prelude::*;
+use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 /// Knobs of a planning run.
@@ -324,8 +325,9 @@ pub struct RobotResult {
 /// Everything a run produced.
 #[derive(Clone, Debug)]
 pub struct Outcome {
-    /// Per robot graphs.
-    pub graphs: Vec<RobotGraph>,
+    /// Per robot graphs (shared with the other plans of the cell made through one
+    /// [`PlanCache`]: they depend on the settings of the costs only).
+    pub graphs: Arc<Vec<RobotGraph>>,
     /// The allocation.
     pub allocated: allocate::Allocated,
     /// Per robot results.
@@ -356,7 +358,7 @@ pub fn plan(
 /// settings plans only the legs no run planned before.
 #[derive(Clone, Debug, Default)]
 pub struct PlanCache {
-    graphs: Option<(MoveModel, usize, u64, Vec<RobotGraph>)>,
+    graphs: Option<(MoveModel, usize, u64, Arc<Vec<RobotGraph>>)>,
     planned: Vec<sequence::Planned>,
 }
 
@@ -400,8 +402,8 @@ pub fn plan_keeping(
         settings.alternatives,
         settings.roomy.to_bits(),
     );
-    let graphs: Vec<RobotGraph> = match &cache.graphs {
-        Some((m, a, r, g)) if (*m, *a, *r) == key => g.clone(),
+    let graphs: Arc<Vec<RobotGraph>> = match &cache.graphs {
+        Some((m, a, r, g)) if (*m, *a, *r) == key => Arc::clone(g),
         _ => {
             let g: Vec<RobotGraph> = cell
                 .robots
@@ -417,7 +419,8 @@ pub fn plan_keeping(
                     )
                 })
                 .collect();
-            cache.graphs = Some((key.0, key.1, key.2, g.clone()));
+            let g = Arc::new(g);
+            cache.graphs = Some((key.0, key.1, key.2, Arc::clone(&g)));
             cache.planned = vec![Default::default(); cell.robots.len()];
             g
         }
@@ -540,7 +543,7 @@ pub fn plan_keeping(
     sequences
         .par_iter_mut()
         .zip(&cell.robots)
-        .zip(&graphs)
+        .zip(&graphs[..])
         .for_each(|((seq, robot), graph)| sequence::polish(cell, robot, graph, seq, settings));
     // On the final allocation (the balanced one may have changed it, dropped tasks moved).
     let kept = kept_of(&allocated.tasks);
@@ -548,7 +551,12 @@ pub fn plan_keeping(
 
     progress(Stage::Timing);
     let mut robots = Vec::with_capacity(sequences.len());
-    for (((sequence, graph), robot), kept) in sequences.into_iter().zip(&graphs).zip(&cell.robots).zip(kept) {
+    for (((sequence, graph), robot), kept) in sequences
+        .into_iter()
+        .zip(graphs.iter())
+        .zip(&cell.robots)
+        .zip(kept)
+    {
         let new = RobotResult {
             program: Program::from_sequence(cell, table, robot, graph, &sequence)?,
             sequence,
