@@ -2,10 +2,10 @@
 //! MPs) and on the bundled examples: the allocation strategies, independence of the thread
 //! count; every plan re-checked independently of the planner (see `common`).
 mod common;
-use cellplan_core::candidates::generate;
+use cellplan_core::candidates::{CandidateTable, generate};
 use cellplan_core::document as output;
 use cellplan_core::plan::{self, Allocation, PlanSettings};
-use cellplan_model::{LoadOptions, TaskId};
+use cellplan_model::{Cell, LoadOptions, TaskId};
 use cellplan_optical::load;
 use cellplan_optical::testing::{repo_root, scratch_dir};
 use common::*;
@@ -284,15 +284,22 @@ fn robots_facing_each_other_make_two_rows_along_the_part() {
     assert!(line[1].abs() > 0.99, "{line:?}");
 }
 
-#[test]
-fn rebalancing_hands_tasks_from_the_robot_ending_last_until_the_robots_end_sooner() {
-    use plan::rebalance::{REBALANCE_PLANS, ends, makespan, rebalance};
+/// The README cell planned with the nearest-robot allocation: the cell, its candidates, the
+/// settings, the leg cache and the plan.
+fn readme_nearest() -> (Cell, CandidateTable, PlanSettings, plan::PlanCache, plan::Outcome) {
     let cell = repo_cell("examples/autobody-4r/cell.toml");
     let table = generate(&cell);
-    // The nearest-robot allocation ignores how long each robot works (5 to 14 MPs here).
     let s = settings(Allocation::Proximity);
     let mut cache = plan::PlanCache::default();
     let base = plan::plan_cached(&cell, &table, &s, &|_| {}, &mut cache).unwrap();
+    (cell, table, s, cache, base)
+}
+
+#[test]
+fn rebalancing_hands_tasks_from_the_robot_ending_last_until_the_robots_end_sooner() {
+    use plan::rebalance::{REBALANCE_PLANS, ends, makespan, rebalance};
+    // The nearest-robot allocation ignores how long each robot works (5 to 14 MPs here).
+    let (cell, table, s, mut cache, base) = readme_nearest();
     let before = makespan(&base);
     let judged = std::cell::Cell::new(0);
     let mut judge = |o: &plan::Outcome| {
@@ -365,11 +372,7 @@ fn rebalancing_hands_tasks_from_the_robot_ending_last_until_the_robots_end_soone
 /// robots of the hand-over measure their new tasks; the plan verifies.
 #[test]
 fn a_hand_over_keeps_the_other_robots_programs() {
-    let cell = repo_cell("examples/autobody-4r/cell.toml");
-    let table = generate(&cell);
-    let s = settings(Allocation::Proximity);
-    let mut cache = plan::PlanCache::default();
-    let base = plan::plan_cached(&cell, &table, &s, &|_| {}, &mut cache).unwrap();
+    let (cell, table, s, mut cache, base) = readme_nearest();
     // The first task of some robot that another robot with room under the cap can do.
     let mut tasks = base.allocated.tasks.clone();
     let m = cell.robots.len();

@@ -255,40 +255,6 @@ impl<'a> Ctx<'a> {
                 .all(|(lo, hi)| probe.first_contact(lo, hi, self.margin).is_none())
         })
     }
-
-    /// The earliest contact of any pair of robots at or after `from`: (time, robot, robot) —
-    /// as [`Timeline::first_conflict`], searching only the windows where `cover` (when it
-    /// holds for the pair) says the two may meet.
-    pub fn first_conflict(
-        &self,
-        timed: &[Timed],
-        from: f64,
-        cover: Option<&Cover>,
-    ) -> Option<(f64, usize, usize)> {
-        let Some(cover) = cover else {
-            return self.timeline(timed).first_conflict(from);
-        };
-        let mut best: Option<(f64, usize, usize)> = None;
-        for a in 0..timed.len() {
-            for b in a + 1..timed.len() {
-                let limit = best.map_or(f64::INFINITY, |x| x.0);
-                let windows = cover
-                    .windows(a, &timed[a], b, &timed[b], from, limit)
-                    .unwrap_or_else(|| vec![(from, limit)]);
-                let (ma, mb) = (self.mover(a, &timed[a]), self.mover(b, &timed[b]));
-                let mut probe = timeline::PairProbe::new(self.cell, &ma, &mb);
-                let found = windows
-                    .into_iter()
-                    .find_map(|(lo, hi)| probe.first_contact(lo, hi, self.margin));
-                if let Some(t) = found
-                    && best.is_none_or(|x| t < x.0)
-                {
-                    best = Some((t, a, b));
-                }
-            }
-        }
-        best
-    }
 }
 
 /// Cycle time and Δt of timed programs.
@@ -529,7 +495,7 @@ pub(crate) fn resolve(
     // Waits only lengthen programs: with waits alone, programs that already end after the
     // bar cannot beat it; the run stops there and says where it ended.
     debug_assert!(bar.is_none() || matches!(mode, Mode::GiveWay | Mode::DelayStartup));
-    while let Some((t, a, b)) = ctx.first_conflict(&timed, from, cover.as_ref()) {
+    while let Some((t, a, b)) = ctx.timeline(&timed).first_conflict(from, cover.as_ref()) {
         let end = timed.iter().map(Timed::end).fold(0.0, f64::max);
         if bar.is_some_and(|bar| end > bar) {
             res.outrun = Some(end);

@@ -256,14 +256,23 @@ impl<'a> Timeline<'a> {
         out
     }
 
-    /// The earliest contact of any pair at or after `from`: (time, robot, robot).
-    pub fn first_conflict(&self, from: f64) -> Option<(f64, usize, usize)> {
+    /// The earliest contact of any pair at or after `from`: (time, robot, robot). With a
+    /// `cover` (see [`super::Cover`]), a pair it holds for is searched only in the windows where
+    /// the two may meet.
+    pub fn first_conflict(&self, from: f64, cover: Option<&super::Cover>) -> Option<(f64, usize, usize)> {
         let mut best: Option<(f64, usize, usize)> = None;
         for a in 0..self.movers.len() {
             for b in a + 1..self.movers.len() {
                 let limit = best.map_or(f64::INFINITY, |x| x.0);
-                let mut probe = PairProbe::new(self.cell, &self.movers[a], &self.movers[b]);
-                if let Some(t) = probe.first_contact(from, limit, self.margin)
+                let (ma, mb) = (&self.movers[a], &self.movers[b]);
+                let windows = cover
+                    .and_then(|c| c.windows(a, ma.timed, b, mb.timed, from, limit))
+                    .unwrap_or_else(|| vec![(from, limit)]);
+                let mut probe = PairProbe::new(self.cell, ma, mb);
+                let found = windows
+                    .into_iter()
+                    .find_map(|(lo, hi)| probe.first_contact(lo, hi, self.margin));
+                if let Some(t) = found
                     && best.is_none_or(|x| t < x.0)
                 {
                     best = Some((t, a, b));
