@@ -147,6 +147,15 @@ fn blocking_penalty(cell: &Cell, coordinated: &Coordinated) -> Vec<Vec<f64>> {
     pen
 }
 
+/// One of ours' extra plans.
+enum Try {
+    /// Planned with these settings.
+    Plan(Box<PlanSettings>),
+    /// The zones allocation again, each task × robot penalised by what the first plan's
+    /// measurement there blocked the other robots (known once the first plan is coordinated).
+    ZonesBlocking,
+}
+
 /// Ours plans the balanced (min-max) allocation too on cells of at most this many MPs × robots.
 pub const BALANCED_MAX_PAIRS: usize = 100;
 
@@ -223,13 +232,11 @@ pub fn coordinate(
         ..settings.clone()
     });
     // The strips first: where they pay, the others are then often beaten before coordination.
-    // `None` stands for the zones allocation again with what the first plan's measurements
-    // blocked the other robots (known once the first plan is coordinated).
-    let mut tries: Vec<Option<PlanSettings>> = [
-        sweep.map(Some),
-        Some(Some(nearest)),
-        Some(None),
-        balanced.map(Some),
+    let mut tries: Vec<Try> = [
+        sweep.map(|s| Try::Plan(Box::new(s))),
+        Some(Try::Plan(Box::new(nearest))),
+        Some(Try::ZonesBlocking),
+        balanced.map(|s| Try::Plan(Box::new(s))),
     ]
     .into_iter()
     .flatten()
@@ -240,7 +247,9 @@ pub fn coordinate(
     // nothing but the diagrams: the result is that of one after the other).
     let mut best: Option<(Outcome, PlanSettings, Coordinated)> = None;
     let mut pending = Some((outcome, settings.clone()));
-    let mut again: Option<Vec<Vec<f64>>> = None;
+    // What the first plan's measurements blocked the other robots (set once it is coordinated,
+    // before [`Try::ZonesBlocking`] comes up: the first try is planned while it is).
+    let mut blocking = Vec::new();
     let mut next = 0;
     let mut cut = false;
     let cycle_of = |b: &Option<(Outcome, PlanSettings, Coordinated)>| {
@@ -249,30 +258,19 @@ pub fn coordinate(
     };
     loop {
         // Past the deadline the other tries are skipped, and the plan says the clock cut it.
+        if next < tries.len() && settings.deadline.is_some_and(|d| Instant::now() >= d) {
+            cut = true;
+        }
         let more = match tries.get(next) {
             _ if cut => None,
-            Some(t)
-                if t.as_ref()
-                    .unwrap_or(&settings)
-                    .deadline
-                    .is_some_and(|d| Instant::now() >= d) =>
-            {
-                cut = true;
-                None
-            }
-            Some(Some(t)) => Some(t.clone()),
-            Some(None) => again.clone().map(|pen| PlanSettings {
-                task_penalty: pen,
+            Some(Try::Plan(t)) => Some(PlanSettings::clone(t)),
+            Some(Try::ZonesBlocking) => Some(PlanSettings {
+                task_penalty: blocking.clone(),
                 ..settings.clone()
             }),
             None => None,
         };
         if pending.is_none() && more.is_none() {
-            if next < tries.len() && !cut {
-                // The try could not be made (the first coordination failed): the next.
-                next += 1;
-                continue;
-            }
             break;
         }
         // Coordination only adds waits: a plan whose robots end no sooner than the best cycle
@@ -307,7 +305,7 @@ pub fn coordinate(
                 // The first plan's coordination is the run's: its failure is the run's.
                 Some(Err(e)) if first => return Err(e),
                 Some(Ok(c)) if first => {
-                    again = Some(blocking_penalty(cell, &c));
+                    blocking = blocking_penalty(cell, &c);
                     best = Some((o, s, c));
                 }
                 Some(Ok(c))
@@ -328,10 +326,10 @@ pub fn coordinate(
                 if more.sweep.is_some() && more.task_penalty.is_empty() {
                     tries.insert(
                         next,
-                        Some(PlanSettings {
+                        Try::Plan(Box::new(PlanSettings {
                             task_penalty: slowness_penalty(cell, &o),
                             ..more.clone()
-                        }),
+                        })),
                     );
                 }
                 pending = Some((o, more));

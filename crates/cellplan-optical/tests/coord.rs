@@ -72,26 +72,39 @@ fn every_strategy_gives_a_verified_conflict_free_plan() {
     }
 }
 
+/// The distance between R1 at `qa` and R2 at `qb` of the crossing cell (capped at 1 m).
+fn distance(qa: &[f64], qb: &[f64]) -> f64 {
+    let f = fixture();
+    let (ra, rb) = (&f.cell.robots[0], &f.cell.robots[1]);
+    let (mut sa, mut sb) = (Default::default(), Default::default());
+    ra.body_poses(qa, &mut sa);
+    rb.body_poses(qb, &mut sb);
+    f.cell
+        .world
+        .group_group_distance(ra.group, &sa.bodies, rb.group, &sb.bodies, 1.0)
+}
+
+/// The uncoordinated plan of the crossing cell and its conflict boxes.
+fn uncoordinated_boxes() -> (coord::Coordinated, Vec<coord::ConflictBox>) {
+    let f = fixture();
+    let (_, none) = document(Coordination::None);
+    let settings = coord::CoordSettings::default();
+    let boxes = coord::conflict_boxes(&f.cell, &f.table, &none.programs, &settings).unwrap();
+    (none, boxes)
+}
+
 /// The pairs of positions (every 50 ms of each program: `ta` of R1, `tb` of R2 of the
 /// crossing cell) at which the two robots come closer than the coordination's distance, with
 /// that distance.
 fn contacts(ta: &coord::Timed, tb: &coord::Timed) -> Vec<(f64, f64, f64)> {
-    let f = fixture();
-    let margin = f.cell.planning.clearance + coord::REPLAY_SLACK;
-    let (ra, rb) = (&f.cell.robots[0], &f.cell.robots[1]);
-    let (mut sa_, mut sb_) = (Default::default(), Default::default());
+    let margin = fixture().cell.planning.clearance + coord::REPLAY_SLACK;
     let mut out = Vec::new();
     let step = 0.05;
     let mut sa = 0.0;
     while sa <= ta.end() {
-        ra.body_poses(&ta.trajectory.position(sa), &mut sa_);
         let mut sb = 0.0;
         while sb <= tb.end() {
-            rb.body_poses(&tb.trajectory.position(sb), &mut sb_);
-            let d = f
-                .cell
-                .world
-                .group_group_distance(ra.group, &sa_.bodies, rb.group, &sb_.bodies, 1.0);
+            let d = distance(&ta.trajectory.position(sa), &tb.trajectory.position(sb));
             if d <= margin {
                 out.push((sa, sb, d));
             }
@@ -108,10 +121,7 @@ fn contacts(ta: &coord::Timed, tb: &coord::Timed) -> Vec<(f64, f64, f64)> {
 /// conflict's start, the programs having no waits). The boxes are not the whole square either.
 #[test]
 fn the_coordination_diagram_covers_every_contact() {
-    let f = fixture();
-    let (_, none) = document(Coordination::None);
-    let settings = coord::CoordSettings::default();
-    let boxes = coord::conflict_boxes(&f.cell, &f.table, &none.programs, &settings).unwrap();
+    let (none, boxes) = uncoordinated_boxes();
     assert!(!boxes.is_empty());
     let inside = |a: usize, b: usize, sa: f64, sb: f64| {
         boxes.iter().any(|x| {
@@ -142,12 +152,9 @@ fn the_coordination_diagram_covers_every_contact() {
 #[test]
 fn the_diagrams_windows_on_the_clock_hold_every_contact() {
     let f = fixture();
-    let (_, none) = document(Coordination::None);
-    let settings = coord::CoordSettings::default();
-    let boxes = coord::conflict_boxes(&f.cell, &f.table, &none.programs, &settings).unwrap();
+    let (none, boxes) = uncoordinated_boxes();
     let cover = coord::Cover::new(2, &boxes);
     let margin = f.cell.planning.clearance + coord::REPLAY_SLACK;
-    let (ra, rb) = (&f.cell.robots[0], &f.cell.robots[1]);
     let limits: Vec<_> = f
         .cell
         .robots
@@ -181,15 +188,9 @@ fn the_diagrams_windows_on_the_clock_hold_every_contact() {
         let windows = cover.windows(0, &ta, 1, &tb, 0.0, horizon).unwrap();
         covered += windows.iter().map(|w| w.1 - w.0).sum::<f64>();
         total += horizon;
-        let (mut sa, mut sb) = (Default::default(), Default::default());
         let mut t = 0.0;
         while t <= horizon {
-            ra.body_poses(&ta.trajectory.position(t), &mut sa);
-            rb.body_poses(&tb.trajectory.position(t), &mut sb);
-            let d = f
-                .cell
-                .world
-                .group_group_distance(ra.group, &sa.bodies, rb.group, &sb.bodies, 1.0);
+            let d = distance(&ta.trajectory.position(t), &tb.trajectory.position(t));
             if d <= margin {
                 contacts += 1;
                 assert!(

@@ -198,8 +198,6 @@ struct Placed {
     /// World bounding sphere of each body with shapes, and which body it is.
     spheres: Vec<(DVec3, f64)>,
     bodies: Vec<usize>,
-    /// Per body, the index of its sphere in `spheres` (`usize::MAX`: no shapes).
-    sphere_of: Vec<usize>,
     /// Each body's sphere cover in the world (empty for a body without shapes).
     covers: Vec<Vec<(DVec3, f64)>>,
 }
@@ -241,9 +239,8 @@ fn covers(ctx: &Ctx, robot: &Robot) -> Vec<Vec<(DVec3, f64)>> {
 enum Rect {
     Free,
     Conflict,
-    /// Halve along the first robot; the body pairs not proven apart over the whole rectangle.
-    HalveA(Vec<(usize, usize)>),
-    HalveB(Vec<(usize, usize)>),
+    HalveA,
+    HalveB,
 }
 
 struct PairDiagram<'a> {
@@ -281,16 +278,12 @@ impl PairDiagram<'_> {
         let q = path.at(s);
         robot.body_poses(&q, &mut self.scratch);
         let local = if first { &self.sa } else { &self.sb };
-        let (spheres, bodies): (Vec<(DVec3, f64)>, Vec<usize>) = local
+        let (spheres, bodies) = local
             .iter()
             .zip(&self.scratch.bodies)
             .enumerate()
             .filter_map(|(i, (s, p))| s.map(|(c, r)| ((p.transform_point(c), r), i)))
             .unzip();
-        let mut sphere_of = vec![usize::MAX; self.scratch.bodies.len()];
-        for (k, &b) in bodies.iter().enumerate() {
-            sphere_of[b] = k;
-        }
         let covers = if first { &self.ca } else { &self.cb }
             .iter()
             .zip(&self.scratch.bodies)
@@ -301,7 +294,6 @@ impl PairDiagram<'_> {
             poses: self.scratch.bodies.clone(),
             spheres,
             bodies,
-            sphere_of,
             covers,
         }
     }
@@ -327,42 +319,31 @@ impl PairDiagram<'_> {
         }
     }
 
-    /// The body pairs of the two placed robots (of `among`, or of all) whose sphere covers
-    /// (body spheres first) come within `need`: every other pair is farther than `need` (the
-    /// covers hold the meshes).
-    fn close_pairs(
-        &self,
-        xa: &Placed,
-        xb: &Placed,
-        need: f64,
-        among: Option<&[(usize, usize)]>,
-    ) -> Vec<(usize, usize)> {
+    /// The body pairs of the two placed robots whose sphere covers (body spheres first) come
+    /// within `need`: every other pair is farther than `need` (the covers hold the meshes).
+    fn close_pairs(&self, xa: &Placed, xb: &Placed, need: f64) -> Vec<(usize, usize)> {
         // Squared distances against squared reaches (all terms are non-negative): no square
         // root per sphere pair.
         let within = |c: DVec3, r: f64, d: DVec3, q: f64| {
             let reach = need + r + q;
             (c - d).length_squared() <= reach * reach
         };
-        let close = |i: usize, j: usize| {
-            let ((ca, ra), (cb, rb)) = (xa.spheres[i], xb.spheres[j]);
-            let (bi, bj) = (xa.bodies[i], xb.bodies[j]);
-            within(ca, ra, cb, rb)
-                && xa.covers[bi]
+        let mut out = Vec::new();
+        for (i, (ca, ra)) in xa.spheres.iter().enumerate() {
+            for (j, (cb, rb)) in xb.spheres.iter().enumerate() {
+                if !within(*ca, *ra, *cb, *rb) {
+                    continue;
+                }
+                let (bi, bj) = (xa.bodies[i], xb.bodies[j]);
+                let close = xa.covers[bi]
                     .iter()
-                    .any(|(c, r)| xb.covers[bj].iter().any(|(d, q)| within(*c, *r, *d, *q)))
-        };
-        match among {
-            Some(pairs) => pairs
-                .iter()
-                .copied()
-                .filter(|&(bi, bj)| close(xa.sphere_of[bi], xb.sphere_of[bj]))
-                .collect(),
-            None => (0..xa.spheres.len())
-                .flat_map(|i| (0..xb.spheres.len()).map(move |j| (i, j)))
-                .filter(|&(i, j)| close(i, j))
-                .map(|(i, j)| (xa.bodies[i], xb.bodies[j]))
-                .collect(),
+                    .any(|(c, r)| xb.covers[bj].iter().any(|(d, q)| within(*c, *r, *d, *q)));
+                if close {
+                    out.push((bi, bj));
+                }
+            }
         }
+        out
     }
 
     /// Whether the two placed robots are farther apart than `need`, exactly (up to the convex
@@ -400,9 +381,8 @@ impl PairDiagram<'_> {
     /// What rectangle `[a0, a1] × [b0, b1]` (inside pieces of the two paths) is: free (the
     /// sphere covers, or the exact distance, exceed the clearance plus both robots' reach over
     /// it), to be halved (along the robot that moves more), or — once nothing is left to halve
-    /// — in conflict. Only the body pairs `among` are looked at (`None`: all): a rectangle
-    /// inside one where a pair was proven apart has that pair apart too.
-    fn judge(&mut self, a: (f64, f64, bool), b: (f64, f64, bool), among: Option<&[(usize, usize)]>) -> Rect {
+    /// — in conflict.
+    fn judge(&mut self, a: (f64, f64, bool), b: (f64, f64, bool)) -> Rect {
         self.work.cells += 1;
         let (pa, pb) = (self.pa, self.pb);
         let xa = self.place(pa, true, 0.5 * (a.0 + a.1));
@@ -416,7 +396,7 @@ impl PairDiagram<'_> {
         // distance only where nothing is left to halve (halving is cheaper than GJK, and
         // the covers decide most rectangles once small), and only for the body pairs whose
         // covers come close.
-        let close = self.close_pairs(&xa, &xb, need, among);
+        let close = self.close_pairs(&xa, &xb, need);
         if close.is_empty() {
             return Rect::Free;
         }
@@ -428,15 +408,15 @@ impl PairDiagram<'_> {
             };
         }
         if split_a && (!split_b || ra >= rb) {
-            Rect::HalveA(close)
+            Rect::HalveA
         } else {
-            Rect::HalveB(close)
+            Rect::HalveB
         }
     }
 
     /// Rectangle `[a0, a1] × [b0, b1]` inside pieces of the two paths: free, or halved, or
     /// recorded as in conflict.
-    fn cell(&mut self, a: (f64, f64, bool), b: (f64, f64, bool), among: Option<&[(usize, usize)]>) {
+    fn cell(&mut self, a: (f64, f64, bool), b: (f64, f64, bool)) {
         // Inside what is already in conflict: nothing to learn.
         if self
             .found
@@ -445,7 +425,7 @@ impl PairDiagram<'_> {
         {
             return;
         }
-        match self.judge(a, b, among) {
+        match self.judge(a, b) {
             Rect::Free => {}
             Rect::Conflict => {
                 let robots = (self.pa.robot, self.pb.robot);
@@ -458,37 +438,24 @@ impl PairDiagram<'_> {
                 f.a = (f.a.0.min(a.0), f.a.1.max(a.1));
                 f.b = (f.b.0.min(b.0), f.b.1.max(b.1));
             }
-            Rect::HalveA(close) => {
-                let m = 0.5 * (a.0 + a.1);
-                self.cell((a.0, m, a.2), b, Some(&close));
-                self.cell((m, a.1, a.2), b, Some(&close));
-            }
-            Rect::HalveB(close) => {
-                let m = 0.5 * (b.0 + b.1);
-                self.cell(a, (b.0, m, b.2), Some(&close));
-                self.cell(a, (m, b.1, b.2), Some(&close));
-            }
+            Rect::HalveA => self.halve_a(a, b),
+            Rect::HalveB => self.halve_b(a, b),
         }
     }
 
     /// Whether rectangle `[a0, a1] × [b0, b1]` is certified free (as [`Self::cell`] decides,
     /// halving until it is or a smallest rectangle is not).
-    fn certify(
-        &mut self,
-        a: (f64, f64, bool),
-        b: (f64, f64, bool),
-        among: Option<&[(usize, usize)]>,
-    ) -> bool {
-        match self.judge(a, b, among) {
+    fn certify(&mut self, a: (f64, f64, bool), b: (f64, f64, bool)) -> bool {
+        match self.judge(a, b) {
             Rect::Free => true,
             Rect::Conflict => false,
-            Rect::HalveA(close) => {
+            Rect::HalveA => {
                 let m = 0.5 * (a.0 + a.1);
-                self.certify((a.0, m, a.2), b, Some(&close)) && self.certify((m, a.1, a.2), b, Some(&close))
+                self.certify((a.0, m, a.2), b) && self.certify((m, a.1, a.2), b)
             }
-            Rect::HalveB(close) => {
+            Rect::HalveB => {
                 let m = 0.5 * (b.0 + b.1);
-                self.certify(a, (b.0, m, b.2), Some(&close)) && self.certify(a, (m, b.1, b.2), Some(&close))
+                self.certify(a, (b.0, m, b.2)) && self.certify(a, (m, b.1, b.2))
             }
         }
     }
@@ -507,24 +474,32 @@ impl PairDiagram<'_> {
         let (la, lb) = (self.pa.len, self.pb.len);
         if x.moving {
             if f.a.0 <= x.from + AT {
-                f.open[0] =
-                    x.from <= AT || self.certify((x.from, x.from, false), (f.b.0, f.b.1, y.moving), None);
+                f.open[0] = x.from <= AT || self.certify((x.from, x.from, false), (f.b.0, f.b.1, y.moving));
             }
             if f.a.1 >= x.to - AT {
-                f.open[1] =
-                    x.to >= la - AT || self.certify((x.to, x.to, false), (f.b.0, f.b.1, y.moving), None);
+                f.open[1] = x.to >= la - AT || self.certify((x.to, x.to, false), (f.b.0, f.b.1, y.moving));
             }
         }
         if y.moving {
             if f.b.0 <= y.from + AT {
-                f.open[2] =
-                    y.from <= AT || self.certify((f.a.0, f.a.1, x.moving), (y.from, y.from, false), None);
+                f.open[2] = y.from <= AT || self.certify((f.a.0, f.a.1, x.moving), (y.from, y.from, false));
             }
             if f.b.1 >= y.to - AT {
-                f.open[3] =
-                    y.to >= lb - AT || self.certify((f.a.0, f.a.1, x.moving), (y.to, y.to, false), None);
+                f.open[3] = y.to >= lb - AT || self.certify((f.a.0, f.a.1, x.moving), (y.to, y.to, false));
             }
         }
+    }
+
+    fn halve_a(&mut self, a: (f64, f64, bool), b: (f64, f64, bool)) {
+        let m = 0.5 * (a.0 + a.1);
+        self.cell((a.0, m, a.2), b);
+        self.cell((m, a.1, a.2), b);
+    }
+
+    fn halve_b(&mut self, a: (f64, f64, bool), b: (f64, f64, bool)) {
+        let m = 0.5 * (b.0 + b.1);
+        self.cell(a, (b.0, m, b.2));
+        self.cell(a, (m, b.1, b.2));
     }
 }
 
@@ -557,7 +532,7 @@ fn pair_boxes(ctx: &Ctx, pa: &RobotPath, pb: &RobotPath) -> (Vec<ConflictBox>, D
             if !sx.may_meet(sy, margin) {
                 continue;
             }
-            d.cell((x.from, x.to, x.moving), (y.from, y.to, y.moving), None);
+            d.cell((x.from, x.to, x.moving), (y.from, y.to, y.moving));
             if let Some(mut f) = d.found.take() {
                 d.open_ends(&mut f, x, y);
                 boxes.push(f);
@@ -598,8 +573,8 @@ pub(crate) fn diagrams(ctx: &Ctx, paths: &[RobotPath]) -> (Vec<ConflictBox>, Dia
 /// Boxes of one robot pair, and what they cost.
 type Built = (Vec<ConflictBox>, DiagramWork);
 
-/// The signatures of a robot pair's two paths.
-type PairKey = (Vec<u64>, Vec<u64>);
+/// Built pairs by the second path's signature.
+type BySecond = HashMap<Vec<u64>, Built>;
 
 /// Boxes of one robot pair, and what they cost (see [`diagrams_reusing`]).
 pub(crate) type PairBoxes = Option<Built>;
@@ -611,13 +586,15 @@ pub(crate) type PairBoxes = Option<Built>;
 /// counts and results are those of a run without the cache.
 #[derive(Default)]
 pub struct DiagramCache {
-    pairs: std::sync::Mutex<HashMap<PairKey, Built>>,
+    /// By the first path's signature, then the second's.
+    pairs: std::sync::Mutex<HashMap<Vec<u64>, BySecond>>,
 }
 
 impl DiagramCache {
     /// Robot pairs' diagrams held.
     pub fn len(&self) -> usize {
-        self.pairs.lock().unwrap_or_else(|e| e.into_inner()).len()
+        let pairs = self.pairs.lock().unwrap_or_else(|e| e.into_inner());
+        pairs.values().map(HashMap::len).sum()
     }
 
     /// Whether none is held.
@@ -627,12 +604,18 @@ impl DiagramCache {
 
     fn get(&self, a: &RobotPath, b: &RobotPath) -> PairBoxes {
         let pairs = self.pairs.lock().unwrap_or_else(|e| e.into_inner());
-        pairs.get(&(a.signature.clone(), b.signature.clone())).cloned()
+        pairs
+            .get(a.signature.as_slice())?
+            .get(b.signature.as_slice())
+            .cloned()
     }
 
-    fn put(&self, a: &RobotPath, b: &RobotPath, part: &(Vec<ConflictBox>, DiagramWork)) {
+    fn put(&self, a: &RobotPath, b: &RobotPath, part: &Built) {
         let mut pairs = self.pairs.lock().unwrap_or_else(|e| e.into_inner());
-        pairs.insert((a.signature.clone(), b.signature.clone()), part.clone());
+        pairs
+            .entry(a.signature.clone())
+            .or_default()
+            .insert(b.signature.clone(), part.clone());
     }
 }
 

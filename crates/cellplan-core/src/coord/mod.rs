@@ -246,13 +246,9 @@ impl<'a> Ctx<'a> {
         let mx = self.mover(x, tx);
         others.iter().filter(|&&o| o != x).all(|&o| {
             let mo = self.mover(o, &timed[o]);
-            let windows = cover
-                .and_then(|c| c.windows(x, tx, o, &timed[o], from, until))
-                .unwrap_or_else(|| vec![(from, until)]);
-            let mut probe = timeline::PairProbe::new(self.cell, &mx, &mo);
-            windows
-                .into_iter()
-                .all(|(lo, hi)| probe.first_contact(lo, hi, self.margin).is_none())
+            timeline::PairProbe::new(self.cell, &mx, &mo)
+                .first_contact_covered((x, o), cover, from, until, self.margin)
+                .is_none()
         })
     }
 }

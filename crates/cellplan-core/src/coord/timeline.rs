@@ -122,6 +122,25 @@ impl<'a> PairProbe<'a> {
         }
     }
 
+    /// [`Self::first_contact`], searched only in the windows of `[from, until]` in which
+    /// `cover` says robots `a` and `b` (this probe's two) may meet — all of it without a
+    /// cover, or where the cover does not hold for them.
+    pub fn first_contact_covered(
+        &mut self,
+        (a, b): (usize, usize),
+        cover: Option<&super::Cover>,
+        from: f64,
+        until: f64,
+        margin: f64,
+    ) -> Option<f64> {
+        let windows = cover
+            .and_then(|c| c.windows(a, self.a.timed, b, self.b.timed, from, until))
+            .unwrap_or_else(|| vec![(from, until)]);
+        windows
+            .into_iter()
+            .find_map(|(lo, hi)| self.first_contact(lo, hi, margin))
+    }
+
     /// Every interval of `[0, horizon]` in which the robots are within `margin`.
     pub fn contacts(&mut self, horizon: f64, margin: f64) -> Vec<(f64, f64)> {
         let mut out = Vec::new();
@@ -264,15 +283,8 @@ impl<'a> Timeline<'a> {
         for a in 0..self.movers.len() {
             for b in a + 1..self.movers.len() {
                 let limit = best.map_or(f64::INFINITY, |x| x.0);
-                let (ma, mb) = (&self.movers[a], &self.movers[b]);
-                let windows = cover
-                    .and_then(|c| c.windows(a, ma.timed, b, mb.timed, from, limit))
-                    .unwrap_or_else(|| vec![(from, limit)]);
-                let mut probe = PairProbe::new(self.cell, ma, mb);
-                let found = windows
-                    .into_iter()
-                    .find_map(|(lo, hi)| probe.first_contact(lo, hi, self.margin));
-                if let Some(t) = found
+                let mut probe = PairProbe::new(self.cell, &self.movers[a], &self.movers[b]);
+                if let Some(t) = probe.first_contact_covered((a, b), cover, from, limit, self.margin)
                     && best.is_none_or(|x| t < x.0)
                 {
                     best = Some((t, a, b));

@@ -438,18 +438,6 @@ pub fn plan_keeping(
     let mut planned: Vec<sequence::Planned> = std::mem::take(&mut cache.planned);
     planned.resize_with(cell.robots.len(), Default::default);
     let mut counts = vec![(0usize, 0usize, 0usize); cell.robots.len()];
-    // The robots that may keep what they have in `prior` (same tasks).
-    let kept_of = |tasks: &[Vec<TaskId>]| -> Vec<Option<&RobotResult>> {
-        (0..cell.robots.len())
-            .map(|r| {
-                prior.and_then(|p| {
-                    (p.allocated.tasks.get(r) == tasks.get(r))
-                        .then(|| p.robots.get(r))
-                        .flatten()
-                })
-            })
-            .collect()
-    };
     let mut sequences = sequence_all(
         cell,
         &graphs,
@@ -545,22 +533,25 @@ pub fn plan_keeping(
         .zip(&cell.robots)
         .zip(&graphs[..])
         .for_each(|((seq, robot), graph)| sequence::polish(cell, robot, graph, seq, settings));
-    // On the final allocation (the balanced one may have changed it, dropped tasks moved).
-    let kept = kept_of(&allocated.tasks);
     tick(Stage::Sequencing, &mut compute);
 
     progress(Stage::Timing);
     let mut robots = Vec::with_capacity(sequences.len());
-    for (((sequence, graph), robot), kept) in sequences
+    for (r, ((sequence, graph), robot)) in sequences
         .into_iter()
         .zip(graphs.iter())
         .zip(&cell.robots)
-        .zip(kept)
+        .enumerate()
     {
         let new = RobotResult {
             program: Program::from_sequence(cell, table, robot, graph, &sequence)?,
             sequence,
         };
+        // What the robot had in `prior`, if its tasks are the same (on the final allocation:
+        // the balanced one may have changed it, dropped tasks moved).
+        let kept = prior
+            .filter(|p| p.allocated.tasks.get(r) == allocated.tasks.get(r))
+            .and_then(|p| p.robots.get(r));
         let result = match kept {
             Some(k) if k.program.duration() <= new.program.duration() + 1e-9 => k.clone(),
             _ => new,
