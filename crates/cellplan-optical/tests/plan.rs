@@ -407,3 +407,64 @@ fn a_hand_over_keeps_the_other_robots_programs() {
     check_plan(&cell, &doc);
     verified(&cell, &doc);
 }
+
+/// A hand-over whose plan keeping the other robots' programs does not help is planned again
+/// with every robot sequenced anew (other paths, which may meet less): the judge gets the two
+/// plans of one allocation, the kept one first, and never the same plan twice; the budgets hold.
+#[test]
+fn a_hand_over_that_does_not_help_is_tried_with_every_robot_sequenced_again() {
+    use plan::rebalance::{REBALANCE_JUDGED, REBALANCE_PLANS, ends, makespan, rebalance};
+    let (cell, table, s, mut cache, base) = readme_nearest();
+    let before = makespan(&base);
+    let mut seen: Vec<plan::Outcome> = Vec::new();
+    // A judge that no plan satisfies: every hand-over's plans are judged, none kept.
+    let mut judge = |o: &plan::Outcome| -> Option<(f64, Vec<f64>, ())> {
+        seen.push(o.clone());
+        None
+    };
+    let (found, clock) = rebalance(
+        &cell,
+        &table,
+        (&base, before, &ends(&base)),
+        &s,
+        &mut cache,
+        &mut judge,
+    )
+    .unwrap();
+    assert!(found.is_none() && !clock);
+    assert!(
+        (2..=REBALANCE_JUDGED).contains(&seen.len()),
+        "{} judged",
+        seen.len()
+    );
+    let mut pairs = 0;
+    for w in seen.windows(2) {
+        let (kept, fresh) = (&w[0], &w[1]);
+        let programs = |o: &plan::Outcome| o.robots.iter().map(|r| r.program.clone()).collect::<Vec<_>>();
+        assert_ne!(programs(kept), programs(fresh), "the same plan judged twice");
+        if kept.allocated.tasks != fresh.allocated.tasks {
+            continue;
+        }
+        pairs += 1;
+        // The kept plan: robots of unchanged tasks have the base's programs or shorter ones.
+        for (r, (now, was)) in kept.robots.iter().zip(&base.robots).enumerate() {
+            if kept.allocated.tasks[r] == base.allocated.tasks[r] {
+                assert!(
+                    now.program.duration() <= was.program.duration() + 1e-9,
+                    "robot {r}"
+                );
+            }
+        }
+    }
+    assert!(pairs >= 1, "no allocation was tried both ways");
+    assert!(seen.len() <= REBALANCE_PLANS);
+    for o in &seen {
+        let fixed = PlanSettings {
+            tasks: Some(o.allocated.tasks.clone()),
+            ..s.clone()
+        };
+        let doc = build(&cell, &table, o, &fixed);
+        check_plan(&cell, &doc);
+        verified(&cell, &doc);
+    }
+}

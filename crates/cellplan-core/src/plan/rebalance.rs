@@ -4,8 +4,9 @@
 //! expected. [`rebalance`] hands one task at a time from the robot that ends last to the robot
 //! that can take it at the least cost, plans the robots again with that allocation (the legs
 //! already planned are reused: see [`super::PlanCache`]; a robot whose tasks did not change
-//! keeps its program unless the new one is shorter) and keeps the change when the robots end
-//! sooner. Spensieri et al. (2016) iterate routing and scheduling the same way, one level
+//! keeps its program unless the new one is shorter — and when that plan does not end sooner,
+//! every robot is sequenced anew: other paths, which may meet less) and keeps the change when
+//! the robots end sooner. Spensieri et al. (2016) iterate routing and scheduling the same way, one level
 //! down.
 use super::{Outcome, PlanCache, PlanError, PlanSettings, dwell, plan_keeping};
 use crate::candidates::CandidateTable;
@@ -15,10 +16,10 @@ use std::time::Instant;
 
 /// Plans [`rebalance`] makes at most (work, not time: the result does not depend on the
 /// machine).
-pub const REBALANCE_PLANS: usize = 6;
+pub const REBALANCE_PLANS: usize = 10;
 
 /// Plans [`rebalance`] hands its judge at most (a coordination each: the costly part).
-pub const REBALANCE_JUDGED: usize = 3;
+pub const REBALANCE_JUDGED: usize = 5;
 
 /// One hand-over: the task, from which robot, to which, and the ends it is expected to give
 /// the two (s).
@@ -41,6 +42,15 @@ pub type Rebalanced<J> = (Outcome, PlanSettings, J);
 /// When each robot of `o` ends without coordination (s).
 pub fn ends(o: &Outcome) -> Vec<f64> {
     o.robots.iter().map(|r| r.program.duration()).collect()
+}
+
+/// Whether every robot of `a` and `b` has the same program (the same poses, paths and times).
+fn same_programs(a: &Outcome, b: &Outcome) -> bool {
+    a.robots.len() == b.robots.len()
+        && a.robots
+            .iter()
+            .zip(&b.robots)
+            .all(|(x, y)| x.program == y.program)
 }
 
 /// The latest of [`ends`].
@@ -133,7 +143,10 @@ fn moves(cell: &Cell, o: &Outcome, end: &[f64]) -> Vec<Move> {
 /// `base` (planned with `settings`; `judge` said `base_score` and `base_ends` of it) balanced
 /// on its real times. Up to [`REBALANCE_PLANS`] times, the best expected hand-over not tried
 /// yet (one task of the robot that ends last as judged to another robot, ranked by the ends it
-/// is expected to give the two) is planned with the allocation fixed ([`PlanSettings::tasks`]).
+/// is expected to give the two) is planned with the allocation fixed ([`PlanSettings::tasks`]),
+/// first with the other robots keeping their programs ([`plan_keeping`]), then, when the judge
+/// does not take that plan, with every robot sequenced anew (each counts as a plan; a plan the
+/// same as the one before is not judged again).
 /// A plan whose robots end, without coordination, sooner than the best score (the judge's
 /// score is never below that end) goes to `judge` — at most [`REBALANCE_JUDGED`] plans; the
 /// first it scores below the best is kept and the next hand-overs start from it and its ends.
@@ -176,27 +189,38 @@ pub fn rebalance<J>(
                 continue;
             }
             tried.push(tasks.clone());
-            plans += 1;
             let next = PlanSettings {
                 tasks: Some(tasks),
                 ..settings.clone()
             };
-            // The robots whose tasks did not change keep their programs unless the new ones
-            // are shorter (and so, mostly, the diagrams of their pairs).
-            let Ok(o) = plan_keeping(cell, table, &next, &|_| {}, cache, Some(current)) else {
-                continue;
-            };
-            // The judge's score is never below the robots' latest end without coordination.
-            if !o.unreached.is_empty() || makespan(&o) >= score - 1e-6 {
-                continue;
-            }
-            judged += 1;
-            if let Some((sc, e, j)) = judge(&o)
-                && sc < score - 1e-6
-            {
-                (score, judged_ends) = (sc, e);
-                best = Some((o, next, j));
-                continue 'rounds;
+            // First the robots whose tasks did not change keep their programs unless the new
+            // ones are shorter (and so, mostly, the diagrams of their pairs); when that does
+            // not help, every robot is sequenced again: other paths, which may meet less.
+            let mut kept: Option<Outcome> = None;
+            for keep in [true, false] {
+                if plans >= REBALANCE_PLANS || judged >= REBALANCE_JUDGED {
+                    break 'rounds;
+                }
+                plans += 1;
+                let prior = if keep { Some(current) } else { None };
+                let Ok(o) = plan_keeping(cell, table, &next, &|_| {}, cache, prior) else {
+                    continue;
+                };
+                // The judge's score is never below the robots' latest end without
+                // coordination; a plan the same as the one just judged is not judged again.
+                let same = kept.as_ref().is_some_and(|k| same_programs(k, &o));
+                if same || !o.unreached.is_empty() || makespan(&o) >= score - 1e-6 {
+                    continue;
+                }
+                judged += 1;
+                if let Some((sc, e, j)) = judge(&o)
+                    && sc < score - 1e-6
+                {
+                    (score, judged_ends) = (sc, e);
+                    best = Some((o, next, j));
+                    continue 'rounds;
+                }
+                kept = Some(o);
             }
         }
         // No hand-over of the robot ending last helped.
