@@ -159,6 +159,22 @@ enum Try {
 /// Ours plans the balanced (min-max) allocation too on cells of at most this many MPs × robots.
 pub const BALANCED_MAX_PAIRS: usize = 100;
 
+/// Beyond this many MPs × robots, by default ([`CoordSettings::plan_first_pairs`]), ours plans
+/// all its tries before coordinating any, and coordinates them most promising first (see
+/// [`coordinate`]).
+pub const PLAN_FIRST_PAIRS: usize = 2_000;
+
+/// Exact robot–robot distances the coordination diagrams of ours' plans may ask in all, by
+/// default ([`CoordSettings::ours_distances`]; each coordination counted as if its diagrams were
+/// built afresh). The first plan is always coordinated; another try or hand-over only while
+/// what the coordinations so far asked, plus as much again as the costliest of them, stays
+/// within this, and only while the costliest asked at most a quarter of it (choosing among
+/// plans pays when several fit; when not even four do, the first plan is kept). Work, not
+/// time: the plan depends on the cell and the seed only. A coordination asks 25–30 thousand on
+/// the README cell, 0.7–1.8 million on the crowded 6- and 8-robot cells (which use up to ten),
+/// about 6.7 million on 4 robots × 2,000 MPs, where ten coordinations took 24 minutes.
+pub const OURS_COORDINATION_DISTANCES: usize = 16_000_000;
+
 /// The line of the robots along which ours draws strips: see [`plan::robot_rows`].
 pub fn robot_line(cell: &Cell) -> Option<[f64; 2]> {
     plan::robot_rows(cell).map(|(line, _)| line)
@@ -247,11 +263,52 @@ pub fn coordinate(
     // nothing but the diagrams: the result is that of one after the other).
     let mut best: Option<(Outcome, PlanSettings, Coordinated)> = None;
     let mut pending = Some((outcome, settings.clone()));
+    // On large cells every try is planned first and the plans are coordinated in the order of
+    // their robots' latest end without coordination (the most promising first: the work budget
+    // may allow only one coordination there); the zones with the blocking penalties are left
+    // out (they need a coordination to start from).
+    let mut ready: Vec<(Outcome, PlanSettings)> = Vec::new();
+    if cell.tasks.len() * cell.robots.len() > coord.plan_first_pairs {
+        ready.extend(pending.take());
+        let mut k = 0;
+        while let Some(t) = tries.get(k) {
+            k += 1;
+            let Try::Plan(more) = t else {
+                continue;
+            };
+            let more = PlanSettings::clone(more);
+            let Ok(o) = plan::plan_cached(cell, table, &more, &|_| {}, &mut *cache) else {
+                continue;
+            };
+            if more.sweep.is_some() && more.task_penalty.is_empty() {
+                tries.insert(
+                    k,
+                    Try::Plan(Box::new(PlanSettings {
+                        task_penalty: slowness_penalty(cell, &o),
+                        ..more.clone()
+                    })),
+                );
+            }
+            ready.push((o, more));
+        }
+        tries.clear();
+        // Latest first, so that the most promising is popped first (ties: the earlier try).
+        ready.reverse();
+        ready.sort_by(|a, b| plan::rebalance::makespan(&b.0).total_cmp(&plan::rebalance::makespan(&a.0)));
+        pending = ready.pop();
+    }
     // What the first plan's measurements blocked the other robots (set once it is coordinated,
     // before [`Try::ZonesBlocking`] comes up: the first try is planned while it is).
     let mut blocking = Vec::new();
     let mut next = 0;
     let mut cut = false;
+    // Diagram work of the coordinations so far, and of the costliest.
+    let spent = std::cell::Cell::new(0usize);
+    let costliest = std::cell::Cell::new(0usize);
+    let affordable = || {
+        let (spent, costliest) = (spent.get(), costliest.get());
+        spent + costliest <= coord.ours_distances && costliest.saturating_mul(4) <= coord.ours_distances
+    };
     let cycle_of = |b: &Option<(Outcome, PlanSettings, Coordinated)>| {
         b.as_ref()
             .map_or(f64::INFINITY, |b| cycle_and_delta(&b.2.timed).0)
@@ -261,8 +318,9 @@ pub fn coordinate(
         if next < tries.len() && settings.deadline.is_some_and(|d| Instant::now() >= d) {
             cut = true;
         }
+        // Past the work budget (one more coordination would pass it) no try is planned.
         let more = match tries.get(next) {
-            _ if cut => None,
+            _ if cut || !affordable() => None,
             Some(Try::Plan(t)) => Some(PlanSettings::clone(t)),
             Some(Try::ZonesBlocking) => Some(PlanSettings {
                 task_penalty: blocking.clone(),
@@ -270,6 +328,9 @@ pub fn coordinate(
             }),
             None => None,
         };
+        if pending.is_none() && affordable() {
+            pending = ready.pop();
+        }
         if pending.is_none() && more.is_none() {
             break;
         }
@@ -277,11 +338,12 @@ pub fn coordinate(
         // so far even without them cannot win, and is not coordinated.
         let bar = cycle_of(&best);
         let first = best.is_none();
+        let may = first || affordable();
         let (judged, planned) = rayon::join(
             || {
                 let (o, _) = pending.as_ref()?;
                 let free = o.robots.iter().map(|r| r.program.duration()).fold(0.0, f64::max);
-                (free < bar).then(|| coordinate_outcome_cached(cell, table, o, coord, &diagrams))
+                (free < bar && may).then(|| coordinate_outcome_cached(cell, table, o, coord, &diagrams))
             },
             || {
                 // The balanced allocation is planned afresh, as it is on its own (legs the
@@ -300,6 +362,10 @@ pub fn coordinate(
                 .ok()
             },
         );
+        if let Some(Ok(c)) = &judged {
+            spent.set(spent.get() + c.diagram_distances);
+            costliest.set(costliest.get().max(c.diagram_distances));
+        }
         if let Some((o, s)) = pending.take() {
             match judged {
                 // The first plan's coordination is the run's: its failure is the run's.
@@ -347,10 +413,13 @@ pub fn coordinate(
     let (score, base_ends) = (cycle_and_delta(&best.2.timed).0, ends(&best.2));
     let mut judge = |o: &Outcome| {
         let c = coordinate_outcome_cached(cell, table, o, coord, &diagrams).ok()?;
+        spent.set(spent.get() + c.diagram_distances);
+        costliest.set(costliest.get().max(c.diagram_distances));
         Some((cycle_and_delta(&c.timed).0, ends(&c), c))
     };
     let base = (&best.0, score, base_ends.as_slice());
-    if let Ok((found, clock_cut)) = plan::rebalance::rebalance(cell, table, base, &best.1, cache, &mut judge)
+    if let Ok((found, clock_cut)) =
+        plan::rebalance::rebalance(cell, table, base, &best.1, cache, &affordable, &mut judge)
     {
         if let Some(found) = found {
             best = found;

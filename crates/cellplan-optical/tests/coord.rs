@@ -633,3 +633,82 @@ fn ours_keeps_the_shortest_of_its_plans() {
     assert!(report.ok, "{:#?}", report.violations);
     assert!(doc.cycle_time_s <= coord::cycle_and_delta(&alone.timed).0 + 1e-9);
 }
+
+/// Ours within a budget of diagram work that no second coordination fits: the first plan (the
+/// zones allocation) is the only one coordinated, so ours gives what the zones plan gives
+/// coordinated alone; with the default budget ours is no longer than that.
+#[test]
+fn ours_past_its_work_budget_keeps_its_first_plan() {
+    use cellplan_core::plan::{self, Allocation, PlanCache, PlanSettings};
+    let f = fixture();
+    let zones = PlanSettings {
+        allocation: Allocation::Zones,
+        ..f.settings.clone()
+    };
+    let tight = coord::CoordSettings {
+        ours_distances: 0,
+        ..coord::CoordSettings::default()
+    };
+    let mut cache = PlanCache::default();
+    let outcome = plan::plan_cached(&f.cell, &f.table, &zones, &|_| {}, &mut cache).unwrap();
+    let alone = coord::coordinate_outcome(&f.cell, &f.table, &outcome, &tight).unwrap();
+    assert!(alone.diagram_distances > 0, "the diagrams asked nothing");
+    let (o, s, c) = cellplan_core::pipeline::coordinate(
+        &f.cell,
+        &f.table,
+        outcome.clone(),
+        zones.clone(),
+        &tight,
+        &mut cache,
+    )
+    .unwrap();
+    assert_eq!(s.allocation, Allocation::Zones);
+    assert!(s.task_penalty.is_empty() && s.tasks.is_none());
+    assert_eq!(c.programs, alone.programs);
+    let doc = cellplan_core::document::build(&f.cell, &f.table, &o, &c, &s, 0.0, 0.0);
+    let report = verify(&f.cell, &doc, &VerifySettings::default());
+    assert!(report.ok, "{:#?}", report.violations);
+    let mut cache = PlanCache::default();
+    let (_, _, wide) = cellplan_core::pipeline::coordinate(
+        &f.cell,
+        &f.table,
+        outcome,
+        zones,
+        &coord::CoordSettings::default(),
+        &mut cache,
+    )
+    .unwrap();
+    assert!(coord::cycle_and_delta(&wide.timed).0 <= doc.cycle_time_s + 1e-9);
+}
+
+/// Ours planning every try first (as on large cells) within a budget that allows one
+/// coordination: the plan coordinated is the most promising of its plans, so its robots end,
+/// uncoordinated, no later than those of the zones plan it starts from (it is that plan or
+/// one that ends sooner); the plan verifies.
+#[test]
+fn ours_planning_first_coordinates_its_most_promising_plan() {
+    use cellplan_core::plan::{self, Allocation, PlanCache, PlanSettings, rebalance::makespan};
+    let f = fixture();
+    let zones = PlanSettings {
+        allocation: Allocation::Zones,
+        ..f.settings.clone()
+    };
+    let first = coord::CoordSettings {
+        ours_distances: 0,
+        plan_first_pairs: 0,
+        ..coord::CoordSettings::default()
+    };
+    let mut cache = PlanCache::default();
+    let outcome = plan::plan_cached(&f.cell, &f.table, &zones, &|_| {}, &mut cache).unwrap();
+    let start = makespan(&outcome);
+    let zones_tasks = outcome.allocated.tasks.clone();
+    let (o, s, c) =
+        cellplan_core::pipeline::coordinate(&f.cell, &f.table, outcome, zones, &first, &mut cache).unwrap();
+    assert!(makespan(&o) <= start + 1e-9, "{} > {start}", makespan(&o));
+    if o.allocated.tasks != zones_tasks {
+        assert!(makespan(&o) < start, "another plan kept though it ends no sooner");
+    }
+    let doc = cellplan_core::document::build(&f.cell, &f.table, &o, &c, &s, 0.0, 0.0);
+    let report = verify(&f.cell, &doc, &VerifySettings::default());
+    assert!(report.ok, "{:#?}", report.violations);
+}

@@ -317,6 +317,7 @@ fn rebalancing_hands_tasks_from_the_robot_ending_last_until_the_robots_end_soone
         (&base, before, &ends(&base)),
         &late,
         &mut cache,
+        &|| true,
         &mut judge,
     )
     .unwrap();
@@ -328,6 +329,7 @@ fn rebalancing_hands_tasks_from_the_robot_ending_last_until_the_robots_end_soone
         (&base, before, &ends(&base)),
         &s,
         &mut cache,
+        &|| true,
         &mut judge,
     )
     .unwrap()
@@ -428,6 +430,7 @@ fn a_hand_over_that_does_not_help_is_tried_with_every_robot_sequenced_again() {
         (&base, before, &ends(&base)),
         &s,
         &mut cache,
+        &|| true,
         &mut judge,
     )
     .unwrap();

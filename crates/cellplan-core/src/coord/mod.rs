@@ -115,6 +115,15 @@ pub struct CoordSettings {
     /// The shortest wait `best` adds (s): at least two trajectory sample steps, so that every
     /// wait shows in the sampled trajectory of the plan.
     pub min_wait: f64,
+    /// Exact robot–robot distances the coordination diagrams of ours' plans may ask in all
+    /// ([`crate::pipeline::coordinate`]; default
+    /// [`crate::pipeline::OURS_COORDINATION_DISTANCES`]): beyond the first plan, a try or a
+    /// hand-over is coordinated only while what was asked so far, plus as much again as the
+    /// costliest coordination, stays within it (work, not time).
+    pub ours_distances: usize,
+    /// Beyond this many MPs × robots ours plans all its tries before coordinating any, and
+    /// coordinates them most promising first (default [`crate::pipeline::PLAN_FIRST_PAIRS`]).
+    pub plan_first_pairs: usize,
 }
 
 impl Default for CoordSettings {
@@ -128,6 +137,8 @@ impl Default for CoordSettings {
             bar: None,
             schedule_nodes: 20_000,
             min_wait: 0.05,
+            ours_distances: crate::pipeline::OURS_COORDINATION_DISTANCES,
+            plan_first_pairs: crate::pipeline::PLAN_FIRST_PAIRS,
         }
     }
 }
@@ -155,8 +166,12 @@ pub struct Coordinated {
     pub after: Vec<Conflict>,
     /// Cycle time without coordination (s).
     pub uncoordinated_cycle: f64,
-    /// `best`'s search over passage orders, when it ran.
+    /// `best`'s search over passage orders, when its schedule was kept.
     pub search: Option<crate::document::PassageSearch>,
+    /// Exact robot–robot distances `best`'s coordination diagrams asked, whichever resolution
+    /// was kept (each pair counted as if built afresh; 0 for the other strategies): the work
+    /// ours budgets ([`CoordSettings::ours_distances`]).
+    pub diagram_distances: usize,
     /// Per robot, per visit (`best` only; else empty): seconds of the other robots' paths that
     /// conflict with the robot measuring there (see `diagram::blocking`).
     pub blocking: Vec<Vec<f64>>,
@@ -286,6 +301,7 @@ fn coordinate_with(
     let before = ctx.timeline(&timed).conflicts();
     let uncoordinated_cycle = cycle_and_delta(&timed).0;
     let cell_order: Vec<usize> = (0..programs.len()).collect();
+    let mut distances = 0;
     let (programs, res, priority) = match settings.strategy {
         Coordination::None => (programs, Resolution::default(), Vec::new()),
         _ if before.is_empty() => (programs, Resolution::default(), cell_order),
@@ -321,7 +337,8 @@ fn coordinate_with(
                 .collect::<Result<_, _>>()?;
             // The diagram of the tours as they are certifies where they cannot meet, for the
             // resolutions below (the exact search then looks only where they may).
-            let (found, cover) = scheduled(&ctx, &programs)?;
+            let (found, cover, asked) = scheduled(&ctx, &programs)?;
+            distances = asked;
             let first = match found {
                 Some(done) => done,
                 None => best(&ctx, programs.clone(), cover.as_ref())?,
@@ -387,6 +404,7 @@ fn coordinate_with(
         after,
         uncoordinated_cycle,
         search: res.search,
+        diagram_distances: distances,
         blocking: res.blocking,
         reversed: res.reversed,
         compute_s: started.elapsed().as_secs_f64(),

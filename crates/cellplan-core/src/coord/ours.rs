@@ -115,7 +115,7 @@ pub(super) fn best(ctx: &Ctx, programs: Vec<Program>, cover: Option<&Cover>) -> 
 pub(super) fn scheduled(
     ctx: &Ctx,
     programs: &[Program],
-) -> Result<(Option<Resolved>, Option<Cover>), PlanError> {
+) -> Result<(Option<Resolved>, Option<Cover>, usize), PlanError> {
     let mut programs = programs.to_vec();
     let mut round = 0;
     let mut parts = Vec::new();
@@ -188,17 +188,17 @@ pub(super) fn scheduled(
             }
         }
         if let Some((_, done)) = kept {
-            return Ok((Some(done), cover));
+            return Ok((Some(done), cover, distances));
         }
         if round == STOP_ROUNDS {
-            return Ok((None, cover));
+            return Ok((None, cover, distances));
         }
         round += 1;
         let core = schedule::infeasible_core(&tracks, &boxes, nodes, min_wait);
         let core: Vec<&ConflictBox> = core.iter().map(|&i| &boxes[i]).collect();
         let changed = add_stops(ctx, &mut programs, &paths, &core)?;
         if changed.iter().all(|&c| !c) {
-            return Ok((None, cover));
+            return Ok((None, cover, distances));
         }
         // The pairs of robots whose paths changed are built again.
         let mut i = 0;

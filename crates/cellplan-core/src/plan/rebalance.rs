@@ -148,7 +148,8 @@ fn moves(cell: &Cell, o: &Outcome, end: &[f64]) -> Vec<Move> {
 /// does not take that plan, with every robot sequenced anew (each counts as a plan; a plan the
 /// same as the one before is not judged again).
 /// A plan whose robots end, without coordination, sooner than the best score (the judge's
-/// score is never below that end) goes to `judge` — at most [`REBALANCE_JUDGED`] plans; the
+/// score is never below that end) goes to `judge` — at most [`REBALANCE_JUDGED`] plans, and
+/// no hand-over is planned once `may_judge` says no (the caller's budget of work); the
 /// first it scores below the best is kept and the next hand-overs start from it and its ends.
 /// Returns the best plan found with its settings and what the judge made of it, or `None` when
 /// no hand-over beat `base_score` (or `base` leaves tasks unreached: it is not rebalanced
@@ -160,6 +161,7 @@ pub fn rebalance<J>(
     (base, base_score, base_ends): (&Outcome, f64, &[f64]),
     settings: &PlanSettings,
     cache: &mut PlanCache,
+    may_judge: &dyn Fn() -> bool,
     judge: &mut dyn FnMut(&Outcome) -> Option<Judged<J>>,
 ) -> Result<(Option<Rebalanced<J>>, bool), PlanError> {
     if !base.unreached.is_empty() || cell.robots.len() < 2 {
@@ -198,7 +200,7 @@ pub fn rebalance<J>(
             // not help, every robot is sequenced again: other paths, which may meet less.
             let mut kept: Option<Outcome> = None;
             for keep in [true, false] {
-                if plans >= REBALANCE_PLANS || judged >= REBALANCE_JUDGED {
+                if plans >= REBALANCE_PLANS || judged >= REBALANCE_JUDGED || !may_judge() {
                     break 'rounds;
                 }
                 plans += 1;
