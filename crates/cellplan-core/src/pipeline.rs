@@ -156,6 +156,32 @@ enum Try {
     ZonesBlocking,
 }
 
+/// One of ours' tries planned, `None` when it fails (it only loses its try). The balanced
+/// allocation is planned afresh, as it is on its own (legs the other plans timed would steer its
+/// lazy sequencing elsewhere): ours is then never longer than it with `best`; the others share
+/// `cache`.
+fn plan_try(
+    cell: &Cell,
+    table: &CandidateTable,
+    more: &PlanSettings,
+    cache: &mut plan::PlanCache,
+) -> Option<Outcome> {
+    let mut own = plan::PlanCache::default();
+    let fresh = more.allocation == Allocation::Balanced;
+    plan::plan_cached(cell, table, more, &|_| {}, if fresh { &mut own } else { cache }).ok()
+}
+
+/// After the strips planned with `more` (as `o`), the strips once more, each robot's estimates
+/// raised by what its legs took beyond their lower bounds in `o`; `None` after any other try.
+fn strips_again(cell: &Cell, more: &PlanSettings, o: &Outcome) -> Option<Try> {
+    (more.sweep.is_some() && more.task_penalty.is_empty()).then(|| {
+        Try::Plan(Box::new(PlanSettings {
+            task_penalty: slowness_penalty(cell, o),
+            ..more.clone()
+        }))
+    })
+}
+
 /// Ours plans the balanced (min-max) allocation too on cells of at most this many MPs × robots.
 pub const BALANCED_MAX_PAIRS: usize = 100;
 
@@ -277,17 +303,11 @@ pub fn coordinate(
                 continue;
             };
             let more = PlanSettings::clone(more);
-            let Ok(o) = plan::plan_cached(cell, table, &more, &|_| {}, &mut *cache) else {
+            let Some(o) = plan_try(cell, table, &more, cache) else {
                 continue;
             };
-            if more.sweep.is_some() && more.task_penalty.is_empty() {
-                tries.insert(
-                    k,
-                    Try::Plan(Box::new(PlanSettings {
-                        task_penalty: slowness_penalty(cell, &o),
-                        ..more.clone()
-                    })),
-                );
+            if let Some(again) = strips_again(cell, &more, &o) {
+                tries.insert(k, again);
             }
             ready.push((o, more));
         }
@@ -345,22 +365,7 @@ pub fn coordinate(
                 let free = o.robots.iter().map(|r| r.program.duration()).fold(0.0, f64::max);
                 (free < bar && may).then(|| coordinate_outcome_cached(cell, table, o, coord, &diagrams))
             },
-            || {
-                // The balanced allocation is planned afresh, as it is on its own (legs the
-                // other plans timed would steer its lazy sequencing elsewhere): ours is then
-                // never longer than it with `best`. A plan that fails only loses its try.
-                let more = more.as_ref()?;
-                let mut own = plan::PlanCache::default();
-                let fresh = more.allocation == Allocation::Balanced;
-                plan::plan_cached(
-                    cell,
-                    table,
-                    more,
-                    &|_| {},
-                    if fresh { &mut own } else { &mut *cache },
-                )
-                .ok()
-            },
+            || plan_try(cell, table, more.as_ref()?, cache),
         );
         if let Some(Ok(c)) = &judged {
             spent.set(spent.get() + c.diagram_distances);
@@ -387,16 +392,8 @@ pub fn coordinate(
         if let Some(more) = more {
             next += 1;
             if let Some(o) = planned {
-                // The strips once more, each robot's estimates raised by what its legs took
-                // beyond their lower bounds in this plan.
-                if more.sweep.is_some() && more.task_penalty.is_empty() {
-                    tries.insert(
-                        next,
-                        Try::Plan(Box::new(PlanSettings {
-                            task_penalty: slowness_penalty(cell, &o),
-                            ..more.clone()
-                        })),
-                    );
+                if let Some(again) = strips_again(cell, &more, &o) {
+                    tries.insert(next, again);
                 }
                 pending = Some((o, more));
             }

@@ -602,21 +602,34 @@ fn best_chooses_the_tour_directions() {
     assert!((cycles[0] - cycles[1]).abs() < 1e-9, "{cycles:?}");
 }
 
-/// Ours (`pipeline::coordinate` with `best` on the zones allocation) keeps the shortest of its
-/// plans: never longer than the zones plan coordinated alone, whichever of its plans wins (the
-/// zones again with the blocking penalties, or the nearest robots), and the plan verifies with
-/// the settings of the plan that won.
-#[test]
-fn ours_keeps_the_shortest_of_its_plans() {
+/// The fixture's zones plan, with its settings and the leg cache it filled (where ours starts).
+fn zones_plan(
+    f: &cellplan_optical::testing::Fixture,
+) -> (
+    cellplan_core::plan::PlanSettings,
+    cellplan_core::plan::PlanCache,
+    cellplan_core::plan::Outcome,
+) {
     use cellplan_core::plan::{self, Allocation, PlanCache, PlanSettings};
-    let f = fixture();
-    let coord_settings = coord::CoordSettings::default();
     let zones = PlanSettings {
         allocation: Allocation::Zones,
         ..f.settings.clone()
     };
     let mut cache = PlanCache::default();
     let outcome = plan::plan_cached(&f.cell, &f.table, &zones, &|_| {}, &mut cache).unwrap();
+    (zones, cache, outcome)
+}
+
+/// Ours (`pipeline::coordinate` with `best` on the zones allocation) keeps the shortest of its
+/// plans: never longer than the zones plan coordinated alone, whichever of its plans wins (the
+/// zones again with the blocking penalties, or the nearest robots), and the plan verifies with
+/// the settings of the plan that won.
+#[test]
+fn ours_keeps_the_shortest_of_its_plans() {
+    use cellplan_core::plan::Allocation;
+    let f = fixture();
+    let coord_settings = coord::CoordSettings::default();
+    let (zones, mut cache, outcome) = zones_plan(f);
     let alone = coord::coordinate_outcome(&f.cell, &f.table, &outcome, &coord_settings).unwrap();
     let (o, s, c) =
         cellplan_core::pipeline::coordinate(&f.cell, &f.table, outcome, zones, &coord_settings, &mut cache)
@@ -639,18 +652,13 @@ fn ours_keeps_the_shortest_of_its_plans() {
 /// coordinated alone; with the default budget ours is no longer than that.
 #[test]
 fn ours_past_its_work_budget_keeps_its_first_plan() {
-    use cellplan_core::plan::{self, Allocation, PlanCache, PlanSettings};
+    use cellplan_core::plan::{Allocation, PlanCache};
     let f = fixture();
-    let zones = PlanSettings {
-        allocation: Allocation::Zones,
-        ..f.settings.clone()
-    };
     let tight = coord::CoordSettings {
         ours_distances: 0,
         ..coord::CoordSettings::default()
     };
-    let mut cache = PlanCache::default();
-    let outcome = plan::plan_cached(&f.cell, &f.table, &zones, &|_| {}, &mut cache).unwrap();
+    let (zones, mut cache, outcome) = zones_plan(f);
     let alone = coord::coordinate_outcome(&f.cell, &f.table, &outcome, &tight).unwrap();
     assert!(alone.diagram_distances > 0, "the diagrams asked nothing");
     let (o, s, c) = cellplan_core::pipeline::coordinate(
@@ -687,19 +695,14 @@ fn ours_past_its_work_budget_keeps_its_first_plan() {
 /// one that ends sooner); the plan verifies.
 #[test]
 fn ours_planning_first_coordinates_its_most_promising_plan() {
-    use cellplan_core::plan::{self, Allocation, PlanCache, PlanSettings, rebalance::makespan};
+    use cellplan_core::plan::rebalance::makespan;
     let f = fixture();
-    let zones = PlanSettings {
-        allocation: Allocation::Zones,
-        ..f.settings.clone()
-    };
     let first = coord::CoordSettings {
         ours_distances: 0,
         plan_first_pairs: 0,
         ..coord::CoordSettings::default()
     };
-    let mut cache = PlanCache::default();
-    let outcome = plan::plan_cached(&f.cell, &f.table, &zones, &|_| {}, &mut cache).unwrap();
+    let (zones, mut cache, outcome) = zones_plan(f);
     let start = makespan(&outcome);
     let zones_tasks = outcome.allocated.tasks.clone();
     let (o, s, c) =

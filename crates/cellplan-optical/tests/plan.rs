@@ -143,9 +143,7 @@ file = "tasks.csv"
     ] {
         let s = settings(a);
         let outcome = plan::plan(&cell, &table, &s, &|_| {}).unwrap();
-        let doc = build(&cell, &table, &outcome, &s);
-        check_plan(&cell, &doc);
-        verified(&cell, &doc);
+        build_checked(&cell, &table, &outcome, &s);
     }
 }
 
@@ -253,9 +251,7 @@ fn strips_cut_the_mps_along_the_line_of_the_robots_and_each_robot_sweeps_its_str
         );
     }
     // The plan holds up.
-    let doc = build(&cell, &table, &outcome, &s);
-    check_plan(&cell, &doc);
-    verified(&cell, &doc);
+    build_checked(&cell, &table, &outcome, &s);
 }
 
 /// A cell of the repository (path from its root), loaded.
@@ -363,9 +359,7 @@ fn rebalancing_hands_tasks_from_the_robot_ending_last_until_the_robots_end_soone
         mine.sort();
         assert_eq!(visited, mine);
     }
-    let doc = build(&cell, &table, &o, &fixed);
-    check_plan(&cell, &doc);
-    verified(&cell, &doc);
+    build_checked(&cell, &table, &o, &fixed);
 }
 
 /// A plan made from another with one task handed over (`plan_keeping`): the robots whose tasks
@@ -405,9 +399,7 @@ fn a_hand_over_keeps_the_other_robots_programs() {
     }
     assert!(o.robots[to].program.visits.iter().any(|v| v.task == t));
     assert!(o.robots[from].program.visits.iter().all(|v| v.task != t));
-    let doc = build(&cell, &table, &o, &fixed);
-    check_plan(&cell, &doc);
-    verified(&cell, &doc);
+    build_checked(&cell, &table, &o, &fixed);
 }
 
 /// A hand-over whose plan keeping the other robots' programs does not help is planned again
@@ -466,8 +458,6 @@ fn a_hand_over_that_does_not_help_is_tried_with_every_robot_sequenced_again() {
             tasks: Some(o.allocated.tasks.clone()),
             ..s.clone()
         };
-        let doc = build(&cell, &table, o, &fixed);
-        check_plan(&cell, &doc);
-        verified(&cell, &doc);
+        build_checked(&cell, &table, o, &fixed);
     }
 }

@@ -68,6 +68,20 @@ pub fn build(cell: &Cell, table: &CandidateTable, outcome: &plan::Outcome, s: &P
     output::build(cell, table, outcome, &c, s, 0.0, 0.0)
 }
 
+/// The plan document of a run ([`build`]), re-checked ([`check_plan`]) and verified
+/// ([`verified`]).
+pub fn build_checked(
+    cell: &Cell,
+    table: &CandidateTable,
+    outcome: &plan::Outcome,
+    s: &PlanSettings,
+) -> output::Plan {
+    let doc = build(cell, table, outcome, s);
+    check_plan(cell, &doc);
+    verified(cell, &doc);
+    doc
+}
+
 /// The verifier accepts the plan, robot–robot clearance included.
 pub fn verified(cell: &Cell, doc: &output::Plan) {
     let report = verify(cell, doc, &VerifySettings::default());
