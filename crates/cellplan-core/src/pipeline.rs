@@ -13,6 +13,7 @@ use crate::coord::{
     cycle_and_delta,
 };
 use crate::document::{self, Plan};
+use crate::plan::rebalance::makespan;
 use crate::plan::{self, Allocation, Outcome, PlanError, PlanSettings, Stage};
 use cellplan_model::{Cell, InputError};
 use std::time::Instant;
@@ -198,7 +199,7 @@ pub const PLAN_FIRST_PAIRS: usize = 2_000;
 /// plans pays when several fit; when not even four do, the first plan is kept). Work, not
 /// time: the plan depends on the cell and the seed only. A coordination asks 25–30 thousand on
 /// the README cell, 0.7–1.8 million on the crowded 6- and 8-robot cells (which use up to ten),
-/// about 6.7 million on 4 robots × 2,000 MPs, where ten coordinations took 24 minutes.
+/// 4.3–6.7 million on 4 robots × 2,000 MPs, where ten coordinations took 24 minutes.
 pub const OURS_COORDINATION_DISTANCES: usize = 16_000_000;
 
 /// The line of the robots along which ours draws strips: see [`plan::robot_rows`].
@@ -312,9 +313,9 @@ pub fn coordinate(
             ready.push((o, more));
         }
         tries.clear();
-        // Latest first, so that the most promising is popped first (ties: the earlier try).
+        // Soonest end first (ties: the earlier try), popped from the back.
+        ready.sort_by(|a, b| makespan(&a.0).total_cmp(&makespan(&b.0)));
         ready.reverse();
-        ready.sort_by(|a, b| plan::rebalance::makespan(&b.0).total_cmp(&plan::rebalance::makespan(&a.0)));
         pending = ready.pop();
     }
     // What the first plan's measurements blocked the other robots (set once it is coordinated,
@@ -325,6 +326,10 @@ pub fn coordinate(
     // Diagram work of the coordinations so far, and of the costliest.
     let spent = std::cell::Cell::new(0usize);
     let costliest = std::cell::Cell::new(0usize);
+    let count = |c: &Coordinated| {
+        spent.set(spent.get() + c.diagram_distances);
+        costliest.set(costliest.get().max(c.diagram_distances));
+    };
     let affordable = || {
         let (spent, costliest) = (spent.get(), costliest.get());
         spent + costliest <= coord.ours_distances && costliest.saturating_mul(4) <= coord.ours_distances
@@ -362,14 +367,13 @@ pub fn coordinate(
         let (judged, planned) = rayon::join(
             || {
                 let (o, _) = pending.as_ref()?;
-                let free = o.robots.iter().map(|r| r.program.duration()).fold(0.0, f64::max);
-                (free < bar && may).then(|| coordinate_outcome_cached(cell, table, o, coord, &diagrams))
+                (makespan(o) < bar && may)
+                    .then(|| coordinate_outcome_cached(cell, table, o, coord, &diagrams))
             },
             || plan_try(cell, table, more.as_ref()?, cache),
         );
         if let Some(Ok(c)) = &judged {
-            spent.set(spent.get() + c.diagram_distances);
-            costliest.set(costliest.get().max(c.diagram_distances));
+            count(c);
         }
         if let Some((o, s)) = pending.take() {
             match judged {
@@ -410,8 +414,7 @@ pub fn coordinate(
     let (score, base_ends) = (cycle_and_delta(&best.2.timed).0, ends(&best.2));
     let mut judge = |o: &Outcome| {
         let c = coordinate_outcome_cached(cell, table, o, coord, &diagrams).ok()?;
-        spent.set(spent.get() + c.diagram_distances);
-        costliest.set(costliest.get().max(c.diagram_distances));
+        count(&c);
         Some((cycle_and_delta(&c.timed).0, ends(&c), c))
     };
     let base = (&best.0, score, base_ends.as_slice());

@@ -690,9 +690,8 @@ fn ours_past_its_work_budget_keeps_its_first_plan() {
 }
 
 /// Ours planning every try first (as on large cells) within a budget that allows one
-/// coordination: the plan coordinated is the most promising of its plans, so its robots end,
-/// uncoordinated, no later than those of the zones plan it starts from (it is that plan or
-/// one that ends sooner); the plan verifies.
+/// coordination: the plan coordinated is the most promising of its plans — here another than the
+/// zones plan it starts from, whose robots end sooner uncoordinated; the plan verifies.
 #[test]
 fn ours_planning_first_coordinates_its_most_promising_plan() {
     use cellplan_core::plan::rebalance::makespan;
@@ -707,10 +706,13 @@ fn ours_planning_first_coordinates_its_most_promising_plan() {
     let zones_tasks = outcome.allocated.tasks.clone();
     let (o, s, c) =
         cellplan_core::pipeline::coordinate(&f.cell, &f.table, outcome, zones, &first, &mut cache).unwrap();
-    assert!(makespan(&o) <= start + 1e-9, "{} > {start}", makespan(&o));
-    if o.allocated.tasks != zones_tasks {
-        assert!(makespan(&o) < start, "another plan kept though it ends no sooner");
-    }
+    // On this cell one of the tries ends sooner than the zones plan (13.9 s against 16.2 s):
+    // coordinating the first plan, as the pipelined order does within this budget, would keep
+    // the zones plan.
+    assert!(
+        o.allocated.tasks != zones_tasks && makespan(&o) < start - 1e-9,
+        "the zones plan ({start} s) was coordinated, not the most promising"
+    );
     let doc = cellplan_core::document::build(&f.cell, &f.table, &o, &c, &s, 0.0, 0.0);
     let report = verify(&f.cell, &doc, &VerifySettings::default());
     assert!(report.ok, "{:#?}", report.violations);
