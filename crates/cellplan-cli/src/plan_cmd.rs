@@ -53,6 +53,12 @@ pub struct PlanArgs {
     /// `none` leaves conflicts in, and the verifier then refuses the plan).
     #[arg(long, value_enum, default_value_t = Coordination::Best)]
     coordination: Coordination,
+    /// After coordination, legs without a wait on the way run through their corners without
+    /// stopping: each corner's blend stays within this much of the corner in every joint
+    /// (rad) and is checked against the scene and the other robots' timelines; 0: every leg
+    /// stops at every waypoint.
+    #[arg(long, value_name = "RAD", default_value_t = cellplan_core::coord::BLEND_DEVIATION)]
+    blend_deviation: f64,
     /// Write the plan even if `cellplan verify` rejects it.
     #[arg(long)]
     pub no_verify: bool,
@@ -150,6 +156,11 @@ pub fn run(args: &PlanArgs) -> Result<(), Failure> {
             "--local-set-radius must be a length in metres between 0 and 100".into(),
         ));
     }
+    if !(args.blend_deviation.is_finite() && (0.0..=1.0).contains(&args.blend_deviation)) {
+        return Err(Failure::Usage(
+            "--blend-deviation must be an angle in radians between 0 (no blends) and 1".into(),
+        ));
+    }
     if args.lazy_rounds > 1000 || args.reallocation_rounds > 1000 {
         return Err(Failure::Usage(
             "--lazy-rounds and --reallocation-rounds must be at most 1000".into(),
@@ -178,6 +189,7 @@ pub fn run(args: &PlanArgs) -> Result<(), Failure> {
     let coord_settings = CoordSettings {
         strategy: args.coordination,
         seed: args.seed,
+        blend_deviation: args.blend_deviation,
         ..CoordSettings::default()
     };
     let words = cell.process.words();
@@ -393,6 +405,13 @@ fn render(doc: &output::Plan, working: &str) -> String {
         "legs planned {} ({} by the sampling planner), sequencing rounds {}\n",
         doc.stats.legs_planned, doc.stats.legs_sampled, doc.stats.sequencing_rounds
     );
+    let legs = doc.robots.iter().flat_map(|r| &r.legs);
+    let (blended, corners) = legs.fold((0, 0), |(l, c), leg| {
+        (l + usize::from(!leg.blends.is_empty()), c + leg.blends.len())
+    });
+    if blended > 0 {
+        s += &format!("blended: {blended} legs run through {corners} corners without stopping\n");
+    }
     let c = &doc.compute_s;
     s += &format!(
         "compute: load {:.2} s, candidates {:.2} s, costs {:.2} s, allocation {:.2} s, sequencing+motion {:.2} s, timing {:.2} s, coordination {:.2} s, verification {:.2} s, total {:.2} s\n",

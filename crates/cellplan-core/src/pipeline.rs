@@ -248,6 +248,14 @@ pub fn coordinate(
         let c = coordinate_outcome(cell, table, &outcome, coord)?;
         return Ok((outcome, settings, c));
     }
+    // Ours compares its plans as coordinated, legs stopping at every waypoint (the bars on
+    // uncoordinated ends are in the same terms); the winner is then blended.
+    let blend = coord.blend_deviation;
+    let unblended = CoordSettings {
+        blend_deviation: 0.0,
+        ..coord.clone()
+    };
+    let coord = &unblended;
     let lap = Instant::now();
     // Pair diagrams shared by the coordinations below (many robots keep their paths).
     let diagrams = DiagramCache::default();
@@ -427,8 +435,17 @@ pub fn coordinate(
         // The clock stopped the hand-overs: the plan says so.
         best.0.time_limit_hit |= clock_cut;
     }
-    let spent = lap.elapsed().as_secs_f64();
     let (o, s, c) = best;
+    let c = crate::coord::blend_coordinated(
+        cell,
+        table,
+        c,
+        &CoordSettings {
+            blend_deviation: blend,
+            ..coord.clone()
+        },
+    )?;
+    let spent = lap.elapsed().as_secs_f64();
     Ok((
         o,
         s,

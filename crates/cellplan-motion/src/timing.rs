@@ -28,5 +28,7 @@ mod trajectory;
 pub use check::{LimitViolation, check_limits, check_position_limits};
 pub use error::TimingError;
 pub use limits::{Limits, joint_min_time, move_time, move_time_instant, move_trajectory};
-pub use path::{Blend, BlendedPath, TimedPath, segment_time, time_path_blended, time_path_exact};
+pub use path::{
+    Blend, BlendedPath, TimedPath, segment_time, time_path_blended, time_path_blended_scaled, time_path_exact,
+};
 pub use trajectory::{Piece, Trajectory};

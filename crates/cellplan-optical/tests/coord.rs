@@ -350,6 +350,7 @@ fn the_verifier_catches_injected_faults() {
         })
         .expect("a leg with a via point");
     rerouted.robots[r].legs[l].waypoints.remove(1);
+    rerouted.robots[r].legs[l].blends.clear();
     assert!(
         kinds(&rerouted).contains(&ViolationKind::OffPath),
         "{:?}",
@@ -408,7 +409,10 @@ fn the_plan_keeps_the_probe_tracks_before_coordination() {
         }
         let length = prog.program.duration();
         assert_eq!(tr.xyz.len(), (length / tr.dt_s).ceil() as usize + 1);
-        assert!(length <= rp.total_s + 1e-9);
+        // Longer than the plan's program only by what blending its legs saved.
+        let saved = prog.program.motion() - rp.motion_s;
+        assert!(saved >= -1e-9, "blending made the legs slower: {saved}");
+        assert!(length <= rp.total_s + saved + 1e-9);
     }
     let waited: f64 = doc.robots.iter().map(|r| r.waiting_s).sum();
     assert!(waited > 0.0 && c.waits > 0);
@@ -576,7 +580,11 @@ fn the_diagram_of_a_reversed_tour_is_the_mirrored_diagram() {
 #[test]
 fn best_chooses_the_tour_directions() {
     let f = fixture();
-    let settings = coord::CoordSettings::default();
+    // Without blends: with them, `best` also runs the baselines on the tours as given.
+    let settings = coord::CoordSettings {
+        blend_deviation: 0.0,
+        ..coord::CoordSettings::default()
+    };
     let limits = cellplan_core::plan::graph::limits_of(&f.cell.robots[1]);
     let mut turned = f.outcome.clone();
     turned.robots[1].program = f.outcome.robots[1].program.reversed(&limits).unwrap();
@@ -659,7 +667,13 @@ fn ours_past_its_work_budget_keeps_its_first_plan() {
         ..coord::CoordSettings::default()
     };
     let (zones, mut cache, outcome) = zones_plan(f);
-    let alone = coord::coordinate_outcome(&f.cell, &f.table, &outcome, &tight).unwrap();
+    // Ours compares its plans unblended and blends the winner.
+    let unblended = coord::CoordSettings {
+        blend_deviation: 0.0,
+        ..tight.clone()
+    };
+    let alone = coord::coordinate_outcome(&f.cell, &f.table, &outcome, &unblended).unwrap();
+    let alone = coord::blend_coordinated(&f.cell, &f.table, alone, &tight).unwrap();
     assert!(alone.diagram_distances > 0, "the diagrams asked nothing");
     let (o, s, c) = cellplan_core::pipeline::coordinate(
         &f.cell,

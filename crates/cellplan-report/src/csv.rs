@@ -3,7 +3,9 @@
 //!   world (position in m, quaternion x, y, z, w), what the robot is doing and at which MP;
 //! - `<robot>-program.csv`: the program as points a robot controller moves through — home, the
 //!   via points of every leg (the collision-free joint path), each measuring pose with its
-//!   arrival and departure, and the waits.
+//!   arrival and departure, and the waits; `blend_rad` on a via point the robot passes without
+//!   stopping: the blend radius (joint space, rad — the controller's zone or blend), empty
+//!   where it stops.
 use crate::playback::{Doing, intervals};
 use crate::scene::{Scene, SceneRobot};
 use cellplan_core::document::{Plan, RobotPlan};
@@ -89,7 +91,11 @@ fn trajectory(rp: &RobotPlan, sr: &SceneRobot) -> String {
 }
 
 fn program(rp: &RobotPlan, sr: &SceneRobot) -> String {
-    let mut s = header(rp, &["step", "kind", "name"], &["arrive_s", "depart_s"]);
+    let mut s = header(
+        rp,
+        &["step", "kind", "name"],
+        &["arrive_s", "depart_s", "blend_rad"],
+    );
     let mut step = 0;
     let mut row = |s: &mut String, kind: &str, name: &str, q: &[f64], times: Option<(f64, f64)>| {
         step += 1;
@@ -97,9 +103,9 @@ fn program(rp: &RobotPlan, sr: &SceneRobot) -> String {
         pose_fields(s, sr, q);
         match times {
             Some((a, d)) => {
-                let _ = writeln!(s, ",{a:.4},{d:.4}");
+                let _ = writeln!(s, ",{a:.4},{d:.4},");
             }
-            None => s.push_str(",,\n"),
+            None => s.push_str(",,,\n"),
         }
     };
     let first = rp.legs.first().map_or(0.0, |l| l.start_s);
@@ -126,7 +132,14 @@ fn program(rp: &RobotPlan, sr: &SceneRobot) -> String {
             if w > 0 {
                 match wait_times {
                     Some(times) => row(&mut s, "wait", &name, q, Some(times)),
-                    None if w < last => row(&mut s, "via", &name, q, None),
+                    None if w < last => {
+                        row(&mut s, "via", &name, q, None);
+                        if let Some(b) = leg.blends.iter().find(|b| b.waypoint == w) {
+                            // The row ends in ",,,\n": the radius goes in its last field.
+                            s.truncate(s.len() - 1);
+                            let _ = writeln!(s, "{:.6}", b.radius);
+                        }
+                    }
                     None => {}
                 }
             }

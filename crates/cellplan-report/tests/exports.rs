@@ -265,10 +265,26 @@ fn the_csv_export_carries_joints_probe_poses_and_the_program() {
         assert_eq!(measures.len(), rp.tasks.len());
         for (m, v) in measures.iter().zip(&rp.tasks) {
             assert_eq!(&m[2], v.task.as_str());
-            let arrive: f64 = m[m.len() - 2].parse().unwrap();
+            let arrive: f64 = m[m.len() - 3].parse().unwrap();
             assert!((arrive - v.arrive_s).abs() < 1e-3);
         }
         assert_eq!(records.iter().filter(|r| &r[1] == "wait").count(), rp.waits.len());
+        // The blends on the via points they round, with their radii.
+        let blended: Vec<f64> = records
+            .iter()
+            .filter(|r| !r[r.len() - 1].is_empty())
+            .map(|r| {
+                assert_eq!(&r[1], "via");
+                r[r.len() - 1].parse().unwrap()
+            })
+            .collect();
+        let stated: Vec<f64> = rp
+            .legs
+            .iter()
+            .flat_map(|l| l.blends.iter().map(|b| b.radius))
+            .collect();
+        assert_eq!(blended.len(), stated.len());
+        assert!(blended.iter().zip(&stated).all(|(a, b)| (a - b).abs() < 1e-6));
         assert_eq!(&records[0][1], "home");
         assert_eq!(&records[records.len() - 1][1], "home");
     }

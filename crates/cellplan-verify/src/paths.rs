@@ -83,6 +83,31 @@ fn check_ends(rp: &RobotPlan, i: usize, leg: &LegOut, at: &[f64], to: &[f64], ou
             stop(i + 1).label()
         ));
     }
+    for b in &leg.blends {
+        let w = &leg.waypoints;
+        let fits = b.waypoint > 0
+            && b.waypoint + 1 < w.len()
+            && 2.0 * b.radius <= dist(&w[b.waypoint - 1], &w[b.waypoint]) + 1e-9
+            && 2.0 * b.radius <= dist(&w[b.waypoint], &w[b.waypoint + 1]) + 1e-9;
+        if !fits {
+            push(format!(
+                "leg {}: the blend at waypoint {} reaches past the middle of a segment",
+                name(leg),
+                b.waypoint
+            ));
+        }
+    }
+    if let Some(wait) = rp
+        .waits
+        .iter()
+        .find(|x| x.leg == i && leg.blends.iter().any(|b| b.waypoint == x.waypoint))
+    {
+        push(format!(
+            "leg {} is blended at waypoint {}, where the robot waits",
+            name(leg),
+            wait.waypoint
+        ));
+    }
     if leg.straight && leg.waypoints.len() != 2 {
         push(format!(
             "leg {} says it is straight but has {} waypoints",
@@ -111,11 +136,20 @@ fn resample(
     let clearance = cell.planning.clearance;
     let mut checked = 0;
     let mut reported = false;
-    for w in leg.waypoints.windows(2) {
-        let steps = (max_abs_diff(&w[0], &w[1]) / settings.joint_step).ceil().max(1.0) as usize;
+    // The straight segments whole (the blends cut their ends, which stay checked), then the
+    // blends' curves.
+    let curves: Vec<Piece> = pieces(leg)
+        .into_iter()
+        .filter(|p| matches!(p, Piece::Curve(..)))
+        .collect();
+    let lines = leg
+        .waypoints
+        .windows(2)
+        .map(|w| Piece::Line(w[0].clone(), w[1].clone()));
+    for piece in lines.chain(curves) {
+        let steps = (piece.max_joint_travel() / settings.joint_step).ceil().max(1.0) as usize;
         for s in 0..=steps {
-            let f = s as f64 / steps as f64;
-            let q: Vec<f64> = w[0].iter().zip(&w[1]).map(|(a, b)| a + f * (b - a)).collect();
+            let q = piece.at(s as f64 / steps as f64);
             checked += 1;
             if !reported && let Some(v) = config_violation(cell, robot, &q, clearance, scratch) {
                 out.push(Violation::robot(
@@ -166,53 +200,178 @@ fn config_violation(
     }
 }
 
+/// One piece of a leg's executed joint path: a straight segment, or the blend of a corner
+/// (the quadratic Bézier curve with control points `a`, `p`, `c`).
+#[derive(Clone, Debug)]
+enum Piece {
+    Line(Vec<f64>, Vec<f64>),
+    Curve(Vec<f64>, Vec<f64>, Vec<f64>),
+}
+
+impl Piece {
+    /// The point at parameter `f` in [0, 1].
+    fn at(&self, f: f64) -> Vec<f64> {
+        match self {
+            Piece::Line(a, b) => a.iter().zip(b).map(|(x, y)| x + f * (y - x)).collect(),
+            Piece::Curve(a, p, c) => (0..a.len())
+                .map(|j| (1.0 - f) * (1.0 - f) * a[j] + 2.0 * f * (1.0 - f) * p[j] + f * f * c[j])
+                .collect(),
+        }
+    }
+
+    /// The largest total travel of one joint over the piece.
+    fn max_joint_travel(&self) -> f64 {
+        (0..self.dof())
+            .map(|j| self.travel(j, 0.0, 1.0))
+            .fold(0.0, f64::max)
+    }
+
+    fn dof(&self) -> usize {
+        match self {
+            Piece::Line(a, _) | Piece::Curve(a, _, _) => a.len(),
+        }
+    }
+
+    /// How far joint `j` travels from parameter `f0` to `f1` (`f0 ≤ f1`): the integral of
+    /// `|q_j'|`, exact (on a curve `q_j'` is linear in the parameter).
+    fn travel(&self, j: usize, f0: f64, f1: f64) -> f64 {
+        match self {
+            Piece::Line(a, b) => (f1 - f0) * (b[j] - a[j]).abs(),
+            Piece::Curve(a, p, c) => {
+                // q_j'(f) = α + β·f
+                let (alpha, beta) = (2.0 * (p[j] - a[j]), 2.0 * (a[j] - 2.0 * p[j] + c[j]));
+                let prim = |f: f64| alpha * f + 0.5 * beta * f * f;
+                let root = if beta != 0.0 { -alpha / beta } else { f64::NAN };
+                if root > f0 && root < f1 {
+                    (prim(root) - prim(f0)).abs() + (prim(f1) - prim(root)).abs()
+                } else {
+                    (prim(f1) - prim(f0)).abs()
+                }
+            }
+        }
+    }
+
+    /// The parameter of the piece's point nearest `q` and its max-abs distance from `q`.
+    fn place(&self, q: &[f64]) -> (f64, f64) {
+        let off = |f: f64| {
+            self.at(f)
+                .iter()
+                .zip(q)
+                .map(|(x, y)| (x - y).abs())
+                .fold(0.0, f64::max)
+        };
+        let f = match self {
+            Piece::Line(a, b) => {
+                let (mut num, mut den) = (0.0, 0.0);
+                for j in 0..a.len() {
+                    num += (q[j] - a[j]) * (b[j] - a[j]);
+                    den += (b[j] - a[j]).powi(2);
+                }
+                if den > 0.0 {
+                    (num / den).clamp(0.0, 1.0)
+                } else {
+                    0.0
+                }
+            }
+            Piece::Curve(..) => {
+                // The squared distance along the curve: the best of a grid, then golden
+                // section around it.
+                let sq = |f: f64| {
+                    self.at(f)
+                        .iter()
+                        .zip(q)
+                        .map(|(x, y)| (x - y).powi(2))
+                        .sum::<f64>()
+                };
+                const GRID: usize = 32;
+                let best = (0..=GRID)
+                    .map(|k| k as f64 / GRID as f64)
+                    .min_by(|x, y| sq(*x).total_cmp(&sq(*y)))
+                    .unwrap_or(0.0);
+                let (mut lo, mut hi) = (
+                    (best - 1.0 / GRID as f64).max(0.0),
+                    (best + 1.0 / GRID as f64).min(1.0),
+                );
+                let g = 0.5 * (5f64.sqrt() - 1.0);
+                for _ in 0..80 {
+                    let (x1, x2) = (hi - g * (hi - lo), lo + g * (hi - lo));
+                    if sq(x1) <= sq(x2) {
+                        hi = x2;
+                    } else {
+                        lo = x1;
+                    }
+                }
+                0.5 * (lo + hi)
+            }
+        };
+        (f, off(f))
+    }
+}
+
+/// A leg's executed joint path, piece by piece: its straight segments, cut short by the
+/// blends at their ends, and each blend's curve at its corner.
+fn pieces(leg: &LegOut) -> Vec<Piece> {
+    let w = &leg.waypoints;
+    let radius = |k: usize| {
+        leg.blends
+            .iter()
+            .find(|b| b.waypoint == k)
+            .map_or(0.0, |b| b.radius)
+    };
+    let mut out = Vec::new();
+    for k in 0..w.len().saturating_sub(1) {
+        let (a, b) = (&w[k], &w[k + 1]);
+        let len = dist(a, b);
+        let u: Vec<f64> = if len > 0.0 {
+            a.iter().zip(b).map(|(x, y)| (y - x) / len).collect()
+        } else {
+            vec![0.0; a.len()]
+        };
+        let (r0, r1) = (radius(k).min(0.5 * len), radius(k + 1).min(0.5 * len));
+        let start: Vec<f64> = a.iter().zip(&u).map(|(x, d)| x + r0 * d).collect();
+        let end: Vec<f64> = b.iter().zip(&u).map(|(x, d)| x - r1 * d).collect();
+        out.push(Piece::Line(start, end.clone()));
+        if r1 > 0.0 && k + 2 < w.len() {
+            let next = &w[k + 2];
+            let ln = dist(b, next);
+            let rn = r1.min(0.5 * ln);
+            let join: Vec<f64> = b
+                .iter()
+                .zip(next)
+                .map(|(x, y)| x + rn * (y - x) / ln.max(f64::MIN_POSITIVE))
+                .collect();
+            out.push(Piece::Curve(end, b.clone(), join));
+        }
+    }
+    out
+}
+
 /// Walks the trajectory forward along the legs' joint paths (home → MPs → home, straight
-/// joint segments between waypoints): each sample must lie on the path (within 1e-6 in every
-/// joint) at or after the previous sample's place, and the path covered between two samples
-/// must not exceed, joint by joint, what the velocity limit allows in their time. The first
-/// failure: its time and a sentence.
+/// joint segments between waypoints, blended corners along their curves): each sample must
+/// lie on the path (within 1e-6 in every joint) at or after the previous sample's place, and
+/// the path covered between two samples must not exceed, joint by joint, what the velocity
+/// limit allows in their time. The first failure: its time and a sentence.
 fn follow_legs(robot: &Robot, rp: &RobotPlan, vtol: f64) -> Option<(f64, String)> {
     const TOL: f64 = 1e-6;
-    // (start, end, leg) of every straight joint segment, in order.
-    let segments: Vec<(&[f64], &[f64], usize)> = rp
+    // (piece, leg) in order.
+    let segments: Vec<(Piece, usize)> = rp
         .legs
         .iter()
         .enumerate()
-        .flat_map(|(k, leg)| {
-            leg.waypoints
-                .windows(2)
-                .map(move |w| (w[0].as_slice(), w[1].as_slice(), k))
-        })
+        .flat_map(|(k, leg)| pieces(leg).into_iter().map(move |p| (p, k)))
         .collect();
-    let leg_name = |s: usize| name(&rp.legs[segments[s].2]);
+    let leg_name = |s: usize| name(&rp.legs[segments[s].1]);
     // Every waypoint and sample has the robot's joint count: the document was validated and
     // the robot's joints matched.
     let dof = robot.dof();
     if segments.is_empty() {
         return None;
     }
-    // Place on a segment: the nearest point's parameter and its max-abs distance.
-    let place = |s: usize, q: &[f64]| -> (f64, f64) {
-        let (a, b, _) = &segments[s];
-        let (mut num, mut den) = (0.0, 0.0);
-        for j in 0..dof {
-            num += (q[j] - a[j]) * (b[j] - a[j]);
-            den += (b[j] - a[j]).powi(2);
-        }
-        let f = if den > 0.0 {
-            (num / den).clamp(0.0, 1.0)
-        } else {
-            0.0
-        };
-        let off = (0..dof)
-            .map(|j| (q[j] - (a[j] + f * (b[j] - a[j]))).abs())
-            .fold(0.0, f64::max);
-        (f, off)
-    };
+    let place = |s: usize, q: &[f64]| segments[s].0.place(q);
     let (mut seg, mut frac) = (0usize, 0.0f64);
     let mut prev_t = rp.trajectory.first()?.t;
     for sample in &rp.trajectory {
-        // The first segment at or after the current place that holds the sample.
+        // The first piece at or after the current place that holds the sample.
         let found = (seg..segments.len()).find_map(|s| {
             let (f, off) = place(s, &sample.q);
             (off <= TOL && (s > seg || f >= frac - 1e-9)).then_some((s, f))
@@ -234,11 +393,13 @@ fn follow_legs(robot: &Robot, rp: &RobotPlan, vtol: f64) -> Option<(f64, String)
         // Path covered per joint from (seg, frac) to (s, f).
         let h = sample.t - prev_t;
         for j in 0..dof {
-            let len = |k: usize| (segments[k].1[j] - segments[k].0[j]).abs();
+            let piece = |k: usize| &segments[k].0;
             let covered = if s == seg {
-                (f - frac) * len(s)
+                piece(s).travel(j, frac.min(f), f)
             } else {
-                (1.0 - frac) * len(seg) + (seg + 1..s).map(len).sum::<f64>() + f * len(s)
+                piece(seg).travel(j, frac, 1.0)
+                    + (seg + 1..s).map(|k| piece(k).travel(j, 0.0, 1.0)).sum::<f64>()
+                    + piece(s).travel(j, 0.0, f)
             };
             if covered > robot.max_velocity[j] * h * (1.0 + vtol) + TOL {
                 return Some((

@@ -317,3 +317,26 @@ fn compare_writes_its_table_and_bar_chart_as_html() {
     assert_eq!(page.matches("<tr><td").count(), rows.len());
     assert!(page.contains("<b>ours + best</b>"));
 }
+
+#[test]
+fn plan_refuses_an_absurd_blend_deviation() {
+    let dir = scratch("plan-blend");
+    let (cell, _) = small_cell(&dir);
+    std::fs::write(dir.join("cell.toml"), cell).unwrap();
+    for bad in ["-0.1", "NaN", "7"] {
+        let out = cellplan(
+            &[
+                "plan",
+                dir.join("cell.toml").to_str().unwrap(),
+                &format!("--blend-deviation={bad}"),
+                "-o",
+                dir.join("out").to_str().unwrap(),
+            ],
+            &dir,
+        );
+        assert_eq!(out.status.code(), Some(2), "{bad}");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(err.contains("--blend-deviation"), "{bad}: {err}");
+        assert!(!dir.join("out").join("plan.json").exists());
+    }
+}

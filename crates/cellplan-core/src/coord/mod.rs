@@ -25,6 +25,7 @@
 //!     search on the clock allows. Where no order exists (a robot's home in another's way)
 //!     it falls back on prioritised resolution: every priority order (all up to 4 robots,
 //!     else a few), at each conflict the shortest wait or another measuring pose.
+pub mod blend;
 mod cover;
 mod diagram;
 mod ours;
@@ -124,7 +125,14 @@ pub struct CoordSettings {
     /// Beyond this many MPs × robots ours plans all its tries before coordinating any, and
     /// coordinates them most promising first (default [`crate::pipeline::PLAN_FIRST_PAIRS`]).
     pub plan_first_pairs: usize,
+    /// After coordination, the legs without a wait on the way are timed through their corners
+    /// without stopping, each corner's blend within this much (rad, per joint) of the corner
+    /// and checked against the scene (see [`blend`]); 0: every leg stops at every waypoint.
+    pub blend_deviation: f64,
 }
+
+/// The default of [`CoordSettings::blend_deviation`] (rad).
+pub const BLEND_DEVIATION: f64 = 0.1;
 
 impl Default for CoordSettings {
     fn default() -> Self {
@@ -139,6 +147,7 @@ impl Default for CoordSettings {
             min_wait: 0.05,
             ours_distances: crate::pipeline::OURS_COORDINATION_DISTANCES,
             plan_first_pairs: crate::pipeline::PLAN_FIRST_PAIRS,
+            blend_deviation: BLEND_DEVIATION,
         }
     }
 }
@@ -179,6 +188,8 @@ pub struct Coordinated {
     /// empty). The programs, `before` and the uncoordinated cycle are those of the tours in
     /// the directions chosen.
     pub reversed: Vec<bool>,
+    /// Corners the final programs cross without stopping (blends; see [`blend`]).
+    pub blended_corners: usize,
     /// Wall seconds.
     pub compute_s: f64,
 }
@@ -324,6 +335,7 @@ fn coordinate_with(
             // Tours in their canonical directions; `reversed` then says which run against the
             // planned ones.
             let against = against_canonical(&programs);
+            let as_planned = programs.clone();
             let programs: Vec<Program> = programs
                 .iter()
                 .zip(&against)
@@ -343,8 +355,14 @@ fn coordinate_with(
                 Some(done) => done,
                 None => best(&ctx, programs.clone(), cover.as_ref())?,
             };
-            let (progs, mut res, priority) =
-                baselines_if_shorter(&ctx, &programs, first, &cell_order, cover.as_ref())?;
+            let (progs, mut res, priority) = baselines_if_shorter(
+                &ctx,
+                &programs,
+                first,
+                &cell_order,
+                cover.as_ref(),
+                (&as_planned, &against),
+            )?;
             res.reversed = (0..programs.len())
                 .map(|i| against[i] != res.reversed.get(i).copied().unwrap_or(false))
                 .collect();
@@ -388,10 +406,19 @@ fn coordinate_with(
             at: c.start,
         });
     }
+    // Legs without a stop on the way run through their corners, where the exact search on
+    // the clock lets them.
+    let (programs, timed, blended_corners) = if settings.strategy == Coordination::None {
+        (programs, timed, 0)
+    } else {
+        blend::blend_all(&ctx, programs, timed, settings, true)?
+    };
+    // (`blend_all` skips legs already blended: programs come in unblended.)
     Ok(Coordinated {
         strategy: settings.strategy,
         programs,
         timed,
+        blended_corners,
         before: if settings.strategy == Coordination::None {
             Vec::new()
         } else {
@@ -408,6 +435,32 @@ fn coordinate_with(
         blocking: res.blocking,
         reversed: res.reversed,
         compute_s: started.elapsed().as_secs_f64(),
+    })
+}
+
+/// `coordinated` (not yet blended) with its legs blended as `settings` asks (see [`blend`]),
+/// where the exact search on the clock keeps the robots clear (the coordination strategy
+/// `none` is left as it is).
+pub fn blend_coordinated(
+    cell: &Cell,
+    table: &CandidateTable,
+    coordinated: Coordinated,
+    settings: &CoordSettings,
+) -> Result<Coordinated, PlanError> {
+    if coordinated.strategy == Coordination::None
+        || settings.blend_deviation.is_nan()
+        || settings.blend_deviation <= 0.0
+    {
+        return Ok(coordinated);
+    }
+    let ctx = Ctx::new(cell, table, settings, None);
+    let (programs, timed, corners) =
+        blend::blend_all(&ctx, coordinated.programs, coordinated.timed, settings, true)?;
+    Ok(Coordinated {
+        programs,
+        timed,
+        blended_corners: coordinated.blended_corners + corners,
+        ..coordinated
     })
 }
 

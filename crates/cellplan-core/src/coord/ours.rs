@@ -9,28 +9,61 @@ use super::*;
 /// `found` (by `best`), or the paper's fixed-priority baseline (cell order, shortest waits on
 /// the exact timeline, run only until it ends after `found`) where it ends sooner (then Δt):
 /// the diagram's boxes are conservative, and on a small cell waits placed on the exact
-/// timeline can give a shorter cycle. (Delay-startup, the other baseline, only delays starts:
-/// it costs twice as much and was never the shorter of the two on the example cells.)
+/// timeline can give a shorter cycle. Delay-startup, the other baseline, only delays starts:
+/// without blends it costs twice as much and was never the shorter of the two on the example
+/// cells; with blends (each candidate is scored with its legs blended, see [`super::blend`])
+/// it is run too, and both baselines also on the tours as planned (`as_planned`: the
+/// programs and, per robot, whether `best`'s tour runs against it). (Then `best`'s result may
+/// depend on the directions the tours were given; without blends it does not.)
 pub(super) fn baselines_if_shorter(
     ctx: &Ctx,
     programs: &[Program],
     found: Resolved,
     cell_order: &[usize],
     cover: Option<&Cover>,
+    as_planned: (&[Program], &[bool]),
 ) -> Result<Resolved, PlanError> {
+    // Scored as they will run: with the legs blended that coordination leaves without a stop
+    // on the way (the programs are blended again, the same way, once one is kept).
     let score = |progs: &[Program]| -> Result<(f64, f64), PlanError> {
         let timed: Vec<Timed> = progs.iter().map(|p| ctx.timed(p)).collect::<Result<_, _>>()?;
+        let (_, timed, _) = super::blend::blend_all(ctx, progs.to_vec(), timed, ctx.settings, true)?;
         Ok(cycle_and_delta(&timed))
     };
     let mut kept = (score(&found.0)?, found);
-    for mode in [Mode::GiveWay] {
-        let mut progs = programs.to_vec();
-        let bar = Some(kept.0.0 + 1e-9);
-        let Ok(res) = resolve(ctx, &mut progs, &rank_of(cell_order), mode, bar, cover.cloned()) else {
+    let blending = ctx.settings.blend_deviation > 0.0;
+    // (mode, on the tours as planned): fixed priority on the tours as `best` turned them; with
+    // blends, both baselines on the tours as planned too, as the strategies themselves run
+    // them: blending gains most where no wait is on the way (delay-startup's waits are all at
+    // home), so a baseline can end sooner blended than `best`'s schedule does.
+    let runs: &[(Mode, bool)] = if blending {
+        &[
+            (Mode::GiveWay, false),
+            (Mode::GiveWay, true),
+            (Mode::DelayStartup, true),
+        ]
+    } else {
+        &[(Mode::GiveWay, false)]
+    };
+    for &(mode, planned) in runs {
+        let mut progs = if planned {
+            as_planned.0.to_vec()
+        } else {
+            programs.to_vec()
+        };
+        // The bar is on ends before blending: with blends, a run that ends after the kept
+        // cycle may still end sooner once blended.
+        let bar = (!blending).then_some(kept.0.0 + 1e-9);
+        let cover = if planned { None } else { cover.cloned() };
+        let Ok(mut res) = resolve(ctx, &mut progs, &rank_of(cell_order), mode, bar, cover) else {
             continue;
         };
         if res.outrun.is_some() {
             continue;
+        }
+        if planned {
+            // Against the canonical directions, as `best`'s results are stated.
+            res.reversed = as_planned.1.to_vec();
         }
         let s = score(&progs)?;
         // Shorter by more than a millisecond (a tie keeps the schedule).

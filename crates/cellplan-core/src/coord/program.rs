@@ -4,6 +4,10 @@
 //! Every leg is timed segment by segment, each segment a synchronised trapezoid from rest to
 //! rest (as [`time_path_exact`] does for a whole polyline: it stops at every waypoint), so a
 //! wait at any waypoint changes nothing but the clock: the robot is at rest there anyway.
+//! After coordination a leg without a wait on the way may be *blended* ([`LegBlend`], made
+//! by `coord::blend`): timed through its corners without stopping, each corner cut by a
+//! parabolic blend whose curve was checked against the scene; a wait put on the way of such
+//! a leg takes the blend away (the robot must stop there).
 use crate::candidates::{Candidate, CandidateTable};
 use crate::plan::graph::RobotGraph;
 use crate::plan::sequence::Sequence;
@@ -54,6 +58,26 @@ pub struct ProgramLeg {
     pub straight: bool,
     /// Duration of each segment (rest to rest).
     pub segments: Vec<f64>,
+    /// The leg timed through its corners without stopping, when it is (see [`LegBlend`]);
+    /// `None`: rest to rest at every waypoint, as `segments` say.
+    pub blend: Option<LegBlend>,
+}
+
+/// A leg crossed without stopping at some of its corners: at corner `w` (an interior waypoint
+/// of the leg) with radius `r` the joints leave the incoming segment at distance `r`
+/// (Euclidean, joint space) before the corner and join the outgoing one `r` after it, along
+/// the quadratic Bézier curve with control points `p_w − r·u_in`, `p_w`, `p_w + r·u_out` — the
+/// curve a constant joint acceleration draws (see
+/// [`cellplan_motion::timing::time_path_blended`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct LegBlend {
+    /// The leg's motion, from rest at its first waypoint to rest at its last.
+    pub trajectory: Trajectory,
+    /// `(waypoint, radius)` of each corner crossed without stopping, in order.
+    pub corners: Vec<(usize, f64)>,
+    /// Time from the leg's start at which the trajectory passes each waypoint (at a blended
+    /// corner: the middle of its blend).
+    pub waypoint_times: Vec<f64>,
 }
 
 impl ProgramLeg {
@@ -67,12 +91,16 @@ impl ProgramLeg {
             waypoints,
             straight,
             segments,
+            blend: None,
         })
     }
 
     /// Moving time (s).
     pub fn duration(&self) -> f64 {
-        self.segments.iter().sum()
+        match &self.blend {
+            Some(b) => b.trajectory.duration(),
+            None => self.segments.iter().sum(),
+        }
     }
 }
 
@@ -328,8 +356,15 @@ impl Program {
         self.waits.iter().find(|w| w.leg == leg && w.waypoint == waypoint)
     }
 
-    /// Sets (replaces) the wait at a waypoint; a duration of 0 removes it.
+    /// Sets (replaces) the wait at a waypoint; a duration of 0 removes it. A wait on the way
+    /// of a blended leg takes its blend away: the robot stops at every waypoint again.
     pub fn set_wait(&mut self, wait: Wait) {
+        if wait.waypoint > 0
+            && wait.duration > 0.0
+            && let Some(leg) = self.legs.get_mut(wait.leg)
+        {
+            leg.blend = None;
+        }
         self.waits
             .retain(|w| !(w.leg == wait.leg && w.waypoint == wait.waypoint));
         if wait.duration > 0.0 {
@@ -368,7 +403,37 @@ impl Program {
         let mut t = 0.0;
         for (k, leg) in self.legs.iter().enumerate() {
             let mut at = Vec::with_capacity(leg.waypoints.len());
+            if let Some(blend) = &leg.blend {
+                // Only a wait at the start: `set_wait` takes the blend away from a leg
+                // given one on the way.
+                at.push(t);
+                if let Some(i) = self.waits.iter().position(|x| x.leg == k && x.waypoint == 0) {
+                    let d = self.waits[i].duration;
+                    wait_starts[i] = t;
+                    parts.push(Trajectory::dwell(&leg.waypoints[0], d));
+                    spans.push(Span {
+                        start: t,
+                        end: t + d,
+                        what: Activity::Wait { leg: k, waypoint: 0 },
+                    });
+                    t += d;
+                }
+                let times = &blend.waypoint_times;
+                at.extend(times.iter().skip(1).map(|&x| t + x));
+                for w in 0..leg.waypoints.len().saturating_sub(1) {
+                    spans.push(Span {
+                        start: t + times[w],
+                        end: t + times[w + 1],
+                        what: Activity::Move { leg: k, segment: w },
+                    });
+                }
+                parts.push(blend.trajectory.clone());
+                t += blend.trajectory.duration();
+            }
             for w in 0..leg.waypoints.len() {
+                if leg.blend.is_some() {
+                    break;
+                }
                 at.push(t);
                 if let Some(i) = self.waits.iter().position(|x| x.leg == k && x.waypoint == w) {
                     let d = self.waits[i].duration;

@@ -1,8 +1,8 @@
 //! The document from a run: per robot its visits, legs, waits and trajectory; the totals; the
 //! coordination record; the unmeasured tasks; the search's counts and times.
 use super::{
-    ActivityOut, ComputeTimes, ConflictOut, CoordinationOut, FORMAT, LegOut, PROBE_TRACK_DT, Plan, PoseOut,
-    ProbeTrack, RobotPlan, Sample, SettingsOut, Stats, UnmeasuredTask, VERSION, Visit, WaitOut,
+    ActivityOut, BlendOut, ComputeTimes, ConflictOut, CoordinationOut, FORMAT, LegOut, PROBE_TRACK_DT, Plan,
+    PoseOut, ProbeTrack, RobotPlan, Sample, SettingsOut, Stats, UnmeasuredTask, VERSION, Visit, WaitOut,
 };
 use crate::candidates::CandidateTable;
 use crate::coord::{Activity, Conflict, Coordinated, Program, Timed};
@@ -113,6 +113,12 @@ fn robot_plan(cell: &Cell, robot: &Robot, prog: &Program, timed: &Timed, sample_
             duration_s: leg.duration(),
             straight: leg.straight,
             waypoints: leg.waypoints.clone(),
+            blends: leg.blend.as_ref().map_or_else(Vec::new, |b| {
+                b.corners
+                    .iter()
+                    .map(|&(waypoint, radius)| BlendOut { waypoint, radius })
+                    .collect()
+            }),
         })
         .collect();
     let waits = prog

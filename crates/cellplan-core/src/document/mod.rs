@@ -326,6 +326,24 @@ pub struct LegOut {
     pub straight: bool,
     /// The collision-free joint path: straight segments between these waypoints.
     pub waypoints: Vec<Vec<f64>>,
+    /// Corners crossed without stopping, in order (none: the leg stops at every waypoint).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub blends: Vec<BlendOut>,
+}
+
+/// A corner of a leg crossed without stopping: the joints leave the segment into waypoint
+/// `waypoint` at distance `radius` before it and join the segment out of it at `radius` after
+/// it (Euclidean joint-space distances), along the quadratic Bézier curve with control points
+/// `p − radius·u_in`, `p`, `p + radius·u_out` (`u_in`, `u_out`: the unit directions of the two
+/// segments) — the curve of a constant joint acceleration.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct BlendOut {
+    /// The corner: an interior waypoint of the leg.
+    pub waypoint: usize,
+    /// Distance (joint space) from the corner at which the blend leaves and joins the path;
+    /// at most half of either segment.
+    pub radius: f64,
 }
 
 /// A trajectory sample.

@@ -263,6 +263,26 @@ fn validate_legs(here: &dyn Fn() -> String, rp: &RobotPlan, dof: usize) -> Resul
         for (w, q) in leg.waypoints.iter().enumerate() {
             joints(&at, &format!("waypoints[{w}]"), q, dof)?;
         }
+        let mut previous = 0;
+        for (b, blend) in leg.blends.iter().enumerate() {
+            if blend.waypoint <= previous || blend.waypoint + 1 >= leg.waypoints.len() {
+                return Err(invalid(
+                    at(),
+                    format!(
+                        "blends[{b}] is at waypoint {} of a leg of {}: blends are at interior waypoints, in order",
+                        blend.waypoint,
+                        leg.waypoints.len()
+                    ),
+                ));
+            }
+            if !(blend.radius.is_finite() && blend.radius > 0.0 && blend.radius <= 1_000.0) {
+                return Err(invalid(
+                    at(),
+                    format!("blends[{b}].radius is {}; it lies in (0, 1000]", blend.radius),
+                ));
+            }
+            previous = blend.waypoint;
+        }
     }
     Ok(())
 }

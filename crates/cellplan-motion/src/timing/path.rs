@@ -66,6 +66,10 @@ pub struct BlendedPath {
     /// `max_deviation` asked for. Re-check collisions along the trajectory, or inflate the
     /// robot by this much, before trusting the blended path.
     pub deviation: Vec<f64>,
+    /// The time in s at which the trajectory passes each input waypoint (same indexing as the
+    /// input path): at a blended corner, the middle of its blend (where the blend comes
+    /// nearest the corner); elsewhere the time the trajectory is there. Non-decreasing.
+    pub waypoint_times: Vec<f64>,
 }
 
 /// Times a piecewise-linear joint path (e.g. a collision-free planner's output) so that it is
@@ -177,6 +181,27 @@ pub fn time_path_blended(
     limits: &Limits,
     max_deviation: &[f64],
 ) -> Result<BlendedPath, TimingError> {
+    time_path_blended_scaled(path, limits, max_deviation, &[])
+}
+
+/// [`time_path_blended`] with the deviation bound at input waypoint `w` multiplied by
+/// `scale[w]` (1 where `scale` is shorter than the path; 0 leaves that corner unblended: the
+/// trajectory stops there). A caller that re-checks blends can so shrink or drop the ones that
+/// failed and time the path again. Errors: as [`time_path_blended`], plus a scale that is
+/// negative or not finite.
+pub fn time_path_blended_scaled(
+    path: &[Vec<f64>],
+    limits: &Limits,
+    max_deviation: &[f64],
+    scale: &[f64],
+) -> Result<BlendedPath, TimingError> {
+    if let Some((joint, &value)) = scale
+        .iter()
+        .enumerate()
+        .find(|(_, s)| !(s.is_finite() && **s >= 0.0))
+    {
+        return Err(TimingError::InvalidDeviation { joint, value });
+    }
     let dof = limits.dof();
     let delta: Vec<f64> = match max_deviation.len() {
         1 => vec![max_deviation[0]; dof],
@@ -201,6 +226,7 @@ pub fn time_path_blended(
     if m < 2 {
         let built = clean.build(&vec![0.0; m + 1]);
         return Ok(BlendedPath {
+            waypoint_times: clean.waypoint_times(&built),
             trajectory: built.trajectory,
             blends: vec![],
             deviation: vec![0.0; dof],
@@ -212,7 +238,8 @@ pub fn time_path_blended(
     for (k, cap_k) in cap.iter_mut().enumerate().take(m).skip(1) {
         let (s0, s1) = (&clean.segments[k - 1], &clean.segments[k]);
         let beta = clean.beta[k];
-        if beta <= 0.0 {
+        let factor = scale.get(clean.corner_waypoint[k]).copied().unwrap_or(1.0);
+        if beta <= 0.0 || factor <= 0.0 {
             continue;
         }
         let v = s0.vmax.min(s1.vmax);
@@ -221,7 +248,7 @@ pub fn time_path_blended(
         for (j, &dj) in delta.iter().enumerate() {
             let du = (s1.dir[j] - s0.dir[j]).abs();
             if du > 0.0 {
-                x = x.min(8.0 * dj / (du * beta));
+                x = x.min(8.0 * dj * factor / (du * beta));
             }
         }
         *cap_k = x;
@@ -253,6 +280,7 @@ pub fn time_path_blended(
         }
     }
     Ok(BlendedPath {
+        waypoint_times: clean.waypoint_times(&built),
         trajectory: built.trajectory,
         blends: built.blends,
         deviation,
@@ -398,6 +426,32 @@ impl Clean {
             corner_waypoint: corner_wp,
             limits: limits.clone(),
         })
+    }
+
+    /// When `built` passes each input waypoint: the middle of the blend at a blended corner,
+    /// else the time its profile reaches the waypoint's distance (made non-decreasing against
+    /// rounding).
+    fn waypoint_times(&self, built: &Built) -> Vec<f64> {
+        let blend_mid = |w: usize| {
+            built
+                .blends
+                .iter()
+                .find(|b| b.waypoint == w)
+                .map(|b| b.start_time + 0.5 * b.duration)
+        };
+        let mut last = 0.0f64;
+        self.waypoint_at
+            .iter()
+            .enumerate()
+            .map(|(w, &(k, d))| {
+                let t = blend_mid(w).unwrap_or_else(|| match built.profiles.get(k) {
+                    Some(prof) => built.segment_starts[k] + time_at_distance(prof, d),
+                    None => 0.0,
+                });
+                last = last.max(t);
+                last
+            })
+            .collect()
     }
 
     /// Lowers the squared corner speeds `x` (at most their caps) until every segment can go

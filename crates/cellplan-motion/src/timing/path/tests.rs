@@ -304,3 +304,32 @@ proptest! {
         prop_assert!(close(&tr.end_position(), &path[0], 1e-9));
     }
 }
+
+#[test]
+fn blended_waypoint_times_and_scaled_corners() {
+    // The L-shaped path of `blend_by_hand` with a collinear waypoint on its first segment.
+    let l = Limits::uniform(2, 1.0, 1.0).unwrap();
+    let path = vec![vec![0.0, 0.0], vec![5.0, 0.0], vec![10.0, 0.0], vec![10.0, 10.0]];
+    let b = time_path_blended(&path, &l, &[10.0]).unwrap();
+    assert!((b.trajectory.duration() - 21.0).abs() < 1e-9);
+    // 0 at the start; the collinear waypoint at 0.5 + 4.5 s (cruising at 1 after 0.5 rad);
+    // the corner at the middle of its blend (10.5 s); the end.
+    let want = [0.0, 5.5, 10.5, 21.0];
+    assert_eq!(b.waypoint_times.len(), 4);
+    for (got, want) in b.waypoint_times.iter().zip(want) {
+        assert!((got - want).abs() < 1e-9, "{:?}", b.waypoint_times);
+    }
+    assert!(close(&b.trajectory.position(5.5), &[5.0, 0.0], 1e-9));
+    // A scale of 0 at the corner stops there, as the exact timing does.
+    let stopped = time_path_blended_scaled(&path, &l, &[10.0], &[1.0, 1.0, 0.0, 1.0]).unwrap();
+    assert!(stopped.blends.is_empty());
+    assert!((stopped.trajectory.duration() - 22.0).abs() < 1e-9);
+    assert!((stopped.waypoint_times[2] - 11.0).abs() < 1e-9);
+    // A quarter of the bound: a smaller blend, slower than the full one, faster than stopping.
+    let small = time_path_blended_scaled(&path, &l, &[0.04], &[1.0, 1.0, 0.25, 1.0]).unwrap();
+    assert!(small.deviation.iter().all(|&d| d <= 0.01 + 1e-12));
+    let full = time_path_blended(&path, &l, &[0.04]).unwrap();
+    assert!(full.trajectory.duration() < small.trajectory.duration());
+    assert!(small.trajectory.duration() < 22.0);
+    assert!(time_path_blended_scaled(&path, &l, &[0.1], &[1.0, -1.0]).is_err());
+}
