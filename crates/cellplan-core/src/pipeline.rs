@@ -222,6 +222,32 @@ fn slowness_penalty(cell: &Cell, o: &plan::Outcome) -> Vec<Vec<f64>> {
     vec![per_task; cell.tasks.len()]
 }
 
+/// How many of ours' coordinated plans that lost are kept to be blended against the winner.
+const RUNNERS_UP: usize = 2;
+/// A runner-up is blended only if its cycle before blending is within this share of the
+/// winner's.
+const RUNNER_UP_REACH: f64 = 0.05;
+
+/// The shortest few coordinated plans that lost (see [`RUNNERS_UP`]).
+struct RunnersUp {
+    kept: Vec<(Outcome, PlanSettings, Coordinated)>,
+    room: usize,
+}
+
+impl RunnersUp {
+    /// Keeps `run` if it is among the `room` shortest (by cycle, then Δt, then the earlier).
+    fn keep(&mut self, run: Option<(Outcome, PlanSettings, Coordinated)>) {
+        let Some(run) = run else { return };
+        if self.room == 0 {
+            return;
+        }
+        let key = cycle_and_delta(&run.2.timed);
+        let at = self.kept.partition_point(|r| cycle_and_delta(&r.2.timed) <= key);
+        self.kept.insert(at, run);
+        self.kept.truncate(self.room);
+    }
+}
+
 /// What `cellplan plan` runs: `outcome` (planned with `settings`) coordinated with `coord`.
 /// With `best` and the zones allocation (ours), more plans are made and coordinated: the
 /// zones as strips across the line of the robots, each robot sweeping its strip
@@ -233,7 +259,11 @@ fn slowness_penalty(cell: &Cell, o: &plan::Outcome) -> Vec<Vec<f64>> {
 /// end no sooner than the best cycle so far even uncoordinated is not coordinated. The shortest
 /// coordinated cycle (then Δt, then the earlier) wins; then [`plan::rebalance::rebalance`]
 /// hands tasks from the robot that ends last to others, one at a time, each hand-over kept
-/// when its plan, coordinated, ends sooner still. The coordination compute of all is counted.
+/// when its plan, coordinated, ends sooner still. Plans are compared with every leg stopping
+/// at every waypoint; the winner and the [`RUNNERS_UP`] shortest plans that lost (within
+/// [`RUNNER_UP_REACH`] of it, on cells of at most `plan_first_pairs` MPs × robots) are then
+/// blended ([`crate::coord::blend`]) and the shortest blended cycle is the plan. The
+/// coordination compute of all is counted.
 /// Returns the winning run, its settings and its coordination. `cache` holds what earlier runs
 /// on the cell planned (see [`plan::PlanCache`]).
 pub fn coordinate(
@@ -342,6 +372,16 @@ pub fn coordinate(
         let (spent, costliest) = (spent.get(), costliest.get());
         spent + costliest <= coord.ours_distances && costliest.saturating_mul(4) <= coord.ours_distances
     };
+    // The coordinated plans that lost, the shortest few (on small cells): blending can reorder
+    // plans whose cycles are close, so the winner and these are blended and compared at the end.
+    let mut runners_up = RunnersUp {
+        kept: Vec::new(),
+        room: if cell.tasks.len() * cell.robots.len() <= coord.plan_first_pairs {
+            RUNNERS_UP
+        } else {
+            0
+        },
+    };
     let cycle_of = |b: &Option<(Outcome, PlanSettings, Coordinated)>| {
         b.as_ref()
             .map_or(f64::INFINITY, |b| cycle_and_delta(&b.2.timed).0)
@@ -396,8 +436,9 @@ pub fn coordinate(
                         .as_ref()
                         .is_some_and(|b| cycle_and_delta(&c.timed) < cycle_and_delta(&b.2.timed)) =>
                 {
-                    best = Some((o, s, c));
+                    runners_up.keep(best.replace((o, s, c)));
                 }
+                Some(Ok(c)) => runners_up.keep(Some((o, s, c))),
                 _ => {}
             }
         }
@@ -430,21 +471,35 @@ pub fn coordinate(
         plan::rebalance::rebalance(cell, table, base, &best.1, cache, &affordable, &mut judge)
     {
         if let Some(found) = found {
-            best = found;
+            runners_up.keep(Some(std::mem::replace(&mut best, found)));
         }
         // The clock stopped the hand-overs: the plan says so.
         best.0.time_limit_hit |= clock_cut;
     }
-    let (o, s, c) = best;
-    let c = crate::coord::blend_coordinated(
-        cell,
-        table,
-        c,
-        &CoordSettings {
-            blend_deviation: blend,
-            ..coord.clone()
-        },
-    )?;
+    // The winner and the runners-up within reach of it, blended; the shortest blended cycle
+    // (then Δt, then the winner first) is the plan.
+    let blending = CoordSettings {
+        blend_deviation: blend,
+        ..coord.clone()
+    };
+    let reach = cycle_and_delta(&best.2.timed).0 * (1.0 + RUNNER_UP_REACH);
+    let mut chosen: Option<(Outcome, PlanSettings, Coordinated)> = None;
+    let candidates = std::iter::once(best).chain(
+        runners_up
+            .kept
+            .into_iter()
+            .filter(|r| cycle_and_delta(&r.2.timed).0 <= reach),
+    );
+    for (o, s, c) in candidates {
+        let c = crate::coord::blend_coordinated(cell, table, c, &blending)?;
+        if chosen
+            .as_ref()
+            .is_none_or(|b| cycle_and_delta(&c.timed) < cycle_and_delta(&b.2.timed))
+        {
+            chosen = Some((o, s, c));
+        }
+    }
+    let (o, s, c) = chosen.expect("the winner is a candidate");
     let spent = lap.elapsed().as_secs_f64();
     Ok((
         o,
