@@ -9,6 +9,8 @@ use cellplan_optical::testing::{document, fixture};
 use cellplan_verify::{VerifySettings, ViolationKind, verify};
 use proptest::prelude::*;
 
+mod faults;
+
 /// A disc of radius `r` about `o` in a two-joint space; the clearance of `q` is its distance
 /// from the disc (radii of 1 per joint: `Σ_j |Δq_j|` bounds the motion of a "point").
 struct Disc {
@@ -140,17 +142,8 @@ fn blended_plans_verify_and_are_never_longer() {
 
 #[test]
 fn the_verifier_rechecks_the_blends() {
-    let f = fixture();
-    let (good, _) = document(Coordination::FixedPriority);
-    let settings = VerifySettings::default();
-    assert!(verify(&f.cell, &good, &settings).ok);
-    let kinds = |doc: &output::Plan| -> Vec<ViolationKind> {
-        verify(&f.cell, doc, &settings)
-            .violations
-            .iter()
-            .map(|v| v.kind)
-            .collect()
-    };
+    let good = faults::good_plan();
+    let kinds = faults::kinds;
     let (r, l) = good
         .robots
         .iter()

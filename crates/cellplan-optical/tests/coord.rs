@@ -10,6 +10,8 @@ use cellplan_optical::load;
 use cellplan_optical::testing::{crossing_cell, document, fixture};
 use cellplan_verify::{VerifySettings, ViolationKind, verify};
 
+mod faults;
+
 #[test]
 fn the_uncoordinated_plan_has_a_conflict_and_the_verifier_names_it() {
     let f = fixture();
@@ -301,16 +303,9 @@ fn coordination_does_not_depend_on_the_thread_count() {
 #[test]
 fn the_verifier_catches_injected_faults() {
     let f = fixture();
-    let (good, _) = document(Coordination::FixedPriority);
+    let good = faults::good_plan();
     let settings = VerifySettings::default();
-    assert!(verify(&f.cell, &good, &settings).ok);
-    let kinds = |doc: &output::Plan| -> Vec<ViolationKind> {
-        verify(&f.cell, doc, &settings)
-            .violations
-            .iter()
-            .map(|v| v.kind)
-            .collect()
-    };
+    let kinds = faults::kinds;
     // The cell as built differs from the plan: R2 stands 5 cm closer to R1. Where the plan
     // passes the robots by each other with little room, they now meet.
     let moved_path = crossing_cell().with_file_name("moved.toml");

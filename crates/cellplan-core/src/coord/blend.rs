@@ -12,8 +12,10 @@
 //! they were (the robot runs ahead of its old timeline), else with each wait lengthened to end
 //! when it ended before (the timeline after every wait is the old one).
 use super::program::{LegBlend, Program, ProgramLeg, Timed};
-use super::{CoordSettings, Ctx};
+use super::{CoordSettings, Coordinated, Coordination, Ctx};
+use crate::candidates::CandidateTable;
 use crate::plan::PlanError;
+use cellplan_model::Cell;
 use cellplan_motion::plan::StateValidity;
 use cellplan_motion::timing::{Limits, time_path_blended_scaled};
 
@@ -251,4 +253,30 @@ pub(crate) fn blend_all(
         }
     }
     Ok((programs, timed, blended_corners))
+}
+
+/// `coordinated` (not yet blended) with its legs blended as `settings` asks (see the module),
+/// where the exact search on the clock keeps the robots clear (the coordination strategy
+/// `none` is left as it is).
+pub fn blend_coordinated(
+    cell: &Cell,
+    table: &CandidateTable,
+    coordinated: Coordinated,
+    settings: &CoordSettings,
+) -> Result<Coordinated, PlanError> {
+    if coordinated.strategy == Coordination::None
+        || settings.blend_deviation.is_nan()
+        || settings.blend_deviation <= 0.0
+    {
+        return Ok(coordinated);
+    }
+    let ctx = Ctx::new(cell, table, settings, None);
+    let (programs, timed, corners) =
+        blend_all(&ctx, coordinated.programs, coordinated.timed, settings, true)?;
+    Ok(Coordinated {
+        programs,
+        timed,
+        blended_corners: coordinated.blended_corners + corners,
+        ..coordinated
+    })
 }

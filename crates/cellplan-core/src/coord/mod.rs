@@ -32,13 +32,16 @@ mod ours;
 mod perturb;
 pub mod program;
 mod schedule;
+mod settings;
 pub mod timeline;
 
+pub use blend::blend_coordinated;
 pub use cover::Cover;
 pub use diagram::{ConflictBox, DiagramCache};
 pub use ours::conflict_boxes;
 use ours::{against_canonical, baselines_if_shorter, best, rank_of, scheduled};
 pub use program::{Activity, Program, Timed, VisitPose, Wait, WaitReason};
+pub use settings::{BLEND_DEVIATION, CoordSettings};
 pub use timeline::{Conflict, Scenario, Timeline};
 
 use crate::candidates::CandidateTable;
@@ -89,67 +92,6 @@ impl Coordination {
         Coordination::PosePerturbation,
         Coordination::Best,
     ];
-}
-
-/// Knobs of coordination.
-#[derive(Clone, Debug)]
-pub struct CoordSettings {
-    /// Strategy.
-    pub strategy: Coordination,
-    /// Delay increment of delay-startup (s).
-    pub delay_step: f64,
-    /// Orientation increment of pose-perturbation (rad); the grid is ±2 increments about each
-    /// of w, p, r.
-    pub perturb_step: f64,
-    /// Perturbed (or alternative) pose combinations whose legs are planned per conflict.
-    pub perturb_evaluations: usize,
-    /// Seed of the local path planner.
-    pub seed: u64,
-    /// A cycle time to beat (s), from another plan of the same cell: `best` stops resolving a
-    /// priority order with waits as soon as its programs end after it (waits only lengthen a
-    /// program) and ranks it by that end; the two best orders are still tried with other
-    /// poses. `None`: every order is resolved to the end.
-    pub bar: Option<f64>,
-    /// Nodes of `best`'s search over passage orders (work, not time: the result does not
-    /// depend on the machine).
-    pub schedule_nodes: usize,
-    /// The shortest wait `best` adds (s): at least two trajectory sample steps, so that every
-    /// wait shows in the sampled trajectory of the plan.
-    pub min_wait: f64,
-    /// Exact robot–robot distances the coordination diagrams of ours' plans may ask in all
-    /// ([`crate::pipeline::coordinate`]; default
-    /// [`crate::pipeline::OURS_COORDINATION_DISTANCES`]): beyond the first plan, a try or a
-    /// hand-over is coordinated only while what was asked so far, plus as much again as the
-    /// costliest coordination, stays within it (work, not time).
-    pub ours_distances: usize,
-    /// Beyond this many MPs × robots ours plans all its tries before coordinating any, and
-    /// coordinates them most promising first (default [`crate::pipeline::PLAN_FIRST_PAIRS`]).
-    pub plan_first_pairs: usize,
-    /// After coordination, the legs without a wait on the way are timed through their corners
-    /// without stopping, each corner's blend within this much (rad, per joint) of the corner
-    /// and checked against the scene (see [`blend`]); 0: every leg stops at every waypoint.
-    pub blend_deviation: f64,
-}
-
-/// The default of [`CoordSettings::blend_deviation`] (rad).
-pub const BLEND_DEVIATION: f64 = 0.1;
-
-impl Default for CoordSettings {
-    fn default() -> Self {
-        CoordSettings {
-            strategy: Coordination::Best,
-            delay_step: 0.1,
-            perturb_step: 4f64.to_radians(),
-            perturb_evaluations: 12,
-            seed: 0,
-            bar: None,
-            schedule_nodes: 20_000,
-            min_wait: 0.05,
-            ours_distances: crate::pipeline::OURS_COORDINATION_DISTANCES,
-            plan_first_pairs: crate::pipeline::PLAN_FIRST_PAIRS,
-            blend_deviation: BLEND_DEVIATION,
-        }
-    }
 }
 
 /// What coordination did.
@@ -313,9 +255,10 @@ fn coordinate_with(
     let uncoordinated_cycle = cycle_and_delta(&timed).0;
     let cell_order: Vec<usize> = (0..programs.len()).collect();
     let mut distances = 0;
-    let (programs, res, priority) = match settings.strategy {
-        Coordination::None => (programs, Resolution::default(), Vec::new()),
-        _ if before.is_empty() => (programs, Resolution::default(), cell_order),
+    // With `best`, the kept programs blended as its choice scored them (not done again below).
+    let (programs, res, priority, pre_blended) = match settings.strategy {
+        Coordination::None => (programs, Resolution::default(), Vec::new(), None),
+        _ if before.is_empty() => (programs, Resolution::default(), cell_order, None),
         Coordination::DelayStartup | Coordination::FixedPriority | Coordination::PosePerturbation => {
             let mode = match settings.strategy {
                 Coordination::DelayStartup => Mode::DelayStartup,
@@ -329,7 +272,7 @@ fn coordinate_with(
             } else {
                 cell_order
             };
-            (progs, res, priority)
+            (progs, res, priority, None)
         }
         Coordination::Best => {
             // Tours in their canonical directions; `reversed` then says which run against the
@@ -355,7 +298,7 @@ fn coordinate_with(
                 Some(done) => done,
                 None => best(&ctx, programs.clone(), cover.as_ref())?,
             };
-            let (progs, mut res, priority) = baselines_if_shorter(
+            let ((progs, mut res, priority), blended) = baselines_if_shorter(
                 &ctx,
                 &programs,
                 first,
@@ -369,7 +312,7 @@ fn coordinate_with(
             if let Some(s) = &mut res.search {
                 s.reversed = res.reversed.iter().filter(|&&r| r).count();
             }
-            (progs, res, priority)
+            (progs, res, priority, blended)
         }
     };
     // Tours `best` runs the other way round: what they meet uncoordinated.
@@ -408,12 +351,11 @@ fn coordinate_with(
     }
     // Legs without a stop on the way run through their corners, where the exact search on
     // the clock lets them.
-    let (programs, timed, blended_corners) = if settings.strategy == Coordination::None {
-        (programs, timed, 0)
-    } else {
-        blend::blend_all(&ctx, programs, timed, settings, true)?
+    let (programs, timed, blended_corners) = match pre_blended {
+        Some(blended) => blended,
+        None if settings.strategy == Coordination::None => (programs, timed, 0),
+        None => blend::blend_all(&ctx, programs, timed, settings, true)?,
     };
-    // (`blend_all` skips legs already blended: programs come in unblended.)
     Ok(Coordinated {
         strategy: settings.strategy,
         programs,
@@ -435,32 +377,6 @@ fn coordinate_with(
         blocking: res.blocking,
         reversed: res.reversed,
         compute_s: started.elapsed().as_secs_f64(),
-    })
-}
-
-/// `coordinated` (not yet blended) with its legs blended as `settings` asks (see [`blend`]),
-/// where the exact search on the clock keeps the robots clear (the coordination strategy
-/// `none` is left as it is).
-pub fn blend_coordinated(
-    cell: &Cell,
-    table: &CandidateTable,
-    coordinated: Coordinated,
-    settings: &CoordSettings,
-) -> Result<Coordinated, PlanError> {
-    if coordinated.strategy == Coordination::None
-        || settings.blend_deviation.is_nan()
-        || settings.blend_deviation <= 0.0
-    {
-        return Ok(coordinated);
-    }
-    let ctx = Ctx::new(cell, table, settings, None);
-    let (programs, timed, corners) =
-        blend::blend_all(&ctx, coordinated.programs, coordinated.timed, settings, true)?;
-    Ok(Coordinated {
-        programs,
-        timed,
-        blended_corners: coordinated.blended_corners + corners,
-        ..coordinated
     })
 }
 

@@ -22,16 +22,20 @@ pub(super) fn baselines_if_shorter(
     cell_order: &[usize],
     cover: Option<&Cover>,
     as_planned: (&[Program], &[bool]),
-) -> Result<Resolved, PlanError> {
-    // Scored as they will run: with the legs blended that coordination leaves without a stop
-    // on the way (the programs are blended again, the same way, once one is kept).
-    let score = |progs: &[Program]| -> Result<(f64, f64), PlanError> {
-        let timed: Vec<Timed> = progs.iter().map(|p| ctx.timed(p)).collect::<Result<_, _>>()?;
-        let (_, timed, _) = super::blend::blend_all(ctx, progs.to_vec(), timed, ctx.settings, true)?;
-        Ok(cycle_and_delta(&timed))
-    };
-    let mut kept = (score(&found.0)?, found);
+) -> Result<(Resolved, Option<Blended>), PlanError> {
     let blending = ctx.settings.blend_deviation > 0.0;
+    // Scored as they will run: with blends, with the legs blended that coordination leaves
+    // without a stop on the way (the kept one's blending is returned, not done again).
+    let score = |progs: &[Program]| -> Result<((f64, f64), Option<Blended>), PlanError> {
+        let timed: Vec<Timed> = progs.iter().map(|p| ctx.timed(p)).collect::<Result<_, _>>()?;
+        if !blending {
+            return Ok((cycle_and_delta(&timed), None));
+        }
+        let blended = super::blend::blend_all(ctx, progs.to_vec(), timed, ctx.settings, true)?;
+        Ok((cycle_and_delta(&blended.1), Some(blended)))
+    };
+    let (s, b) = score(&found.0)?;
+    let mut kept = (s, found, b);
     // (mode, on the tours as planned): fixed priority on the tours as `best` turned them; with
     // blends, both baselines on the tours as planned too, as the strategies themselves run
     // them: blending gains most where no wait is on the way (delay-startup's waits are all at
@@ -65,14 +69,17 @@ pub(super) fn baselines_if_shorter(
             // Against the canonical directions, as `best`'s results are stated.
             res.reversed = as_planned.1.to_vec();
         }
-        let s = score(&progs)?;
+        let (s, b) = score(&progs)?;
         // Shorter by more than a millisecond (a tie keeps the schedule).
         if s.0 < kept.0.0 - 1e-3 || (s.0 <= kept.0.0 + 1e-3 && s.1 < kept.0.1 - 1e-3) {
-            kept = (s, (progs, res, cell_order.to_vec()));
+            kept = (s, (progs, res, cell_order.to_vec()), b);
         }
     }
-    Ok(kept.1)
+    Ok((kept.1, kept.2))
 }
+
+/// Programs blended, their timing and the corners blended (see [`super::blend::blend_all`]).
+pub(super) type Blended = (Vec<Program>, Vec<Timed>, usize);
 
 /// Programs resolved by a strategy, its counts, and the priority order it used (if any).
 pub(super) type Resolved = (Vec<Program>, Resolution, Vec<usize>);
