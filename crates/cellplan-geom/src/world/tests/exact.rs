@@ -126,7 +126,9 @@ proptest! {
         let d1 = w1.min_distance_to_static(g1, &[pb]);
         let d2 = w2.min_distance_to_static(g2, &[pa]);
         prop_assert!(d1 >= 0.0 && d2 >= 0.0);
-        prop_assert!((d1 - d2).abs() < 1e-6, "{} vs {}", d1, d2);
+        // GJK stops within its tolerance of the true distance, which against curved shapes
+        // (cylinders, balls) is a few millionths of it either way round.
+        prop_assert!((d1 - d2).abs() < 1e-6 + 1e-4 * d1.max(d2), "{} vs {}", d1, d2);
         // Contact agrees with the distance away from the boundary.
         for margin in [0.0, 0.05, 0.3] {
             let c1 = w1.group_vs_static(g1, &[pb], margin).is_some();
