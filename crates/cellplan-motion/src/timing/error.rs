@@ -56,4 +56,12 @@ pub enum TimingError {
         /// The offending value.
         value: f64,
     },
+    /// A waypoint's scale of the deviation bound is negative or not finite.
+    #[error("waypoint {waypoint}: deviation scale {value} must be finite and >= 0")]
+    InvalidScale {
+        /// Waypoint index.
+        waypoint: usize,
+        /// The offending value.
+        value: f64,
+    },
 }

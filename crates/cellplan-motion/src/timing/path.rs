@@ -195,12 +195,12 @@ pub fn time_path_blended_scaled(
     max_deviation: &[f64],
     scale: &[f64],
 ) -> Result<BlendedPath, TimingError> {
-    if let Some((joint, &value)) = scale
+    if let Some((waypoint, &value)) = scale
         .iter()
         .enumerate()
         .find(|(_, s)| !(s.is_finite() && **s >= 0.0))
     {
-        return Err(TimingError::InvalidDeviation { joint, value });
+        return Err(TimingError::InvalidScale { waypoint, value });
     }
     let dof = limits.dof();
     let delta: Vec<f64> = match max_deviation.len() {

@@ -331,5 +331,8 @@ fn blended_waypoint_times_and_scaled_corners() {
     let full = time_path_blended(&path, &l, &[0.04]).unwrap();
     assert!(full.trajectory.duration() < small.trajectory.duration());
     assert!(small.trajectory.duration() < 22.0);
-    assert!(time_path_blended_scaled(&path, &l, &[0.1], &[1.0, -1.0]).is_err());
+    assert!(matches!(
+        time_path_blended_scaled(&path, &l, &[0.1], &[1.0, -1.0]),
+        Err(TimingError::InvalidScale { waypoint: 1, .. })
+    ));
 }
