@@ -490,8 +490,10 @@ pub fn coordinate(
             .into_iter()
             .filter(|r| cycle_and_delta(&r.2.timed).0 <= reach),
     );
+    // One context for all of them: the robots' checkers are built once.
+    let ctx = crate::coord::Ctx::new(cell, table, &blending, None);
     for (o, s, c) in candidates {
-        let c = crate::coord::blend_coordinated(cell, table, c, &blending)?;
+        let c = crate::coord::blend::blend_with(&ctx, c)?;
         if chosen
             .as_ref()
             .is_none_or(|b| cycle_and_delta(&c.timed) < cycle_and_delta(&b.2.timed))

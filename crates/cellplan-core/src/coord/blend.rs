@@ -162,20 +162,13 @@ fn blend_leg(
         }
         if !failed {
             let corners = path.blends.iter().map(|b| (b.waypoint, b.radius)).collect();
-            let segments = waypoints
-                .windows(2)
-                .map(|w| super::program::segment_trajectory(&w[0], &w[1], limits).map(|t| t.duration()))
-                .collect::<Result<_, _>>()?;
-            return Ok(Some(ProgramLeg {
-                waypoints,
-                straight: leg.straight,
-                segments,
-                blend: Some(LegBlend {
-                    trajectory: path.trajectory,
-                    corners,
-                    waypoint_times: path.waypoint_times,
-                }),
-            }));
+            let mut blended = ProgramLeg::new(waypoints, leg.straight, limits)?;
+            blended.blend = Some(LegBlend {
+                trajectory: path.trajectory,
+                corners,
+                waypoint_times: path.waypoint_times,
+            });
+            return Ok(Some(blended));
         }
     }
     Ok(None)
@@ -264,15 +257,17 @@ pub fn blend_coordinated(
     coordinated: Coordinated,
     settings: &CoordSettings,
 ) -> Result<Coordinated, PlanError> {
-    if coordinated.strategy == Coordination::None
-        || settings.blend_deviation.is_nan()
-        || settings.blend_deviation <= 0.0
-    {
+    blend_with(&Ctx::new(cell, table, settings, None), coordinated)
+}
+
+/// [`blend_coordinated`] in a coordination context made once for several plans of a cell
+/// (with `ctx.settings` the blending asked for).
+pub(crate) fn blend_with(ctx: &Ctx, coordinated: Coordinated) -> Result<Coordinated, PlanError> {
+    if coordinated.strategy == Coordination::None {
         return Ok(coordinated);
     }
-    let ctx = Ctx::new(cell, table, settings, None);
     let (programs, timed, corners) =
-        blend_all(&ctx, coordinated.programs, coordinated.timed, settings, true)?;
+        blend_all(ctx, coordinated.programs, coordinated.timed, ctx.settings, true)?;
     Ok(Coordinated {
         programs,
         timed,

@@ -403,36 +403,16 @@ impl Program {
         let mut t = 0.0;
         for (k, leg) in self.legs.iter().enumerate() {
             let mut at = Vec::with_capacity(leg.waypoints.len());
-            if let Some(blend) = &leg.blend {
-                // Only a wait at the start: `set_wait` takes the blend away from a leg
-                // given one on the way.
-                at.push(t);
-                if let Some(i) = self.waits.iter().position(|x| x.leg == k && x.waypoint == 0) {
-                    let d = self.waits[i].duration;
-                    wait_starts[i] = t;
-                    parts.push(Trajectory::dwell(&leg.waypoints[0], d));
-                    spans.push(Span {
-                        start: t,
-                        end: t + d,
-                        what: Activity::Wait { leg: k, waypoint: 0 },
-                    });
-                    t += d;
-                }
-                let times = &blend.waypoint_times;
-                at.extend(times.iter().skip(1).map(|&x| t + x));
-                for w in 0..leg.waypoints.len().saturating_sub(1) {
-                    spans.push(Span {
-                        start: t + times[w],
-                        end: t + times[w + 1],
-                        what: Activity::Move { leg: k, segment: w },
-                    });
-                }
-                parts.push(blend.trajectory.clone());
-                t += blend.trajectory.duration();
-            }
+            // A blended leg moves on from its first waypoint in one piece: the others are
+            // passed, not stood at (`set_wait` takes the blend away from a leg given a wait on
+            // the way).
+            let mut moving_from = t;
             for w in 0..leg.waypoints.len() {
-                if leg.blend.is_some() {
-                    break;
+                if let Some(blend) = &leg.blend
+                    && w > 0
+                {
+                    at.push(moving_from + blend.waypoint_times[w]);
+                    continue;
                 }
                 at.push(t);
                 if let Some(i) = self.waits.iter().position(|x| x.leg == k && x.waypoint == w) {
@@ -446,7 +426,19 @@ impl Program {
                     });
                     t += d;
                 }
-                if w + 1 < leg.waypoints.len() {
+                if let Some(blend) = &leg.blend {
+                    let times = &blend.waypoint_times;
+                    for segment in 0..leg.waypoints.len().saturating_sub(1) {
+                        spans.push(Span {
+                            start: t + times[segment],
+                            end: t + times[segment + 1],
+                            what: Activity::Move { leg: k, segment },
+                        });
+                    }
+                    parts.push(blend.trajectory.clone());
+                    moving_from = t;
+                    t += blend.trajectory.duration();
+                } else if w + 1 < leg.waypoints.len() {
                     let seg = segment_trajectory(&leg.waypoints[w], &leg.waypoints[w + 1], limits)?;
                     let d = seg.duration();
                     parts.push(seg);
