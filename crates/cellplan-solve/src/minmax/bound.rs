@@ -17,7 +17,10 @@
 //!   vehicles able to do both (no vehicle: no such leg).
 //!
 //! The bound is the largest of these (each the smallest over the numbers `k` of vehicles the
-//! caps allow) and of [`own_bound`]: a vehicle's route is at least the tasks only it can do.
+//! caps allow), of [`own_bound`] (a vehicle's route is at least the tasks only it can do) and of
+//! [`count_bound`]: the vehicles' numbers of tasks add up to `n`, and a vehicle doing `m` tasks
+//! pays at least its `m` cheapest — which, when tasks are few per vehicle, is more than the
+//! `k`-th of the sum (one of three equal vehicles does two of four tasks).
 use super::MinMaxProblem;
 
 /// Most tasks for which [`tree_bound`] runs (its matrix holds `n²` numbers).
@@ -38,7 +41,7 @@ pub fn lower_bound(p: &MinMaxProblem) -> f64 {
     let legs = Legs::new(p);
     let fewest = fewest_vehicles(p);
     let most = p.vehicles.len().min(p.tasks);
-    let mut best = own_bound(p, &legs);
+    let mut best = own_bound(p, &legs).max(count_bound(p, &legs));
     if fewest <= most {
         let service: f64 = p.service.iter().sum();
         let entries = Entries::new(p, &legs);
@@ -74,6 +77,11 @@ fn fewest_vehicles(p: &MinMaxProblem) -> usize {
 struct Legs {
     /// `from_task[v][t]`: the cheapest arc into a node of `t` from a node of another task.
     from_task: Vec<Vec<f64>>,
+    /// `to_task[v][t]`: the cheapest arc from a node of `t` into a node of another task.
+    to_task: Vec<Vec<f64>>,
+    /// `near[v][t]`: the two cheapest arcs, either way, between a node of `t` and two distinct
+    /// others (tasks or the depot) — the two legs at `t` of a route through two or more tasks.
+    near: Vec<Vec<Nearest>>,
     /// `from_depot[v][t]`: the cheapest arc from the depot into a node of `t`.
     from_depot: Vec<Vec<f64>>,
     /// `home[v][t]`: the cheapest arc from a node of `t` to the depot.
@@ -100,6 +108,8 @@ impl Legs {
         let (m, n) = (p.vehicles.len(), p.tasks);
         let mut legs = Legs {
             from_task: vec![vec![f64::INFINITY; n]; m],
+            to_task: vec![vec![f64::INFINITY; n]; m],
+            near: vec![vec![Nearest::default(); n]; m],
             from_depot: vec![vec![f64::INFINITY; n]; m],
             home: vec![vec![f64::INFINITY; n]; m],
             tree: (n <= TREE_MAX_TASKS).then(|| Tree {
@@ -125,12 +135,16 @@ impl Legs {
                         }
                     }
                     legs.from_task[v][t] = legs.from_task[v][t].min(c);
+                    legs.to_task[v][s] = legs.to_task[v][s].min(c);
+                    legs.near[v][t].offer(c, s);
+                    legs.near[v][s].offer(c, t);
                     if let Some(tree) = &mut legs.tree {
                         let w = n + 1;
                         tree.cost[s * w + t] = tree.cost[s * w + t].min(c);
                         tree.cost[t * w + s] = tree.cost[t * w + s].min(c);
                     }
                 }
+                legs.near[v][t].offer(legs.from_depot[v][t].min(legs.home[v][t]), n);
                 if let Some(tree) = &mut legs.tree {
                     let w = n + 1;
                     let c = legs.from_depot[v][t].min(legs.home[v][t]);
@@ -140,6 +154,36 @@ impl Legs {
             }
         }
         legs
+    }
+}
+
+/// The two cheapest arcs between a node and two distinct others (see [`Legs::near`]).
+#[derive(Clone, Copy, Debug)]
+struct Nearest([(f64, usize); 2]);
+
+impl Default for Nearest {
+    fn default() -> Self {
+        Nearest([(f64::INFINITY, usize::MAX); 2])
+    }
+}
+
+impl Nearest {
+    /// An arc of cost `c` to `other` (the cheaper of its arcs to `other` is kept).
+    fn offer(&mut self, c: f64, other: usize) {
+        let x = &mut self.0;
+        if let Some(i) = x.iter().position(|e| e.1 == other) {
+            x[i].0 = x[i].0.min(c);
+        } else if c < x[1].0 {
+            x[1] = (c, other);
+        }
+        if x[1].0 < x[0].0 {
+            x.swap(0, 1);
+        }
+    }
+
+    /// Half the two cheapest arcs: what a route through `t` and others pays at `t`.
+    fn half(&self) -> f64 {
+        0.5 * (self.0[0].0 + self.0[1].0)
     }
 }
 
@@ -293,6 +337,108 @@ fn priced_tree(tree: &Tree, price: &[f64], k: usize) -> (f64, Vec<usize>) {
     (value, degree)
 }
 
+/// The bound by the numbers of tasks: the vehicles' numbers of tasks add up to `n`, and a
+/// vehicle doing `m` tasks (at most its cap and the tasks it can do) takes at least
+/// [`route_by_ends`] of them, entries or exits, whichever is larger (nothing when `m` is 0).
+/// The makespan is at least the smallest time `T` at which the most tasks each vehicle could do
+/// within `T` add up to `n`: the relaxation lets vehicles share tasks and cheap legs, never
+/// exceed `T`. (With equal vehicles it says that one of them does `⌈n / vehicles⌉` tasks.)
+fn count_bound(p: &MinMaxProblem, legs: &Legs) -> f64 {
+    // Per vehicle, what `m = 1, 2, …` tasks take at least (non-decreasing in `m`).
+    let times: Vec<Vec<f64>> = p
+        .vehicles
+        .iter()
+        .enumerate()
+        .map(|(v, veh)| {
+            let tasks: Vec<usize> = (0..p.tasks).filter(|&t| p.can_do(v, t)).collect();
+            let most = tasks.len().min(veh.cap);
+            let entries = route_by_ends(p, &tasks, &legs.from_task[v], &legs.from_depot[v], &legs.home[v]);
+            let exits = route_by_ends(p, &tasks, &legs.to_task[v], &legs.home[v], &legs.from_depot[v]);
+            let halves = route_by_halves(p, &tasks, &legs.near[v], &legs.from_depot[v], &legs.home[v]);
+            let mut at = 0.0f64;
+            (0..most)
+                .map(|i| {
+                    // Monotone as it must be (rounding aside).
+                    let by_halves = if i > 0 { halves[i] } else { 0.0 };
+                    at = at.max(entries[i].max(exits[i]).max(by_halves));
+                    at
+                })
+                .collect()
+        })
+        .collect();
+    // How many tasks the vehicles could do in all within `t`.
+    let within = |t: f64| -> usize { times.iter().map(|f| f.partition_point(|&x| x <= t)).sum() };
+    let mut candidates: Vec<f64> = times
+        .iter()
+        .flatten()
+        .copied()
+        .filter(|x| x.is_finite())
+        .collect();
+    candidates.sort_by(f64::total_cmp);
+    // The smallest candidate time within which `n` tasks fit (a time between two candidates
+    // fits no more than the lower one).
+    let at = candidates.partition_point(|&t| within(t) < p.tasks);
+    candidates.get(at).copied().unwrap_or(0.0)
+}
+
+/// What a route through `m = 2, 3, …` of `tasks` costs at least (entry `m - 1`; entry 0 is
+/// not a bound): every leg is half paid at each of its ends. Each task has two legs, to two
+/// distinct others, so it pays at least [`Nearest::half`]; the depot has two, so at least the
+/// cheapest depot arc. The `m` smallest of a task's service plus its half, plus that.
+fn route_by_halves(
+    p: &MinMaxProblem,
+    tasks: &[usize],
+    near: &[Nearest],
+    from_depot: &[f64],
+    home: &[f64],
+) -> Vec<f64> {
+    let mut cost: Vec<f64> = tasks.iter().map(|&t| p.service[t] + near[t].half()).collect();
+    cost.sort_by(f64::total_cmp);
+    let depot = tasks
+        .iter()
+        .map(|&t| from_depot[t].min(home[t]))
+        .fold(f64::INFINITY, f64::min);
+    let mut sum = 0.0;
+    cost.iter()
+        .map(|c| {
+            sum += c;
+            sum + depot
+        })
+        .collect()
+}
+
+/// What a route through `m = 1, 2, …` of `tasks` costs at least, for every `m`: the `m`
+/// smallest of a task's service plus its cheapest `end` (an arc between it and another task),
+/// or its `depot_end` where that is cheaper; plus the smallest extra of one task's `depot_end`
+/// over that (one task's end is at the depot); plus the cheapest `other` (the route's other
+/// depot arc, at any task). Read with entries (`end` the arcs in, `depot_end` from the depot,
+/// `other` home) or backwards with exits.
+fn route_by_ends(
+    p: &MinMaxProblem,
+    tasks: &[usize],
+    end: &[f64],
+    depot_end: &[f64],
+    other: &[f64],
+) -> Vec<f64> {
+    let mut cost: Vec<f64> = tasks
+        .iter()
+        .map(|&t| p.service[t] + end[t].min(depot_end[t]))
+        .collect();
+    cost.sort_by(f64::total_cmp);
+    let extra = tasks
+        .iter()
+        .map(|&t| depot_end[t] - end[t].min(depot_end[t]))
+        .fold(f64::INFINITY, f64::min);
+    let other = tasks.iter().map(|&t| other[t]).fold(f64::INFINITY, f64::min);
+    let mut sum = 0.0;
+    cost.iter()
+        .map(|c| {
+            sum += c;
+            sum + extra + other
+        })
+        .collect()
+}
+
 /// The bound of each vehicle alone: its route is at least the sum, over the tasks only it can
 /// do, of their service and cheapest entry (from the depot or another task), plus its cheapest
 /// way home (from any task it can do: the last need not be one of them).
@@ -346,5 +492,28 @@ mod tests {
             assert!(lower_bound(&p) <= sol.makespan + 1e-9);
         }
         assert!(tighter >= 3, "the trees beat the entries on {tighter} of 5");
+    }
+
+    #[test]
+    fn counts_bound_a_route_of_the_busiest_vehicle() {
+        // Three vehicles, four tasks on a line, legs as distances, service 1: whatever the
+        // allocation one vehicle does two tasks: at least two services, its way out and home,
+        // and one leg between two tasks (0.1 apart).
+        let x: [f64; 5] = [0.0, 1.0, 1.1, 1.2, 1.3];
+        let vehicle = || {
+            let costs = crate::problem::CostMatrix::from_fn(5, |i, j| (x[i] - x[j]).abs());
+            crate::minmax::Vehicle::new(costs, 0, 4, (1..5).map(|a| vec![a]).collect()).unwrap()
+        };
+        let p = MinMaxProblem::new(vec![vehicle(), vehicle(), vehicle()], 4, vec![1.0; 4], None).unwrap();
+        let legs = Legs::new(&p);
+        let counts = count_bound(&p, &legs);
+        // The best route of two: 0 → 1.0 → 1.1 → 0, 2 + 2.2 = 4.2; by entries 2 + 0.1 + 0.1
+        // (entries, the extra of one from home 0.9) + 1.0 home = 4.1.
+        assert!((counts - 4.1).abs() < 1e-9, "count bound {counts}");
+        assert!(counts <= 4.2 + 1e-9);
+        // The k-th of the sum is lower: (4 + 0.4 + 3.0 + 3.3) / 3 = 3.57.
+        assert!(lower_bound(&p) >= counts - 1e-12);
+        let service: f64 = p.service.iter().sum();
+        assert!((service + Entries::new(&p, &legs).bound(3)) / 3.0 < counts - 0.5);
     }
 }
