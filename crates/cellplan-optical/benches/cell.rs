@@ -1,6 +1,10 @@
 //! Benchmarks on the bundled autobody-4r cell: one robot configuration's full collision check
-//! against the car body, fixtures and itself; and candidate generation for the whole cell.
+//! against the car body, fixtures and itself; candidate generation for the whole cell; and,
+//! on the zones plan of the cell, the coordination diagrams of its programs and one `best`
+//! coordination of them (what ours does per plan it judges).
 use cellplan_core::candidates::generate;
+use cellplan_core::coord::{self, CoordSettings};
+use cellplan_core::plan::{self, PlanSettings};
 use cellplan_model::robot::Scratch;
 use cellplan_model::{LoadOptions, TaskId};
 use cellplan_optical::load;
@@ -38,6 +42,23 @@ fn cell_benches(c: &mut Criterion) {
     group.sample_size(10);
     group.bench_function("autobody-4r, 45 MPs x 4 robots", |b| {
         b.iter(|| black_box(generate(&cell)))
+    });
+    group.finish();
+    let outcome = plan::plan(&cell, &table, &PlanSettings::default(), &|_| {}).expect("the cell plans");
+    let programs: Vec<_> = outcome.robots.iter().map(|r| r.program.clone()).collect();
+    let settings = CoordSettings {
+        blend_deviation: 0.0,
+        ..CoordSettings::default()
+    };
+    let mut group = c.benchmark_group("coordination");
+    group.sample_size(10);
+    group.bench_function("autobody-4r zones plan, diagrams of 6 robot pairs", |b| {
+        b.iter(|| black_box(coord::conflict_boxes(&cell, &table, &programs, &settings).expect("boxes")))
+    });
+    group.bench_function("autobody-4r zones plan, best coordination", |b| {
+        b.iter(|| {
+            black_box(coord::coordinate(&cell, &table, programs.clone(), &settings).expect("coordinated"))
+        })
     });
     group.finish();
 }

@@ -258,6 +258,10 @@ struct PairDiagram<'a> {
     found: Option<ConflictBox>,
     /// Placements in the current pair of pieces, by robot (first or not) and position.
     placed: HashMap<(bool, u64), Rc<Placed>>,
+    /// Room for the close body pairs of a smallest rectangle.
+    close: Vec<(usize, usize)>,
+    /// Configurations at positions in the current pair of pieces, as `placed` keys them.
+    positions: HashMap<(bool, u64), Vec<f64>>,
 }
 
 impl PairDiagram<'_> {
@@ -302,7 +306,7 @@ impl PairDiagram<'_> {
     fn swept(&mut self, path: &RobotPath, first: bool, piece: &Piece) -> Swept {
         let mid = 0.5 * (piece.from + piece.to);
         let placed = self.place(path, first, mid);
-        let reach = self.reach(path.robot, &placed.q, path, piece.from, piece.to, piece.moving);
+        let reach = self.reach(first, &placed.q, path, piece.from, piece.to, piece.moving);
         let bodies: Vec<(DVec3, f64)> = placed.spheres.iter().map(|&(c, r)| (c, r + reach)).collect();
         let centre = if bodies.is_empty() {
             DVec3::ZERO
@@ -320,30 +324,43 @@ impl PairDiagram<'_> {
     }
 
     /// The body pairs of the two placed robots whose sphere covers (body spheres first) come
-    /// within `need`: every other pair is farther than `need` (the covers hold the meshes).
-    fn close_pairs(&self, xa: &Placed, xb: &Placed, need: f64) -> Vec<(usize, usize)> {
+    /// within `need`, into `out`: every other pair is farther than `need` (the covers hold the
+    /// meshes). Without `out`, whether there is one (stops at the first).
+    fn close_pairs(
+        &self,
+        xa: &Placed,
+        xb: &Placed,
+        need: f64,
+        mut out: Option<&mut Vec<(usize, usize)>>,
+    ) -> bool {
         // Squared distances against squared reaches (all terms are non-negative): no square
         // root per sphere pair.
         let within = |c: DVec3, r: f64, d: DVec3, q: f64| {
             let reach = need + r + q;
             (c - d).length_squared() <= reach * reach
         };
-        let mut out = Vec::new();
-        for (i, (ca, ra)) in xa.spheres.iter().enumerate() {
-            for (j, (cb, rb)) in xb.spheres.iter().enumerate() {
-                if !within(*ca, *ra, *cb, *rb) {
+        let mut any = false;
+        for (i, &(ca, ra)) in xa.spheres.iter().enumerate() {
+            for (j, &(cb, rb)) in xb.spheres.iter().enumerate() {
+                if !within(ca, ra, cb, rb) {
                     continue;
                 }
                 let (bi, bj) = (xa.bodies[i], xb.bodies[j]);
-                let close = xa.covers[bi]
-                    .iter()
-                    .any(|(c, r)| xb.covers[bj].iter().any(|(d, q)| within(*c, *r, *d, *q)));
+                // A sphere of the first cover farther than `need` from the second body's
+                // sphere is farther from every sphere it holds.
+                let close = xa.covers[bi].iter().any(|&(c, r)| {
+                    within(c, r, cb, rb) && xb.covers[bj].iter().any(|&(d, q)| within(c, r, d, q))
+                });
                 if close {
-                    out.push((bi, bj));
+                    any = true;
+                    match out.as_deref_mut() {
+                        Some(out) => out.push((bi, bj)),
+                        None => return true,
+                    }
                 }
             }
         }
-        out
+        any
     }
 
     /// Whether the two placed robots are farther apart than `need`, exactly (up to the convex
@@ -360,15 +377,20 @@ impl PairDiagram<'_> {
 
     /// How far any point of the robot can be from where it is at `mid` while at positions in
     /// `[from, to]` (inside one piece).
-    fn reach(&self, r: usize, mid: &[f64], path: &RobotPath, from: f64, to: f64, moving: bool) -> f64 {
+    fn reach(&mut self, first: bool, mid: &[f64], path: &RobotPath, from: f64, to: f64, moving: bool) -> f64 {
         if !moving || to <= from {
             return 0.0;
         }
-        let radii = &self.ctx.radii[r];
+        let ctx = self.ctx;
+        let radii = &ctx.radii[path.robot];
         [from, to]
             .iter()
             .map(|&s| {
-                let q = path.at(s);
+                // Rectangles share their ends: each position is evaluated once per pair of pieces.
+                let q = self
+                    .positions
+                    .entry((first, s.to_bits()))
+                    .or_insert_with(|| path.at(s));
                 q.iter()
                     .zip(mid)
                     .zip(radii)
@@ -387,8 +409,8 @@ impl PairDiagram<'_> {
         let (pa, pb) = (self.pa, self.pb);
         let xa = self.place(pa, true, 0.5 * (a.0 + a.1));
         let xb = self.place(pb, false, 0.5 * (b.0 + b.1));
-        let ra = self.reach(pa.robot, &xa.q, pa, a.0, a.1, a.2);
-        let rb = self.reach(pb.robot, &xb.q, pb, b.0, b.1, b.2);
+        let ra = self.reach(true, &xa.q, pa, a.0, a.1, a.2);
+        let rb = self.reach(false, &xb.q, pb, b.0, b.1, b.2);
         let need = self.ctx.margin + ra + rb;
         let split_a = a.2 && a.1 - a.0 > MIN_CELL;
         let split_b = b.2 && b.1 - b.0 > MIN_CELL;
@@ -396,16 +418,16 @@ impl PairDiagram<'_> {
         // distance only where nothing is left to halve (halving is cheaper than GJK, and
         // the covers decide most rectangles once small), and only for the body pairs whose
         // covers come close.
-        let close = self.close_pairs(&xa, &xb, need);
-        if close.is_empty() {
-            return Rect::Free;
-        }
         if !(split_a || split_b) {
-            return if self.apart(&xa, &xb, &close, need) {
-                Rect::Free
-            } else {
-                Rect::Conflict
-            };
+            let mut close = std::mem::take(&mut self.close);
+            close.clear();
+            let free =
+                !self.close_pairs(&xa, &xb, need, Some(&mut close)) || self.apart(&xa, &xb, &close, need);
+            self.close = close;
+            return if free { Rect::Free } else { Rect::Conflict };
+        }
+        if !self.close_pairs(&xa, &xb, need, None) {
+            return Rect::Free;
         }
         if split_a && (!split_b || ra >= rb) {
             Rect::HalveA
@@ -518,6 +540,8 @@ fn pair_boxes(ctx: &Ctx, pa: &RobotPath, pb: &RobotPath) -> (Vec<ConflictBox>, D
         work: DiagramWork::default(),
         found: None,
         placed: HashMap::new(),
+        close: Vec::new(),
+        positions: HashMap::new(),
     };
     // Each piece's swept body spheres (placed at its middle, grown by its reach) and one
     // sphere around them: most pairs of pieces are far apart, and a sphere test says so
@@ -525,6 +549,7 @@ fn pair_boxes(ctx: &Ctx, pa: &RobotPath, pb: &RobotPath) -> (Vec<ConflictBox>, D
     let swept_a: Vec<Swept> = pa.pieces.iter().map(|x| d.swept(pa, true, x)).collect();
     let swept_b: Vec<Swept> = pb.pieces.iter().map(|y| d.swept(pb, false, y)).collect();
     d.placed.clear();
+    d.positions.clear();
     let margin = ctx.margin;
     let mut boxes = Vec::new();
     for (x, sx) in pa.pieces.iter().zip(&swept_a) {
@@ -538,6 +563,7 @@ fn pair_boxes(ctx: &Ctx, pa: &RobotPath, pb: &RobotPath) -> (Vec<ConflictBox>, D
                 boxes.push(f);
             }
             d.placed.clear();
+            d.positions.clear();
         }
     }
     (boxes, d.work)

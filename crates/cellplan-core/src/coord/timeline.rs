@@ -64,6 +64,8 @@ pub struct PairProbe<'a> {
     b: &'a Mover<'a>,
     sa: Scratch,
     sb: Scratch,
+    /// The body pair found closest at the last sample (asked first at the next).
+    closest: Option<(usize, usize)>,
 }
 
 impl<'a> PairProbe<'a> {
@@ -75,6 +77,7 @@ impl<'a> PairProbe<'a> {
             b,
             sa: Scratch::default(),
             sb: Scratch::default(),
+            closest: None,
         }
     }
 
@@ -84,12 +87,13 @@ impl<'a> PairProbe<'a> {
         let qb = self.b.timed.trajectory.position(t);
         self.a.robot.body_poses(&qa, &mut self.sa);
         self.b.robot.body_poses(&qb, &mut self.sb);
-        self.cell.world.group_group_distance(
+        self.cell.world.group_group_distance_from(
             self.a.robot.group,
             &self.sa.bodies,
             self.b.robot.group,
             &self.sb.bodies,
             DISTANCE_CAP,
+            &mut self.closest,
         )
     }
 

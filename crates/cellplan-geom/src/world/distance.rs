@@ -54,6 +54,23 @@ impl CollisionWorld {
         poses_b: &[Pose],
         cap: f64,
     ) -> f64 {
+        self.group_group_distance_from(a, poses_a, b, poses_b, cap, &mut None)
+    }
+
+    /// [`CollisionWorld::group_group_distance`], asking the body pair `closest` (body of `a`,
+    /// body of `b`) first and leaving there the pair found closest (unchanged when none came
+    /// within `cap`). The answer is the same whatever `closest` says; when it names the pair
+    /// that is closest now — as it mostly does for the next sample of a motion — the best so
+    /// far is small from the start and most other pairs are settled by their sphere covers.
+    pub fn group_group_distance_from(
+        &self,
+        a: GroupId,
+        poses_a: &[Pose],
+        b: GroupId,
+        poses_b: &[Pose],
+        cap: f64,
+        closest: &mut Option<(usize, usize)>,
+    ) -> f64 {
         let mut best = sanitize_margin(cap);
         // Each body placed once, with its sphere cover in the world; a body pair whose covers
         // are already at least `best` apart needs no exact query (the covers hold the bodies).
@@ -87,29 +104,41 @@ impl CollisionWorld {
         };
         let pa = placed(a, poses_a);
         let pb = placed(b, poses_b);
-        for (x, cover_x) in &pa {
-            let x = match x {
-                Placement::Empty => continue,
-                Placement::Invalid => return 0.0,
-                Placement::At(x) => x,
-            };
-            for (y, cover_y) in &pb {
-                match y {
-                    Placement::Empty => {}
-                    Placement::Invalid => return 0.0,
-                    Placement::At(y) => {
-                        if !covers_within(cover_x, cover_y, best) {
-                            continue;
-                        }
-                        best = placed_distance(x, y, best);
-                    }
+        let invalid =
+            |p: &[(Placement<'_>, Vec<Sphere>)]| p.iter().any(|(x, _)| matches!(x, Placement::Invalid));
+        if invalid(&pa) || invalid(&pb) {
+            return 0.0;
+        }
+        let mut found = None;
+        let mut ask = |i: usize, j: usize, best: &mut f64| {
+            if let ((Placement::At(x), cover_x), (Placement::At(y), cover_y)) = (&pa[i], &pb[j])
+                && covers_within(cover_x, cover_y, *best)
+            {
+                let d = placed_distance(x, y, *best);
+                if d < *best {
+                    *best = d;
+                    found = Some((i, j));
                 }
+            }
+        };
+        let first = closest.filter(|&(i, j)| i < pa.len() && j < pb.len());
+        if let Some((i, j)) = first {
+            ask(i, j, &mut best);
+        }
+        'pairs: for i in 0..pa.len() {
+            for j in 0..pb.len() {
                 if best <= 0.0 {
-                    return 0.0;
+                    break 'pairs;
+                }
+                if first != Some((i, j)) {
+                    ask(i, j, &mut best);
                 }
             }
         }
-        best
+        if found.is_some() {
+            *closest = found;
+        }
+        best.max(0.0)
     }
 
     /// Smallest distance from any body of `g` to the static scene (0 when touching).

@@ -457,6 +457,19 @@ fn group_group_distance_is_the_smallest_body_distance_at_random_poses() {
                 .map(|i| w.body_group_distance(a, i, &pa, b, &pb, cap))
                 .fold(cap, f64::min);
             assert!((d - by_body).abs() < 1e-9, "{d} against {by_body} (cap {cap})");
+            // Asking any pair first gives the same answer, and leaves the closest pair.
+            for start in [None, Some((0, 0)), Some((2, 1)), Some((1, 0)), Some((7, 7))] {
+                let mut closest = start;
+                let from = w.group_group_distance_from(a, &pa, b, &pb, cap, &mut closest);
+                assert_eq!(from.to_bits(), d.to_bits(), "from {start:?}: {from} against {d}");
+                if d < cap {
+                    let (i, j) = closest.expect("a pair within the cap");
+                    let pair = w.body_body_distance(a, i, &pa, b, j, &pb[j], cap);
+                    assert!((pair - d).abs() < 1e-9, "pair {i}, {j} at {pair}, closest {d}");
+                } else {
+                    assert_eq!(closest, start, "nothing within the cap: the pair stays");
+                }
+            }
             near += usize::from(d > 0.0 && d < cap);
             touching += usize::from(d == 0.0);
         }
