@@ -198,8 +198,9 @@ struct Placed {
     /// World bounding sphere of each body with shapes, and which body it is.
     spheres: Vec<(DVec3, f64)>,
     bodies: Vec<usize>,
-    /// Each body's sphere cover in the world (empty for a body without shapes).
-    covers: Vec<Vec<(DVec3, f64)>>,
+    /// Every body's sphere cover in the world, body `i`'s at the robot's [`Covers::ranges`]
+    /// `[i]` (empty for a body without shapes).
+    covers: Vec<(DVec3, f64)>,
 }
 
 /// Per robot, per body: one sphere (body frame) holding the body's sphere cover.
@@ -221,18 +222,32 @@ fn body_spheres(ctx: &Ctx, robot: &Robot) -> Vec<Option<(DVec3, f64)>> {
         .collect()
 }
 
-/// Per body, its sphere cover (body frame).
-fn covers(ctx: &Ctx, robot: &Robot) -> Vec<Vec<(DVec3, f64)>> {
-    let world = &ctx.cell.world;
-    (0..world.body_count(robot.group))
-        .map(|i| {
-            world
-                .body_cover(robot.group, i)
-                .iter()
-                .map(|s| (s.centre, s.radius))
-                .collect()
-        })
-        .collect()
+/// A robot's sphere covers in their body frames, one list for all bodies.
+struct Covers {
+    spheres: Vec<(DVec3, f64)>,
+    /// Body `i`'s spheres are `spheres[ranges[i]]`.
+    ranges: Vec<std::ops::Range<usize>>,
+}
+
+impl Covers {
+    fn of(ctx: &Ctx, robot: &Robot) -> Covers {
+        let world = &ctx.cell.world;
+        let mut c = Covers {
+            spheres: Vec::new(),
+            ranges: Vec::new(),
+        };
+        for i in 0..world.body_count(robot.group) {
+            let from = c.spheres.len();
+            c.spheres.extend(
+                world
+                    .body_cover(robot.group, i)
+                    .iter()
+                    .map(|s| (s.centre, s.radius)),
+            );
+            c.ranges.push(from..c.spheres.len());
+        }
+        c
+    }
 }
 
 /// What a rectangle of two pieces' positions is (see [`PairDiagram::judge`]).
@@ -250,8 +265,8 @@ struct PairDiagram<'a> {
     sa: Vec<Option<(DVec3, f64)>>,
     sb: Vec<Option<(DVec3, f64)>>,
     /// Per body of each robot, its sphere cover (body frame).
-    ca: Vec<Vec<(DVec3, f64)>>,
-    cb: Vec<Vec<(DVec3, f64)>>,
+    ca: Covers,
+    cb: Covers,
     scratch: Scratch,
     work: DiagramWork,
     /// The bounding box of the conflicts found so far in the current pair of pieces.
@@ -288,10 +303,17 @@ impl PairDiagram<'_> {
             .enumerate()
             .filter_map(|(i, (s, p))| s.map(|(c, r)| ((p.transform_point(c), r), i)))
             .unzip();
-        let covers = if first { &self.ca } else { &self.cb }
+        let own = if first { &self.ca } else { &self.cb };
+        let bodies_at = &self.scratch.bodies;
+        let covers = own
+            .ranges
             .iter()
-            .zip(&self.scratch.bodies)
-            .map(|(cover, p)| cover.iter().map(|&(c, r)| (p.transform_point(c), r)).collect())
+            .zip(bodies_at)
+            .flat_map(|(range, p)| {
+                own.spheres[range.clone()]
+                    .iter()
+                    .map(|&(c, r)| (p.transform_point(c), r))
+            })
             .collect();
         Placed {
             q,
@@ -348,8 +370,9 @@ impl PairDiagram<'_> {
                 let (bi, bj) = (xa.bodies[i], xb.bodies[j]);
                 // A sphere of the first cover farther than `need` from the second body's
                 // sphere is farther from every sphere it holds.
-                let close = xa.covers[bi].iter().any(|&(c, r)| {
-                    within(c, r, cb, rb) && xb.covers[bj].iter().any(|&(d, q)| within(c, r, d, q))
+                let (span_a, span_b) = (self.ca.ranges[bi].clone(), self.cb.ranges[bj].clone());
+                let close = xa.covers[span_a].iter().any(|&(c, r)| {
+                    within(c, r, cb, rb) && xb.covers[span_b.clone()].iter().any(|&(d, q)| within(c, r, d, q))
                 });
                 if close {
                     any = true;
@@ -534,8 +557,8 @@ fn pair_boxes(ctx: &Ctx, pa: &RobotPath, pb: &RobotPath) -> (Vec<ConflictBox>, D
         pb,
         sa: body_spheres(ctx, &cell.robots[pa.robot]),
         sb: body_spheres(ctx, &cell.robots[pb.robot]),
-        ca: covers(ctx, &cell.robots[pa.robot]),
-        cb: covers(ctx, &cell.robots[pb.robot]),
+        ca: Covers::of(ctx, &cell.robots[pa.robot]),
+        cb: Covers::of(ctx, &cell.robots[pb.robot]),
         scratch: Scratch::default(),
         work: DiagramWork::default(),
         found: None,
