@@ -18,6 +18,13 @@ For each cell (release binary, `cargo build --release` first; standard library o
     python3 bench/hard_cells.py --all           # every cell, the long ones too
     python3 bench/hard_cells.py --quick         # three fast cells, a smoke test
     python3 bench/hard_cells.py --cells crowded-6r,facing-4r-roof --json
+    python3 bench/hard_cells.py --seeds 0,1,2,3  # each cell with each seed: how much the plan
+                                                # owes to one seed (a row per cell and seed,
+                                                # then each cell's spread and each seed's mean)
+    python3 bench/hard_cells.py --cells examples/autobody-4r --seeds 0,1,2,3 --no-threads1
+
+A cell is a folder of bench/cells (by name) or any folder holding a cell.toml (by path from the
+repository root, e.g. the examples).
 
 Exit code 0 when every selected cell planned (0 or 3), verified and matched with one thread;
 1 otherwise (the table says which and why).
@@ -137,14 +144,23 @@ def count_robots(cell_toml):
     return sum(1 for l in cell_toml.read_text().splitlines() if l.strip() == "[[robots]]")
 
 
-def bench_cell(name, out_root, timeout, threads1):
-    cell_dir = CELLS_DIR / name
+def cell_dir_of(name):
+    """The folder of a cell given by name (bench/cells) or by path (from the repository root)."""
+    if (CELLS_DIR / name / "cell.toml").exists():
+        return CELLS_DIR / name
+    return (ROOT / name).resolve()
+
+
+def bench_cell(name, out_root, timeout, threads1, seed=0):
+    cell_dir = cell_dir_of(name)
     cell = cell_dir / "cell.toml"
-    row = {"cell": name, "robots": count_robots(cell), "mps": count_mps(cell_dir), "ok": True,
-           "problems": []}
-    out = out_root / name
-    rc, so, se, wall, rss = run([str(BIN), "plan", str(cell), "-o", str(out), "--json", "--no-report"],
-                                timeout)
+    row = {"cell": name, "seed": seed, "robots": count_robots(cell), "mps": count_mps(cell_dir),
+           "ok": True, "problems": []}
+    label = name.strip("/").replace("/", "_") + f"-seed{seed}"
+    out = out_root / label
+    seeded = ["--seed", str(seed)]
+    rc, so, se, wall, rss = run([str(BIN), "plan", str(cell), "-o", str(out), "--json", "--no-report"]
+                                + seeded, timeout)
     row.update(exit=rc, wall_s=wall, peak_rss_mb=rss)
     if rc not in (0, 3):
         row["ok"] = False
@@ -154,7 +170,7 @@ def bench_cell(name, out_root, timeout, threads1):
         # The planner's own verification refused the plan: plan again with --no-verify for the
         # numbers, and let `verify` say what is wrong (the row stays a failure).
         rc, so, se, _, _ = run([str(BIN), "plan", str(cell), "-o", str(out), "--json", "--no-report",
-                                "--no-verify"], timeout)
+                                "--no-verify"] + seeded, timeout)
         if rc not in (0, 3):
             row["problems"].append("plan --no-verify timed out" if rc is None else
                                    f"plan --no-verify exit {rc}: {last_error(se)}")
@@ -190,9 +206,9 @@ def bench_cell(name, out_root, timeout, threads1):
                                    (f" (+{len(found) - 3} more)" if len(found) > 3 else ""))
     if not threads1:
         return row
-    out1 = out_root / (name + "-threads1")
+    out1 = out_root / (label + "-threads1")
     rc1, so1, se1, wall1, rss1 = run([str(BIN), "--threads", "1", "plan", str(cell), "-o", str(out1),
-                                      "--json", "--no-report"], timeout)
+                                      "--json", "--no-report"] + seeded, timeout)
     row.update(threads1_exit=rc1, threads1_wall_s=wall1)
     if rc1 != rc:
         row["ok"] = False
@@ -227,13 +243,16 @@ def counted(r):
 
 
 def table(rows):
-    lines = ["| cell | robots | MPs | exit | unmeasured | cycle s | lower bound s | ratio | Δt s | "
-             "wall s | peak RSS MB | verify | threads 1 | threads-1 wall s | failed leg queries |",
-             "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+    seeds = sorted({r["seed"] for r in rows})
+    many = len(seeds) > 1
+    lines = ["| cell | " + ("seed | " if many else "") + "robots | MPs | exit | unmeasured | cycle s | "
+             "lower bound s | ratio | Δt s | wall s | peak RSS MB | verify | threads 1 | threads-1 wall s | "
+             "failed leg queries |",
+             "|---|" + ("---|" if many else "") + "---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for r in rows:
         same = r.get("threads1_same")
         lines.append(
-            f"| {r['cell']} | {r['robots']} | {r['mps']} | {exit_text(r)} | "
+            f"| {r['cell']} | " + (f"{r['seed']} | " if many else "") + f"{r['robots']} | {r['mps']} | {exit_text(r)} | "
             f"{fmt(r.get('unmeasured'), '{}')} | {fmt(r.get('cycle_time_s'))} | {fmt(r.get('lower_bound_s'))} | "
             f"{fmt(r.get('ratio'), '{:.3f}')} | {fmt(r.get('delta_t_s'))} | {fmt(r['wall_s'], '{:.1f}')} | "
             f"{fmt(r['peak_rss_mb'], '{:.0f}')} | "
@@ -242,8 +261,25 @@ def table(rows):
             f"{fmt(r.get('legs_failed'), '{}')} |")
     ratios = [r["ratio"] for r in rows if counted(r)]
     lines.append("")
-    lines.append(f"mean cycle/lower-bound ratio: {sum(ratios) / len(ratios):.3f} over the {len(ratios)} cells "
-                 "planned and verified" if ratios else "mean cycle/lower-bound ratio: – (no cell planned and verified)")
+    lines.append(f"mean cycle/lower-bound ratio: {sum(ratios) / len(ratios):.3f} over the {len(ratios)} "
+                 f"{'plans' if many else 'cells'} planned and verified" if ratios
+                 else "mean cycle/lower-bound ratio: – (no cell planned and verified)")
+    if many:
+        lines.append("")
+        lines.append("| cell | ratio min | ratio mean | ratio max | cycle s per seed |")
+        lines.append("|---|---|---|---|---|")
+        for cell in dict.fromkeys(r["cell"] for r in rows):
+            mine = [r for r in rows if r["cell"] == cell and counted(r)]
+            if not mine:
+                continue
+            rs = [r["ratio"] for r in mine]
+            lines.append(f"| {cell} | {min(rs):.3f} | {sum(rs) / len(rs):.3f} | {max(rs):.3f} | "
+                         + ", ".join(f"{r['cycle_time_s']:.2f} ({r['seed']})" for r in mine) + " |")
+        lines.append("")
+        for seed in seeds:
+            rs = [r["ratio"] for r in rows if r["seed"] == seed and counted(r)]
+            if rs:
+                lines.append(f"seed {seed}: mean ratio {sum(rs) / len(rs):.3f} over {len(rs)} cells")
     problems = [(r["cell"], p) for r in rows for p in r["problems"]]
     if problems:
         lines.append("")
@@ -261,13 +297,21 @@ def main():
     ap.add_argument("--out", help="keep the plans in this folder (default: a temporary one)")
     ap.add_argument("--timeout", type=float, default=3600, help="seconds per command (default 3600)")
     ap.add_argument("--no-threads1", action="store_true", help="skip the --threads 1 comparison")
+    ap.add_argument("--seeds", default="0",
+                    help="comma-separated seeds (default 0): each cell is planned with each")
     args = ap.parse_args()
+    try:
+        seeds = [int(x) for x in args.seeds.split(",") if x.strip()]
+    except ValueError:
+        sys.exit(f"--seeds takes whole numbers separated by commas, not {args.seeds!r}")
+    if not seeds or any(x < 0 for x in seeds):
+        sys.exit(f"--seeds takes one or more seeds of 0 or more, not {args.seeds!r}")
     if not BIN.exists():
         sys.exit(f"{BIN} is missing: run `cargo build --release` first")
     known = [c for c, _ in CELLS]
     if args.cells:
         names = [c.strip() for c in args.cells.split(",") if c.strip()]
-        unknown = [c for c in names if not (CELLS_DIR / c / "cell.toml").exists()]
+        unknown = [c for c in names if not (cell_dir_of(c) / "cell.toml").exists()]
         if unknown:
             sys.exit(f"unknown cell(s) {', '.join(unknown)}; known: {', '.join(known)}")
     elif args.quick:
@@ -284,16 +328,19 @@ def main():
     rows = []
     t0 = time.monotonic()
     for name in names:
-        print(f"[{time.monotonic() - t0:7.1f} s] {name} ...", file=sys.stderr, flush=True)
-        row = bench_cell(name, out_root, args.timeout, not args.no_threads1)
-        print(f"[{time.monotonic() - t0:7.1f} s] {name}: exit {row['exit']}, "
-              f"{'ok' if row['ok'] else '; '.join(row['problems'])}", file=sys.stderr, flush=True)
-        rows.append(row)
+        for seed in seeds:
+            what = name if len(seeds) == 1 else f"{name} (seed {seed})"
+            print(f"[{time.monotonic() - t0:7.1f} s] {what} ...", file=sys.stderr, flush=True)
+            row = bench_cell(name, out_root, args.timeout, not args.no_threads1, seed)
+            print(f"[{time.monotonic() - t0:7.1f} s] {what}: exit {row['exit']}, "
+                  f"{'ok' if row['ok'] else '; '.join(row['problems'])}", file=sys.stderr, flush=True)
+            rows.append(row)
     if args.json:
         print(json.dumps(rows, indent=2))
     else:
         print(table(rows))
-        print(f"\n{len(rows)} cell(s) in {time.monotonic() - t0:.0f} s; binary {BIN.relative_to(ROOT)}")
+        runs = f"{len(names)} cell(s) × {len(seeds)} seeds" if len(seeds) > 1 else f"{len(rows)} cell(s)"
+        print(f"\n{runs} in {time.monotonic() - t0:.0f} s; binary {BIN.relative_to(ROOT)}")
     if tmp:
         tmp.cleanup()
     sys.exit(0 if all(r["ok"] for r in rows) else 1)
