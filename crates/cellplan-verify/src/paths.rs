@@ -7,6 +7,7 @@ use cellplan_core::plan::Stop;
 use cellplan_geom::BodyContact;
 use cellplan_model::Cell;
 use cellplan_model::robot::{Robot, Scratch};
+use rayon::prelude::*;
 
 /// The leg checks; returns the configurations checked.
 pub(super) fn check(
@@ -15,39 +16,62 @@ pub(super) fn check(
     settings: &VerifySettings,
     out: &mut Vec<Violation>,
 ) -> usize {
+    // Robot by robot, side by side; the violations are reported in robot order.
+    let per_robot: Vec<(Vec<Violation>, usize)> = robots
+        .par_iter()
+        .map(|&(robot, rp)| {
+            let mut found = Vec::new();
+            let checked = check_robot(cell, robot, rp, settings, &mut found);
+            (found, checked)
+        })
+        .collect();
+    let mut checked = 0;
+    for (found, n) in per_robot {
+        out.extend(found);
+        checked += n;
+    }
+    checked
+}
+
+/// [`check`] for one robot: the number of samples checked.
+fn check_robot(
+    cell: &Cell,
+    robot: &Robot,
+    rp: &RobotPlan,
+    settings: &VerifySettings,
+    out: &mut Vec<Violation>,
+) -> usize {
+    if rp.legs.len() != rp.tasks.len() + 1 {
+        out.push(Violation::robot(
+            ViolationKind::Continuity,
+            &rp.name,
+            None,
+            None,
+            format!(
+                "{} legs for {} tasks (want one more)",
+                rp.legs.len(),
+                rp.tasks.len()
+            ),
+        ));
+        return 0;
+    }
     let mut checked = 0;
     let mut scratch = Scratch::default();
-    for (robot, rp) in robots {
-        if rp.legs.len() != rp.tasks.len() + 1 {
-            out.push(Violation::robot(
-                ViolationKind::Continuity,
-                &rp.name,
-                None,
-                None,
-                format!(
-                    "{} legs for {} tasks (want one more)",
-                    rp.legs.len(),
-                    rp.tasks.len()
-                ),
-            ));
-            continue;
-        }
-        let mut at: &[f64] = &rp.home;
-        for (i, leg) in rp.legs.iter().enumerate() {
-            let to: &[f64] = rp.tasks.get(i).map_or(&rp.home, |v| &v.q);
-            check_ends(rp, i, leg, at, to, out);
-            checked += resample(cell, robot, rp, leg, settings, &mut scratch, out);
-            at = to;
-        }
-        if let Some((t, detail)) = follow_legs(robot, rp, settings.limit_tolerance) {
-            out.push(Violation::robot(
-                ViolationKind::OffPath,
-                &rp.name,
-                Some(t),
-                None,
-                detail,
-            ));
-        }
+    let mut at: &[f64] = &rp.home;
+    for (i, leg) in rp.legs.iter().enumerate() {
+        let to: &[f64] = rp.tasks.get(i).map_or(&rp.home, |v| &v.q);
+        check_ends(rp, i, leg, at, to, out);
+        checked += resample(cell, robot, rp, leg, settings, &mut scratch, out);
+        at = to;
+    }
+    if let Some((t, detail)) = follow_legs(robot, rp, settings.limit_tolerance) {
+        out.push(Violation::robot(
+            ViolationKind::OffPath,
+            &rp.name,
+            Some(t),
+            None,
+            detail,
+        ));
     }
     checked
 }

@@ -11,6 +11,7 @@ use cellplan_geom::DVec3;
 use cellplan_model::Cell;
 use cellplan_model::robot::Robot;
 use cellplan_model::tasks::TaskId;
+use rayon::prelude::*;
 
 /// How far a conflict's stated tool position may lie from the track before coordination
 /// (m), beyond how far the track's two samples around it lie apart: the tracks are sampled
@@ -71,9 +72,10 @@ fn settings(cell: &Cell, plan: &Plan, totals: &mut dyn FnMut(String)) {
 /// The lower bound, recomputed on the graphs the settings name, and its ratio.
 fn lower_bound(cell: &Cell, table: &CandidateTable, plan: &Plan, totals: &mut dyn FnMut(String)) {
     let s = &plan.settings;
+    // One graph per robot, built side by side (each on its own; `collect` keeps the order).
     let graphs: Vec<RobotGraph> = cell
         .robots
-        .iter()
+        .par_iter()
         .map(|r| RobotGraph::new(cell, r, table, s.move_model, s.alternatives, s.roomy_m))
         .collect();
     // The tasks the plan does not measure are left out of the bound.

@@ -5,7 +5,11 @@ use super::{VerifySettings, Violation, ViolationKind};
 use cellplan_core::document::RobotPlan;
 use cellplan_model::Cell;
 use cellplan_model::robot::{Robot, Scratch};
+use rayon::prelude::*;
 use std::collections::BTreeMap;
+
+/// Steps of the timeline checked side by side before their contacts are read off.
+const TIME_CHUNK: usize = 1024;
 
 /// The robot–robot check; `times` are the robots' recomputed times.
 pub(super) fn check(
@@ -42,12 +46,10 @@ fn contacts(
     let clearance = cell.planning.clearance;
     let horizon = times.iter().copied().fold(0.0, f64::max);
     let steps = (horizon / time_step).ceil() as usize;
-    let mut scratches: Vec<Scratch> = vec![Scratch::default(); robots.len()];
-    // (pair) → (first time, last time) of the current contact interval.
-    let mut open: BTreeMap<(usize, usize), (f64, f64)> = BTreeMap::new();
-    let mut intervals: Vec<((usize, usize), f64, f64)> = Vec::new();
-    for k in 0..=steps {
-        let t = (k as f64 * time_step).min(horizon);
+    let at = |k: usize| (k as f64 * time_step).min(horizon);
+    // The pairs closer than the clearance at a step, at the robots' poses in `scratches`.
+    let hits_at = |scratches: &mut [Scratch], k: usize| {
+        let t = at(k);
         for (i, (robot, rp)) in robots.iter().enumerate() {
             let q = if rp.trajectory.is_empty() {
                 rp.home.clone()
@@ -56,29 +58,44 @@ fn contacts(
             };
             robot.body_poses(&q, &mut scratches[i]);
         }
+        let mut hit = Vec::new();
         for a in 0..robots.len() {
             for b in a + 1..robots.len() {
-                let hit = cell
-                    .world
-                    .group_vs_group(
-                        robots[a].0.group,
-                        &scratches[a].bodies,
-                        robots[b].0.group,
-                        &scratches[b].bodies,
-                        clearance,
-                    )
-                    .is_some();
-                match (hit, open.get_mut(&(a, b))) {
-                    (true, Some(iv)) => iv.1 = t,
-                    (true, None) => {
-                        open.insert((a, b), (t, t));
-                    }
-                    (false, Some(_)) => {
-                        let (s, e) = open.remove(&(a, b)).unwrap_or((t, t));
-                        intervals.push(((a, b), s, e));
-                    }
-                    (false, None) => {}
+                let near = cell.world.group_vs_group(
+                    robots[a].0.group,
+                    &scratches[a].bodies,
+                    robots[b].0.group,
+                    &scratches[b].bodies,
+                    clearance,
+                );
+                if near.is_some() {
+                    hit.push((a, b));
                 }
+            }
+        }
+        hit
+    };
+    // (pair) → (first time, last time) of the current contact interval.
+    let mut open: BTreeMap<(usize, usize), (f64, f64)> = BTreeMap::new();
+    let mut intervals: Vec<((usize, usize), f64, f64)> = Vec::new();
+    // The steps of a chunk side by side (each thread with its own scratch), then read off in
+    // step order; chunks bound the memory whatever the timeline's length.
+    for first in (0..=steps).step_by(TIME_CHUNK) {
+        let hits: Vec<Vec<(usize, usize)>> = (first..=steps.min(first + TIME_CHUNK - 1))
+            .into_par_iter()
+            .map_init(|| vec![Scratch::default(); robots.len()], |s, k| hits_at(s, k))
+            .collect();
+        for (k, hit) in (first..).zip(&hits) {
+            let t = at(k);
+            // The pairs not hit at this step close their interval at its last hit.
+            let closed: Vec<(usize, usize)> = open.keys().filter(|p| !hit.contains(p)).copied().collect();
+            for p in closed {
+                if let Some((s, e)) = open.remove(&p) {
+                    intervals.push((p, s, e));
+                }
+            }
+            for &p in hit {
+                open.entry(p).and_modify(|iv| iv.1 = t).or_insert((t, t));
             }
         }
     }
