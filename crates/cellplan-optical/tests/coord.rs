@@ -300,6 +300,26 @@ fn coordination_does_not_depend_on_the_thread_count() {
     assert_eq!(run(1), run(2));
 }
 
+/// The verifier checks legs, the robot–robot timeline and the lower bound's graphs in
+/// parallel; its report — every violation, their order, the figures — is the same on one
+/// thread as on two. The uncoordinated plan's robots meet, so the report has robot–robot
+/// violations to order.
+#[test]
+fn the_verifier_says_the_same_on_one_thread_and_on_two() {
+    let f = fixture();
+    let (doc, _) = document(Coordination::None);
+    let run = |threads| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap()
+            .install(|| format!("{:?}", verify(&f.cell, &doc, &VerifySettings::default())))
+    };
+    let one = run(1);
+    assert!(one.contains("RobotRobot"), "{one}");
+    assert_eq!(one, run(2));
+}
+
 #[test]
 fn the_verifier_catches_injected_faults() {
     let f = fixture();
