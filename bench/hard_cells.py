@@ -2,15 +2,16 @@
 """Plans every hard benchmark cell of bench/cells/, verifies each plan, checks that the plan does
 not depend on the number of worker threads, and prints a table.
 
-For each cell (release binary, `cargo build --release` first; standard library only):
+For each cell and seed S (release binary, `cargo build --release` first; standard library
+only):
 
-1. `cellplan plan CELL -o OUT --json --no-report`: exit code (0 every MP measured, 3 some MPs
+1. `cellplan plan CELL -o OUT --json --no-report --seed S`: exit code (0 every MP measured, 3 some MPs
    unmeasured — both fine; anything else is a failure and its last error line is reported),
    wall time and peak RSS (`/usr/bin/time -f '%e %M'`, else the clock and getrusage), cycle
    time, lower bound, ratio, Δt, MPs, robots, unmeasured MPs, and the leg queries that found
    no path (the plan's `stats.legs_failed`);
 2. `cellplan verify OUT/plan.json CELL --json` must exit 0;
-3. `cellplan --threads 1 plan CELL -o OUT1 --json --no-report` must give the same exit code and a
+3. `cellplan --threads 1 plan CELL -o OUT1 --json --no-report --seed S` must give the same exit code and a
    plan.json equal to the first apart from compute times (`compute_s` and wall-time fields are
    removed before comparing).
 

@@ -88,12 +88,13 @@ fn contacts(
         for (k, hit) in (first..).zip(&hits) {
             let t = at(k);
             // The pairs not hit at this step close their interval at its last hit.
-            let closed: Vec<(usize, usize)> = open.keys().filter(|p| !hit.contains(p)).copied().collect();
-            for p in closed {
-                if let Some((s, e)) = open.remove(&p) {
-                    intervals.push((p, s, e));
+            open.retain(|p, &mut (s, e)| {
+                let still = hit.contains(p);
+                if !still {
+                    intervals.push((*p, s, e));
                 }
-            }
+                still
+            });
             for &p in hit {
                 open.entry(p).and_modify(|iv| iv.1 = t).or_insert((t, t));
             }
