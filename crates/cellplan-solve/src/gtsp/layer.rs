@@ -28,6 +28,7 @@ pub(super) fn layer_pass(inst: &Inst, st: &mut State) -> Vec<usize> {
     let mut parent = vec![0usize; total];
     let mut best = (f64::INFINITY, 0usize, 0usize); // (cost, start index, last index)
     let mut best_parent = Vec::new();
+    let mut columns = Vec::new();
     for (si, &s) in layers[0].iter().enumerate() {
         value[si] = inst.s(s);
         for l in 0..m {
@@ -37,16 +38,30 @@ pub(super) fn layer_pass(inst: &Inst, st: &mut State) -> Vec<usize> {
                 continue;
             }
             let (prev, cur) = (layers[l - 1], layers[l]);
-            for (j, &v) in cur.iter().enumerate() {
-                let mut b = (f64::INFINITY, 0);
-                for (i, &u) in prev.iter().enumerate() {
-                    let x = value[offset[l - 1] + i] + inst.w(u, v);
-                    if x < b.0 {
-                        b = (x, i);
+            // Row by row of the cost table (each `u` of the layer before, in order, so every
+            // `v` keeps the first cheapest `u` as before).
+            let (before, here) = value.split_at_mut(offset[l]);
+            let (before, here) = (&before[offset[l - 1]..], &mut here[..cur.len()]);
+            let parents = &mut parent[offset[l]..offset[l] + cur.len()];
+            here.fill(f64::INFINITY);
+            columns.clear();
+            columns.extend(cur.iter().map(|&v| inst.column(v)));
+            for (i, (&u, &vu)) in prev.iter().zip(before.iter()).enumerate() {
+                let row = inst.row(u);
+                for ((h, p), &c) in here.iter_mut().zip(parents.iter_mut()).zip(columns.iter()) {
+                    let x = vu + row[c];
+                    if x < *h {
+                        *h = x;
+                        *p = i;
                     }
                 }
-                value[offset[l] + j] = b.0 + inst.s(v);
-                parent[offset[l] + j] = b.1;
+            }
+            for ((h, p), &v) in here.iter_mut().zip(parents.iter_mut()).zip(cur.iter()) {
+                if *h == f64::INFINITY {
+                    // As before: no cheaper `u` than infinity, the first one's index.
+                    *p = 0;
+                }
+                *h += inst.s(v);
             }
         }
         let last = layers[m - 1];

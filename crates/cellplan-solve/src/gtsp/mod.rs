@@ -120,7 +120,29 @@ pub(crate) struct Inst<'a> {
     neigh: Vec<Vec<usize>>,
     /// Service of the depots, constant.
     fixed: f64,
+    /// Per cluster, the cheapest arcs into and out of it (see [`ClusterBounds`]); `None` when
+    /// every cluster has one node or the table would be too large.
+    bounds: Option<ClusterBounds>,
 }
+
+/// Lower bounds for the scans over a cluster's nodes (a node re-chosen between two others):
+/// for cluster `c` and node `u` (the depot item included), the cheapest arc from `u` into `c`
+/// and out of `c` into `u`, and the cheapest service in `c`. A scan whose bound cannot beat
+/// what it must beat is skipped; the bound is a sum of the same terms in the same order as
+/// every scanned value, each no larger, so (rounding being monotone) no skipped value could
+/// have won and the search takes the same moves.
+pub(crate) struct ClusterBounds {
+    /// `into[c * (n + 1) + u]`: min over `z` in `c` of `w(u, z)`.
+    into: Vec<f64>,
+    /// `out[c * (n + 1) + v]`: min over `z` in `c` of `w(z, v)`.
+    out: Vec<f64>,
+    /// Min over `z` in `c` of `s(z)`.
+    service: Vec<f64>,
+}
+
+/// Largest `into` / `out` table built (entries each; 16 MB apiece): larger instances scan
+/// their clusters whole.
+const BOUNDS_MAX_ENTRIES: usize = 2_000_000;
 
 impl<'a> Inst<'a> {
     fn new(p: &'a Gtsp) -> Self {
@@ -150,9 +172,63 @@ impl<'a> Inst<'a> {
             sym: p.costs.is_symmetric(0.0),
             neigh: Vec::new(),
             fixed,
+            bounds: None,
         };
         inst.neigh = construct::neighbours(&inst, 12);
+        inst.bounds = inst.cluster_bounds();
         inst
+    }
+
+    /// The [`ClusterBounds`] of the instance, when some cluster has several nodes and the
+    /// tables stay within [`BOUNDS_MAX_ENTRIES`].
+    fn cluster_bounds(&self) -> Option<ClusterBounds> {
+        let nn = self.n + 1;
+        let k = self.clusters.len();
+        if self.clusters.iter().all(|c| c.len() < 2) || k.saturating_mul(nn) > BOUNDS_MAX_ENTRIES {
+            return None;
+        }
+        let mut into = vec![f64::INFINITY; k * nn];
+        let mut out = vec![f64::INFINITY; k * nn];
+        let mut service = vec![f64::INFINITY; k];
+        for (c, cluster) in self.clusters.iter().enumerate() {
+            let (into, out) = (&mut into[c * nn..(c + 1) * nn], &mut out[c * nn..(c + 1) * nn]);
+            for &z in cluster {
+                service[c] = service[c].min(self.s(z));
+                for u in 0..nn {
+                    into[u] = into[u].min(self.w(u, z));
+                    out[u] = out[u].min(self.w(z, u));
+                }
+            }
+        }
+        Some(ClusterBounds { into, out, service })
+    }
+
+    /// A lower bound on `w(u, z) + s(z) + w(z, v)` (summed in that order) over the nodes `z`
+    /// of cluster `c`; minus infinity without [`ClusterBounds`].
+    #[inline]
+    pub(crate) fn through_bound(&self, u: usize, c: usize, v: usize) -> f64 {
+        match &self.bounds {
+            Some(b) => {
+                let nn = self.n + 1;
+                b.into[c * nn + u] + b.service[c] + b.out[c * nn + v]
+            }
+            None => f64::NEG_INFINITY,
+        }
+    }
+
+    /// The row of arc costs out of node `u` (the depot item standing for start), to be indexed
+    /// by [`Inst::column`].
+    #[inline]
+    pub(crate) fn row(&self, u: usize) -> &[f64] {
+        let u = if u == self.n { self.start } else { u };
+        &self.data[u * self.n..(u + 1) * self.n]
+    }
+
+    /// The index of node `v` in a [`Inst::row`] (the depot item standing for end):
+    /// `w(u, v) == row(u)[column(v)]`.
+    #[inline]
+    pub(crate) fn column(&self, v: usize) -> usize {
+        if v == self.n { self.end } else { v }
     }
 
     /// Number of items (clusters plus the depot item).
@@ -358,6 +434,124 @@ pub(crate) mod tests {
             assert_optimal(&g, seed);
             assert_optimal(&g.with_depots(Some(n - 1), None).unwrap(), seed);
         }
+    }
+
+    /// The layer pass as first written (for each node of a layer, every node of the layer
+    /// before through `w`), to compare with the row-by-row one.
+    fn layer_pass_plain(inst: &Inst, st: &mut State) -> Vec<usize> {
+        let m = st.t.len();
+        let first = (0..m)
+            .min_by_key(|&i| (inst.clusters[st.t[i]].len(), i))
+            .unwrap_or(0);
+        let first = if inst.depot { st.pos[inst.k] } else { first };
+        let layers: Vec<&[usize]> = (0..m)
+            .map(|i| inst.clusters[st.t[(first + i) % m]].as_slice())
+            .collect();
+        let mut best = (f64::INFINITY, Vec::new());
+        for &s in layers[0] {
+            let mut value = vec![(inst.s(s), vec![s])];
+            for layer in &layers[1..] {
+                value = layer
+                    .iter()
+                    .map(|&v| {
+                        let mut b = (f64::INFINITY, 0);
+                        for (i, (x, path)) in value.iter().enumerate() {
+                            let x = x + inst.w(*path.last().unwrap(), v);
+                            if x < b.0 {
+                                b = (x, i);
+                            }
+                        }
+                        let mut path = value[b.1].1.clone();
+                        path.push(v);
+                        (b.0 + inst.s(v), path)
+                    })
+                    .collect();
+            }
+            for (x, path) in value {
+                let x = x + inst.w(*path.last().unwrap(), s);
+                if x < best.0 {
+                    best = (x, path);
+                }
+            }
+        }
+        if best.0 >= inst.cost(st) - inst.fixed - EPS {
+            return Vec::new();
+        }
+        let mut changed = Vec::new();
+        for (l, &node) in best.1.iter().enumerate().rev() {
+            let item = st.t[(first + l) % m];
+            if st.choice[item] != node {
+                st.choice[item] = node;
+                changed.push(item);
+            }
+        }
+        st.refresh(inst);
+        changed
+    }
+
+    /// Random instances of every shape the sequencer and the benchmarks use: closed or with a
+    /// start depot, symmetric or not, with service times, clusters of 1–6 nodes.
+    fn shaped_instances() -> Vec<Gtsp> {
+        let mut out = Vec::new();
+        for seed in 0..8u64 {
+            let (k, per) = (5 + seed as usize * 3, 1 + seed as usize % 6);
+            let g = random_gtsp(300 + seed, k, per, 1, seed % 2 == 1);
+            let n = g.costs.n();
+            let service = (0..n)
+                .map(|v| ((v * 7 + seed as usize) % 4) as f64 * 0.5)
+                .collect();
+            let g = g.with_service(service).unwrap();
+            out.push(g.clone());
+            out.push(g.with_depots(Some(n - 1), None).unwrap());
+        }
+        out
+    }
+
+    #[test]
+    fn the_row_by_row_layer_pass_chooses_as_the_plain_one() {
+        let mut rng = ChaCha8Rng::seed_from_u64(11);
+        for g in shaped_instances() {
+            let inst = Inst::new(&g);
+            for _ in 0..5 {
+                let mut order: Vec<usize> = (0..inst.items()).collect();
+                for i in (1..order.len()).rev() {
+                    order.swap(i, rng.random_range(0..=i));
+                }
+                let mut st = State::new(&inst, order);
+                for (x, c) in inst.clusters.iter().enumerate() {
+                    st.choice[x] = c[rng.random_range(0..c.len())];
+                }
+                st.refresh(&inst);
+                let mut plain = st.clone();
+                let changed = layer::layer_pass(&inst, &mut st);
+                let expected = layer_pass_plain(&inst, &mut plain);
+                assert_eq!(changed, expected);
+                assert_eq!(st.choice, plain.choice);
+            }
+        }
+    }
+
+    #[test]
+    fn the_cluster_bounds_change_no_move() {
+        let mut pruned_some = false;
+        for g in shaped_instances() {
+            let with = Inst::new(&g);
+            let mut without = Inst::new(&g);
+            pruned_some |= with.bounds.is_some();
+            without.bounds = None;
+            let params = GtspParams {
+                time_limit: Duration::from_secs(3600),
+                seed: 3,
+                max_iterations: Some(60),
+                max_stall: None,
+                method: GtspMethod::Ils,
+            };
+            let far = Instant::now() + params.time_limit;
+            let (a, ia) = ils::run(&with, &params, far);
+            let (b, ib) = ils::run(&without, &params, far);
+            assert_eq!((a.t, a.choice, ia), (b.t, b.choice, ib));
+        }
+        assert!(pruned_some);
     }
 
     #[test]

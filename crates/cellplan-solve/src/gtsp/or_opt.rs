@@ -27,8 +27,17 @@ fn inner(inst: &Inst, st: &State, l: usize, r: usize) -> (f64, f64) {
 }
 
 /// The best move of segment `l..=r` to between `q` and its successor (both orientations, and
-/// the best node for a single cluster), with its cost change; `None` if illegal.
-pub(super) fn best_at(inst: &Inst, st: &State, l: usize, r: usize, q: usize) -> Option<(f64, Move)> {
+/// the best node for a single cluster), with its cost change; `None` if illegal. The caller
+/// takes the move only if its change is below `bar`: a single cluster's nodes are not scanned
+/// when their bound shows none can be (the change returned is then that of the cluster's
+/// current node, no smaller than the scan's and no smaller than `bar` either).
+pub(super) fn best_at(
+    inst: &Inst,
+    st: &State,
+    (l, r): (usize, usize),
+    q: usize,
+    bar: f64,
+) -> Option<(f64, Move)> {
     let m = st.t.len();
     let qn = st.next(q);
     if (l..=r).contains(&q) || (l..=r).contains(&qn) || (inst.depot && l == 0) {
@@ -48,7 +57,10 @@ pub(super) fn best_at(inst: &Inst, st: &State, l: usize, r: usize, q: usize) -> 
         if cluster.len() > 1 {
             let base = best.0 + inst.s(f);
             best.0 = base;
-            for &z in cluster {
+            // No node beats the current one here, or none can give a change below `bar`.
+            let bound = inst.through_bound(u, st.t[l], v);
+            let hopeless = bound >= base || (bound.min(base) - inst.s(f)) - removed >= bar;
+            for &z in if hopeless { &[][..] } else { cluster } {
                 let x = inst.w(u, z) + inst.s(z) + inst.w(z, v);
                 if x < best.0 {
                     best = (x, z);

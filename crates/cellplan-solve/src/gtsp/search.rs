@@ -48,7 +48,9 @@ fn best_move(inst: &Inst, st: &State, x: usize) -> Best {
         let (a, b) = (st.node(st.prev(px)), st.node(st.next(px)));
         let cur = st.choice[x];
         let now = inst.w(a, cur) + inst.s(cur) + inst.w(cur, b);
-        for &z in &inst.clusters[x] {
+        // Every node's change is at least the bound's (see `ClusterBounds`).
+        let hopeless = inst.through_bound(a, x, b) - now >= best.0;
+        for &z in if hopeless { &[][..] } else { &inst.clusters[x][..] } {
             let d = inst.w(a, z) + inst.s(z) + inst.w(z, b) - now;
             if d < best.0 {
                 best = (d, Best::Node(x, z));
@@ -91,7 +93,7 @@ fn best_move(inst: &Inst, st: &State, x: usize) -> Best {
             for &y in &inst.neigh[x] {
                 let py = st.pos[y];
                 for q in [py, st.prev(py)] {
-                    if let Some((d, mv)) = or_opt::best_at(inst, st, l, r, q)
+                    if let Some((d, mv)) = or_opt::best_at(inst, st, (l, r), q, best.0)
                         && d < best.0
                     {
                         best = (d, Best::Or(mv));
