@@ -62,6 +62,9 @@ fn trusted(d: f64) -> f64 {
     d - DISTANCE_SLACK
 }
 
+/// How far past a threshold [`ArmValidity::clear_by`] caps its queries (m).
+const CAP_PAST: f64 = 1e-9;
+
 /// The measured distance whose trusted part is `t` (the inverse of [`trusted`]).
 #[inline]
 fn measured_for(t: f64) -> f64 {
@@ -511,6 +514,38 @@ impl<'a> ArmValidity<'a> {
             let (scene, pairs) = out.split_at(self.moving.len().min(out.len()));
             let min = |parts: &[Clearance]| parts.iter().map(|c| c.distance).fold(self.cap, f64::min);
             (min(scene), min(pairs))
+        })
+    }
+
+    /// Whether `scene_and_self_clearance(q)` is at least `(scene, own)`, both parts — the same
+    /// answer, cheaper: every part is asked only as far as the comparison needs (its query
+    /// capped just past the threshold, so the broad phase skips the exact query of whatever its
+    /// covers show to be farther), and the first part short of its threshold ends the check.
+    pub fn clear_by(&self, q: &[f64], scene: f64, own: f64) -> bool {
+        if !self.arm.chain.within_limits(q, 1e-9) {
+            return f64::NEG_INFINITY >= scene && f64::NEG_INFINITY >= own;
+        }
+        // Both parts are capped at `cap` (and a part's trusted distance at less).
+        if !(scene <= self.cap && own <= self.cap) {
+            return false;
+        }
+        let margin = self.margin.max(0.0);
+        // A query capped at `cap` answers at most `cap`: the caps sit a nanometre past the
+        // measured distance whose trusted part is the threshold, so that a part answering its
+        // cap passes (the trusted part of `measured_for(x)` may round below `x`).
+        let past = |x: f64| measured_for(x) + CAP_PAST;
+        self.posed(q, |bodies, placed| {
+            let cap = past(scene).min(self.cap) + margin;
+            let scene_clear = self
+                .moving
+                .iter()
+                .all(|(i, _)| trusted(self.scene_part(*i, bodies, placed, cap)) - margin >= scene);
+            let cap = past(own).min(self.cap);
+            scene_clear
+                && self
+                    .pairs
+                    .iter()
+                    .all(|(i, j, _, _)| trusted(self.pair_part(*i, *j, bodies, placed, cap)) >= own)
         })
     }
 

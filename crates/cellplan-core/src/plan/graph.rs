@@ -191,12 +191,7 @@ impl RobotGraph {
         for (t, row) in table.table.iter().enumerate() {
             let cands = &row[robot.id.0].candidates;
             let all: Vec<&[f64]> = cands.iter().map(|c| c.q.as_slice()).collect();
-            let roomy = |i: usize| {
-                roomy <= 0.0 || {
-                    let (scene, own) = validity.scene_and_self_clearance(all[i]);
-                    scene >= roomy && own >= self_roomy
-                }
-            };
+            let roomy = |i: usize| roomy <= 0.0 || validity.clear_by(all[i], roomy, self_roomy);
             for c in select(&all, &robot.home, per_task, &limits, &roomy) {
                 alternatives[t].push(q.len());
                 q.push(cands[c].q.clone());

@@ -217,3 +217,45 @@ fn point_speed_weights_bound_the_vertices_speeds_and_are_tight() {
         }
     }
 }
+
+/// `clear_by` answers as `scene_and_self_clearance` compared with the thresholds, for
+/// thresholds on both sides of each configuration's clearances (the value itself, one ulp
+/// either way, a millimetre either way, and far) and for configurations outside the limits, with and without a margin.
+#[test]
+fn clear_by_answers_as_the_clearances_compared() {
+    let setup = ur5();
+    let arm = setup.arm();
+    let mut rng = ChaCha8Rng::seed_from_u64(5);
+    let (mut yes, mut no) = (0, 0);
+    for margin in [0.0, 0.01] {
+        let validity = setup.validity(margin);
+        for k in 0..150 {
+            let mut q = random_q(&arm, &mut rng);
+            if k % 25 == 0 {
+                q[1] = arm.chain.joints[1].upper + 0.1;
+            }
+            let (scene, own) = validity.scene_and_self_clearance(&q);
+            let near = |x: f64, rng: &mut ChaCha8Rng| {
+                if x.is_finite() {
+                    match rng.random_range(0..7) {
+                        // The value itself and its neighbours: the caps must not round a
+                        // part that meets its threshold below it.
+                        0 => x,
+                        1 => x.next_up(),
+                        2 => x.next_down(),
+                        k => x + [-1e-3, 1e-3, -0.2, 0.2][k - 3],
+                    }
+                } else {
+                    rng.random_range(-0.1..0.1)
+                }
+            };
+            for _ in 0..4 {
+                let (s, o) = (near(scene, &mut rng), near(own, &mut rng));
+                let expected = scene >= s && own >= o;
+                assert_eq!(validity.clear_by(&q, s, o), expected, "{q:?} {s} {o}");
+                if expected { yes += 1 } else { no += 1 }
+            }
+        }
+    }
+    assert!(yes > 100 && no > 100, "{yes} {no}");
+}
