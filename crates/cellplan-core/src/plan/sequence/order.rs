@@ -1,6 +1,6 @@
 //! The best order of a robot's tasks: a GTSP over their candidates under the current costs,
 //! optionally sweeping the tasks along a line.
-use super::{NO_PATH, Planned, key};
+use super::{NO_PATH, Planned};
 use crate::plan::graph::RobotGraph;
 use cellplan_model::tasks::TaskId;
 use cellplan_solve::{CostMatrix, Gtsp, GtspParams};
@@ -70,11 +70,6 @@ pub fn best_order_with(
         }
         clusters.push(cl);
     }
-    let cost = |a: usize, b: usize| match planned.get(&key(a, b)) {
-        Some(Ok(leg)) => leg.duration,
-        Some(Err(_)) => NO_PATH,
-        None => graph.costs.get(a, b),
-    };
     let back = |i: usize, j: usize| {
         let (gi, gj) = (group_of[i], group_of[j]);
         if gi != usize::MAX && gj != usize::MAX && gj < gi {
@@ -83,13 +78,34 @@ pub fn best_order_with(
             0.0
         }
     };
-    let costs = CostMatrix::from_fn(local.len(), |i, j| {
-        if i == j {
-            0.0
-        } else {
-            cost(local[i], local[j]) + back(i, j)
+    // The lower bounds, then the planned legs over them (a leg is planned both ways at once):
+    // a walk over the planned legs instead of a lookup per pair.
+    let n = local.len();
+    let mut data = vec![0.0; n * n];
+    for (i, row) in data.chunks_exact_mut(n).enumerate() {
+        for (j, c) in row.iter_mut().enumerate() {
+            if i != j {
+                *c = graph.costs.get(local[i], local[j]) + back(i, j);
+            }
         }
-    });
+    }
+    let mut at = vec![usize::MAX; graph.len()];
+    for (i, &node) in local.iter().enumerate() {
+        at[node] = i;
+    }
+    for (&(a, b), leg) in planned {
+        let (i, j) = (at[a], at[b]);
+        if i == usize::MAX || j == usize::MAX || i == j {
+            continue;
+        }
+        let time = match leg {
+            Ok(leg) => leg.duration,
+            Err(_) => NO_PATH,
+        };
+        data[i * n + j] = time + back(i, j);
+        data[j * n + i] = time + back(j, i);
+    }
+    let costs = CostMatrix::new(n, data).expect("leg times and their bounds are finite and non-negative");
     let service = (0..local.len()).map(|i| graph.dwell[local[i]]).collect();
     let g = Gtsp::new(costs, clusters)
         .and_then(|g| g.with_depots(Some(0), None))
