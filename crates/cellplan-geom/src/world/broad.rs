@@ -4,9 +4,9 @@
 //! A motion planner asks the same group thousands of times per query, so [`BroadPhase`] does
 //! the lookups of shapes, covers and poses once:
 //!
-//! - each body's cover (see [`crate::spheres`]) is kept in one flat array, and
-//!   [`BroadPhase::place`] puts every cover in the world at once (one rotation matrix per
-//!   body);
+//! - each body's cover (see [`crate::spheres`]) is kept in one flat array;
+//!   [`BroadPhase::place`] puts every body's outer sphere in the world at once (one rotation
+//!   matrix per body) and a body's cover the first time a query needs it;
 //! - each object — a static object, or a body of another group parked at a fixed pose — gets
 //!   its world box and, for boxes, cylinders and balls, its inverse pose, so that a sphere's
 //!   distance to it is a few lines of arithmetic (meshes and other shapes fall back to a point
@@ -23,6 +23,7 @@
 use super::{CollisionWorld, GroupId, sanitize_margin};
 use crate::spheres::Sphere;
 use crate::{DMat3, DVec3, Pose};
+use std::cell::Cell;
 use std::ops::Range;
 
 /// Distance from `p` to a box, 0 inside.
@@ -76,10 +77,17 @@ struct Object {
 }
 
 /// The world covers of a group's bodies at one set of poses (see [`BroadPhase::place`]).
+/// The outer spheres are placed at once; a body's cover only when a query first needs it
+/// (most queries settle most bodies by their outer spheres).
 #[derive(Clone, Debug, Default)]
 pub struct PlacedCovers {
-    /// Every body's cover in the world; body `i`'s spheres are `spheres[ranges[i]]`.
-    spheres: Vec<Sphere>,
+    /// Every body's cover in the world; body `i`'s spheres are `spheres[ranges[i]]`, valid
+    /// once `placed[i]` is set.
+    spheres: Vec<Cell<Sphere>>,
+    /// Whether each body's cover is in `spheres` yet.
+    placed: Vec<Cell<bool>>,
+    /// Each body's rotation and translation, to place its cover.
+    frames: Vec<(DMat3, DVec3)>,
     /// Each body's outer sphere in the world (`None`: no shape).
     outer: Vec<Option<Sphere>>,
     /// Whether each body's pose is finite.
@@ -239,25 +247,47 @@ impl BroadPhase {
 
     /// Places every body's cover at `poses` (world frame, one per body of the group) into `out`.
     pub fn place(&self, poses: &[Pose], out: &mut PlacedCovers) {
-        out.spheres.clear();
         out.outer.clear();
         out.finite.clear();
-        for (i, range) in self.ranges.iter().enumerate() {
+        out.frames.clear();
+        out.spheres.resize(
+            self.local.len(),
+            Cell::new(Sphere {
+                centre: DVec3::ZERO,
+                radius: 0.0,
+            }),
+        );
+        out.placed.clear();
+        out.placed.resize(self.ranges.len(), Cell::new(false));
+        for i in 0..self.ranges.len() {
             let pose = poses.get(i).copied().unwrap_or(Pose::IDENTITY);
             let finite = pose.is_finite();
             out.finite.push(finite);
             let rot = DMat3::from_quat(pose.rotation);
             let t = pose.translation;
-            out.spheres
-                .extend(self.local[range.clone()].iter().map(|s| Sphere {
-                    centre: rot * s.centre + t,
-                    radius: s.radius,
-                }));
+            out.frames.push((rot, t));
             out.outer.push(self.outer[i].map(|s| Sphere {
                 centre: rot * s.centre + t,
                 radius: s.radius,
             }));
         }
+    }
+
+    /// Body `i`'s cover in the world, placed now if no query has needed it yet.
+    fn cover<'p>(&self, placed: &'p PlacedCovers, i: usize) -> &'p [Cell<Sphere>] {
+        let range = self.ranges[i].clone();
+        let out = &placed.spheres[range.clone()];
+        if !placed.placed[i].get() {
+            let (rot, t) = placed.frames[i];
+            for (o, s) in out.iter().zip(&self.local[range]) {
+                o.set(Sphere {
+                    centre: rot * s.centre + t,
+                    radius: s.radius,
+                });
+            }
+            placed.placed[i].set(true);
+        }
+        out
     }
 
     /// Distance from body `i` (placed in `placed`, at `poses`) to every object, capped at
@@ -276,8 +306,8 @@ impl BroadPhase {
         cap: f64,
     ) -> f64 {
         let mut best = sanitize_margin(cap);
-        let (outer, spheres) = match self.placed_body(i, placed, best) {
-            Ok(body) => body,
+        let outer = match self.placed_body(i, placed, best) {
+            Ok(outer) => outer,
             Err(answer) => return answer,
         };
         for (mins, maxs, run) in &self.runs {
@@ -289,7 +319,7 @@ impl BroadPhase {
                 if point_box_distance(outer.centre, object.mins, object.maxs) - outer.radius >= best {
                     continue;
                 }
-                let (bound, towards) = self.object_bound(world, object, spheres, best);
+                let (bound, towards) = self.object_bound(world, object, self.cover(placed, i), best);
                 if bound >= best {
                     continue;
                 }
@@ -314,30 +344,25 @@ impl BroadPhase {
         best
     }
 
-    /// Body `i`'s outer sphere and cover as placed, or the answer of a distance query capped
-    /// at `best` when there is nothing to measure: `best` for a body without shapes, 0 at a
-    /// non-finite pose (when there is an object).
-    fn placed_body<'p>(
-        &self,
-        i: usize,
-        placed: &'p PlacedCovers,
-        best: f64,
-    ) -> Result<(Sphere, &'p [Sphere]), f64> {
+    /// Body `i`'s outer sphere as placed, or the answer of a distance query capped at `best`
+    /// when there is nothing to measure: `best` for a body without shapes, 0 at a non-finite
+    /// pose (when there is an object).
+    fn placed_body(&self, i: usize, placed: &PlacedCovers, best: f64) -> Result<Sphere, f64> {
         let Some(Some(outer)) = placed.outer.get(i) else {
             return Err(best);
         };
         if !placed.finite[i] {
             return Err(if self.objects.is_empty() { best } else { 0.0 });
         }
-        Ok((*outer, &placed.spheres[self.ranges[i].clone()]))
+        Ok(*outer)
     }
 
     /// A lower bound on the distance from body `i` to every object, capped at `cap` (the cover
     /// only, never an exact query).
     pub fn scene_bound(&self, world: &CollisionWorld, i: usize, placed: &PlacedCovers, cap: f64) -> f64 {
         let mut best = sanitize_margin(cap);
-        let (outer, spheres) = match self.placed_body(i, placed, best) {
-            Ok(body) => body,
+        let outer = match self.placed_body(i, placed, best) {
+            Ok(outer) => outer,
             Err(answer) => return answer,
         };
         for (mins, maxs, run) in &self.runs {
@@ -348,7 +373,7 @@ impl BroadPhase {
                 if point_box_distance(outer.centre, object.mins, object.maxs) - outer.radius >= best {
                     continue;
                 }
-                best = best.min(self.object_bound(world, object, spheres, best).0);
+                best = best.min(self.object_bound(world, object, self.cover(placed, i), best).0);
                 if best <= 0.0 {
                     return 0.0;
                 }
@@ -397,11 +422,7 @@ impl BroadPhase {
         if (oa.centre - ob.centre).length() - oa.radius - ob.radius >= best {
             return (best, DVec3::ZERO);
         }
-        spheres_bound(
-            &placed.spheres[self.ranges[i].clone()],
-            &placed.spheres[self.ranges[j].clone()],
-            best,
-        )
+        spheres_bound(self.cover(placed, i), self.cover(placed, j), best)
     }
 
     /// Lower bound on the distance from `spheres` to `object`, capped at `best`, with the
@@ -411,7 +432,7 @@ impl BroadPhase {
         &self,
         world: &CollisionWorld,
         object: &Object,
-        spheres: &[Sphere],
+        spheres: &[Cell<Sphere>],
         best: f64,
     ) -> (f64, DVec3) {
         let mut b = best;
@@ -423,14 +444,14 @@ impl BroadPhase {
                 centre,
                 half,
             } => {
-                for (k, s) in spheres.iter().enumerate() {
+                for (k, s) in spheres.iter().map(Cell::get).enumerate() {
                     let p = *to_local * (s.centre - *centre);
                     let d = (p.abs() - *half).max(DVec3::ZERO).length() - s.radius;
                     if d < b {
                         (b, arg) = (d, k);
                     }
                 }
-                if let Some(s) = spheres.get(arg) {
+                if let Some(s) = spheres.get(arg).map(Cell::get) {
                     let p = *to_local * (s.centre - *centre);
                     towards = to_local.transpose() * (p.clamp(-*half, *half) - p);
                 }
@@ -441,7 +462,7 @@ impl BroadPhase {
                 radius,
                 half_height,
             } => {
-                for (k, s) in spheres.iter().enumerate() {
+                for (k, s) in spheres.iter().map(Cell::get).enumerate() {
                     let p = *to_local * (s.centre - *centre);
                     let radial = (p.x * p.x + p.z * p.z).sqrt() - radius;
                     let axial = p.y.abs() - half_height;
@@ -450,7 +471,7 @@ impl BroadPhase {
                         (b, arg) = (d, k);
                     }
                 }
-                if let Some(s) = spheres.get(arg) {
+                if let Some(s) = spheres.get(arg).map(Cell::get) {
                     let p = *to_local * (s.centre - *centre);
                     let r = (p.x * p.x + p.z * p.z).sqrt();
                     let shrink = if r > *radius { radius / r } else { 1.0 };
@@ -459,13 +480,13 @@ impl BroadPhase {
                 }
             }
             Kind::Ball { centre, radius } => {
-                for (k, s) in spheres.iter().enumerate() {
+                for (k, s) in spheres.iter().map(Cell::get).enumerate() {
                     let d = (s.centre - *centre).length() - radius - s.radius;
                     if d < b {
                         (b, arg) = (d, k);
                     }
                 }
-                if let Some(s) = spheres.get(arg) {
+                if let Some(s) = spheres.get(arg).map(Cell::get) {
                     towards = *centre - s.centre;
                 }
             }
@@ -475,7 +496,7 @@ impl BroadPhase {
                     return (best, DVec3::ZERO);
                 };
                 let solid = shape.as_trimesh().is_none();
-                for s in spheres {
+                for s in spheres.iter().map(Cell::get) {
                     if point_box_distance(s.centre, object.mins, object.maxs) - s.radius >= b {
                         continue;
                     }
@@ -507,11 +528,11 @@ impl BroadPhase {
 /// Lower bound on the distance between two sphere sets, capped at `best`, with the direction
 /// from the sphere of `a` towards the sphere of `b` that give it (zero when no pair does).
 #[inline]
-fn spheres_bound(a: &[Sphere], b: &[Sphere], best: f64) -> (f64, DVec3) {
+fn spheres_bound<B: SphereRead>(a: &[Cell<Sphere>], b: &[B], best: f64) -> (f64, DVec3) {
     let mut least = best;
     let mut arg = (usize::MAX, usize::MAX);
-    for (kb, sb) in b.iter().enumerate() {
-        for (ka, sa) in a.iter().enumerate() {
+    for (kb, sb) in b.iter().map(SphereRead::read).enumerate() {
+        for (ka, sa) in a.iter().map(Cell::get).enumerate() {
             let d = (sb.centre - sa.centre).length() - sa.radius - sb.radius;
             if d < least {
                 (least, arg) = (d, (ka, kb));
@@ -519,10 +540,29 @@ fn spheres_bound(a: &[Sphere], b: &[Sphere], best: f64) -> (f64, DVec3) {
         }
     }
     let towards = match (a.get(arg.0), b.get(arg.1)) {
-        (Some(sa), Some(sb)) => sb.centre - sa.centre,
+        (Some(sa), Some(sb)) => sb.read().centre - sa.get().centre,
         _ => DVec3::ZERO,
     };
     (least.max(0.0), towards)
+}
+
+/// A sphere as stored: placed lazily (in a [`Cell`]) or fixed.
+trait SphereRead {
+    fn read(&self) -> Sphere;
+}
+
+impl SphereRead for Sphere {
+    #[inline]
+    fn read(&self) -> Sphere {
+        *self
+    }
+}
+
+impl SphereRead for Cell<Sphere> {
+    #[inline]
+    fn read(&self) -> Sphere {
+        self.get()
+    }
 }
 
 #[cfg(test)]

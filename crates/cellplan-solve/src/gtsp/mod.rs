@@ -490,7 +490,8 @@ pub(crate) mod tests {
     }
 
     /// Random instances of every shape the sequencer and the benchmarks use: closed or with a
-    /// start depot, symmetric or not, with service times, clusters of 1–6 nodes.
+    /// start depot, symmetric or not, with service times, clusters of 1–6 nodes, consecutive
+    /// or interleaved.
     fn shaped_instances() -> Vec<Gtsp> {
         let mut out = Vec::new();
         for seed in 0..8u64 {
@@ -502,6 +503,10 @@ pub(crate) mod tests {
                 .collect();
             let g = g.with_service(service).unwrap();
             out.push(g.clone());
+            // The same nodes in interleaved clusters (no cluster of consecutive nodes).
+            let interleaved = (0..k).map(|c| (0..per).map(|x| x * k + c).collect()).collect();
+            let spread = Gtsp::new(g.costs.clone(), interleaved).unwrap();
+            out.push(spread.with_depots(Some(n - 1), None).unwrap());
             out.push(g.with_depots(Some(n - 1), None).unwrap());
         }
         out
