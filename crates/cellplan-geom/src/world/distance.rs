@@ -74,44 +74,49 @@ impl CollisionWorld {
         let mut best = sanitize_margin(cap);
         // Each body placed once, with its sphere cover in the world; a body pair whose covers
         // are already at least `best` apart needs no exact query (the covers hold the bodies).
-        let placed = |g: GroupId, poses: &[Pose]| -> Vec<(Placement<'_>, Vec<Sphere>)> {
+        // With each cover, the sphere around it (placed too): a body pair whose outer spheres
+        // are `best` apart has no cover spheres within `best` either.
+        let placed = |g: GroupId, poses: &[Pose]| -> Vec<(Placement<'_>, Vec<Sphere>, Option<Sphere>)> {
             self.group(g)
                 .bodies
                 .iter()
                 .zip(poses)
                 .map(|(body, pose)| {
                     let p = place(body, pose);
-                    let cover = match p {
-                        Placement::At(_) => body
-                            .convex
-                            .as_ref()
-                            .map(|c| {
-                                c.cover
-                                    .spheres
-                                    .iter()
-                                    .map(|s| Sphere {
-                                        centre: pose.transform_point(s.centre),
-                                        radius: s.radius,
-                                    })
-                                    .collect()
-                            })
-                            .unwrap_or_default(),
-                        _ => Vec::new(),
+                    let (cover, outer) = match (&p, body.convex.as_ref()) {
+                        (Placement::At(_), Some(c)) => (
+                            c.cover
+                                .spheres
+                                .iter()
+                                .map(|s| Sphere {
+                                    centre: pose.transform_point(s.centre),
+                                    radius: s.radius,
+                                })
+                                .collect(),
+                            c.cover.outer.map(|s| Sphere {
+                                centre: pose.transform_point(s.centre),
+                                radius: s.radius,
+                            }),
+                        ),
+                        _ => (Vec::new(), None),
                     };
-                    (p, cover)
+                    (p, cover, outer)
                 })
                 .collect()
         };
         let pa = placed(a, poses_a);
         let pb = placed(b, poses_b);
-        let invalid =
-            |p: &[(Placement<'_>, Vec<Sphere>)]| p.iter().any(|(x, _)| matches!(x, Placement::Invalid));
+        let invalid = |p: &[(Placement<'_>, Vec<Sphere>, Option<Sphere>)]| {
+            p.iter().any(|(x, _, _)| matches!(x, Placement::Invalid))
+        };
         if invalid(&pa) || invalid(&pb) {
             return 0.0;
         }
         let mut found = None;
         let mut ask = |i: usize, j: usize, best: &mut f64| {
-            if let ((Placement::At(x), cover_x), (Placement::At(y), cover_y)) = (&pa[i], &pb[j])
+            if let ((Placement::At(x), cover_x, outer_x), (Placement::At(y), cover_y, outer_y)) =
+                (&pa[i], &pb[j])
+                && !outers_apart(cover_x, *outer_x, cover_y, *outer_y, *best)
                 && covers_within(cover_x, cover_y, *best)
             {
                 let d = placed_distance(x, y, *best);
@@ -360,6 +365,21 @@ impl CollisionWorld {
 /// `min(distance between two placed bodies, best)` (0 when they touch); the AABB test first.
 /// Whether two sphere covers may come closer than `d`: false when every sphere pair is at
 /// least `d` apart (empty covers: true, nothing is known).
+/// Whether the spheres around two non-empty covers show that no sphere of one comes within `d`
+/// of a sphere of the other (so [`covers_within`] would say no); a nanometre of slack for the
+/// rounding of the placed centres. False when either cover is empty or has no outer sphere.
+fn outers_apart(a: &[Sphere], oa: Option<Sphere>, b: &[Sphere], ob: Option<Sphere>, d: f64) -> bool {
+    match (oa, ob) {
+        (Some(oa), Some(ob)) if !a.is_empty() && !b.is_empty() => {
+            (oa.centre - ob.centre).length() - oa.radius - ob.radius >= d + OUTER_SLACK
+        }
+        _ => false,
+    }
+}
+
+/// See [`outers_apart`] (m).
+const OUTER_SLACK: f64 = 1e-9;
+
 fn covers_within(a: &[Sphere], b: &[Sphere], d: f64) -> bool {
     if a.is_empty() || b.is_empty() {
         return true;
