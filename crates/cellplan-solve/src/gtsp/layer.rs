@@ -3,6 +3,20 @@
 //! cluster is fixed first and each of its nodes tried; with depots the depot item is that layer.
 use super::{EPS, Inst, State};
 
+/// The position of the first layer (the depot item, or the smallest cluster) and the clusters
+/// in tour order from it.
+pub(super) fn layers<'a>(inst: &'a Inst, st: &State) -> (usize, Vec<&'a [usize]>) {
+    let m = st.t.len();
+    let first = (0..m)
+        .min_by_key(|&i| (inst.clusters[st.t[i]].len(), i))
+        .unwrap_or(0);
+    let first = if inst.depot { st.pos[inst.k] } else { first };
+    let layers = (0..m)
+        .map(|i| inst.clusters[st.t[(first + i) % m]].as_slice())
+        .collect();
+    (first, layers)
+}
+
 /// Re-choose every cluster's node optimally for the current order. Returns the items whose node
 /// changed (empty when the tour did not improve).
 pub(super) fn layer_pass(inst: &Inst, st: &mut State) -> Vec<usize> {
@@ -10,14 +24,7 @@ pub(super) fn layer_pass(inst: &Inst, st: &mut State) -> Vec<usize> {
     if m == 0 || inst.clusters.iter().all(|c| c.len() == 1) {
         return Vec::new();
     }
-    // The first layer: the depot item, or the smallest cluster.
-    let first = (0..m)
-        .min_by_key(|&i| (inst.clusters[st.t[i]].len(), i))
-        .unwrap_or(0);
-    let first = if inst.depot { st.pos[inst.k] } else { first };
-    let layers: Vec<&[usize]> = (0..m)
-        .map(|i| inst.clusters[st.t[(first + i) % m]].as_slice())
-        .collect();
+    let (first, layers) = layers(inst, st);
     let mut offset = Vec::with_capacity(m + 1);
     offset.push(0);
     for l in &layers {

@@ -440,13 +440,7 @@ pub(crate) mod tests {
     /// before through `w`), to compare with the row-by-row one.
     fn layer_pass_plain(inst: &Inst, st: &mut State) -> Vec<usize> {
         let m = st.t.len();
-        let first = (0..m)
-            .min_by_key(|&i| (inst.clusters[st.t[i]].len(), i))
-            .unwrap_or(0);
-        let first = if inst.depot { st.pos[inst.k] } else { first };
-        let layers: Vec<&[usize]> = (0..m)
-            .map(|i| inst.clusters[st.t[(first + i) % m]].as_slice())
-            .collect();
+        let (first, layers) = layer::layers(inst, st);
         let mut best = (f64::INFINITY, Vec::new());
         for &s in layers[0] {
             let mut value = vec![(inst.s(s), vec![s])];
