@@ -362,9 +362,6 @@ impl CollisionWorld {
     }
 }
 
-/// `min(distance between two placed bodies, best)` (0 when they touch); the AABB test first.
-/// Whether two sphere covers may come closer than `d`: false when every sphere pair is at
-/// least `d` apart (empty covers: true, nothing is known).
 /// Whether the spheres around two non-empty covers show that no sphere of one comes within `d`
 /// of a sphere of the other (so [`covers_within`] would say no); a nanometre of slack for the
 /// rounding of the placed centres. False when either cover is empty or has no outer sphere.
@@ -380,6 +377,8 @@ fn outers_apart(a: &[Sphere], oa: Option<Sphere>, b: &[Sphere], ob: Option<Spher
 /// See [`outers_apart`] (m).
 const OUTER_SLACK: f64 = 1e-9;
 
+/// Whether two sphere covers may come closer than `d`: false when every sphere pair is at
+/// least `d` apart (empty covers: true, nothing is known).
 fn covers_within(a: &[Sphere], b: &[Sphere], d: f64) -> bool {
     if a.is_empty() || b.is_empty() {
         return true;
@@ -390,6 +389,7 @@ fn covers_within(a: &[Sphere], b: &[Sphere], d: f64) -> bool {
     })
 }
 
+/// `min(distance between two placed bodies, best)` (0 when they touch); the AABB test first.
 fn placed_distance(a: &Placed, b: &Placed, best: f64) -> f64 {
     if aabb_distance(&a.aabb, &b.aabb) >= best {
         return best;
