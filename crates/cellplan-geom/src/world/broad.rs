@@ -245,7 +245,8 @@ impl BroadPhase {
         self.objects.len()
     }
 
-    /// Places every body's cover at `poses` (world frame, one per body of the group) into `out`.
+    /// Places the group at `poses` (world frame, one per body of the group) into `out`: every
+    /// body's outer sphere now, its cover when a query first asks for it.
     pub fn place(&self, poses: &[Pose], out: &mut PlacedCovers) {
         out.outer.clear();
         out.finite.clear();

@@ -76,7 +76,7 @@ impl CollisionWorld {
         // are already at least `best` apart needs no exact query (the covers hold the bodies).
         // With each cover, the sphere around it (placed too): a body pair whose outer spheres
         // are `best` apart has no cover spheres within `best` either.
-        let placed = |g: GroupId, poses: &[Pose]| -> Vec<(Placement<'_>, Vec<Sphere>, Option<Sphere>)> {
+        let placed = |g: GroupId, poses: &[Pose]| -> Vec<PlacedBody<'_>> {
             self.group(g)
                 .bodies
                 .iter()
@@ -106,9 +106,7 @@ impl CollisionWorld {
         };
         let pa = placed(a, poses_a);
         let pb = placed(b, poses_b);
-        let invalid = |p: &[(Placement<'_>, Vec<Sphere>, Option<Sphere>)]| {
-            p.iter().any(|(x, _, _)| matches!(x, Placement::Invalid))
-        };
+        let invalid = |p: &[PlacedBody<'_>]| p.iter().any(|(x, _, _)| matches!(x, Placement::Invalid));
         if invalid(&pa) || invalid(&pb) {
             return 0.0;
         }
@@ -116,7 +114,7 @@ impl CollisionWorld {
         let mut ask = |i: usize, j: usize, best: &mut f64| {
             if let ((Placement::At(x), cover_x, outer_x), (Placement::At(y), cover_y, outer_y)) =
                 (&pa[i], &pb[j])
-                && !outers_apart(cover_x, *outer_x, cover_y, *outer_y, *best)
+                && !outers_apart(*outer_x, *outer_y, *best)
                 && covers_within(cover_x, cover_y, *best)
             {
                 let d = placed_distance(x, y, *best);
@@ -362,14 +360,16 @@ impl CollisionWorld {
     }
 }
 
-/// Whether the spheres around two non-empty covers show that no sphere of one comes within `d`
-/// of a sphere of the other (so [`covers_within`] would say no); a nanometre of slack for the
-/// rounding of the placed centres. False when either cover is empty or has no outer sphere.
-fn outers_apart(a: &[Sphere], oa: Option<Sphere>, b: &[Sphere], ob: Option<Sphere>, d: f64) -> bool {
+/// A body placed for a group–group query: its placement, its cover in the world and the
+/// sphere around that cover (`None` exactly when the cover is empty: `Cover::outer`).
+type PlacedBody<'a> = (Placement<'a>, Vec<Sphere>, Option<Sphere>);
+
+/// Whether the spheres around two covers show that no sphere of one comes within `d` of a
+/// sphere of the other (so [`covers_within`] would say no); a nanometre of slack for the
+/// rounding of the placed centres. False when either cover is empty (has no outer sphere).
+fn outers_apart(oa: Option<Sphere>, ob: Option<Sphere>, d: f64) -> bool {
     match (oa, ob) {
-        (Some(oa), Some(ob)) if !a.is_empty() && !b.is_empty() => {
-            (oa.centre - ob.centre).length() - oa.radius - ob.radius >= d + OUTER_SLACK
-        }
+        (Some(oa), Some(ob)) => (oa.centre - ob.centre).length() - oa.radius - ob.radius >= d + OUTER_SLACK,
         _ => false,
     }
 }

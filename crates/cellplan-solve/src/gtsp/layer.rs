@@ -63,11 +63,8 @@ pub(super) fn layer_pass(inst: &Inst, st: &mut State) -> Vec<usize> {
                     }
                 }
             }
-            for ((h, p), &v) in here.iter_mut().zip(parents.iter_mut()).zip(cur.iter()) {
-                if *h == f64::INFINITY {
-                    // As before: no cheaper `u` than infinity, the first one's index.
-                    *p = 0;
-                }
+            // (Costs are finite: every node of `cur` got a parent from `prev`.)
+            for (h, &v) in here.iter_mut().zip(cur.iter()) {
                 *h += inst.s(v);
             }
         }

@@ -220,8 +220,14 @@ impl<'a> Inst<'a> {
     /// by [`Inst::column`].
     #[inline]
     pub(crate) fn row(&self, u: usize) -> &[f64] {
-        let u = if u == self.n { self.start } else { u };
-        &self.data[u * self.n..(u + 1) * self.n]
+        let from = self.row_start(u);
+        &self.data[from..from + self.n]
+    }
+
+    /// Where the row of node `u` starts in the table (the depot item standing for start).
+    #[inline]
+    fn row_start(&self, u: usize) -> usize {
+        (if u == self.n { self.start } else { u }) * self.n
     }
 
     /// The index of node `v` in a [`Inst::row`] (the depot item standing for end):
@@ -240,14 +246,7 @@ impl<'a> Inst<'a> {
     /// Arc cost between two nodes, the depot item `n` standing for start (out) and end (in).
     #[inline]
     pub(crate) fn w(&self, u: usize, v: usize) -> f64 {
-        let n = self.n;
-        let (u, v) = match (u == n, v == n) {
-            (false, false) => (u, v),
-            (true, false) => (self.start, v),
-            (false, true) => (u, self.end),
-            (true, true) => (self.start, self.end),
-        };
-        self.data[u * n + v]
+        self.data[self.row_start(u) + self.column(v)]
     }
 
     /// Service of a node (0 for the depot item, whose service is in `fixed`).

@@ -59,7 +59,7 @@ pub(super) fn best_at(
             best.0 = base;
             // No node beats the current one here, or none can give a change below `bar`.
             let bound = inst.through_bound(u, st.t[l], v);
-            let hopeless = bound >= base || (bound.min(base) - inst.s(f)) - removed >= bar;
+            let hopeless = bound >= base || (bound - inst.s(f)) - removed >= bar;
             for &z in if hopeless { &[][..] } else { cluster } {
                 let x = inst.w(u, z) + inst.s(z) + inst.w(z, v);
                 if x < best.0 {
