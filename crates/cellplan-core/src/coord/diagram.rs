@@ -22,7 +22,33 @@ use cellplan_geom::{DVec3, Pose};
 use cellplan_model::robot::{Robot, Scratch};
 use rayon::prelude::*;
 use std::collections::HashMap;
+use std::hash::{BuildHasherDefault, Hasher};
 use std::rc::Rc;
+
+/// A hasher for the diagram's keys by position (a robot flag and the bits of an `f64`): one
+/// multiply and rotate per word, as rustc's Fx hash; the keys are few and not adversarial.
+#[derive(Default)]
+struct PositionHasher(u64);
+
+impl Hasher for PositionHasher {
+    fn finish(&self) -> u64 {
+        self.0
+    }
+    fn write(&mut self, bytes: &[u8]) {
+        for &b in bytes {
+            self.write_u64(u64::from(b));
+        }
+    }
+    fn write_u8(&mut self, i: u8) {
+        self.write_u64(u64::from(i));
+    }
+    fn write_u64(&mut self, i: u64) {
+        self.0 = (self.0.rotate_left(5) ^ i).wrapping_mul(0x51_7c_c1_b7_27_22_0a_95);
+    }
+}
+
+/// Maps keyed by a robot flag and a position's bits.
+type ByPosition<V> = HashMap<(bool, u64), V, BuildHasherDefault<PositionHasher>>;
 
 /// Smallest rectangle side (s of position) that is still halved.
 pub(crate) const MIN_CELL: f64 = 0.02;
@@ -272,11 +298,13 @@ struct PairDiagram<'a> {
     /// The bounding box of the conflicts found so far in the current pair of pieces.
     found: Option<ConflictBox>,
     /// Placements in the current pair of pieces, by robot (first or not) and position.
-    placed: HashMap<(bool, u64), Rc<Placed>>,
+    placed: ByPosition<Rc<Placed>>,
     /// Room for the close body pairs of a smallest rectangle.
     close: Vec<(usize, usize)>,
     /// Configurations at positions in the current pair of pieces, as `placed` keys them.
-    positions: HashMap<(bool, u64), Vec<f64>>,
+    positions: ByPosition<Vec<f64>>,
+    /// Placements no longer in `placed`, their buffers reused by the next ones.
+    pool: Vec<Placed>,
 }
 
 impl PairDiagram<'_> {
@@ -294,34 +322,45 @@ impl PairDiagram<'_> {
 
     fn place_new(&mut self, path: &RobotPath, first: bool, s: f64) -> Placed {
         let robot = &self.ctx.cell.robots[path.robot];
-        let q = path.at(s);
-        robot.body_poses(&q, &mut self.scratch);
-        let local = if first { &self.sa } else { &self.sb };
-        let (spheres, bodies) = local
-            .iter()
-            .zip(&self.scratch.bodies)
-            .enumerate()
-            .filter_map(|(i, (s, p))| s.map(|(c, r)| ((p.transform_point(c), r), i)))
-            .unzip();
-        let own = if first { &self.ca } else { &self.cb };
+        let mut out = self.pool.pop().unwrap_or_else(|| Placed {
+            q: Vec::new(),
+            poses: Vec::new(),
+            spheres: Vec::new(),
+            bodies: Vec::new(),
+            covers: Vec::new(),
+        });
+        out.q = path.at(s);
+        robot.body_poses(&out.q, &mut self.scratch);
         let bodies_at = &self.scratch.bodies;
-        let covers = own
-            .ranges
-            .iter()
-            .zip(bodies_at)
-            .flat_map(|(range, p)| {
+        let local = if first { &self.sa } else { &self.sb };
+        out.spheres.clear();
+        out.bodies.clear();
+        for (i, (s, p)) in local.iter().zip(bodies_at).enumerate() {
+            if let Some((c, r)) = s {
+                out.spheres.push((p.transform_point(*c), *r));
+                out.bodies.push(i);
+            }
+        }
+        let own = if first { &self.ca } else { &self.cb };
+        out.covers.clear();
+        for (range, p) in own.ranges.iter().zip(bodies_at) {
+            out.covers.extend(
                 own.spheres[range.clone()]
                     .iter()
-                    .map(|&(c, r)| (p.transform_point(c), r))
-            })
-            .collect();
-        Placed {
-            q,
-            poses: self.scratch.bodies.clone(),
-            spheres,
-            bodies,
-            covers,
+                    .map(|&(c, r)| (p.transform_point(c), r)),
+            );
         }
+        out.poses.clear();
+        out.poses.extend_from_slice(bodies_at);
+        out
+    }
+
+    /// Forgets the placements and positions of the current pair of pieces (their buffers are
+    /// kept for the next).
+    fn forget(&mut self) {
+        self.pool
+            .extend(self.placed.drain().filter_map(|(_, p)| Rc::try_unwrap(p).ok()));
+        self.positions.clear();
     }
 
     /// The swept spheres of one piece of `path` (see [`Swept`]).
@@ -562,17 +601,17 @@ fn pair_boxes(ctx: &Ctx, pa: &RobotPath, pb: &RobotPath) -> (Vec<ConflictBox>, D
         scratch: Scratch::default(),
         work: DiagramWork::default(),
         found: None,
-        placed: HashMap::new(),
+        placed: ByPosition::default(),
         close: Vec::new(),
-        positions: HashMap::new(),
+        positions: ByPosition::default(),
+        pool: Vec::new(),
     };
     // Each piece's swept body spheres (placed at its middle, grown by its reach) and one
     // sphere around them: most pairs of pieces are far apart, and a sphere test says so
     // without placing the robots again.
     let swept_a: Vec<Swept> = pa.pieces.iter().map(|x| d.swept(pa, true, x)).collect();
     let swept_b: Vec<Swept> = pb.pieces.iter().map(|y| d.swept(pb, false, y)).collect();
-    d.placed.clear();
-    d.positions.clear();
+    d.forget();
     let margin = ctx.margin;
     let mut boxes = Vec::new();
     for (x, sx) in pa.pieces.iter().zip(&swept_a) {
@@ -585,8 +624,7 @@ fn pair_boxes(ctx: &Ctx, pa: &RobotPath, pb: &RobotPath) -> (Vec<ConflictBox>, D
                 d.open_ends(&mut f, x, y);
                 boxes.push(f);
             }
-            d.placed.clear();
-            d.positions.clear();
+            d.forget();
         }
     }
     (boxes, d.work)
