@@ -218,6 +218,7 @@ pub(crate) struct DiagramWork {
 }
 
 /// One robot placed at a position: its configuration and body bounding spheres.
+#[derive(Default)]
 struct Placed {
     q: Vec<f64>,
     poses: Vec<Pose>,
@@ -322,13 +323,7 @@ impl PairDiagram<'_> {
 
     fn place_new(&mut self, path: &RobotPath, first: bool, s: f64) -> Placed {
         let robot = &self.ctx.cell.robots[path.robot];
-        let mut out = self.pool.pop().unwrap_or_else(|| Placed {
-            q: Vec::new(),
-            poses: Vec::new(),
-            spheres: Vec::new(),
-            bodies: Vec::new(),
-            covers: Vec::new(),
-        });
+        let mut out = self.pool.pop().unwrap_or_default();
         out.q = path.at(s);
         robot.body_poses(&out.q, &mut self.scratch);
         let bodies_at = &self.scratch.bodies;
