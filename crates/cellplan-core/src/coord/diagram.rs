@@ -304,7 +304,8 @@ struct PairDiagram<'a> {
     close: Vec<(usize, usize)>,
     /// Configurations at positions in the current pair of pieces, as `placed` keys them.
     positions: ByPosition<Vec<f64>>,
-    /// Placements no longer in `placed`, their buffers reused by the next ones.
+    /// Placements no longer in `placed`, their buffers reused by the next ones (all but the
+    /// configuration's, which the trajectory hands over new).
     pool: Vec<Placed>,
 }
 
