@@ -173,8 +173,10 @@ pub fn reach(
         for q in &solutions {
             // The pose the joints reach, which the verifier checks: a numeric IK solution
             // misses the asked pose by its tolerance, and a pose on the edge of what the
-            // process accepts may fall outside.
-            let reached = robot.tcp_pose(q);
+            // process accepts may fall outside. (The links posed here serve the
+            // configuration's checks below too.)
+            robot.link_poses(q, &mut scratch);
+            let reached = robot.tcp_from_links(&scratch);
             let verdict = match verdicts.iter().find(|(p, _)| same_geometry(p, q)) {
                 Some((_, v)) => *v,
                 None => {
@@ -224,7 +226,8 @@ fn check_reached(
 }
 
 /// The process's checks of one configuration (the cheap ones first), then collision with the
-/// scene, the robot itself and the parked robots, by the planner's own test.
+/// scene, the robot itself and the parked robots, by the planner's own test. `scratch.links`
+/// holds the links posed at `q` ([`Robot::link_poses`]).
 #[allow(clippy::too_many_arguments)]
 fn check_configuration(
     cell: &Cell,
@@ -236,11 +239,12 @@ fn check_configuration(
     validity: &crate::motion::RobotValidity,
     scratch: &mut Scratch,
 ) -> Result<(), Rejection> {
-    robot.body_poses(q, scratch);
+    robot.bodies_from_links(scratch);
     process
         .arm_check(&cell.world, robot, &scratch.bodies, task, tcp)
         .map_err(Rejection::Reached)?;
-    if !validity.is_valid(q) {
+    // The bodies were posed at `q` just above, as the checker poses them.
+    if !validity.is_valid_posed(q, &scratch.bodies) {
         return Err(Rejection::Collision);
     }
     Ok(())

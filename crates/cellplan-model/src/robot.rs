@@ -119,9 +119,28 @@ impl Robot {
 
     /// World poses of the robot's collision bodies at `q` into `scratch.bodies`.
     pub fn body_poses(&self, q: &[f64], scratch: &mut Scratch) {
+        self.link_poses(q, scratch);
+        self.bodies_from_links(scratch);
+    }
+
+    /// The chain's link poses at `q` (in the chain's root frame) into `scratch.links`.
+    pub fn link_poses(&self, q: &[f64], scratch: &mut Scratch) {
         let chain = &self.model.chain;
         scratch.links.resize(chain.links.len(), Pose::IDENTITY);
         chain.fk_all(q, &mut scratch.links);
+    }
+
+    /// The TCP's world pose from the link poses in `scratch.links` ([`Robot::link_poses`]):
+    /// [`Robot::tcp_pose`] at the same `q`, bit for bit, without its forward kinematics.
+    pub fn tcp_from_links(&self, scratch: &Scratch) -> Pose {
+        let tip = scratch.links.last().copied().unwrap_or(Pose::IDENTITY);
+        self.base * tip * self.tool.tcp
+    }
+
+    /// `scratch.bodies` from the link poses in `scratch.links` ([`Robot::link_poses`]): what
+    /// [`Robot::body_poses`] gives at the same `q`.
+    pub fn bodies_from_links(&self, scratch: &mut Scratch) {
+        let chain = &self.model.chain;
         let tip = chain.links.len() - 1;
         scratch.bodies.clear();
         for b in &self.bodies {

@@ -469,6 +469,29 @@ impl<'a> ArmValidity<'a> {
         if !self.arm.chain.within_limits(q, 1e-9) {
             return false;
         }
+        self.posed(q, |bodies, placed| self.valid_posed(bodies, placed))
+    }
+
+    /// [`Self::is_valid`] for a caller that has posed the arm at `q` already: `bodies` are its
+    /// body poses there, as [`Arm::body_poses`] gives them (the same answer, without posing
+    /// the arm again; with poses of another length, `q` is posed here).
+    pub fn is_valid_posed(&self, q: &[f64], bodies: &[Pose]) -> bool {
+        if !self.arm.chain.within_limits(q, 1e-9) {
+            return false;
+        }
+        if bodies.len() != self.arm.body_links.len() {
+            return self.is_valid(q);
+        }
+        COVERS.with_borrow_mut(|placed| {
+            if self.broad_phase {
+                self.broad.place(bodies, placed);
+            }
+            self.valid_posed(bodies, placed)
+        })
+    }
+
+    /// The parts of [`Self::is_valid`] at body poses `bodies` (covers placed in `placed`).
+    fn valid_posed(&self, bodies: &[Pose], placed: &PlacedCovers) -> bool {
         // Strictly farther than the margin, as the clearance (> 0) requires.
         let need = measured_for(self.margin.max(0.0));
         let apart = measured_for(0.0);
@@ -484,21 +507,19 @@ impl<'a> ArmValidity<'a> {
                 true
             }
         };
-        self.posed(q, |bodies, placed| {
-            // The part that failed last is asked first: samples near each other usually fail
-            // on the same part. Only the work depends on it, never the answer.
-            let first = self.last_failed.get();
-            if !clear(first, bodies, placed) {
-                return false;
+        // The part that failed last is asked first: samples near each other usually fail on
+        // the same part. Only the work depends on it, never the answer.
+        let first = self.last_failed.get();
+        if !clear(first, bodies, placed) {
+            return false;
+        }
+        match (0..m + self.pairs.len()).find(|&k| k != first && !clear(k, bodies, placed)) {
+            Some(k) => {
+                self.last_failed.set(k);
+                false
             }
-            match (0..m + self.pairs.len()).find(|&k| k != first && !clear(k, bodies, placed)) {
-                Some(k) => {
-                    self.last_failed.set(k);
-                    false
-                }
-                None => true,
-            }
-        })
+            None => true,
+        }
     }
 
     /// The clearance of `q` from the scene (minus the margin) and the smallest distance between

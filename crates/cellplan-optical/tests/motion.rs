@@ -117,6 +117,46 @@ fn radii_bound_every_hull_vertex_displacement() {
     }
 }
 
+/// The robot's body poses are the motion core's, bit for bit, and its TCP from the posed links
+/// is `tcp_pose`'s (the candidates pose a configuration once, for its TCP, its process checks
+/// and the checker), and the checker answers the same on the poses it is given as on its own —
+/// at random configurations, valid and not, and outside the limits.
+#[test]
+fn the_checker_answers_the_same_on_poses_it_is_given() {
+    let f = fixture();
+    let cell = &f.cell;
+    let mut rng = ChaCha8Rng::seed_from_u64(12);
+    let mut scratch = Scratch::default();
+    let (mut links, mut poses) = (Vec::new(), Vec::new());
+    for robot in &cell.robots {
+        let v = robot_validity(cell, robot, margin(cell));
+        let arm = robot.arm(&cell.world);
+        let (mut valid, mut invalid) = (0, 0);
+        for _ in 0..300 {
+            let q = random_q(robot, &mut rng);
+            robot.body_poses(&q, &mut scratch);
+            arm.body_poses(&q, &mut links, &mut poses);
+            assert_eq!(scratch.bodies, poses);
+            assert_eq!(robot.tcp_from_links(&scratch), robot.tcp_pose(&q));
+            let own = v.is_valid(&q);
+            assert_eq!(v.is_valid_posed(&q, &scratch.bodies), own);
+            valid += usize::from(own);
+            invalid += usize::from(!own);
+        }
+        assert!(
+            valid > 10 && invalid > 10,
+            "{}: {valid} valid, {invalid} not",
+            robot.name
+        );
+        let mut out = robot.home.clone();
+        out[0] = robot.model.chain.joints[0].upper + 0.1;
+        robot.body_poses(&out, &mut scratch);
+        assert!(!v.is_valid_posed(&out, &scratch.bodies));
+        // Poses of another length: the checker poses the arm itself.
+        assert_eq!(v.is_valid_posed(&robot.home, &[]), v.is_valid(&robot.home));
+    }
+}
+
 #[test]
 fn clearance_agrees_with_contact_checks() {
     let f = fixture();
