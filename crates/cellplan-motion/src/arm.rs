@@ -433,12 +433,18 @@ impl<'a> ArmValidity<'a> {
     fn posed<T>(&self, q: &[f64], f: impl FnOnce(&[Pose], &PlacedCovers) -> T) -> T {
         LINKS.with_borrow_mut(|(links, bodies)| {
             self.arm.body_poses(q, links, bodies);
-            COVERS.with_borrow_mut(|placed| {
-                if self.broad_phase {
-                    self.broad.place(bodies, placed);
-                }
-                f(bodies, placed)
-            })
+            self.covered(bodies, f)
+        })
+    }
+
+    /// Runs `f` with the body poses `bodies` and, with the broad phase on, the arm's covers
+    /// placed there, in this thread's scratch.
+    fn covered<T>(&self, bodies: &[Pose], f: impl FnOnce(&[Pose], &PlacedCovers) -> T) -> T {
+        COVERS.with_borrow_mut(|placed| {
+            if self.broad_phase {
+                self.broad.place(bodies, placed);
+            }
+            f(bodies, placed)
         })
     }
 
@@ -482,12 +488,7 @@ impl<'a> ArmValidity<'a> {
         if bodies.len() != self.arm.body_links.len() {
             return self.is_valid(q);
         }
-        COVERS.with_borrow_mut(|placed| {
-            if self.broad_phase {
-                self.broad.place(bodies, placed);
-            }
-            self.valid_posed(bodies, placed)
-        })
+        self.covered(bodies, |bodies, placed| self.valid_posed(bodies, placed))
     }
 
     /// The parts of [`Self::is_valid`] at body poses `bodies` (covers placed in `placed`).
