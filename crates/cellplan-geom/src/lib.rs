@@ -18,6 +18,7 @@ mod hull;
 pub mod mesh;
 pub mod pieces;
 pub mod read;
+pub mod revolved;
 pub mod shape;
 pub mod spheres;
 pub mod world;
@@ -30,4 +31,5 @@ pub use shape::ShapeSpec;
 pub use spheres::Sphere;
 pub use world::{
     BodyContact, BroadPhase, CollisionWorld, GroupBody, GroupId, PlacedCovers, RayHit, StaticId,
+    convex_distance,
 };

@@ -276,6 +276,36 @@ impl CollisionWorld {
             .map_or(&[], |c| c.cover.spheres.as_slice())
     }
 
+    /// The points whose convex hull is body `i`'s convex shape, in the body frame: a convex
+    /// polyhedron's vertices, a box's corners; `None` for other shapes and bodies without one.
+    pub fn body_points(&self, g: GroupId, i: usize) -> Option<Vec<DVec3>> {
+        let c = self.group(g).bodies.get(i)?.convex.as_ref()?;
+        let points: Vec<DVec3> = if let Some(p) = c.shape.as_convex_polyhedron() {
+            p.points().to_vec()
+        } else if let Some(b) = c.shape.as_cuboid() {
+            let h = b.half_extents;
+            (0..8)
+                .map(|k| {
+                    DVec3::new(
+                        if k & 1 == 0 { -h.x } else { h.x },
+                        if k & 2 == 0 { -h.y } else { h.y },
+                        if k & 4 == 0 { -h.z } else { h.z },
+                    )
+                })
+                .collect()
+        } else {
+            return None;
+        };
+        Some(points.into_iter().map(|p| c.local.transform_point(p)).collect())
+    }
+
+    /// Body `i`'s convex shape as a support map, with its pose in the body frame; `None` for
+    /// a body without shapes.
+    pub fn body_support(&self, g: GroupId, i: usize) -> Option<(&dyn SupportMap, Pose)> {
+        let c = self.group(g).bodies.get(i)?.convex.as_ref()?;
+        Some((c.support(), c.local))
+    }
+
     /// The convex shape that stands for body `i` of group `g`, as a mesh in the body frame
     /// (for drawing and checks); `None` for a body without shapes.
     pub fn body_hull(&self, g: GroupId, i: usize) -> Option<Mesh> {
@@ -510,6 +540,7 @@ mod narrow;
 mod rays;
 
 pub use broad::{BroadPhase, PlacedCovers};
+pub use distance::convex_distance;
 
 use narrow::{convex_within, static_within};
 

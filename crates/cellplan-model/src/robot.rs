@@ -72,6 +72,9 @@ pub struct Robot {
     pub body_shapes: Vec<(ShapeSpec, Pose)>,
     /// Body pairs checked for self-collision (the rest are adjacent, never or always in contact).
     pub self_pairs: Vec<(usize, usize)>,
+    /// The tables of the close self pairs ([`cellplan_motion::arm::PairTables::build`]), shared
+    /// by the robots of one geometry.
+    pub pair_tables: Arc<cellplan_motion::arm::PairTables>,
     /// Upper bound on the distance from the base origin to the TCP (m): the sum of the
     /// chain's link offsets and the TCP offset.
     pub reach: f64,
@@ -180,6 +183,7 @@ impl Robot {
             group: self.group,
             body_links: &self.body_links,
             self_pairs: &self.self_pairs,
+            pair_tables: Some(&self.pair_tables),
         }
     }
 

@@ -45,8 +45,10 @@ use std::ops::Range;
 mod apart;
 #[cfg(test)]
 mod tests;
+mod turned;
 
 pub use apart::{APART_BUDGET, apart_everywhere, pairs_that_may_touch};
+pub use turned::{CLOSE, PROBES, PairTable, PairTables, pair_table};
 
 /// Clearances are capped at this (m) by default: larger values only lengthen the steps of a
 /// segment check a little, and the cap lets the distance queries skip everything further.
@@ -86,6 +88,9 @@ pub struct Arm<'a> {
     pub body_links: &'a [usize],
     /// Body pairs `(i, j)` checked for self-collision.
     pub self_pairs: &'a [(usize, usize)],
+    /// Tables bounding the close self pairs over one joint, shared by the arm's checkers
+    /// ([`PairTables::build`]); `None`: none are used.
+    pub pair_tables: Option<&'a PairTables>,
 }
 
 impl std::fmt::Debug for Arm<'_> {
@@ -458,11 +463,28 @@ impl<'a> ArmValidity<'a> {
         }
     }
 
-    /// Distance between bodies `i` and `j`, capped at `cap` (as [`Self::scene_part`]).
-    fn pair_part(&self, i: usize, j: usize, bodies: &[Pose], placed: &PlacedCovers, cap: f64) -> f64 {
+    /// Distance between bodies `i` and `j` at `q` (posed in `bodies`), capped at `cap` (as
+    /// [`Self::scene_part`]); with the broad phase, the pair's table over one joint
+    /// ([`PairTables`]) comes after the covers and before the exact query.
+    fn pair_part(
+        &self,
+        i: usize,
+        j: usize,
+        q: &[f64],
+        bodies: &[Pose],
+        placed: &PlacedCovers,
+        cap: f64,
+    ) -> f64 {
         if self.broad_phase {
+            let table = || {
+                self.arm
+                    .pair_tables
+                    .and_then(|t| t.get(i, j))
+                    .and_then(|t| Some(t.least_within(*q.get(t.joint())?, 0.0)))
+                    .unwrap_or(0.0)
+            };
             self.broad
-                .pair_distance(self.arm.world, i, j, bodies, placed, cap)
+                .pair_distance_or(self.arm.world, i, j, bodies, placed, cap, table)
         } else {
             self.arm.world.pair_distance(self.arm.group, i, j, bodies, cap)
         }
@@ -475,7 +497,7 @@ impl<'a> ArmValidity<'a> {
         if !self.arm.chain.within_limits(q, 1e-9) {
             return false;
         }
-        self.posed(q, |bodies, placed| self.valid_posed(bodies, placed))
+        self.posed(q, |bodies, placed| self.valid_posed(q, bodies, placed))
     }
 
     /// [`Self::is_valid`] for a caller that has posed the arm at `q` already: `bodies` are its
@@ -488,11 +510,12 @@ impl<'a> ArmValidity<'a> {
         if bodies.len() != self.arm.body_links.len() {
             return self.is_valid(q);
         }
-        self.covered(bodies, |bodies, placed| self.valid_posed(bodies, placed))
+        self.covered(bodies, |bodies, placed| self.valid_posed(q, bodies, placed))
     }
 
-    /// The parts of [`Self::is_valid`] at body poses `bodies` (covers placed in `placed`).
-    fn valid_posed(&self, bodies: &[Pose], placed: &PlacedCovers) -> bool {
+    /// The parts of [`Self::is_valid`] at `q`, posed at body poses `bodies` (covers placed in
+    /// `placed`).
+    fn valid_posed(&self, q: &[f64], bodies: &[Pose], placed: &PlacedCovers) -> bool {
         // Strictly farther than the margin, as the clearance (> 0) requires.
         let need = measured_for(self.margin.max(0.0));
         let apart = measured_for(0.0);
@@ -503,7 +526,7 @@ impl<'a> ArmValidity<'a> {
             if let Some((i, _)) = self.moving.get(k) {
                 self.scene_part(*i, bodies, placed, need + tiny) > need
             } else if let Some(&(i, j, _, _)) = self.pairs.get(k - m) {
-                self.pair_part(i, j, bodies, placed, apart + tiny) > apart
+                self.pair_part(i, j, q, bodies, placed, apart + tiny) > apart
             } else {
                 true
             }
@@ -567,7 +590,7 @@ impl<'a> ArmValidity<'a> {
                 && self
                     .pairs
                     .iter()
-                    .all(|(i, j, _, _)| trusted(self.pair_part(*i, *j, bodies, placed, cap)) >= own)
+                    .all(|(i, j, _, _)| trusted(self.pair_part(*i, *j, q, bodies, placed, cap)) >= own)
         })
     }
 
@@ -637,7 +660,7 @@ impl StateValidity for ArmValidity<'_> {
                 });
             }
             for (i, j, joints, _) in &self.pairs {
-                let d = self.pair_part(*i, *j, bodies, placed, self.cap);
+                let d = self.pair_part(*i, *j, q, bodies, placed, self.cap);
                 out.push(Clearance {
                     distance: trusted(d),
                     joints: joints.clone(),
@@ -668,9 +691,17 @@ impl StateValidity for ArmValidity<'_> {
                 step = narrow_step(step, part, b, floor)?;
             }
             for (i, j, joints, radii) in &self.pairs {
+                // A pair whose table shows it apart over every value its joint takes within the
+                // step neither shortens the step nor costs a query.
+                if let Some(t) = self.arm.pair_tables.and_then(|t| t.get(*i, *j))
+                    && let Some(&v) = q.get(t.joint())
+                    && t.least_within(v, step * motion.delta(t.joint())) >= floor
+                {
+                    continue;
+                }
                 let b = self.part_bound(motion, joints, radii);
                 let part = self.capped_part(
-                    |cap| self.pair_part(*i, *j, bodies, placed, cap),
+                    |cap| self.pair_part(*i, *j, q, bodies, placed, cap),
                     0.0,
                     b,
                     step,

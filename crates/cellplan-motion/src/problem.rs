@@ -426,6 +426,8 @@ pub struct ArmSetup {
     pub checked_pairs: Vec<(usize, usize)>,
     /// Where the root stands.
     pub base: Pose,
+    /// The tables of the close self pairs ([`crate::arm::PairTables::build`]).
+    pub pair_tables: crate::arm::PairTables,
     /// For each chain joint, its index in the file's joint list.
     order: Vec<usize>,
 }
@@ -513,6 +515,7 @@ impl ArmSetup {
         }
         let mut setup = ArmSetup {
             base: set.robot.base,
+            pair_tables: crate::arm::PairTables::default(),
             model,
             world,
             group,
@@ -523,6 +526,7 @@ impl ArmSetup {
             order,
         };
         setup.checked_pairs = pairs_that_may_touch(&setup.arm());
+        setup.pair_tables = crate::arm::PairTables::build(&setup.arm());
         Ok(setup)
     }
 
@@ -562,6 +566,7 @@ impl ArmSetup {
             group: self.group,
             body_links: &self.body_links,
             self_pairs: &self.checked_pairs,
+            pair_tables: Some(&self.pair_tables),
         }
     }
 

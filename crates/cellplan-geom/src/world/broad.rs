@@ -395,9 +395,26 @@ impl BroadPhase {
         placed: &PlacedCovers,
         cap: f64,
     ) -> f64 {
+        self.pair_distance_or(world, i, j, poses, placed, cap, || 0.0)
+    }
+
+    /// [`BroadPhase::pair_distance`] with another lower bound on the pair's distance, `other`,
+    /// asked only when the covers fall short: where it reaches the cap, the exact query is
+    /// skipped too (the same answer, when `other` never exceeds the distance).
+    #[allow(clippy::too_many_arguments)]
+    pub fn pair_distance_or(
+        &self,
+        world: &CollisionWorld,
+        i: usize,
+        j: usize,
+        poses: &[Pose],
+        placed: &PlacedCovers,
+        cap: f64,
+        other: impl FnOnce() -> f64,
+    ) -> f64 {
         let best = sanitize_margin(cap);
         let (bound, towards) = self.pair_bound_towards(i, j, placed, best);
-        if bound >= best {
+        if bound >= best || other() >= best {
             return best;
         }
         world.pair_distance_hinted(self.group, i, j, poses, best, towards)

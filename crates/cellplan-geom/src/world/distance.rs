@@ -3,6 +3,7 @@
 use super::narrow::{hinted_distance, static_distance, static_distance_hinted};
 use super::{CollisionWorld, GroupId, Placed, Placement, aabb_distance, place, place_with, sanitize_margin};
 use crate::{DVec3, Pose, Sphere};
+use parry3d_f64::shape::SupportMap;
 
 impl CollisionWorld {
     /// Distance from body `i` of `g` (at `poses[i]`) to every body of group `other` (at
@@ -395,4 +396,15 @@ fn placed_distance(a: &Placed, b: &Placed, best: f64) -> f64 {
         return best;
     }
     hinted_distance(&a.pose.inv_mul(&b.pose), a.support, b.support, best, DVec3::ZERO)
+}
+
+/// Distance between two convex support maps at poses `pa` and `pb` (world), capped at `cap`
+/// and certified from below (never above the true distance; 0 when they overlap): for sets a
+/// body's shape does not describe, such as a body turned about an axis
+/// ([`crate::revolved::Revolved`]).
+pub fn convex_distance(pa: &Pose, a: &dyn SupportMap, pb: &Pose, b: &dyn SupportMap, cap: f64) -> f64 {
+    if !(pa.is_finite() && pb.is_finite()) {
+        return 0.0;
+    }
+    hinted_distance(&pa.inv_mul(pb), a, b, sanitize_margin(cap), DVec3::ZERO)
 }

@@ -414,13 +414,15 @@ fn check_homes(
 }
 
 /// Sets each robot's self-collision pairs, sampled once per distinct robot geometry (or read
-/// from the cache); returns the cache entries still to be written.
+/// from the cache), and the tables of its close pairs (built once per geometry); returns the
+/// cache entries still to be written.
 fn find_self_pairs(
     world: &mut CollisionWorld,
     robots: &mut [Robot],
     opts: &LoadOptions,
 ) -> Vec<crate::self_pairs::PendingCache> {
     let mut sampled: HashMap<u64, SelfPairs> = HashMap::new();
+    let mut tables_by_key: HashMap<u64, std::sync::Arc<cellplan_motion::arm::PairTables>> = HashMap::new();
     let mut pending_cache = Vec::new();
     for robot in robots {
         let key = geometry_key(robot, opts.self_pair_samples, opts.seed);
@@ -441,6 +443,16 @@ fn find_self_pairs(
         };
         world.set_self_pairs(robot.group, pairs.pairs.clone());
         robot.self_pairs = pairs.pairs;
+        // The tables depend on the robot's geometry alone (the same key as its pairs).
+        let tables = match tables_by_key.get(&key) {
+            Some(t) => std::sync::Arc::clone(t),
+            None => {
+                let t = std::sync::Arc::new(cellplan_motion::arm::PairTables::build(&robot.arm(&*world)));
+                tables_by_key.insert(key, std::sync::Arc::clone(&t));
+                t
+            }
+        };
+        robot.pair_tables = tables;
     }
     pending_cache
 }

@@ -92,6 +92,7 @@ pub(super) fn robot(
         body_links: Vec::new(),
         body_shapes: Vec::new(),
         self_pairs: Vec::new(),
+        pair_tables: Default::default(),
         reach,
     })
 }

@@ -259,3 +259,113 @@ fn clear_by_answers_as_the_clearances_compared() {
     }
     assert!(yes > 100 && no > 100, "{yes} {no}");
 }
+
+/// The tables of the pairs with two or three joints between their bodies bound the pair's
+/// exact distance from below: at random configurations, and over intervals of their joint
+/// (every configuration whose joint lies within the radius asked, the other joints anywhere);
+/// they apply to the always-close pairs (the base and the upper arm among them) and clear most
+/// of that pair's range.
+#[test]
+fn pair_tables_bound_the_exact_distances() {
+    let setup = ur5();
+    let arm = setup.arm();
+    let mut rng = ChaCha8Rng::seed_from_u64(5);
+    let (mut links, mut poses) = (Vec::new(), Vec::<Pose>::new());
+    let mut tables = 0;
+    for &(i, j) in arm.self_pairs {
+        let Some(t) = super::pair_table(&arm, i, j) else {
+            continue;
+        };
+        tables += 1;
+        let k = t.joint();
+        let mut positive = 0;
+        for _ in 0..150 {
+            let q = random_q(&arm, &mut rng);
+            arm.body_poses(&q, &mut links, &mut poses);
+            let exact = arm.world.pair_distance(arm.group, i, j, &poses, 1.0);
+            let at = t.least_within(q[k], 0.0);
+            assert!(
+                at <= exact + 1e-9,
+                "pair ({i}, {j}): table {at} beyond the distance {exact}"
+            );
+            positive += usize::from(at > 0.0);
+            // An interval about another value of the joint holding this configuration's.
+            let radius = rng.random_range(0.0..0.6);
+            let centre = q[k] + rng.random_range(-radius..=radius);
+            let within = t.least_within(centre, radius);
+            assert!(
+                within <= exact + 1e-9,
+                "pair ({i}, {j}): interval {within} beyond {exact}"
+            );
+            assert!(within <= t.least_within(centre, 0.0) + 1e-12);
+        }
+        if (i, j) == (0, 2) {
+            assert!(
+                positive > 75,
+                "the base and the upper arm cleared in {positive} of 150"
+            );
+        }
+    }
+    assert!(tables >= 5, "only {tables} tables");
+    // Out of range and non-finite values say nothing.
+    let t = super::pair_table(&arm, 0, 2).expect("the base and the upper arm have a table");
+    assert_eq!(t.least_within(f64::NAN, 0.0), 0.0);
+    assert_eq!(t.least_within(0.0, f64::INFINITY), 0.0);
+}
+
+/// With the tables (a check asks them before exact distances, and a segment check skips a
+/// pair its table clears over the step), every configuration and every segment gets the answer
+/// it gets without them, with fewer validity calls; the tables are built for the close pairs
+/// only (the base and the upper arm among them) and the same every time.
+#[test]
+fn pair_tables_change_no_answer() {
+    let setup = ur5();
+    let plain = crate::arm::Arm {
+        pair_tables: None,
+        ..setup.arm()
+    };
+    let tables = crate::arm::PairTables::build(&plain);
+    assert!(
+        tables.get(0, 2).is_some(),
+        "no table for the base and the upper arm"
+    );
+    assert!(
+        (2..plain.self_pairs.len() / 2).contains(&tables.len()),
+        "{} tables for {} pairs",
+        tables.len(),
+        plain.self_pairs.len()
+    );
+    assert_eq!(tables.len(), setup.pair_tables.len());
+    let with = crate::arm::Arm {
+        pair_tables: Some(&tables),
+        ..setup.arm()
+    };
+    let (a, b) = (
+        super::ArmValidity::new(plain, 0.0, Vec::new()),
+        super::ArmValidity::new(with, 0.0, Vec::new()),
+    );
+    let space = crate::arm::joint_space(&plain, &[1.0; 6]);
+    let mut rng = ChaCha8Rng::seed_from_u64(9);
+    for _ in 0..400 {
+        let q = random_q(&plain, &mut rng);
+        assert_eq!(a.is_valid(&q), b.is_valid(&q));
+    }
+    let (mut calls_a, mut calls_b, mut valid) = (0, 0, 0);
+    for _ in 0..300 {
+        let p = random_q(&plain, &mut rng);
+        let r: Vec<f64> = p.iter().map(|x| x + rng.random_range(-0.5..0.5)).collect();
+        let (ca, cb) = (
+            crate::plan::check_segment(&space, &a, &p, &r, 1e-9),
+            crate::plan::check_segment(&space, &b, &p, &r, 1e-9),
+        );
+        assert_eq!(ca.valid, cb.valid, "{p:?} → {r:?}");
+        valid += usize::from(ca.valid);
+        calls_a += ca.calls;
+        calls_b += cb.calls;
+    }
+    assert!(valid > 20, "only {valid} valid segments");
+    assert!(
+        calls_b < calls_a,
+        "{calls_b} calls with the tables, {calls_a} without"
+    );
+}

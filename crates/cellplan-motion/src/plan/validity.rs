@@ -111,6 +111,11 @@ impl SegmentMotion {
         SegmentMotion { delta, radii, prefix }
     }
 
+    /// `|b_j − a_j|`: how far the segment moves joint `j` (0 beyond the segment's joints).
+    pub fn delta(&self, j: usize) -> f64 {
+        self.delta.get(j).copied().unwrap_or(0.0)
+    }
+
     /// The motion of the segment `a → b` in `space`.
     pub fn of(space: &JointSpace, a: &[f64], b: &[f64]) -> SegmentMotion {
         let n = space.dim().min(a.len()).min(b.len());
