@@ -92,6 +92,39 @@ fn the_broad_phase_changes_no_answer() {
     assert!(valid > 0 && steps > 0);
 }
 
+/// Segment checks with the broad phase (whose steps take a part at its cover bound when that
+/// bound is enough for a good step, `ENOUGH_SHARE` in arm.rs) and with exact distances only
+/// answer alike, on random segments near the shelves (valid and invalid ones).
+#[test]
+fn segment_checks_answer_as_with_exact_distances() {
+    use rand::{RngExt, SeedableRng};
+    let set = read_problems(&mbm("bookshelf_small")).unwrap();
+    let mut setup = ArmSetup::load(&set).unwrap();
+    let p = &set.problems[3];
+    setup.set_obstacles(&p.obstacles);
+    let fast = setup.validity(0.0);
+    let mut exact = setup.validity(0.0);
+    exact.broad_phase = false;
+    let space = arm::joint_space(&setup.arm(), &[]);
+    let start = setup.to_chain(&p.start);
+    let goal = setup.to_chain(&p.goals[0]);
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
+    let (mut valid, mut invalid) = (0, 0);
+    let mut a = Vec::new();
+    for _ in 0..40 {
+        space.interpolate(&start, &goal, rng.random_range(0.0..1.0), &mut a);
+        let b: Vec<f64> = a.iter().map(|x| x + rng.random_range(-0.4..0.4)).collect();
+        let (f, e) = (
+            check_segment(&space, &fast, &a, &b, 1e-4),
+            check_segment(&space, &exact, &a, &b, 1e-4),
+        );
+        assert_eq!(f.valid, e.valid, "{a:?} → {b:?}");
+        valid += usize::from(f.valid);
+        invalid += usize::from(!f.valid);
+    }
+    assert!(valid >= 10 && invalid >= 5, "{valid} valid, {invalid} invalid");
+}
+
 #[test]
 fn every_registered_planner_solves_an_mbm_problem_with_checked_segments() {
     let set = read_problems(&mbm("box")).unwrap();

@@ -306,6 +306,21 @@ impl BroadPhase {
         placed: &PlacedCovers,
         cap: f64,
     ) -> f64 {
+        self.scene_distance_enough(world, i, poses, placed, cap, cap)
+    }
+
+    /// [`BroadPhase::scene_distance`] content with less: an object whose cover bound reaches
+    /// `enough` is taken at that bound (a lower bound of its distance) without the exact query.
+    /// With `enough >= cap`, the same answer as `scene_distance`.
+    pub fn scene_distance_enough(
+        &self,
+        world: &CollisionWorld,
+        i: usize,
+        poses: &[Pose],
+        placed: &PlacedCovers,
+        cap: f64,
+        enough: f64,
+    ) -> f64 {
         let mut best = sanitize_margin(cap);
         let outer = match self.placed_body(i, placed, best) {
             Ok(outer) => outer,
@@ -322,6 +337,10 @@ impl BroadPhase {
                 }
                 let (bound, towards) = self.object_bound(world, object, self.cover(placed, i), best);
                 if bound >= best {
+                    continue;
+                }
+                if bound >= enough {
+                    best = bound;
                     continue;
                 }
                 let d = match &object.kind {
@@ -395,12 +414,14 @@ impl BroadPhase {
         placed: &PlacedCovers,
         cap: f64,
     ) -> f64 {
-        self.pair_distance_or(world, i, j, poses, placed, cap, || 0.0)
+        self.pair_distance_or(world, i, j, poses, placed, (cap, cap), || 0.0)
     }
 
     /// [`BroadPhase::pair_distance`] with another lower bound on the pair's distance, `other`,
     /// asked only when the covers fall short: where it reaches the cap, the exact query is
-    /// skipped too (the same answer, when `other` never exceeds the distance).
+    /// skipped too (the same answer, when `other` never exceeds the distance). Of `(cap,
+    /// enough)`, a bound reaching `enough` is answered without the exact query (a lower bound
+    /// of the distance; with `enough >= cap`, the same answer as [`BroadPhase::pair_distance`]).
     #[allow(clippy::too_many_arguments)]
     pub fn pair_distance_or(
         &self,
@@ -409,13 +430,20 @@ impl BroadPhase {
         j: usize,
         poses: &[Pose],
         placed: &PlacedCovers,
-        cap: f64,
+        (cap, enough): (f64, f64),
         other: impl FnOnce() -> f64,
     ) -> f64 {
         let best = sanitize_margin(cap);
         let (bound, towards) = self.pair_bound_towards(i, j, placed, best);
-        if bound >= best || other() >= best {
+        if bound >= best {
             return best;
+        }
+        let bound = bound.max(other());
+        if bound >= best {
+            return best;
+        }
+        if bound >= enough {
+            return bound;
         }
         world.pair_distance_hinted(self.group, i, j, poses, best, towards)
     }

@@ -82,7 +82,7 @@ pub trait StateValidity: Sync {
 
 /// How far a straight joint-space segment moves each joint, and the Cartesian bounds that
 /// follow (the `bound` of [`StateValidity::segment_step`]).
-#[derive(Clone, Debug, Default, PartialEq)]
+#[derive(Clone, Debug, Default)]
 pub struct SegmentMotion {
     /// `|b_j − a_j|` per joint.
     delta: Vec<f64>,
@@ -90,6 +90,16 @@ pub struct SegmentMotion {
     radii: Vec<f64>,
     /// Prefix sums of `radii[j]·delta[j]`.
     prefix: Vec<f64>,
+    /// Per-part bounds a checker keeps for this segment ([`SegmentMotion::memo`]): they depend
+    /// on the segment alone, while the segment check asks them at every sample.
+    memo: std::cell::OnceCell<(usize, Vec<f64>)>,
+}
+
+impl PartialEq for SegmentMotion {
+    /// The same motion (the memo is a cache, not part of the value).
+    fn eq(&self, other: &Self) -> bool {
+        self.delta == other.delta && self.radii == other.radii && self.prefix == other.prefix
+    }
 }
 
 impl SegmentMotion {
@@ -108,7 +118,25 @@ impl SegmentMotion {
             let term = if delta[j] == 0.0 { 0.0 } else { radii[j] * delta[j] };
             prefix.push(prefix[j] + term);
         }
-        SegmentMotion { delta, radii, prefix }
+        SegmentMotion {
+            delta,
+            radii,
+            prefix,
+            memo: std::cell::OnceCell::new(),
+        }
+    }
+
+    /// Values that depend on this motion alone, computed by `make` on the first call and kept
+    /// for the segment's later samples. `owner` names the caller (a checker's address): a
+    /// memo made by another owner is not returned (`make` runs again, and its result is not
+    /// kept).
+    pub fn memo(&self, owner: usize, make: impl Fn() -> Vec<f64>) -> std::borrow::Cow<'_, [f64]> {
+        let (by, values) = self.memo.get_or_init(|| (owner, make()));
+        if *by == owner {
+            std::borrow::Cow::Borrowed(values)
+        } else {
+            std::borrow::Cow::Owned(make())
+        }
     }
 
     /// `|b_j − a_j|`: how far the segment moves joint `j` (0 beyond the segment's joints).

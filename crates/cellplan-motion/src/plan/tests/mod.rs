@@ -244,6 +244,26 @@ fn deterministic_for_a_seed_in_3d() {
 }
 
 #[test]
+fn a_segments_memo_is_made_once_and_only_for_its_owner() {
+    let motion = SegmentMotion::new(&[1.0, 2.0], &[0.5, -0.25]);
+    let made = AtomicUsize::new(0);
+    let make = |x: f64| {
+        made.fetch_add(1, Ordering::Relaxed);
+        vec![x]
+    };
+    assert_eq!(&*motion.memo(7, || make(1.0)), &[1.0]);
+    assert_eq!(&*motion.memo(7, || make(2.0)), &[1.0], "made again");
+    assert_eq!(made.load(Ordering::Relaxed), 1);
+    // Another owner gets its own values, made each time, and the first owner's stay.
+    assert_eq!(&*motion.memo(8, || make(3.0)), &[3.0]);
+    assert_eq!(&*motion.memo(7, || make(4.0)), &[1.0]);
+    assert_eq!(made.load(Ordering::Relaxed), 2);
+    // The memo is no part of the value.
+    assert_eq!(motion, SegmentMotion::new(&[1.0, 2.0], &[0.5, -0.25]));
+    assert_eq!(motion.total(), 1.0);
+}
+
+#[test]
 fn segment_check_steps_by_clearance() {
     let space = square(2, 10.0);
     let v = Discs::new(vec![(vec![5.0, 5.0], 1.0)], 0.0);
