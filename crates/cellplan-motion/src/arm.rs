@@ -37,9 +37,10 @@
 //! (`bench/motion/README.md`). Pairs proven apart everywhere are not checked at all
 //! ([`apart_everywhere`]).
 use crate::plan::{Clearance, JointSpace, SegmentMotion, StateValidity, narrow_step};
+use cellplan_geom::spheres::Sphere;
 use cellplan_geom::{BroadPhase, CollisionWorld, GroupId, PlacedCovers, Pose};
 use cellplan_kin::Chain;
-use std::cell::RefCell;
+use std::cell::{Cell, RefCell};
 use std::ops::Range;
 
 mod apart;
@@ -123,11 +124,16 @@ impl Arm<'_> {
         links.resize(self.chain.links.len(), Pose::IDENTITY);
         self.chain.fk_all(q, links);
         out.clear();
-        out.extend(
-            self.body_links
-                .iter()
-                .map(|&l| self.base * links.get(l).copied().unwrap_or(Pose::IDENTITY)),
-        );
+        // Bodies of one link are listed together and share its pose: composed once.
+        let mut last: Option<(usize, Pose)> = None;
+        for &l in self.body_links {
+            let pose = match last {
+                Some((k, pose)) if k == l => pose,
+                _ => self.base * links.get(l).copied().unwrap_or(Pose::IDENTITY),
+            };
+            last = Some((l, pose));
+            out.push(pose);
+        }
     }
 }
 
@@ -370,6 +376,167 @@ pub struct ArmValidity<'a> {
     parked_extra: f64,
     /// The arm's covers against the scene and the parked groups.
     broad: BroadPhase,
+    /// Bodies grouped by link ([`Clusters`]), to settle several parts with one test.
+    clusters: Clusters,
+}
+
+/// The bodies of one link share its frame, so one sphere holds their outer spheres; where that
+/// sphere is clear of the scene (or of another link's) by what each of its parts is asked,
+/// those parts answer their caps without a query of their own (the test they would make, on a
+/// larger sphere: the same answers). A pair is in up to two groups: the two links' clusters,
+/// and, when its first body's link has several bodies, that body alone against the other
+/// link's cluster (the UR5's forearm pieces against its gripper's twelve). At most 64 clusters
+/// moving against the scene and 64 groups (bits of a mask).
+#[derive(Clone, Debug, Default)]
+struct Clusters {
+    /// Per sphere: one of its bodies (whose pose places it) and the sphere in that frame. The
+    /// links' clusters first, then single bodies of the groups.
+    spheres: Vec<(usize, Sphere)>,
+    /// Per moving part (index into `moving`): its cluster, when that has two moving parts or
+    /// more.
+    scene: Vec<Option<usize>>,
+    /// Per pair (index into `pairs`): its groups, coarse then fine, each when it holds two
+    /// pairs or more.
+    pair: Vec<[Option<usize>; 2]>,
+    /// The groups: two spheres.
+    groups: Vec<(usize, usize)>,
+}
+
+/// How many groups a `u64` mask tracks.
+const MASK_BITS: usize = 64;
+
+impl Clusters {
+    fn new(
+        arm: &Arm,
+        broad: &BroadPhase,
+        moving: &[(usize, Range<usize>)],
+        pairs: &[(usize, usize)],
+    ) -> Clusters {
+        let n = arm.body_links.len();
+        // One cluster per link with bodies, in body order.
+        let mut of_body = vec![usize::MAX; n];
+        let mut members: Vec<Vec<usize>> = Vec::new();
+        for i in 0..n {
+            let found = (0..i)
+                .find(|&k| arm.body_links[k] == arm.body_links[i])
+                .map(|k| of_body[k]);
+            let c = found.unwrap_or_else(|| {
+                members.push(Vec::new());
+                members.len() - 1
+            });
+            of_body[i] = c;
+            members[c].push(i);
+        }
+        let mut spheres: Vec<Option<(usize, Sphere)>> = members
+            .iter()
+            .map(|m| broad.outer_of(m).map(|s| (m[0], s)))
+            .collect();
+        // Body `i` alone, for the fine groups (its link has other bodies).
+        let mut alone = vec![None; n];
+        for i in 0..n {
+            if members[of_body[i]].len() >= 2 {
+                alone[i] = Some(spheres.len());
+                spheres.push(broad.outer_of(&[i]).map(|s| (i, s)));
+            }
+        }
+        let usable = |c: usize| spheres.get(c).is_some_and(Option::is_some);
+        let mut moving_in = vec![0usize; members.len()];
+        for (i, _) in moving {
+            moving_in[of_body[*i]] += 1;
+        }
+        let scene = moving
+            .iter()
+            .map(|(i, _)| {
+                let c = of_body[*i];
+                (usable(c) && moving_in[c] >= 2 && c < MASK_BITS).then_some(c)
+            })
+            .collect();
+        // Each pair's candidate groups (coarse, fine), counted.
+        let keys: Vec<[Option<(usize, usize)>; 2]> = pairs
+            .iter()
+            .map(|&(i, j)| {
+                let (ci, cj) = (of_body[i], of_body[j]);
+                let fine = alone[i].filter(|_| members[cj].len() >= 2).map(|a| (a, cj));
+                [Some((ci, cj)), fine]
+            })
+            .collect();
+        let mut counts: Vec<((usize, usize), usize)> = Vec::new();
+        for key in keys.iter().flatten().flatten() {
+            match counts.iter_mut().find(|(k, _)| k == key) {
+                Some((_, c)) => *c += 1,
+                None => counts.push((*key, 1)),
+            }
+        }
+        let mut groups: Vec<(usize, usize)> = Vec::new();
+        let pair = keys
+            .iter()
+            .map(|ks| {
+                ks.map(|key| {
+                    let key = key?;
+                    let size = counts.iter().find(|(k, _)| *k == key).map_or(0, |(_, c)| *c);
+                    if !(usable(key.0) && usable(key.1) && key.0 != key.1 && size >= 2) {
+                        return None;
+                    }
+                    let g = groups.iter().position(|&k| k == key).unwrap_or_else(|| {
+                        groups.push(key);
+                        groups.len() - 1
+                    });
+                    (g < MASK_BITS).then_some(g)
+                })
+            })
+            .collect();
+        let nowhere = Sphere {
+            centre: cellplan_geom::DVec3::ZERO,
+            radius: f64::INFINITY,
+        };
+        Clusters {
+            spheres: spheres.into_iter().map(|s| s.unwrap_or((0, nowhere))).collect(),
+            scene,
+            pair,
+            groups,
+        }
+    }
+
+    /// Cluster `c`'s sphere placed at the body poses `bodies`.
+    #[inline]
+    fn placed(&self, c: usize, bodies: &[Pose]) -> Sphere {
+        let (body, s) = self.spheres[c];
+        let pose = bodies.get(body).copied().unwrap_or(Pose::IDENTITY);
+        Sphere {
+            centre: pose.rotation * s.centre + pose.translation,
+            radius: s.radius,
+        }
+    }
+
+    /// Whether group `g`'s two clusters, placed at `bodies`, are at least `best` apart.
+    #[inline]
+    fn group_apart(&self, g: usize, bodies: &[Pose], best: f64) -> bool {
+        let (a, b) = self.groups[g];
+        let (sa, sb) = (self.placed(a, bodies), self.placed(b, bodies));
+        (sa.centre - sb.centre).length() - sa.radius - sb.radius >= best.max(0.0)
+    }
+}
+
+/// Groups tested and found clear within one check (bits of [`Clusters`]' indices).
+#[derive(Clone, Copy, Default)]
+struct Settled {
+    tested: u64,
+    clear: u64,
+}
+
+impl Settled {
+    /// Whether group `k` is clear: `test()` asked the first time only.
+    #[inline]
+    fn clear(&mut self, k: usize, test: impl FnOnce() -> bool) -> bool {
+        let bit = 1u64 << k;
+        if self.tested & bit == 0 {
+            self.tested |= bit;
+            if test() {
+                self.clear |= bit;
+            }
+        }
+        self.clear & bit != 0
+    }
 }
 
 impl<'a> ArmValidity<'a> {
@@ -377,7 +544,7 @@ impl<'a> ArmValidity<'a> {
     /// the `parked` groups. Bodies on links before the first joint never move and are not
     /// checked against the scene (a robot's base stands on its floor).
     pub fn new(arm: Arm<'a>, margin: f64, parked: Vec<(GroupId, Vec<Pose>)>) -> Self {
-        let moving = (0..arm.body_links.len())
+        let moving: Vec<(usize, Range<usize>)> = (0..arm.body_links.len())
             .map(|i| (i, 0..moved_by(&arm, i)))
             .filter(|(_, r)| !r.is_empty())
             .collect();
@@ -388,7 +555,7 @@ impl<'a> ArmValidity<'a> {
         let mut poses = Vec::new();
         arm.body_poses(&arm.chain.mid_configuration(), &mut links, &mut poses);
         let body_radii: Vec<Vec<f64>> = (0..arm.body_links.len()).map(|i| body_radii(&arm, i)).collect();
-        let pairs = arm
+        let pairs: Vec<(usize, usize, Range<usize>, Vec<f64>)> = arm
             .self_pairs
             .iter()
             .map(|&(i, j)| {
@@ -401,8 +568,12 @@ impl<'a> ArmValidity<'a> {
                 !r.is_empty() || arm.world.pair_distance(arm.group, *i, *j, &poses, 1.0) <= DISTANCE_SLACK
             })
             .collect();
+        let broad = BroadPhase::new(arm.world, arm.group, &parked);
+        let pair_bodies: Vec<(usize, usize)> = pairs.iter().map(|&(i, j, _, _)| (i, j)).collect();
+        let clusters = Clusters::new(&arm, &broad, &moving, &pair_bodies);
         ArmValidity {
-            broad: BroadPhase::new(arm.world, arm.group, &parked),
+            broad,
+            clusters,
             arm,
             margin,
             cap: DEFAULT_CLEARANCE_CAP,
@@ -542,11 +713,43 @@ impl<'a> ArmValidity<'a> {
         let apart = measured_for(0.0);
         let tiny = 1e-9;
         let m = self.moving.len();
-        // Part `k`: a moving body against the scene (k < m), else a self pair.
+        // Part `k`: a moving body against the scene (k < m), else a self pair; a body of a
+        // cluster clear of the scene, or a pair of two clusters apart, is clear without its
+        // own query (see [`Clusters`]).
+        let (scene_sets, pair_sets) = (Cell::new(Settled::default()), Cell::new(Settled::default()));
+        let settled = |sets: &Cell<Settled>, c: usize, test: &dyn Fn() -> bool| {
+            let mut s = sets.get();
+            let clear = s.clear(c, test);
+            sets.set(s);
+            clear
+        };
         let clear = |k: usize, bodies: &[Pose], placed: &PlacedCovers| {
             if let Some((i, _)) = self.moving.get(k) {
+                if let Some(c) = self.clusters.scene.get(k).copied().flatten()
+                    && settled(&scene_sets, c, &|| {
+                        self.broad
+                            .sphere_clears_scene(self.clusters.placed(c, bodies), need + tiny)
+                    })
+                {
+                    return true;
+                }
                 self.scene_part(*i, bodies, placed, need + tiny) > need
             } else if let Some(&(i, j, _, _)) = self.pairs.get(k - m) {
+                if self
+                    .clusters
+                    .pair
+                    .get(k - m)
+                    .into_iter()
+                    .flatten()
+                    .flatten()
+                    .any(|&g| {
+                        settled(&pair_sets, g, &|| {
+                            self.clusters.group_apart(g, bodies, apart + tiny)
+                        })
+                    })
+                {
+                    return true;
+                }
                 self.pair_part(i, j, q, bodies, placed, (apart + tiny, apart + tiny)) > apart
             } else {
                 true
@@ -625,17 +828,49 @@ impl<'a> ArmValidity<'a> {
         }
     }
 
-    /// Every part's [`Self::part_bound`] over `motion`: the moving bodies', then the pairs'.
+    /// Every part's [`Self::part_bound`] over `motion`: the moving bodies', then the pairs',
+    /// then the largest of each cluster's moving bodies' and of each group's pairs' (see
+    /// [`Clusters`]).
     fn part_bounds(&self, motion: &SegmentMotion) -> Vec<f64> {
-        let scene = self
+        let scene: Vec<f64> = self
             .moving
             .iter()
-            .map(|(i, joints)| self.part_bound(motion, joints, self.body_radii.get(*i).map_or(&[], |r| r)));
-        let pairs = self
+            .map(|(i, joints)| self.part_bound(motion, joints, self.body_radii.get(*i).map_or(&[], |r| r)))
+            .collect();
+        let pairs: Vec<f64> = self
             .pairs
             .iter()
-            .map(|(_, _, joints, radii)| self.part_bound(motion, joints, radii));
-        scene.chain(pairs).collect()
+            .map(|(_, _, joints, radii)| self.part_bound(motion, joints, radii))
+            .collect();
+        let largest = |n: usize, of: &[Option<usize>], bounds: &[f64]| {
+            let mut out = vec![0.0f64; n];
+            for (c, b) in of.iter().zip(bounds) {
+                if let Some(c) = c {
+                    out[*c] = out[*c].max(*b);
+                }
+            }
+            out
+        };
+        let clusters = largest(self.clusters.spheres.len(), &self.clusters.scene, &scene);
+        let mut groups = vec![0.0f64; self.clusters.groups.len()];
+        for (gs, b) in self.clusters.pair.iter().zip(&pairs) {
+            for g in gs.iter().flatten() {
+                groups[*g] = groups[*g].max(*b);
+            }
+        }
+        [scene, pairs, clusters, groups].concat()
+    }
+
+    /// The clearance a part with motion bound `bound` is asked for, in a step of `step`: the
+    /// step times the bound, at most [`Self::cap`] and at least the floor (the floor alone for
+    /// a part that does not move).
+    #[inline]
+    fn wanted(&self, bound: f64, step: f64, floor: f64) -> f64 {
+        if bound > 0.0 {
+            (step * bound).min(self.cap).max(floor)
+        } else {
+            floor
+        }
     }
 
     /// The distance of one part, asked only as far as it matters: `wanted` is the clearance
@@ -654,11 +889,7 @@ impl<'a> ArmValidity<'a> {
         step: f64,
         floor: f64,
     ) -> f64 {
-        let wanted = if bound > 0.0 {
-            (step * bound).min(self.cap).max(floor)
-        } else {
-            floor
-        };
+        let wanted = self.wanted(bound, step, floor);
         let cap = measured_for(wanted + offset);
         let enough = measured_for((ENOUGH_SHARE * wanted).max(floor) + offset).min(cap);
         let d = query((cap, enough));
@@ -718,10 +949,33 @@ impl StateValidity for ArmValidity<'_> {
         // Each part's bound depends on the segment alone: made at its first sample (moving
         // bodies, then pairs, in `self`'s order) and kept for the others.
         let bounds = motion.memo(self as *const Self as usize, || self.part_bounds(motion));
-        let (scene_bounds, pair_bounds) = bounds.split_at(self.moving.len().min(bounds.len()));
+        let (m, p) = (self.moving.len(), self.pairs.len());
+        let c = self.clusters.spheres.len();
+        let part = |range: Range<usize>| bounds.get(range).unwrap_or(&[]);
+        let (scene_bounds, pair_bounds) = (part(0..m), part(m..m + p));
+        let (cluster_bounds, group_bounds) = (part(m + p..m + p + c), part(m + p + c..bounds.len()));
         self.posed(q, |bodies, placed| {
             let mut step = limit;
-            for ((i, _), &b) in self.moving.iter().zip(scene_bounds).rev() {
+            let mut settled = Settled::default();
+            for (k, ((i, _), &b)) in self.moving.iter().zip(scene_bounds).enumerate().rev() {
+                // A cluster clear of the scene by what its farthest-moving body is asked
+                // settles each of its bodies as that body's own query would (its cap).
+                if let Some(c) = self.clusters.scene.get(k).copied().flatten()
+                    && settled.clear(c, || {
+                        let asked = self.wanted(
+                            cluster_bounds.get(c).copied().unwrap_or(f64::INFINITY),
+                            step,
+                            floor,
+                        );
+                        self.broad.sphere_clears_scene(
+                            self.clusters.placed(c, bodies),
+                            measured_for(asked + margin),
+                        )
+                    })
+                {
+                    step = narrow_step(step, self.wanted(b, step, floor), b, floor)?;
+                    continue;
+                }
                 let part = self.capped_part(
                     |cap| self.scene_part_enough(*i, bodies, placed, cap),
                     margin,
@@ -731,13 +985,37 @@ impl StateValidity for ArmValidity<'_> {
                 );
                 step = narrow_step(step, part, b, floor)?;
             }
-            for ((i, j, _, _), &b) in self.pairs.iter().zip(pair_bounds) {
+            let mut settled = Settled::default();
+            for (k, ((i, j, _, _), &b)) in self.pairs.iter().zip(pair_bounds).enumerate() {
                 // A pair whose table shows it apart over every value its joint takes within the
                 // step neither shortens the step nor costs a query.
                 if let Some(t) = self.arm.pair_tables.and_then(|t| t.get(*i, *j))
                     && let Some(&v) = q.get(t.joint())
                     && t.least_within(v, step * motion.delta(t.joint())) >= floor
                 {
+                    continue;
+                }
+                // Two links' clusters (or a body and a cluster) apart by what their pairs are
+                // asked settle those pairs.
+                if self
+                    .clusters
+                    .pair
+                    .get(k)
+                    .into_iter()
+                    .flatten()
+                    .flatten()
+                    .any(|&g| {
+                        settled.clear(g, || {
+                            let asked = self.wanted(
+                                group_bounds.get(g).copied().unwrap_or(f64::INFINITY),
+                                step,
+                                floor,
+                            );
+                            self.clusters.group_apart(g, bodies, measured_for(asked))
+                        })
+                    })
+                {
+                    step = narrow_step(step, self.wanted(b, step, floor), b, floor)?;
                     continue;
                 }
                 let part = self.capped_part(

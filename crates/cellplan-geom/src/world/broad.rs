@@ -377,6 +377,43 @@ impl BroadPhase {
         Ok(*outer)
     }
 
+    /// A sphere holding the outer spheres of `bodies` (bodies that share one frame, as the
+    /// bodies of one link do: the sphere is in that frame); `None` when none of them has a
+    /// shape. Where such a sphere, placed, is at least `best` from the scene
+    /// ([`BroadPhase::sphere_clears_scene`]) or from another one, every query of its bodies
+    /// capped at `best` or less answers its cap: their outer spheres settle it.
+    pub fn outer_of(&self, bodies: &[usize]) -> Option<Sphere> {
+        let spheres: Vec<Sphere> = bodies
+            .iter()
+            .filter_map(|&i| self.outer.get(i).copied().flatten())
+            .collect();
+        let first = spheres.first()?;
+        let (lo, hi) = spheres.iter().fold((first.centre, first.centre), |(lo, hi), s| {
+            (lo.min(s.centre - s.radius), hi.max(s.centre + s.radius))
+        });
+        let centre = 0.5 * (lo + hi);
+        let radius = spheres
+            .iter()
+            .map(|s| (s.centre - centre).length() + s.radius)
+            .fold(0.0, f64::max);
+        // Rounding: the sphere must hold every one of them.
+        Some(Sphere {
+            centre,
+            radius: radius * (1.0 + 1e-12) + 1e-12,
+        })
+    }
+
+    /// Whether `sphere` (in the world) is at least `best` from the box of every run of objects:
+    /// then a body whose outer sphere it holds answers [`BroadPhase::scene_distance`] capped at
+    /// `best` or less with its cap (the same test, on a larger sphere). False for a sphere that
+    /// is not finite.
+    pub fn sphere_clears_scene(&self, sphere: Sphere, best: f64) -> bool {
+        let best = sanitize_margin(best);
+        self.runs
+            .iter()
+            .all(|(mins, maxs, _)| point_box_distance(sphere.centre, *mins, *maxs) - sphere.radius >= best)
+    }
+
     /// A lower bound on the distance from body `i` to every object, capped at `cap` (the cover
     /// only, never an exact query).
     pub fn scene_bound(&self, world: &CollisionWorld, i: usize, placed: &PlacedCovers, cap: f64) -> f64 {
@@ -635,6 +672,89 @@ mod tests {
                 ),
             ],
         }
+    }
+
+    /// The sphere of several bodies sharing a frame holds each one's outer sphere (and is not
+    /// much larger than it must be), and a sphere clears the scene at a threshold exactly when
+    /// every run's box is that far from it.
+    #[test]
+    fn a_sphere_of_bodies_holds_their_outer_spheres_and_clears_as_the_boxes_say() {
+        let mut world = CollisionWorld::new();
+        world.add_static(
+            "box",
+            &ShapeSpec::Box {
+                half_extents: DVec3::new(0.3, 0.2, 0.05),
+            },
+            Pose::from_parts(DVec3::new(0.0, 0.0, -0.6), DQuat::from_rotation_z(0.4)),
+        );
+        world.add_static(
+            "ball",
+            &ShapeSpec::Sphere { radius: 0.15 },
+            Pose::translation(0.8, 0.3, 0.2),
+        );
+        let bodies = (0..4)
+            .map(|k| GroupBody {
+                name: format!("b{k}"),
+                shapes: vec![(
+                    ShapeSpec::Box {
+                        half_extents: DVec3::new(0.02 + 0.03 * k as f64, 0.03, 0.02),
+                    },
+                    Pose::translation(0.1 * k as f64, 0.05 * k as f64, 0.0),
+                )],
+            })
+            .collect();
+        let g = world.add_group("arm", bodies);
+        let broad = BroadPhase::new(&world, g, &[]);
+        assert!(broad.outer_of(&[]).is_none());
+        for set in [vec![0], vec![0, 1], vec![1, 3], vec![0, 1, 2, 3]] {
+            let s = broad.outer_of(&set).unwrap();
+            let mut needed = 0.0f64;
+            for &i in &set {
+                let o = broad.outer[i].unwrap();
+                let reach = (o.centre - s.centre).length() + o.radius;
+                assert!(
+                    reach <= s.radius,
+                    "{set:?}: body {i} reaches {reach} > {}",
+                    s.radius
+                );
+                needed = needed.max(reach);
+            }
+            assert!(
+                s.radius <= needed * 1.3 + 1e-9,
+                "{set:?}: {} for {needed}",
+                s.radius
+            );
+        }
+        let mut rng = ChaCha8Rng::seed_from_u64(3);
+        let mut clear = 0;
+        for _ in 0..2000 {
+            let sphere = super::Sphere {
+                centre: DVec3::new(
+                    rng.random_range(-1.0..1.5),
+                    rng.random_range(-1.0..1.0),
+                    rng.random_range(-1.0..1.0),
+                ),
+                radius: rng.random_range(0.0..0.3),
+            };
+            let best = rng.random_range(-0.1..0.5);
+            let gap = broad
+                .runs
+                .iter()
+                .map(|(lo, hi, _)| super::point_box_distance(sphere.centre, *lo, *hi) - sphere.radius)
+                .fold(f64::INFINITY, f64::min);
+            assert_eq!(
+                broad.sphere_clears_scene(sphere, best),
+                gap >= best.max(0.0),
+                "{sphere:?} at {best}"
+            );
+            clear += usize::from(gap >= best.max(0.0));
+        }
+        assert!((200..1800).contains(&clear), "{clear} clear");
+        let nan = super::Sphere {
+            centre: DVec3::NAN,
+            radius: 0.1,
+        };
+        assert!(!broad.sphere_clears_scene(nan, 0.0));
     }
 
     /// Over random placements, the broad phase (with its guesses of the separating directions)

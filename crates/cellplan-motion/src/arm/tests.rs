@@ -369,3 +369,87 @@ fn pair_tables_change_no_answer() {
         "{calls_b} calls with the tables, {calls_a} without"
     );
 }
+
+/// Clusters (a link's bodies held by one sphere, tested against the scene or another link's
+/// sphere first) settle parts exactly as the parts' own tests would: the same validity and the
+/// same segment steps, bit for bit, on random configurations and segments among the obstacles
+/// of `bookshelf_small`; and they do settle parts (fewer exact queries is not observable here,
+/// so the test checks that some cluster and group exist and that some clear).
+#[test]
+fn clusters_change_no_answer() {
+    use crate::plan::{SegmentMotion, StateValidity};
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../bench/motion/mbm-ur5/bookshelf_small.json");
+    let set = read_problems(&path).unwrap();
+    let mut setup = ArmSetup::load(&set).unwrap();
+    setup.set_obstacles(&set.problems[3].obstacles);
+    let with = setup.validity(0.0);
+    let mut without = setup.validity(0.0);
+    without.clusters = super::Clusters::default();
+    assert!(
+        with.clusters.scene.iter().flatten().count() >= 12,
+        "{:?}",
+        with.clusters.scene
+    );
+    assert!(with.clusters.pair.iter().flatten().flatten().count() >= 60);
+    let space = crate::arm::joint_space(&setup.arm(), &[]);
+    let mut rng = ChaCha8Rng::seed_from_u64(17);
+    let (mut valid, mut steps) = (0, 0);
+    for _ in 0..400 {
+        let q = random_q(&setup.arm(), &mut rng);
+        let v = with.is_valid(&q);
+        assert_eq!(v, without.is_valid(&q), "{q:?}");
+        valid += usize::from(v);
+        let r: Vec<f64> = q.iter().map(|x| x + rng.random_range(-0.6..0.6)).collect();
+        let motion = SegmentMotion::of(&space, &q, &r);
+        let floor = [1e-9, 1e-4, 0.01][steps % 3];
+        let (a, b) = (
+            with.segment_step(&q, &motion, floor, 1.0),
+            without.segment_step(&q, &motion, floor, 1.0),
+        );
+        assert_eq!(a.map(f64::to_bits), b.map(f64::to_bits), "{q:?} → {r:?}");
+        steps += usize::from(a.is_some());
+    }
+    assert!(valid > 50 && steps > 50, "{valid} valid, {steps} steps");
+    // Every sphere, placed, holds the hull vertices of the bodies it stands for: a link's
+    // cluster its bodies', a body's own sphere that body's.
+    let vertices = hull_vertices(&setup.arm());
+    let links = setup.arm().body_links;
+    let mut held = 0;
+    for _ in 0..50 {
+        let q = random_q(&setup.arm(), &mut rng);
+        let (mut bl, mut bodies) = (Vec::new(), Vec::new());
+        setup.arm().body_poses(&q, &mut bl, &mut bodies);
+        for (c, &(first, _)) in cl_spheres(&with).iter().enumerate() {
+            let sphere = with.clusters.placed(c, &bodies);
+            // A link's cluster (the first spheres) or one body alone.
+            let own: Vec<usize> = if c < with.clusters.spheres.len() - alone_count(&with) {
+                (0..links.len()).filter(|&i| links[i] == links[first]).collect()
+            } else {
+                vec![first]
+            };
+            for i in own {
+                for v in &vertices[i] {
+                    let w = bodies[i].transform_point(*v);
+                    assert!(
+                        (w - sphere.centre).length() <= sphere.radius + 1e-9,
+                        "sphere {c}, body {i}"
+                    );
+                    held += 1;
+                }
+            }
+        }
+    }
+    assert!(held > 1000);
+}
+
+fn cl_spheres(v: &super::ArmValidity) -> Vec<(usize, cellplan_geom::spheres::Sphere)> {
+    v.clusters.spheres.clone()
+}
+
+/// How many of the checker's spheres stand for one body alone (the last ones).
+fn alone_count(v: &super::ArmValidity) -> usize {
+    let links = v.arm.body_links;
+    (0..links.len())
+        .filter(|&i| links.iter().filter(|&&l| l == links[i]).count() >= 2)
+        .count()
+}
