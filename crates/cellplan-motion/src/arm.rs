@@ -597,6 +597,29 @@ impl<'a> ArmValidity<'a> {
         self
     }
 
+    /// The cluster of moving part `k` ([`Clusters`]; none with the broad phase off).
+    #[inline]
+    fn scene_cluster(&self, k: usize) -> Option<usize> {
+        self.clusters
+            .scene
+            .get(k)
+            .copied()
+            .flatten()
+            .filter(|_| self.broad_phase)
+    }
+
+    /// The groups of pair `k` ([`Clusters`]; none with the broad phase off).
+    #[inline]
+    fn pair_groups(&self, k: usize) -> impl Iterator<Item = &usize> {
+        self.clusters
+            .pair
+            .get(k)
+            .filter(|_| self.broad_phase)
+            .into_iter()
+            .flatten()
+            .flatten()
+    }
+
     /// Distance of body `i` (posed in `bodies`) to the scene and the parked groups, capped.
     fn body_scene_distance(&self, i: usize, bodies: &[Pose], cap: f64) -> f64 {
         let world = self.arm.world;
@@ -725,7 +748,7 @@ impl<'a> ArmValidity<'a> {
         };
         let clear = |k: usize, bodies: &[Pose], placed: &PlacedCovers| {
             if let Some((i, _)) = self.moving.get(k) {
-                if let Some(c) = self.clusters.scene.get(k).copied().flatten()
+                if let Some(c) = self.scene_cluster(k)
                     && settled(&scene_sets, c, &|| {
                         self.broad
                             .sphere_clears_scene(self.clusters.placed(c, bodies), need + tiny)
@@ -735,19 +758,11 @@ impl<'a> ArmValidity<'a> {
                 }
                 self.scene_part(*i, bodies, placed, need + tiny) > need
             } else if let Some(&(i, j, _, _)) = self.pairs.get(k - m) {
-                if self
-                    .clusters
-                    .pair
-                    .get(k - m)
-                    .into_iter()
-                    .flatten()
-                    .flatten()
-                    .any(|&g| {
-                        settled(&pair_sets, g, &|| {
-                            self.clusters.group_apart(g, bodies, apart + tiny)
-                        })
+                if self.pair_groups(k - m).any(|&g| {
+                    settled(&pair_sets, g, &|| {
+                        self.clusters.group_apart(g, bodies, apart + tiny)
                     })
-                {
+                }) {
                     return true;
                 }
                 self.pair_part(i, j, q, bodies, placed, (apart + tiny, apart + tiny)) > apart
@@ -960,7 +975,7 @@ impl StateValidity for ArmValidity<'_> {
             for (k, ((i, _), &b)) in self.moving.iter().zip(scene_bounds).enumerate().rev() {
                 // A cluster clear of the scene by what its farthest-moving body is asked
                 // settles each of its bodies as that body's own query would (its cap).
-                if let Some(c) = self.clusters.scene.get(k).copied().flatten()
+                if let Some(c) = self.scene_cluster(k)
                     && settled.clear(c, || {
                         let asked = self.wanted(
                             cluster_bounds.get(c).copied().unwrap_or(f64::INFINITY),
@@ -997,24 +1012,13 @@ impl StateValidity for ArmValidity<'_> {
                 }
                 // Two links' clusters (or a body and a cluster) apart by what their pairs are
                 // asked settle those pairs.
-                if self
-                    .clusters
-                    .pair
-                    .get(k)
-                    .into_iter()
-                    .flatten()
-                    .flatten()
-                    .any(|&g| {
-                        settled.clear(g, || {
-                            let asked = self.wanted(
-                                group_bounds.get(g).copied().unwrap_or(f64::INFINITY),
-                                step,
-                                floor,
-                            );
-                            self.clusters.group_apart(g, bodies, measured_for(asked))
-                        })
+                if self.pair_groups(k).any(|&g| {
+                    settled.clear(g, || {
+                        let asked =
+                            self.wanted(group_bounds.get(g).copied().unwrap_or(f64::INFINITY), step, floor);
+                        self.clusters.group_apart(g, bodies, measured_for(asked))
                     })
-                {
+                }) {
                     step = narrow_step(step, self.wanted(b, step, floor), b, floor)?;
                     continue;
                 }
