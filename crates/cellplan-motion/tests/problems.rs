@@ -53,19 +53,24 @@ fn starts_and_goals_of_the_mbm_problems_are_valid_with_fitted_bodies() {
     assert!(valid >= 18, "{valid} of 20 starts and goals valid");
 }
 
-#[test]
-fn the_broad_phase_changes_no_answer() {
-    use cellplan_motion::plan::StateValidity;
+/// The UR5 among the shelves of `bookshelf_small`'s fourth problem, with its start and goal.
+fn shelves() -> (ArmSetup, Vec<f64>, Vec<f64>) {
     let set = read_problems(&mbm("bookshelf_small")).unwrap();
     let mut setup = ArmSetup::load(&set).unwrap();
     let p = &set.problems[3];
     setup.set_obstacles(&p.obstacles);
+    let (start, goal) = (setup.to_chain(&p.start), setup.to_chain(&p.goals[0]));
+    (setup, start, goal)
+}
+
+#[test]
+fn the_broad_phase_changes_no_answer() {
+    use cellplan_motion::plan::StateValidity;
+    let (setup, start, goal) = shelves();
     let fast = setup.validity(0.0);
     let mut exact = setup.validity(0.0);
     exact.broad_phase = false;
     let space = arm::joint_space(&setup.arm(), &[]);
-    let start = setup.to_chain(&p.start);
-    let goal = setup.to_chain(&p.goals[0]);
     let mut q = Vec::new();
     let (mut valid, mut steps) = (0, 0);
     for k in 0..=200 {
@@ -98,16 +103,11 @@ fn the_broad_phase_changes_no_answer() {
 #[test]
 fn segment_checks_answer_as_with_exact_distances() {
     use rand::{RngExt, SeedableRng};
-    let set = read_problems(&mbm("bookshelf_small")).unwrap();
-    let mut setup = ArmSetup::load(&set).unwrap();
-    let p = &set.problems[3];
-    setup.set_obstacles(&p.obstacles);
+    let (setup, start, goal) = shelves();
     let fast = setup.validity(0.0);
     let mut exact = setup.validity(0.0);
     exact.broad_phase = false;
     let space = arm::joint_space(&setup.arm(), &[]);
-    let start = setup.to_chain(&p.start);
-    let goal = setup.to_chain(&p.goals[0]);
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
     let (mut valid, mut invalid) = (0, 0);
     let mut a = Vec::new();

@@ -356,9 +356,11 @@ fn accepted_segments_pass_the_dense_recheck() {
     assert!(accepted >= 5 && refused >= 5, "{accepted} {refused}");
 }
 
-/// The robot's capped `segment_step` agrees with the default built on `clearances` (the same
-/// contact verdict and the same step, up to GJK's tolerance), at candidates (close
-/// to the body) and at random configurations, for random segment bounds.
+/// The robot's capped `segment_step` agrees with the default built on `clearances`: the same
+/// contact verdict, a step never longer (up to GJK's tolerance) and, where a part was taken at
+/// a cover bound that is enough (`ENOUGH_SHARE` in cellplan-motion's arm.rs), shorter but not by
+/// much over all — at candidates (close to the body) and at random configurations, for random
+/// segment bounds.
 #[test]
 fn capped_segment_step_agrees_with_the_default() {
     struct Plain<'a>(&'a RobotValidity<'a>);
@@ -372,7 +374,7 @@ fn capped_segment_step_agrees_with_the_default() {
     }
     let f = fixture();
     let mut rng = ChaCha8Rng::seed_from_u64(11);
-    let mut checked = 0;
+    let (mut checked, mut shorter, mut fast_sum, mut slow_sum) = (0, 0, 0.0, 0.0);
     for robot in &f.cell.robots {
         let mut v = robot_validity(&f.cell, robot, margin(&f.cell));
         v.own_radii = false;
@@ -391,12 +393,21 @@ fn capped_segment_step_agrees_with_the_default() {
                 (Some(a), Some(b)) => {
                     // GJK stops at a tolerance that depends on the cap: the two distances may
                     // differ by a few µm·1e-3, far inside the 1 µm slack taken off every one.
-                    assert!((a - b).abs() <= 1e-5 * b + 1e-9, "capped step {a}, default {b}");
+                    assert!(
+                        a > 0.0 && a <= b + 1e-5 * b + 1e-9,
+                        "capped step {a}, default {b}"
+                    );
                     checked += 1;
+                    shorter += usize::from(a < b - 1e-5 * b - 1e-9);
+                    fast_sum += a;
+                    slow_sum += b;
                 }
                 other => panic!("verdicts differ at {q:?}: {other:?}"),
             }
         }
     }
     assert!(checked > 100, "only {checked} valid configurations compared");
+    // Most steps are the same; the shorter ones cost little length over all.
+    assert!(shorter * 4 < checked, "{shorter} of {checked} shorter");
+    assert!(fast_sum >= 0.8 * slow_sum, "steps {fast_sum} against {slow_sum}");
 }

@@ -309,7 +309,7 @@ impl BroadPhase {
         self.scene_distance_enough(world, i, poses, placed, cap, cap)
     }
 
-    /// [`BroadPhase::scene_distance`] content with less: an object whose cover bound reaches
+    /// [`BroadPhase::scene_distance`], settling for less: an object whose cover bound reaches
     /// `enough` is taken at that bound (a lower bound of its distance) without the exact query.
     /// With `enough >= cap`, the same answer as `scene_distance`.
     pub fn scene_distance_enough(
