@@ -37,18 +37,22 @@
 //! (`bench/motion/README.md`). Pairs proven apart everywhere are not checked at all
 //! ([`apart_everywhere`]).
 use crate::plan::{Clearance, JointSpace, SegmentMotion, StateValidity, narrow_step};
-use cellplan_geom::spheres::Sphere;
 use cellplan_geom::{BroadPhase, CollisionWorld, GroupId, PlacedCovers, Pose};
 use cellplan_kin::Chain;
 use std::cell::{Cell, RefCell};
 use std::ops::Range;
 
 mod apart;
+mod clusters;
+mod radii;
 #[cfg(test)]
 mod tests;
 mod turned;
 
 pub use apart::{APART_BUDGET, apart_everywhere, pairs_that_may_touch};
+use clusters::{Clusters, Settled};
+use radii::{body_radii, moved_by, pair_radii};
+pub use radii::{joint_radii, point_speed_weights};
 pub use turned::{CLOSE, PROBES, PairTable, PairTables, pair_table};
 
 /// Clearances are capped at this (m) by default: larger values only lengthen the steps of a
@@ -135,140 +139,6 @@ impl Arm<'_> {
             out.push(pose);
         }
     }
-}
-
-/// For each joint, an upper bound (m) on the distance from its axis of any point of any body it
-/// moves, valid in every configuration (1 for a prismatic joint).
-///
-/// [`Chain::joint_radii`] (which says why it bounds motion) with each body's reach from its
-/// link's origin taken from its sphere cover: at most `|c| + r` over the spheres `(c, r)`,
-/// which contain the body. The root is fixed in the world, so the bound holds in world
-/// coordinates.
-pub fn joint_radii(arm: &Arm) -> Vec<f64> {
-    let bodies: Vec<(usize, f64)> = arm
-        .body_links
-        .iter()
-        .enumerate()
-        .filter_map(|(i, &link)| Some((link, body_reach(arm, i)?)))
-        .collect();
-    arm.chain.joint_radii(&bodies)
-}
-
-/// The largest distance of body `i`'s points from its link's origin, from its cover (`None`
-/// for a body without shapes).
-fn body_reach(arm: &Arm, i: usize) -> Option<f64> {
-    arm.world
-        .body_cover(arm.group, i)
-        .iter()
-        .map(|s| s.centre.length() + s.radius)
-        .fold(None, |m: Option<f64>, v| Some(m.map_or(v, |m| m.max(v))))
-}
-
-/// The chain link body `i` hangs on (the tip for a body without one).
-fn body_link(arm: &Arm, i: usize) -> usize {
-    let tip = arm.chain.links.len().saturating_sub(1);
-    arm.body_links.get(i).copied().unwrap_or(tip).min(tip)
-}
-
-/// The number of joints that move body `i`: joints `0..moved_by(arm, i)`.
-fn moved_by(arm: &Arm, i: usize) -> usize {
-    arm.chain.joints_to().get(body_link(arm, i)).copied().unwrap_or(0)
-}
-
-/// Body `i`'s radii: [`Chain::body_radii`] with its reach taken from its cover, and for the
-/// last joint before its link — whose axis stands still in the body's frame
-/// ([`Chain::joint_axis_in`]) — the reach of its cover from that axis, where smaller. A body
-/// turning about an axis moves no farther than its points lie from it: the gripper's bodies,
-/// centred on the wrist's last axis, reach a few centimetres from it, where the bound through
-/// the link's origin counts the whole offset to the flange.
-fn body_radii(arm: &Arm, i: usize) -> Vec<f64> {
-    let link = body_link(arm, i);
-    let mut radii = arm
-        .chain
-        .body_radii(link, body_reach(arm, i).unwrap_or(f64::INFINITY));
-    let last = arm
-        .chain
-        .joints_to()
-        .get(link)
-        .copied()
-        .unwrap_or(0)
-        .checked_sub(1);
-    if let Some(j) = last
-        && let Some(r) = axis_reach(arm, i, j, link)
-        && let Some(slot) = radii.get_mut(j)
-    {
-        *slot = slot.min(r);
-    }
-    radii
-}
-
-/// The radii bounding how fast the distance of a self pair can fall: those of its distal body
-/// (`far`, its [`body_radii`]), except for the first joint between the two, `first`, whose
-/// axis stands still in the frame of the proximal body `near`: turning it turns the distal
-/// body about that axis, or equally the proximal body about it the other way, so the distance
-/// changes no faster than the nearer of the two bodies' reaches from the axis allows. The
-/// upper arm reaches 0.64 m from the UR5's base axis; the base, 0.11 m.
-fn pair_radii(arm: &Arm, near: usize, first: usize, far: &[f64]) -> Vec<f64> {
-    let mut radii = far.to_vec();
-    if let Some(r) = axis_reach(arm, near, first, body_link(arm, near))
-        && let Some(slot) = radii.get_mut(first)
-    {
-        *slot = slot.min(r);
-    }
-    radii
-}
-
-/// The largest distance of body `i`'s points (its cover, in the frame of its link `link`) from
-/// the axis of joint `j` when that axis stands still in the link's frame; `None` when it does
-/// not, or for a body without shapes.
-fn axis_reach(arm: &Arm, i: usize, j: usize, link: usize) -> Option<f64> {
-    let (p, d) = arm.chain.joint_axis_in(j, link)?;
-    let cover = arm.world.body_cover(arm.group, i);
-    (!cover.is_empty()).then(|| {
-        cover
-            .iter()
-            .map(|s| (s.centre - p).cross(d).length() + s.radius)
-            .fold(0.0, f64::max)
-    })
-}
-
-/// Paper 002 §2.4's joint weights at `q`: for each joint `j`, `w_j(q) = max_p ‖∂p/∂q_j‖₁` over
-/// the points `p` of the bodies joint `j` moves — bounded from above over their sphere covers,
-/// which contain them: `‖a_j × (c − o_j)‖₁ + √3·r` for a sphere `(c, r)` and a turning joint
-/// with unit axis `a_j` through `o_j` (`‖a_j × δ‖₁ ≤ √3 |δ|`), `‖a_j‖₁` for a sliding one. 0 for a
-/// joint that moves no body. Each sphere holds some body point within `r` of its centre, so the
-/// bound exceeds the exact maximum by at most `2√3` times the largest radius. Unlike
-/// [`joint_radii`], which hold in every configuration, these hold at `q` only (to first order
-/// nearby).
-pub fn point_speed_weights(arm: &Arm, q: &[f64]) -> Vec<f64> {
-    let chain = arm.chain;
-    let mut links = Vec::new();
-    let mut bodies = Vec::new();
-    arm.body_poses(q, &mut links, &mut bodies);
-    let moved: Vec<usize> = (0..arm.body_links.len()).map(|i| moved_by(arm, i)).collect();
-    (0..chain.dof())
-        .map(|j| {
-            let (Some(joint), Some(k)) = (chain.joints.get(j), chain.joint_link(j)) else {
-                return 0.0;
-            };
-            let frame = arm.base * links.get(k).copied().unwrap_or(Pose::IDENTITY);
-            let a = (frame.rotation * joint.axis).normalize_or_zero();
-            let o = frame.translation;
-            let l1 = |v: cellplan_geom::DVec3| v.x.abs() + v.y.abs() + v.z.abs();
-            // Every sphere of every body joint `j` moves.
-            let mut spheres = bodies
-                .iter()
-                .enumerate()
-                .filter(|(i, _)| moved.get(*i).is_some_and(|&m| j < m))
-                .flat_map(|(i, pose)| arm.world.body_cover(arm.group, i).iter().map(move |s| (pose, s)));
-            if !joint.is_rotational() {
-                return if spheres.next().is_some() { l1(a) } else { 0.0 };
-            }
-            spheres
-                .map(|(pose, s)| l1(a.cross(pose.transform_point(s.centre) - o)) + 3f64.sqrt() * s.radius)
-                .fold(0.0, f64::max)
-        })
-        .collect()
 }
 
 /// The configurations that move the tool point `tcp` (a pose in the chain's tip frame) from
@@ -378,165 +248,6 @@ pub struct ArmValidity<'a> {
     broad: BroadPhase,
     /// Bodies grouped by link ([`Clusters`]), to settle several parts with one test.
     clusters: Clusters,
-}
-
-/// The bodies of one link share its frame, so one sphere holds their outer spheres; where that
-/// sphere is clear of the scene (or of another link's) by what each of its parts is asked,
-/// those parts answer their caps without a query of their own (the test they would make, on a
-/// larger sphere: the same answers). A pair is in up to two groups: the two links' clusters,
-/// and, when its first body's link has several bodies, that body alone against the other
-/// link's cluster (the UR5's forearm pieces against its gripper's twelve). At most 64 clusters
-/// moving against the scene and 64 groups (bits of a mask).
-#[derive(Clone, Debug, Default)]
-struct Clusters {
-    /// Per sphere: one of its bodies (whose pose places it) and the sphere in that frame. The
-    /// links' clusters first, then single bodies of the groups.
-    spheres: Vec<(usize, Sphere)>,
-    /// Per moving part (index into `moving`): its cluster, when that has two moving parts or
-    /// more.
-    scene: Vec<Option<usize>>,
-    /// Per pair (index into `pairs`): its groups, coarse then fine, each when it holds two
-    /// pairs or more.
-    pair: Vec<[Option<usize>; 2]>,
-    /// The groups: two spheres.
-    groups: Vec<(usize, usize)>,
-}
-
-/// How many groups a `u64` mask tracks.
-const MASK_BITS: usize = 64;
-
-impl Clusters {
-    fn new(
-        arm: &Arm,
-        broad: &BroadPhase,
-        moving: &[(usize, Range<usize>)],
-        pairs: &[(usize, usize)],
-    ) -> Clusters {
-        let n = arm.body_links.len();
-        // One cluster per link with bodies, in body order.
-        let mut of_body = vec![usize::MAX; n];
-        let mut members: Vec<Vec<usize>> = Vec::new();
-        for i in 0..n {
-            let found = (0..i)
-                .find(|&k| arm.body_links[k] == arm.body_links[i])
-                .map(|k| of_body[k]);
-            let c = found.unwrap_or_else(|| {
-                members.push(Vec::new());
-                members.len() - 1
-            });
-            of_body[i] = c;
-            members[c].push(i);
-        }
-        let mut spheres: Vec<Option<(usize, Sphere)>> = members
-            .iter()
-            .map(|m| broad.outer_of(m).map(|s| (m[0], s)))
-            .collect();
-        // Body `i` alone, for the fine groups (its link has other bodies).
-        let mut alone = vec![None; n];
-        for i in 0..n {
-            if members[of_body[i]].len() >= 2 {
-                alone[i] = Some(spheres.len());
-                spheres.push(broad.outer_of(&[i]).map(|s| (i, s)));
-            }
-        }
-        let usable = |c: usize| spheres.get(c).is_some_and(Option::is_some);
-        let mut moving_in = vec![0usize; members.len()];
-        for (i, _) in moving {
-            moving_in[of_body[*i]] += 1;
-        }
-        let scene = moving
-            .iter()
-            .map(|(i, _)| {
-                let c = of_body[*i];
-                (usable(c) && moving_in[c] >= 2 && c < MASK_BITS).then_some(c)
-            })
-            .collect();
-        // Each pair's candidate groups (coarse, fine), counted.
-        let keys: Vec<[Option<(usize, usize)>; 2]> = pairs
-            .iter()
-            .map(|&(i, j)| {
-                let (ci, cj) = (of_body[i], of_body[j]);
-                let fine = alone[i].filter(|_| members[cj].len() >= 2).map(|a| (a, cj));
-                [Some((ci, cj)), fine]
-            })
-            .collect();
-        let mut counts: Vec<((usize, usize), usize)> = Vec::new();
-        for key in keys.iter().flatten().flatten() {
-            match counts.iter_mut().find(|(k, _)| k == key) {
-                Some((_, c)) => *c += 1,
-                None => counts.push((*key, 1)),
-            }
-        }
-        let mut groups: Vec<(usize, usize)> = Vec::new();
-        let pair = keys
-            .iter()
-            .map(|ks| {
-                ks.map(|key| {
-                    let key = key?;
-                    let size = counts.iter().find(|(k, _)| *k == key).map_or(0, |(_, c)| *c);
-                    if !(usable(key.0) && usable(key.1) && key.0 != key.1 && size >= 2) {
-                        return None;
-                    }
-                    let g = groups.iter().position(|&k| k == key).unwrap_or_else(|| {
-                        groups.push(key);
-                        groups.len() - 1
-                    });
-                    (g < MASK_BITS).then_some(g)
-                })
-            })
-            .collect();
-        let nowhere = Sphere {
-            centre: cellplan_geom::DVec3::ZERO,
-            radius: f64::INFINITY,
-        };
-        Clusters {
-            spheres: spheres.into_iter().map(|s| s.unwrap_or((0, nowhere))).collect(),
-            scene,
-            pair,
-            groups,
-        }
-    }
-
-    /// Cluster `c`'s sphere placed at the body poses `bodies`.
-    #[inline]
-    fn placed(&self, c: usize, bodies: &[Pose]) -> Sphere {
-        let (body, s) = self.spheres[c];
-        let pose = bodies.get(body).copied().unwrap_or(Pose::IDENTITY);
-        Sphere {
-            centre: pose.rotation * s.centre + pose.translation,
-            radius: s.radius,
-        }
-    }
-
-    /// Whether group `g`'s two clusters, placed at `bodies`, are at least `best` apart.
-    #[inline]
-    fn group_apart(&self, g: usize, bodies: &[Pose], best: f64) -> bool {
-        let (a, b) = self.groups[g];
-        let (sa, sb) = (self.placed(a, bodies), self.placed(b, bodies));
-        (sa.centre - sb.centre).length() - sa.radius - sb.radius >= best.max(0.0)
-    }
-}
-
-/// Groups tested and found clear within one check (bits of [`Clusters`]' indices).
-#[derive(Clone, Copy, Default)]
-struct Settled {
-    tested: u64,
-    clear: u64,
-}
-
-impl Settled {
-    /// Whether group `k` is clear: `test()` asked the first time only.
-    #[inline]
-    fn clear(&mut self, k: usize, test: impl FnOnce() -> bool) -> bool {
-        let bit = 1u64 << k;
-        if self.tested & bit == 0 {
-            self.tested |= bit;
-            if test() {
-                self.clear |= bit;
-            }
-        }
-        self.clear & bit != 0
-    }
 }
 
 impl<'a> ArmValidity<'a> {

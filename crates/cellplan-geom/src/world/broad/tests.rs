@@ -1,0 +1,206 @@
+//! The broad phase against the world's exact queries.
+use super::BroadPhase;
+use crate::world::tests::random_pose;
+use crate::world::{CollisionWorld, GroupBody};
+use crate::{DQuat, DVec3, Pose, ShapeSpec};
+use rand::{RngExt, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+
+fn close(a: f64, b: f64) -> bool {
+    (a - b).abs() <= 1e-9 + 1e-3 * b.abs()
+}
+
+fn hull_body(name: &str, half: DVec3) -> GroupBody {
+    GroupBody {
+        name: name.into(),
+        shapes: vec![
+            (ShapeSpec::Box { half_extents: half }, Pose::IDENTITY),
+            (
+                ShapeSpec::Sphere { radius: half.y },
+                Pose::translation(half.x, 0.0, 0.0),
+            ),
+        ],
+    }
+}
+
+/// The sphere of several bodies sharing a frame holds each one's outer sphere (and is not
+/// much larger than it must be), and a sphere clears the scene at a threshold exactly when
+/// every run's box is that far from it.
+#[test]
+fn a_sphere_of_bodies_holds_their_outer_spheres_and_clears_as_the_boxes_say() {
+    let mut world = CollisionWorld::new();
+    world.add_static(
+        "box",
+        &ShapeSpec::Box {
+            half_extents: DVec3::new(0.3, 0.2, 0.05),
+        },
+        Pose::from_parts(DVec3::new(0.0, 0.0, -0.6), DQuat::from_rotation_z(0.4)),
+    );
+    world.add_static(
+        "ball",
+        &ShapeSpec::Sphere { radius: 0.15 },
+        Pose::translation(0.8, 0.3, 0.2),
+    );
+    let bodies = (0..4)
+        .map(|k| GroupBody {
+            name: format!("b{k}"),
+            shapes: vec![(
+                ShapeSpec::Box {
+                    half_extents: DVec3::new(0.02 + 0.03 * k as f64, 0.03, 0.02),
+                },
+                Pose::translation(0.1 * k as f64, 0.05 * k as f64, 0.0),
+            )],
+        })
+        .collect();
+    let g = world.add_group("arm", bodies);
+    let broad = BroadPhase::new(&world, g, &[]);
+    assert!(broad.outer_of(&[]).is_none());
+    for set in [vec![0], vec![0, 1], vec![1, 3], vec![0, 1, 2, 3]] {
+        let s = broad.outer_of(&set).unwrap();
+        let mut needed = 0.0f64;
+        for &i in &set {
+            let o = broad.outer[i].unwrap();
+            let reach = (o.centre - s.centre).length() + o.radius;
+            assert!(
+                reach <= s.radius,
+                "{set:?}: body {i} reaches {reach} > {}",
+                s.radius
+            );
+            needed = needed.max(reach);
+        }
+        assert!(
+            s.radius <= needed * 1.3 + 1e-9,
+            "{set:?}: {} for {needed}",
+            s.radius
+        );
+    }
+    let mut rng = ChaCha8Rng::seed_from_u64(3);
+    let mut clear = 0;
+    for _ in 0..2000 {
+        let sphere = super::Sphere {
+            centre: DVec3::new(
+                rng.random_range(-1.0..1.5),
+                rng.random_range(-1.0..1.0),
+                rng.random_range(-1.0..1.0),
+            ),
+            radius: rng.random_range(0.0..0.3),
+        };
+        let best = rng.random_range(-0.1..0.5);
+        let gap = broad
+            .runs
+            .iter()
+            .map(|(lo, hi, _)| super::point_box_distance(sphere.centre, *lo, *hi) - sphere.radius)
+            .fold(f64::INFINITY, f64::min);
+        assert_eq!(
+            broad.sphere_clears_scene(sphere, best),
+            gap >= best.max(0.0),
+            "{sphere:?} at {best}"
+        );
+        clear += usize::from(gap >= best.max(0.0));
+    }
+    assert!((200..1800).contains(&clear), "{clear} clear");
+    let nan = super::Sphere {
+        centre: DVec3::NAN,
+        radius: 0.1,
+    };
+    assert!(!broad.sphere_clears_scene(nan, 0.0));
+}
+
+/// Over random placements, the broad phase (with its guesses of the separating directions)
+/// gives the exact distances of the world's own
+/// queries: to every object kind, to a parked group, between two bodies, under any cap —
+/// up to GJK's tolerance: a seeded run stops at another point of its convergence, which is
+/// slow against curved shapes (the ball: a few 1e-4 of the distance). Both answers are
+/// certified lower bounds (see `hinted_distance`), so neither is ever too large.
+#[test]
+fn broad_phase_distances_equal_the_exact_ones() {
+    let mut world = CollisionWorld::new();
+    world.add_static(
+        "box",
+        &ShapeSpec::Box {
+            half_extents: DVec3::new(0.3, 0.2, 0.05),
+        },
+        Pose::from_parts(DVec3::new(0.0, 0.0, 0.0), DQuat::from_rotation_z(0.4)),
+    );
+    world.add_static(
+        "drum",
+        &ShapeSpec::Cylinder {
+            radius: 0.1,
+            half_height: 0.3,
+        },
+        Pose::from_parts(DVec3::new(0.6, 0.0, 0.0), DQuat::from_rotation_x(0.7)),
+    );
+    world.add_static(
+        "ball",
+        &ShapeSpec::Sphere { radius: 0.15 },
+        Pose::translation(-0.5, 0.3, 0.2),
+    );
+    let sheet = crate::Mesh {
+        vertices: vec![
+            DVec3::new(-1.0, -1.0, 0.5),
+            DVec3::new(1.0, -1.0, 0.5),
+            DVec3::new(1.0, 1.0, 0.5),
+            DVec3::new(-1.0, 1.0, 0.7),
+        ],
+        triangles: vec![[0, 1, 2], [0, 2, 3]],
+    };
+    world.add_static(
+        "sheet",
+        &ShapeSpec::Mesh(std::sync::Arc::new(sheet)),
+        Pose::IDENTITY,
+    );
+    let g = world.add_group(
+        "arm",
+        vec![
+            hull_body("a", DVec3::new(0.2, 0.03, 0.04)),
+            hull_body("b", DVec3::new(0.1, 0.05, 0.05)),
+        ],
+    );
+    let other = world.add_group("parked", vec![hull_body("c", DVec3::new(0.15, 0.04, 0.04))]);
+    let parked_poses = vec![Pose::translation(0.2, -0.5, -0.3)];
+    let broad = BroadPhase::new(&world, g, &[(other, parked_poses.clone())]);
+    assert_eq!(broad.object_count(), 5);
+    let mut rng = ChaCha8Rng::seed_from_u64(5);
+    let mut placed = super::PlacedCovers::default();
+    let (mut near, mut touching) = (0, 0);
+    for _ in 0..4000 {
+        let poses = [random_pose(&mut rng, 0.8), random_pose(&mut rng, 0.8)];
+        let cap = if rng.random_bool(0.5) {
+            10.0
+        } else {
+            rng.random_range(0.0..0.2)
+        };
+        broad.place(&poses, &mut placed);
+        for i in 0..2 {
+            let exact = world
+                .body_static_distance(g, i, &poses, cap)
+                .min(world.body_group_distance(g, i, &poses, other, &parked_poses, cap));
+            let fast = broad.scene_distance(&world, i, &poses, &placed, cap);
+            assert!(close(fast, exact), "body {i}: {fast} vs {exact} (cap {cap})");
+            let bound = broad.scene_bound(&world, i, &placed, cap);
+            assert!(bound <= exact + 1e-9, "bound {bound} above {exact}");
+            assert!(bound <= cap.max(0.0));
+            if exact > 0.0 && exact < cap.min(0.05) {
+                near += 1;
+                // Tight enough to be of use near the objects.
+                assert!(bound >= exact - 0.12, "bound {bound} far below {exact}");
+            }
+            touching += usize::from(exact == 0.0);
+        }
+        let exact = world.pair_distance(g, 0, 1, &poses, cap);
+        let fast = broad.pair_distance(&world, 0, 1, &poses, &placed, cap);
+        assert!(close(fast, exact), "pair: {fast} vs {exact} (cap {cap})");
+        let bound = broad.pair_bound(0, 1, &placed, cap);
+        assert!(bound <= exact + 1e-9, "pair bound {bound} above {exact}");
+    }
+    assert!(
+        near > 50 && touching > 50,
+        "the test places bodies near and on the objects ({near}, {touching})"
+    );
+    // A non-finite pose is at distance 0, bound and exact alike.
+    let bad = [Pose::translation(f64::NAN, 0.0, 0.0), Pose::IDENTITY];
+    broad.place(&bad, &mut placed);
+    assert_eq!(broad.scene_bound(&world, 0, &placed, 1.0), 0.0);
+    assert_eq!(broad.scene_distance(&world, 0, &bad, &placed, 1.0), 0.0);
+    assert_eq!(broad.pair_bound(0, 1, &placed, 1.0), 0.0);
+}
