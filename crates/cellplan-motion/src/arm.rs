@@ -128,7 +128,7 @@ impl Arm<'_> {
         links.resize(self.chain.links.len(), Pose::IDENTITY);
         self.chain.fk_all(q, links);
         out.clear();
-        // Bodies of one link are listed together and share its pose: composed once.
+        // A body on the same link as the one before shares its pose: composed once.
         let mut last: Option<(usize, Pose)> = None;
         for &l in self.body_links {
             let pose = match last {
@@ -366,24 +366,14 @@ impl<'a> ArmValidity<'a> {
         })
     }
 
-    /// Distance of moving body `i` to the scene and the parked groups, capped at `cap`: through
-    /// the broad phase when it is on, else exact for every object.
-    fn scene_part(&self, i: usize, bodies: &[Pose], placed: &PlacedCovers, cap: f64) -> f64 {
-        self.scene_part_enough(i, bodies, placed, (cap, cap))
-    }
-
-    /// [`Self::scene_part`], where a cover bound reaching `enough` answers without the exact
-    /// query (see [`BroadPhase::scene_distance_enough`]).
-    fn scene_part_enough(
-        &self,
-        i: usize,
-        bodies: &[Pose],
-        placed: &PlacedCovers,
-        (cap, enough): (f64, f64),
-    ) -> f64 {
+    /// Distance of moving body `i` to the scene and the parked groups, of `(cap, enough)` capped
+    /// at `cap`: through the broad phase when it is on — where a cover bound reaching `enough`
+    /// answers without the exact query ([`BroadPhase::scene_distance_enough`]) — else exact for
+    /// every object.
+    fn scene_part(&self, i: usize, bodies: &[Pose], placed: &PlacedCovers, (cap, enough): (f64, f64)) -> f64 {
         if self.broad_phase {
             self.broad
-                .scene_distance_enough(self.arm.world, i, bodies, placed, cap, enough)
+                .scene_distance_enough(self.arm.world, i, bodies, placed, (cap, enough))
         } else {
             self.body_scene_distance(i, bodies, cap)
         }
@@ -467,7 +457,7 @@ impl<'a> ArmValidity<'a> {
                 {
                     return true;
                 }
-                self.scene_part(*i, bodies, placed, need + tiny) > need
+                self.scene_part(*i, bodies, placed, (need + tiny, need + tiny)) > need
             } else if let Some(&(i, j, _, _)) = self.pairs.get(k - m) {
                 if self.pair_groups(k - m).any(|&g| {
                     settled(&pair_sets, g, &|| {
@@ -534,7 +524,7 @@ impl<'a> ArmValidity<'a> {
             let scene_clear = self
                 .moving
                 .iter()
-                .all(|(i, _)| trusted(self.scene_part(*i, bodies, placed, cap)) - margin >= scene);
+                .all(|(i, _)| trusted(self.scene_part(*i, bodies, placed, (cap, cap))) - margin >= scene);
             let cap = past(own).min(self.cap);
             scene_clear
                 && self
@@ -648,7 +638,7 @@ impl StateValidity for ArmValidity<'_> {
         let margin = self.margin.max(0.0);
         self.posed(q, |bodies, placed| {
             for (i, joints) in &self.moving {
-                let d = self.scene_part(*i, bodies, placed, self.cap + margin);
+                let d = self.scene_part(*i, bodies, placed, (self.cap + margin, self.cap + margin));
                 out.push(Clearance {
                     distance: trusted(d) - margin,
                     joints: joints.clone(),
@@ -703,7 +693,7 @@ impl StateValidity for ArmValidity<'_> {
                     continue;
                 }
                 let part = self.capped_part(
-                    |cap| self.scene_part_enough(*i, bodies, placed, cap),
+                    |cap| self.scene_part(*i, bodies, placed, cap),
                     margin,
                     b,
                     step,

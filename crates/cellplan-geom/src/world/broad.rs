@@ -306,20 +306,19 @@ impl BroadPhase {
         placed: &PlacedCovers,
         cap: f64,
     ) -> f64 {
-        self.scene_distance_enough(world, i, poses, placed, cap, cap)
+        self.scene_distance_enough(world, i, poses, placed, (cap, cap))
     }
 
-    /// [`BroadPhase::scene_distance`], settling for less: an object whose cover bound reaches
-    /// `enough` is taken at that bound (a lower bound of its distance) without the exact query.
-    /// With `enough >= cap`, the same answer as `scene_distance`.
+    /// [`BroadPhase::scene_distance`] capped at `cap`, settling for less: an object whose cover
+    /// bound reaches `enough` is taken at that bound (a lower bound of its distance) without the
+    /// exact query. With `enough >= cap`, the same answer as `scene_distance`.
     pub fn scene_distance_enough(
         &self,
         world: &CollisionWorld,
         i: usize,
         poses: &[Pose],
         placed: &PlacedCovers,
-        cap: f64,
-        enough: f64,
+        (cap, enough): (f64, f64),
     ) -> f64 {
         let mut best = sanitize_margin(cap);
         let outer = match self.placed_body(i, placed, best) {

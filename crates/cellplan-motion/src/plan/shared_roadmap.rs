@@ -118,7 +118,7 @@ fn nearest(space: &JointSpace, nodes: &[Vec<f64>], q: &[f64], k: usize, skip: us
 
 impl SharedRoadmap {
     /// Builds the roadmap from `seeds` (the valid ones are kept) and `settings.samples` samples
-    /// of `space` (seeded by `settings.seed`; every other one uniform, the rest within [`NEAR`]
+    /// of `space` (seeded by `settings.seed`; every other one uniform, the rest within `NEAR` (0.5 rad)
     /// of a valid seed on every joint; the valid ones are kept), each node
     /// linked to its `settings.neighbours` nearest. Single-threaded and deterministic. Returns
     /// the roadmap and the validity calls made.
