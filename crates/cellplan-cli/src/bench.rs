@@ -87,6 +87,10 @@ pub struct BenchArgs {
     /// planner alone).
     #[arg(long)]
     pub no_exact: bool,
+    /// Motion: no post-processing (shortcuts, redundant waypoints): the planner's raw path, as
+    /// VAMP's and OMPL's planners return it without their simplification.
+    #[arg(long)]
+    pub no_simplify: bool,
     /// Motion: keep the paths in the JSON rows.
     #[arg(long)]
     pub with_paths: bool,

@@ -31,6 +31,8 @@ pub struct Request<'a> {
     pub first: Option<usize>,
     /// Largest point motion between two samples of the exact re-check (m); `None`: no re-check.
     pub exact_step: Option<f64>,
+    /// Post-process found paths ([`PlannerParams::simplify`]).
+    pub simplify: bool,
 }
 
 /// One problem × run.
@@ -57,6 +59,9 @@ pub struct Row {
     /// Of those, the checks of the path's simplification.
     #[serde(default)]
     pub simplify_checks: usize,
+    /// Of the query's time, the simplification's (s).
+    #[serde(default)]
+    pub simplify_time_s: f64,
     /// The exact re-check passed (`false` when there is no path).
     pub exact_valid: bool,
     /// Configurations the exact re-check tested.
@@ -139,6 +144,7 @@ pub fn run(req: &Request) -> Result<Vec<Row>, ProblemError> {
             for seed in 0..req.runs {
                 let params = PlannerParams {
                     seed,
+                    simplify: req.simplify,
                     ..PlannerParams::default()
                 };
                 let stop = Termination::samples(req.max_samples)
@@ -164,6 +170,7 @@ pub fn run(req: &Request) -> Result<Vec<Row>, ProblemError> {
                     waypoints: file_path.as_ref().map_or(0, Vec::len),
                     validity_checks: checks,
                     simplify_checks,
+                    simplify_time_s: result.work.simplify_time.as_secs_f64(),
                     exact_valid: false,
                     exact_samples: 0,
                     exact_contact: None,
@@ -233,6 +240,7 @@ pub fn recheck(files: &[PathBuf], run_file: &Path, step: f64) -> Result<Vec<Row>
                 waypoints: p.path.as_ref().map_or(0, Vec::len),
                 validity_checks: p.validity_checks.unwrap_or(0),
                 simplify_checks: 0,
+                simplify_time_s: 0.0,
                 exact_valid: false,
                 exact_samples: 0,
                 exact_contact: None,

@@ -500,6 +500,7 @@ fn run_bench_motion(args: &bench::BenchArgs) -> Result<(), Failure> {
             runs: args.runs,
             first: args.first,
             exact_step: (!args.no_exact).then_some(step),
+            simplify: !args.no_simplify,
         })
         .map_err(problem_failure)?,
     };

@@ -298,12 +298,12 @@ impl<'a> Run<'a> {
     }
 }
 
-/// The edge length of tree planners: `params.range`, or a fifth of the space's extent.
-pub(crate) fn range_of(space: &JointSpace, params: &PlannerParams) -> f64 {
+/// The edge length of tree planners: `params.range`, or `share` of the space's extent.
+pub(crate) fn range_of(space: &JointSpace, params: &PlannerParams, share: f64) -> f64 {
     if params.range > 0.0 {
         params.range
     } else {
-        (0.2 * space.extent()).max(1e-6)
+        (share * space.extent()).max(1e-6)
     }
 }
 

@@ -21,9 +21,20 @@ pub trait MotionPlanner: Send {
 pub struct PlannerParams {
     /// Seed of the random numbers (ChaCha8) of the search and of the post-processing.
     pub seed: u64,
-    /// Longest tree edge (RRT-Connect, RRT*), in the space's metric; 0 or less: a fifth of
-    /// the space's [`super::JointSpace::extent`] (OMPL's default).
+    /// Longest tree edge (RRT-Connect, RRT*), in the space's metric; 0 or less: a share of
+    /// the space's [`super::JointSpace::extent`], [`PlannerParams::range_share`] for
+    /// RRT-Connect, a fifth for RRT* (OMPL's default).
     pub range: f64,
+    /// RRT-Connect's range when `range` is 0, in shares of the space's extent: by default a
+    /// tenth (VAMP's 1.5 rad on the MBM UR5; OMPL's fifth makes edges that fail far more
+    /// often in cluttered scenes).
+    pub range_share: f64,
+    /// RRT-Connect: dynamic domains (Yershova et al. 2005, with VAMP's settings): a node
+    /// whose extension failed is extended only towards samples near it.
+    pub dynamic_domain: bool,
+    /// RRT-Connect: a tree less than half the other's size is extended again instead of in
+    /// turn (VAMP's balancing).
+    pub balance: bool,
     /// Whether a found path is post-processed by [`super::shortcut`] (shortcuts, then
     /// redundant waypoints dropped).
     pub simplify: bool,
@@ -46,6 +57,9 @@ impl Default for PlannerParams {
         PlannerParams {
             seed: 0,
             range: 0.0,
+            range_share: 0.1,
+            dynamic_domain: true,
+            balance: true,
             simplify: true,
             shortcut_iterations: 100,
             goal_bias: 0.05,

@@ -20,11 +20,25 @@ pub struct RrtConnect {
     pub params: PlannerParams,
 }
 
+/// The dynamic domain's radius after a node's first failed extension, in ranges (VAMP's UR5
+/// settings: 4 against a range of 1.5).
+const DOMAIN_RADIUS: f64 = 4.0 / 1.5;
+
+/// The smallest dynamic-domain radius, in ranges (VAMP: 1 against 1.5).
+const DOMAIN_MIN: f64 = 1.0 / 1.5;
+
+/// A failed extension shrinks its node's radius by this share, a successful one from a node
+/// with a radius grows it by as much (Yershova et al.'s adaptive variant, as VAMP tunes it).
+const DOMAIN_ALPHA: f64 = 1e-4;
+
 struct Tree {
     nodes: Vec<Vec<f64>>,
     parent: Vec<usize>,
     /// For each node, the index of its root's query end (0 for the start, else the goal's).
     origin: Vec<usize>,
+    /// For each node, its dynamic domain: samples farther from it than this are not extended
+    /// from it (infinite until an extension from it fails).
+    domain: Vec<f64>,
 }
 
 impl Tree {
@@ -33,13 +47,32 @@ impl Tree {
             nodes: Vec::new(),
             parent: Vec::new(),
             origin: Vec::new(),
+            domain: Vec::new(),
         };
         for (q, origin) in roots {
-            tree.nodes.push(q);
-            tree.parent.push(usize::MAX);
-            tree.origin.push(origin);
+            tree.push(q, usize::MAX, origin);
         }
         tree
+    }
+
+    fn push(&mut self, q: Vec<f64>, parent: usize, origin: usize) -> usize {
+        self.nodes.push(q);
+        self.parent.push(parent);
+        self.origin.push(origin);
+        self.domain.push(f64::INFINITY);
+        self.nodes.len() - 1
+    }
+
+    /// An extension from node `i` failed (`ok` false) or succeeded: its domain shrinks (set
+    /// on the first failure) or grows, never below `min`.
+    fn learn(&mut self, i: usize, ok: bool, (radius, min): (f64, f64)) {
+        let r = &mut self.domain[i];
+        *r = match (ok, r.is_finite()) {
+            (false, false) => radius,
+            (false, true) => (*r * (1.0 - DOMAIN_ALPHA)).max(min),
+            (true, true) => *r * (1.0 + DOMAIN_ALPHA),
+            (true, false) => return,
+        };
     }
 
     /// Root-to-node path.
@@ -68,10 +101,7 @@ fn extend_from(run: &mut Run, range: f64, tree: &mut Tree, from: usize, target: 
     if !run.segment(near, &q_new) {
         return Extend::Trapped;
     }
-    tree.nodes.push(q_new);
-    tree.parent.push(from);
-    tree.origin.push(tree.origin[from]);
-    let i = tree.nodes.len() - 1;
+    let i = tree.push(q_new, from, tree.origin[from]);
     if reached {
         Extend::Reached(i)
     } else {
@@ -103,7 +133,8 @@ pub(crate) fn search(
     goals: &[Vec<f64>],
     valid: &[usize],
 ) -> Found {
-    let range = range_of(run.space, params);
+    let range = range_of(run.space, params, params.range_share);
+    let domain = (DOMAIN_RADIUS * range, DOMAIN_MIN * range);
     let mut rng = ChaCha8Rng::seed_from_u64(params.seed);
     // trees[0] grows from the start, trees[1] from the goals; `a` is the one extended.
     let mut trees = [
@@ -123,9 +154,20 @@ pub(crate) fn search(
             (&mut y[0], &mut x[0])
         };
         let from = run.space.nearest(&ta.nodes, &q_rand);
-        let new = match extend_from(run, range, ta, from, &q_rand) {
-            Extend::Trapped => None,
-            Extend::Advanced(i) | Extend::Reached(i) => Some(i),
+        // Dynamic domain (Yershova et al. 2005): a node whose extension failed before is
+        // extended only towards samples within its radius, so that samples behind the
+        // obstacles it met cost no segment check.
+        let new = if params.dynamic_domain && run.space.distance(&ta.nodes[from], &q_rand) > ta.domain[from] {
+            None
+        } else {
+            let new = match extend_from(run, range, ta, from, &q_rand) {
+                Extend::Trapped => None,
+                Extend::Advanced(i) | Extend::Reached(i) => Some(i),
+            };
+            if params.dynamic_domain {
+                ta.learn(from, new.is_some(), domain);
+            }
+            new
         };
         if let Some(i) = new {
             let target = ta.nodes[i].clone();
@@ -140,7 +182,10 @@ pub(crate) fn search(
                 return Found::path(waypoints, trees[1].origin[gi]);
             }
         }
-        a = 1 - a;
+        // Balanced (as VAMP): a tree less than half the other's size is extended again.
+        if !params.balance || trees[1 - a].nodes.len() < 2 * trees[a].nodes.len() {
+            a = 1 - a;
+        }
     }
 }
 
@@ -180,5 +225,35 @@ impl Planner for RrtConnect {
             })
             .into_planned()
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A node's domain is unbounded until an extension from it fails, then the set radius,
+    /// shrinking with each failure down to the smallest, growing with each success.
+    #[test]
+    fn dynamic_domains_shrink_on_failure_and_grow_on_success() {
+        let mut tree = Tree::new([(vec![0.0], 0)]);
+        let (radius, min) = (4.0, 1.0);
+        tree.learn(0, true, (radius, min));
+        assert_eq!(tree.domain[0], f64::INFINITY);
+        tree.learn(0, false, (radius, min));
+        assert_eq!(tree.domain[0], radius);
+        tree.learn(0, false, (radius, min));
+        assert_eq!(tree.domain[0], radius * (1.0 - DOMAIN_ALPHA));
+        tree.learn(0, true, (radius, min));
+        assert_eq!(
+            tree.domain[0],
+            radius * (1.0 - DOMAIN_ALPHA) * (1.0 + DOMAIN_ALPHA)
+        );
+        for _ in 0..200_000 {
+            tree.learn(0, false, (radius, min));
+        }
+        assert_eq!(tree.domain[0], min);
+        let i = tree.push(vec![1.0], 0, 0);
+        assert_eq!(tree.domain[i], f64::INFINITY);
     }
 }

@@ -119,7 +119,7 @@ pub(crate) fn search(
     valid: &[usize],
 ) -> Found {
     let space = run.space;
-    let range = range_of(space, params);
+    let range = range_of(space, params, 0.2);
     let d = free_dim(space) as f64;
     let gamma = params.rewire_factor * gamma_min(space);
     let mut rng = ChaCha8Rng::seed_from_u64(params.seed);

@@ -334,3 +334,35 @@ fn rrt_star_gives_an_approximate_path_when_asked() {
         Err(PlanError::NoPath { samples: 500, .. })
     ));
 }
+
+/// RRT-Connect with and without the VAMP tuning (dynamic domains, balanced trees): both solve
+/// the wall and the ring's outside, with valid paths, and the tuning changes the search; a
+/// cell's legs keep the OMPL-like search.
+#[test]
+fn rrt_connect_tuning_solves_and_cells_keep_the_ompl_search() {
+    let space = square(2, 10.0);
+    let v = wall();
+    let goals = [vec![9.0, 1.0]];
+    let problem = Problem::new(&space, &v, &[1.0, 1.0], &goals);
+    let stop = Termination::samples(5_000);
+    let mut calls = Vec::new();
+    for (dynamic_domain, balance) in [(false, false), (true, false), (false, true), (true, true)] {
+        let mut total = 0;
+        for seed in 0..4 {
+            let p = PlannerParams {
+                dynamic_domain,
+                balance,
+                ..params(seed)
+            };
+            let r = solve("rrt-connect", &p, &problem, &v, &stop);
+            assert_valid_path("rrt-connect", &problem, &v, &r);
+            total += r.work.validity_calls;
+        }
+        calls.push(total);
+    }
+    assert!(calls[1..].iter().any(|&c| c != calls[0]), "{calls:?}");
+    let cell = PlanSettings::default().params();
+    assert!(!cell.dynamic_domain && !cell.balance && cell.range_share == 0.2);
+    let standalone = PlannerParams::default();
+    assert!(standalone.dynamic_domain && standalone.balance && standalone.range_share == 0.1);
+}
