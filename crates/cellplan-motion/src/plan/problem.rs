@@ -358,9 +358,9 @@ pub(crate) fn solve_with(
             run.space,
             run.validity,
             &mut result.waypoints,
-            params.seed,
-            params.shortcut_iterations,
+            (params.seed, params.shortcut_iterations),
             run.floor,
+            params.skip_small_shortcuts,
         );
         result.work.simplify_calls = calls;
         run.calls += calls;

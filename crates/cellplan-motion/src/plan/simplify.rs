@@ -33,9 +33,9 @@ pub fn shortcut(
         space,
         validity,
         waypoints,
-        settings.seed,
-        settings.shortcut_iterations,
+        (settings.seed, settings.shortcut_iterations),
         settings.min_clearance,
+        false,
     )
 }
 
@@ -58,7 +58,7 @@ pub fn shortcut_timed(
         space,
         validity,
         waypoints,
-        (settings.seed, settings.shortcut_iterations),
+        (settings.seed, settings.shortcut_iterations, false),
         settings.min_clearance,
         Some(&cost),
     )
@@ -67,20 +67,21 @@ pub fn shortcut_timed(
 /// A segment's cost: its time (rest to rest) when shortcutting for time.
 type SegmentCost<'a> = &'a dyn Fn(&[f64], &[f64]) -> f64;
 
-/// [`shortcut`] with its settings spelled out.
+/// [`shortcut`] with its settings spelled out; `skip_small`: a shortcut that would gain less
+/// than [`MIN_GAIN`] is not checked (see [`super::PlannerParams::skip_small_shortcuts`]).
 pub(crate) fn shortcut_with(
     space: &JointSpace,
     validity: &dyn StateValidity,
     waypoints: &mut Vec<Vec<f64>>,
-    seed: u64,
-    iterations: usize,
+    (seed, iterations): (u64, usize),
     min_clearance: f64,
+    skip_small: bool,
 ) -> usize {
     shortcut_by(
         space,
         validity,
         waypoints,
-        (seed, iterations),
+        (seed, iterations, skip_small),
         min_clearance,
         None,
     )
@@ -91,7 +92,7 @@ fn shortcut_by(
     space: &JointSpace,
     validity: &dyn StateValidity,
     waypoints: &mut Vec<Vec<f64>>,
-    (seed, iterations): (u64, usize),
+    (seed, iterations, skip_small): (u64, usize, bool),
     min_clearance: f64,
     timed: Option<SegmentCost<'_>>,
 ) -> usize {
@@ -143,7 +144,9 @@ fn shortcut_by(
                 seg(&p1, &p2),
             ),
         };
-        if new >= old - 1e-9 {
+        // With `skip_small`, a shortcut that would gain little is a miss left unchecked: the
+        // path is near its local optimum there, and a valid segment costs a whole covering.
+        if new >= old - 1e-9 || (skip_small && old - new < MIN_GAIN * total(waypoints)) {
             misses += 1;
             continue;
         }

@@ -366,3 +366,39 @@ fn rrt_connect_tuning_solves_and_cells_keep_the_ompl_search() {
     let standalone = PlannerParams::default();
     assert!(standalone.dynamic_domain && standalone.balance && standalone.range_share == 0.1);
 }
+
+/// Shortcuts that would gain little are left unchecked with `skip_small_shortcuts`: fewer
+/// simplification checks over eight seeds, every path still valid and never longer than the
+/// raw one.
+#[test]
+fn small_shortcuts_left_unchecked_save_checks() {
+    let space = square(2, 10.0);
+    let v = wall();
+    let goals = [vec![9.0, 1.0]];
+    let problem = Problem::new(&space, &v, &[1.0, 1.0], &goals);
+    let stop = Termination::samples(5_000);
+    let mut calls = [0, 0];
+    for (i, skip_small_shortcuts) in [false, true].into_iter().enumerate() {
+        for seed in 0..8 {
+            let raw = solve(
+                "leg",
+                &PlannerParams {
+                    simplify: false,
+                    ..params(seed)
+                },
+                &problem,
+                &v,
+                &stop,
+            );
+            let p = PlannerParams {
+                skip_small_shortcuts,
+                ..params(seed)
+            };
+            let r = solve("leg", &p, &problem, &v, &stop);
+            assert_valid_path("leg", &problem, &v, &r);
+            assert!(path_length(&space, &r.waypoints) <= path_length(&space, &raw.waypoints) + 1e-12);
+            calls[i] += r.work.simplify_calls;
+        }
+    }
+    assert!(calls[1] < calls[0], "{calls:?}");
+}
