@@ -317,14 +317,15 @@ impl PlanSettings {
     }
 
     /// The planner parameters of these settings (seed, range, shortcut iterations;
-    /// post-processing on, checking every shortening shortcut). RRT-Connect searches as OMPL's does — a range of a fifth of the
-    /// extent (when `range` is 0), no dynamic domains, trees in turn — not with the
-    /// standalone planner's VAMP tuning: a cell's legs have a small sample budget and reach
-    /// through openings, where that tuning failed legs the OMPL-like search planned
-    /// (`crowded-6r-home-out`: 0 → 12 failed leg queries, cycle 30.60 → 32.46 s). Skipping
-    /// small shortcuts is left off too: the cells' plans move with every leg's shape (the
-    /// README cell 24.35 → 26.02 s with seed 0, within the 26.0–26.8 s of seeds 1–3), and
-    /// that wants a measurement over seeds and cells first.
+    /// post-processing on, checking every shortening shortcut). RRT-Connect searches as
+    /// OMPL's does — a range of a fifth of the extent (when `range` is 0), no dynamic
+    /// domains, trees in turn — not with the standalone planner's VAMP tuning: a cell's legs
+    /// have a small sample budget and reach through openings, where that tuning failed legs
+    /// the OMPL-like search planned (`crowded-6r-home-out`: 0 → 12 failed leg queries, cycle
+    /// 30.60 → 32.46 s). Small shortcuts are checked as before: the cells' plans move with
+    /// every leg's shape (README cell seeds 0–3: 24.35 / 26.68 / 26.78 / 26.70 s as now,
+    /// 26.78 / 24.01 / 25.88 / 26.70 s with them unchecked), which wants the hard cells over
+    /// seeds before a change (bench/motion/README.md).
     pub fn params(&self) -> PlannerParams {
         PlannerParams {
             seed: self.seed,

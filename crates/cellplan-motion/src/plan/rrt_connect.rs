@@ -8,11 +8,14 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 
 /// RRT-Connect (Kuffner & LaValle 2000): two trees, one rooted at the start, the other at
-/// every valid goal (a forest), grown in turn towards random samples; after each extension
-/// the other tree greedily connects to the new node. The path ends at the goal whose root the
-/// connection reached. Every edge passes [`super::check_segment`]. Deterministic for a seed
-/// (ChaCha8); uses [`PlannerParams::seed`], [`PlannerParams::range`] and the post-processing
-/// settings.
+/// every valid goal (a forest), grown in turn towards random samples (with
+/// [`PlannerParams::balance`], a tree less than half the other's size again); after each
+/// extension the other tree greedily connects to the new node. With
+/// [`PlannerParams::dynamic_domain`], a node whose extension failed is extended only towards
+/// samples within its domain. The path ends at the goal whose root the connection reached.
+/// Every edge passes [`super::check_segment`]. Deterministic for a seed (ChaCha8); uses
+/// [`PlannerParams::seed`], [`PlannerParams::range`] (or [`PlannerParams::range_share`]),
+/// those two and the post-processing settings.
 #[derive(Clone, Debug, Default)]
 pub struct RrtConnect {
     /// Its parameters (for [`MotionPlanner::solve`]; [`Planner::plan`] takes them from its
