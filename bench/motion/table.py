@@ -1,7 +1,10 @@
 #!/usr/bin/env python3
 """Per-scene table of a `cellplan bench motion --json` run, against a VAMP run of the same session.
 
-usage: python3 bench/motion/table.py CELLPLAN_RUN.json VAMP_RUN.json   (standard library only)
+usage: python3 bench/motion/table.py CELLPLAN_RUN.json VAMP_RUN.json [OURS_RAW.json VAMP_SIMPLIFY.json]
+(standard library only). With the two more files — ours with `--no-simplify` and VAMP with
+`--simplify`, from the same session — it also prints the like-for-like ratios: raw paths against
+raw paths, simplified against simplified.
 """
 import collections
 import json
@@ -41,7 +44,23 @@ def main(ours_file, vamp_file):
     )
 
 
+def like_for_like(ours_file, vamp_file, ours_raw_file, vamp_simplify_file):
+    """Ours raw against VAMP raw, ours simplified against VAMP simplified (medians of solved)."""
+    def median(f, key):
+        return st.median(x[key] for x in json.load(open(f)) if x["solved"])
+
+    print()
+    for what, ours, vamp in [("raw", ours_raw_file, vamp_file), ("simplified", ours_file, vamp_simplify_file)]:
+        m, v_own, v_call = median(ours, "time_s"), median(vamp, "vamp_time_s"), median(vamp, "time_s")
+        print(
+            f"like for like, {what}: ours {m * 1e3:.2f} ms; VAMP own {v_own * 1e6:.0f} us, "
+            f"around the call {v_call * 1e6:.0f} us; ratio {m / v_own:.1f}x own, {m / v_call:.1f}x call"
+        )
+
+
 if __name__ == "__main__":
-    if len(sys.argv) != 3:
+    if len(sys.argv) not in (3, 5):
         sys.exit(__doc__)
     main(sys.argv[1], sys.argv[2])
+    if len(sys.argv) == 5:
+        like_for_like(*sys.argv[1:5])
