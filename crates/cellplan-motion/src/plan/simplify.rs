@@ -144,22 +144,22 @@ fn shortcut_by(
                 seg(&p1, &p2),
             ),
         };
-        // With `skip_small`, a shortcut that would gain little is a miss left unchecked: the
-        // path is near its local optimum there, and a valid segment costs a whole covering.
-        if new >= old - 1e-9 || (skip_small && old - new < MIN_GAIN * total(waypoints)) {
+        if new >= old - 1e-9 {
+            misses += 1;
+            continue;
+        }
+        let gain = old - new;
+        // A shortcut that gains little counts as a miss even when valid: the path is near its
+        // local optimum, and every further shortcut costs a whole segment check. With
+        // `skip_small` it is not checked at all.
+        let small = gain < MIN_GAIN * total(waypoints);
+        if skip_small && small {
             misses += 1;
             continue;
         }
         let check = check_segment(space, validity, &p1, &p2, min_clearance);
         calls += check.calls;
-        // A shortcut that gains little counts as a miss too: the path is near its local
-        // optimum, and every further shortcut costs a whole segment check.
-        let gain = old - new;
-        misses = if check.valid && gain >= MIN_GAIN * total(waypoints) {
-            0
-        } else {
-            misses + 1
-        };
+        misses = if check.valid && !small { 0 } else { misses + 1 };
         if check.valid {
             // waypoints[..=i], p1, p2, waypoints[j+1..]
             let tail = waypoints.split_off(j + 1);
