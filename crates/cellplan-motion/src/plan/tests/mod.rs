@@ -321,6 +321,62 @@ fn shortcut_never_lengthens_and_stays_valid() {
     }
 }
 
+/// A dense polyline (1 cm steps, as a retract is) over the wall's top: the redundant
+/// waypoints go by galloping, for far fewer checks than growing each segment one waypoint
+/// at a time (the same path or a shorter one), and the path stays valid with its ends.
+#[test]
+fn redundant_waypoints_of_a_dense_polyline_go_by_galloping() {
+    let space = square(2, 10.0);
+    let v = wall();
+    let mut dense: Vec<Vec<f64>> = Vec::new();
+    let corners = [[1.0, 1.0], [1.0, 9.0], [9.0, 9.0], [9.0, 1.0]];
+    for w in corners.windows(2) {
+        let n = (space.distance(&w[0], &w[1]) / 0.01).round() as usize;
+        for k in 0..n {
+            let t = k as f64 / n as f64;
+            dense.push(vec![
+                w[0][0] + t * (w[1][0] - w[0][0]),
+                w[0][1] + t * (w[1][1] - w[0][1]),
+            ]);
+        }
+    }
+    dense.push(corners[3].to_vec());
+    assert!(brute_force_valid(&v, &dense, 1e-3));
+    // One waypoint at a time: from each kept waypoint, the segment grows while it is seen.
+    let mut greedy = dense.clone();
+    let mut greedy_calls = 0;
+    let mut i = 0;
+    while i + 2 < greedy.len() {
+        let check = check_segment(&space, &v, &greedy[i], &greedy[i + 2], 1e-4);
+        greedy_calls += check.calls;
+        if check.valid {
+            greedy.remove(i + 1);
+        } else {
+            i += 1;
+        }
+    }
+    let mut path = dense.clone();
+    let s = PlanSettings {
+        shortcut_iterations: 0,
+        ..settings(0)
+    };
+    let calls = shortcut(&space, &v, &mut path, &s);
+    assert!(brute_force_valid(&v, &path, 1e-3));
+    assert_eq!(path.first(), dense.first());
+    assert_eq!(path.last(), dense.last());
+    assert!(
+        path.len() <= 6,
+        "{} waypoints left of {}",
+        path.len(),
+        dense.len()
+    );
+    assert!(path_length(&space, &path) <= path_length(&space, &greedy) + 1e-9);
+    assert!(
+        calls * 5 < greedy_calls,
+        "galloping {calls} calls against {greedy_calls} one waypoint at a time"
+    );
+}
+
 #[test]
 fn timed_shortcut_never_slows_the_path_and_stays_valid() {
     use crate::timing::{Limits, time_path_exact};
