@@ -159,17 +159,20 @@ enum Try {
 
 /// One of ours' tries planned, `None` when it fails (it only loses its try). The balanced
 /// allocation is planned afresh, as it is on its own (legs the other plans timed would steer its
-/// lazy sequencing elsewhere): ours is then never longer than it with `best`; the others share
-/// `cache`.
+/// lazy sequencing elsewhere): ours is then never longer than it with `best`. It shares the
+/// graphs, so the legs the motion planner already gave are not planned again
+/// ([`plan::sequence::LegMemo`]; the same legs, so the same plan); the others share `cache`.
 fn plan_try(
     cell: &Cell,
     table: &CandidateTable,
     more: &PlanSettings,
     cache: &mut plan::PlanCache,
 ) -> Option<Outcome> {
-    let mut own = plan::PlanCache::default();
-    let fresh = more.allocation == Allocation::Balanced;
-    plan::plan_cached(cell, table, more, &|_| {}, if fresh { &mut own } else { cache }).ok()
+    if more.allocation == Allocation::Balanced {
+        plan::plan_cached(cell, table, more, &|_| {}, &mut cache.graphs_only()).ok()
+    } else {
+        plan::plan_cached(cell, table, more, &|_| {}, cache).ok()
+    }
 }
 
 /// After the strips planned with `more` (as `o`), the strips once more, each robot's estimates

@@ -643,6 +643,34 @@ fn zones_plan(
     (zones, cache, outcome)
 }
 
+/// A plan made with another plan's graphs but none of its planned legs
+/// (`PlanCache::graphs_only`, as ours plans its balanced allocation) is the plan made afresh,
+/// and the legs the motion planner already gave are served by the graphs' memos.
+#[test]
+fn a_plan_on_shared_graphs_is_the_plan_made_afresh() {
+    use cellplan_core::plan::{self, Allocation, PlanCache, PlanSettings};
+    let f = fixture();
+    let (_, cache, _) = zones_plan(f);
+    let balanced = PlanSettings {
+        allocation: Allocation::Balanced,
+        ..f.settings.clone()
+    };
+    let afresh = plan::plan_cached(&f.cell, &f.table, &balanced, &|_| {}, &mut PlanCache::default()).unwrap();
+    let mut shared = cache.graphs_only();
+    let before = shared.legs_served();
+    let again = plan::plan_cached(&f.cell, &f.table, &balanced, &|_| {}, &mut shared).unwrap();
+    assert!(shared.legs_served() > before, "no leg was served by the memo");
+    assert_eq!(afresh.robots.len(), again.robots.len());
+    for (a, b) in afresh.robots.iter().zip(&again.robots) {
+        assert_eq!(a.sequence.nodes, b.sequence.nodes);
+        assert_eq!(a.program.duration(), b.program.duration());
+        let paths = |r: &plan::RobotResult| -> Vec<Vec<Vec<f64>>> {
+            r.sequence.legs.iter().map(|l| l.waypoints.clone()).collect()
+        };
+        assert_eq!(paths(a), paths(b));
+    }
+}
+
 /// Ours (`pipeline::coordinate` with `best` on the zones allocation) keeps the shortest of its
 /// plans: never longer than the zones plan coordinated alone, whichever of its plans wins (the
 /// zones again with the blocking penalties, or the nearest robots), and the plan verifies with

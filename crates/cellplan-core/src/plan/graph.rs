@@ -39,6 +39,9 @@ pub struct RobotGraph {
     /// The robot's roadmap in the cell (see [`RobotGraph::roadmap`]), built on first need and
     /// shared by the legs planned on any thread.
     pub roadmap: Arc<OnceLock<SharedRoadmap>>,
+    /// Every leg the motion planner was asked for between two of its nodes (see
+    /// [`super::sequence::LegMemo`]), shared by every plan that shares the graph.
+    pub legs: Arc<super::sequence::LegMemo>,
 }
 
 /// At most this many of a graph's configurations become roadmap nodes (evenly spread over the
@@ -214,6 +217,7 @@ impl RobotGraph {
             costs,
             limits,
             roadmap: Arc::default(),
+            legs: Arc::default(),
         }
     }
 

@@ -362,6 +362,26 @@ pub struct PlanCache {
     planned: Vec<sequence::Planned>,
 }
 
+impl PlanCache {
+    /// A cache with this one's robot graphs (and the legs their memos hold) but no planned
+    /// legs: a plan made with it is the plan made afresh, without planning again the legs
+    /// the motion planner already gave.
+    pub fn graphs_only(&self) -> PlanCache {
+        PlanCache {
+            graphs: self.graphs.clone(),
+            planned: Vec::new(),
+        }
+    }
+
+    /// Legs the motion planner did not plan again because its graphs' memos held them
+    /// (see [`sequence::LegMemo`]).
+    pub fn legs_served(&self) -> usize {
+        self.graphs
+            .as_ref()
+            .map_or(0, |(.., g)| g.iter().map(|g| g.legs.served()).sum())
+    }
+}
+
 /// [`plan`], sharing graphs and planned legs with earlier runs through `cache`.
 pub fn plan_cached(
     cell: &Cell,

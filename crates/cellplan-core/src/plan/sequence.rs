@@ -467,6 +467,72 @@ fn plan_leg(
     b: usize,
     settings: &PlanSettings,
 ) -> Result<Leg, LegError> {
+    let asked = (settings.seed, settings.roadmap, settings.motion.clone());
+    if let Some(found) = graph.legs.get(a, b, &asked) {
+        return found;
+    }
+    let leg = plan_leg_afresh(cell, robot, graph, a, b, settings);
+    graph.legs.put(a, b, asked, leg.clone());
+    leg
+}
+
+/// The legs the motion planner gave between two nodes of one robot's graph, by the settings
+/// it was asked with: a leg is a function of its robot, its two nodes (in that order) and
+/// those settings alone, so a plan that asks again gets the same answer without planning it
+/// — also a plan that does not share the other plan's [`Planned`] legs (the balanced
+/// allocation of ours, planned as on its own: which legs a plan knows steers its lazy
+/// sequencing, so each plan keeps its own `Planned`, and this memo below them).
+#[derive(Debug, Default)]
+pub struct LegMemo {
+    legs: std::sync::Mutex<BTreeMap<(usize, usize), Vec<MemoLeg>>>,
+    /// Legs given from the memo instead of planned.
+    served: std::sync::atomic::AtomicUsize,
+}
+
+/// What a leg depends on beyond its robot and nodes: the plan's seed, whether the roadmap
+/// is used, the motion settings.
+type LegAsked = (u64, bool, MotionSettings);
+
+/// A leg of the memo with what it was asked with.
+type MemoLeg = (LegAsked, Result<Leg, LegError>);
+
+impl LegMemo {
+    fn get(&self, a: usize, b: usize, asked: &LegAsked) -> Option<Result<Leg, LegError>> {
+        let legs = self
+            .legs
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner);
+        let leg = legs.get(&(a, b))?.iter().find(|(k, _)| k == asked)?.1.clone();
+        self.served.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        Some(leg)
+    }
+
+    /// How many legs the memo has given instead of their planning.
+    pub fn served(&self) -> usize {
+        self.served.load(std::sync::atomic::Ordering::Relaxed)
+    }
+
+    fn put(&self, a: usize, b: usize, asked: LegAsked, leg: Result<Leg, LegError>) {
+        let mut legs = self
+            .legs
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner);
+        let known = legs.entry((a, b)).or_default();
+        if !known.iter().any(|(k, _)| *k == asked) {
+            known.push((asked, leg));
+        }
+    }
+}
+
+/// [`plan_leg`] without the memo.
+fn plan_leg_afresh(
+    cell: &Cell,
+    robot: &Robot,
+    graph: &RobotGraph,
+    a: usize,
+    b: usize,
+    settings: &PlanSettings,
+) -> Result<Leg, LegError> {
     let started = Instant::now();
     let motion = MotionSettings {
         seed: leg_seed(settings.seed, robot.id.0, a, b),
