@@ -3,7 +3,8 @@
 everything planned: compute times are dropped, and what changed spelling between document
 versions (settings.measure_time_s in version 1; settings.process in version 2; typed stops and
 activities, derived wait places and conflict legs, the wait count, in version 3) is set aside.
-Usage: plan_diff.py OLD_DIR NEW_DIR; exit 1 when any plan differs."""
+Usage: plan_diff.py OLD NEW (two plan.json files, or two trees of them); exit 1 when any plan
+differs, 2 when there is nothing to compare."""
 import json, sys, pathlib
 
 def stop(v):
@@ -58,13 +59,20 @@ def diff(a, b, path=""):
     return [] if a == b else [f"{path}: {a!r} vs {b!r}"]
 
 old, new = pathlib.Path(sys.argv[1]), pathlib.Path(sys.argv[2])
+# Two plan files, or two trees of them (every plan.json under OLD against the same path under NEW).
+if old.is_file() and new.is_file():
+    pairs = [(old, new, old.name)]
+else:
+    pairs = [(p, new / p.relative_to(old), p.parent.relative_to(old)) for p in sorted(old.rglob("plan.json"))]
+if not pairs:
+    print(f"no plan.json under {old}: give two plan files or two trees of them", file=sys.stderr)
+    sys.exit(2)
 bad = 0
-for p in sorted(old.rglob("plan.json")):
-    q = new / p.relative_to(old)
+for p, q, name in pairs:
     if not q.exists():
-        print(f"{p.relative_to(old)}: missing in new"); bad += 1; continue
+        print(f"{name}: missing in new"); bad += 1; continue
     d = diff(norm(json.loads(p.read_text())), norm(json.loads(q.read_text())))
-    print(f"{p.parent.relative_to(old)}: {'identical' if not d else f'{len(d)} differences'}")
+    print(f"{name}: {'identical' if not d else f'{len(d)} differences'}")
     for line in d[:5]:
         print("   ", line)
     bad += bool(d)
