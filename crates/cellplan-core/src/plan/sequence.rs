@@ -459,6 +459,9 @@ fn shortcut_and_time(
     Ok((waypoints, duration))
 }
 
+/// The leg from node `a` to node `b` as the motion planner gives it (the robot's roadmap and
+/// retracts included, see [`crate::motion::plan_leg_with_margin`]), timed; from the graph's
+/// [`LegMemo`] when it was asked before with the same settings.
 fn plan_leg(
     cell: &Cell,
     robot: &Robot,
@@ -471,7 +474,34 @@ fn plan_leg(
     if let Some(found) = graph.legs.get(a, b, &asked) {
         return found;
     }
-    let leg = plan_leg_afresh(cell, robot, graph, a, b, settings);
+    let afresh = || -> Result<Leg, LegError> {
+        let started = Instant::now();
+        let motion = MotionSettings {
+            seed: leg_seed(settings.seed, robot.id.0, a, b),
+            ..settings.motion.clone()
+        };
+        let roadmap_seed = leg_seed(settings.seed, robot.id.0, usize::MAX, usize::MAX);
+        let roadmap = || graph.roadmap(cell, robot, roadmap_seed);
+        let path = crate::motion::plan_leg_with_margin(
+            cell,
+            robot,
+            &graph.q[a],
+            &graph.q[b],
+            cell.planning.clearance,
+            &motion,
+            settings.roadmap.then_some(&roadmap as &dyn Fn() -> _),
+        )?;
+        let timed = time_path_exact(&path.waypoints, &graph.limits)?;
+        Ok(Leg {
+            waypoints: path.waypoints,
+            duration: timed.trajectory.duration(),
+            straight: path.straight,
+            samples: path.samples,
+            validity_calls: path.validity_calls,
+            compute_s: started.elapsed().as_secs_f64(),
+        })
+    };
+    let leg = afresh();
     graph.legs.put(a, b, asked, leg.clone());
     leg
 }
@@ -522,42 +552,6 @@ impl LegMemo {
             known.push((asked, leg));
         }
     }
-}
-
-/// [`plan_leg`] without the memo.
-fn plan_leg_afresh(
-    cell: &Cell,
-    robot: &Robot,
-    graph: &RobotGraph,
-    a: usize,
-    b: usize,
-    settings: &PlanSettings,
-) -> Result<Leg, LegError> {
-    let started = Instant::now();
-    let motion = MotionSettings {
-        seed: leg_seed(settings.seed, robot.id.0, a, b),
-        ..settings.motion.clone()
-    };
-    let roadmap_seed = leg_seed(settings.seed, robot.id.0, usize::MAX, usize::MAX);
-    let roadmap = || graph.roadmap(cell, robot, roadmap_seed);
-    let path = crate::motion::plan_leg_with_margin(
-        cell,
-        robot,
-        &graph.q[a],
-        &graph.q[b],
-        cell.planning.clearance,
-        &motion,
-        settings.roadmap.then_some(&roadmap as &dyn Fn() -> _),
-    )?;
-    let timed = time_path_exact(&path.waypoints, &graph.limits)?;
-    Ok(Leg {
-        waypoints: path.waypoints,
-        duration: timed.trajectory.duration(),
-        straight: path.straight,
-        samples: path.samples,
-        validity_calls: path.validity_calls,
-        compute_s: started.elapsed().as_secs_f64(),
-    })
 }
 
 /// Candidates of one task cut off (see [`Reach`]) after which all of its candidates are.
