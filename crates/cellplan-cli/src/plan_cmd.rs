@@ -413,14 +413,22 @@ fn render(doc: &output::Plan, working: &str) -> String {
         s += &format!("blended: {blended} legs run through {corners} corners without stopping\n");
     }
     let c = &doc.compute_s;
+    // Ours plans and coordinates its other plans and hand-overs within its coordination stage.
+    let ours =
+        doc.settings.coordination == Coordination::Best && doc.settings.allocation == Allocation::Zones;
     s += &format!(
-        "compute: load {:.2} s, candidates {:.2} s, costs {:.2} s, allocation {:.2} s, sequencing+motion {:.2} s, timing {:.2} s, coordination {:.2} s, verification {:.2} s, total {:.2} s\n",
+        "compute: load {:.2} s, candidates {:.2} s, costs {:.2} s, allocation {:.2} s, sequencing+motion {:.2} s, timing {:.2} s, {} {:.2} s, verification {:.2} s, total {:.2} s\n",
         c.load,
         c.candidates,
         c.costs,
         c.allocation,
         c.sequencing_motion,
         c.timing,
+        if ours {
+            "coordination with ours' other plans"
+        } else {
+            "coordination"
+        },
         c.coordination,
         c.verification,
         c.total

@@ -439,7 +439,8 @@ pub struct ComputeTimes {
     pub sequencing_motion: f64,
     /// Timing and assembly.
     pub timing: f64,
-    /// Coordination.
+    /// Coordination; for ours (`best` on the zones allocation), also the planning and
+    /// coordinating of its other plans and hand-overs (see `pipeline::coordinate`).
     pub coordination: f64,
     /// The verifier.
     pub verification: f64,
