@@ -414,8 +414,7 @@ fn render(doc: &output::Plan, working: &str) -> String {
     }
     let c = &doc.compute_s;
     // Ours plans and coordinates its other plans and hand-overs within its coordination stage.
-    let ours =
-        doc.settings.coordination == Coordination::Best && doc.settings.allocation == Allocation::Zones;
+    let ours = pipeline::is_ours(doc.settings.allocation, doc.settings.coordination);
     s += &format!(
         "compute: load {:.2} s, candidates {:.2} s, costs {:.2} s, allocation {:.2} s, sequencing+motion {:.2} s, timing {:.2} s, {} {:.2} s, verification {:.2} s, total {:.2} s\n",
         c.load,

@@ -124,7 +124,13 @@ pub fn run<R>(
 /// Whether ours runs: `best` on the zones allocation, which then plans and coordinates the
 /// other plans of [`coordinate`].
 pub fn ours_tries_zones(settings: &PlanSettings, coord: &CoordSettings) -> bool {
-    coord.strategy == Coordination::Best && settings.allocation == Allocation::Zones
+    is_ours(settings.allocation, coord.strategy)
+}
+
+/// Whether an allocation and a coordination strategy are ours' (`best` on the zones
+/// allocation), as a plan document states them too.
+pub fn is_ours(allocation: Allocation, strategy: Coordination) -> bool {
+    strategy == Coordination::Best && allocation == Allocation::Zones
 }
 
 /// Weight of the blocking seconds (see [`crate::coord::Coordinated::blocking`]) in the zones
