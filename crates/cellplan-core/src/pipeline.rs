@@ -233,6 +233,10 @@ fn slowness_penalty(cell: &Cell, o: &plan::Outcome) -> Vec<Vec<f64>> {
     vec![per_task; cell.tasks.len()]
 }
 
+/// The plan ours makes aside (see [`coordinate`]): the plan, its settings and its
+/// coordination (`None` when it ended no sooner than the best cycle so far, uncoordinated).
+type AsideRun = Option<(Outcome, PlanSettings, Option<Result<Coordinated, PlanError>>)>;
+
 /// How many of ours' coordinated plans that lost are kept to be blended against the winner.
 const RUNNERS_UP: usize = 2;
 /// A runner-up is blended only if its cycle before blending is within this share of the
@@ -266,7 +270,10 @@ impl RunnersUp {
 /// robot's estimates raised by how much slower than their lower bounds its legs were
 /// ([`PlanSettings::task_penalty`]); the nearest-robot allocation; the zones allocation
 /// again with what the first plan's measurements blocked the other robots; and, on cells of at
-/// most [`BALANCED_MAX_PAIRS`] MPs × robots, the balanced allocation. A plan whose robots
+/// most [`BALANCED_MAX_PAIRS`] MPs × robots, the balanced allocation (which shares no planned
+/// legs with the others: it is planned and coordinated aside while they are, and judged at
+/// its turn, the last; on cells of more than `plan_first_pairs` it is a try like the others).
+/// A plan whose robots
 /// end no sooner than the best cycle so far even uncoordinated is not coordinated. The shortest
 /// coordinated cycle (then Δt, then the earlier) wins; then [`plan::rebalance::rebalance`]
 /// hands tasks from the robot that ends last to others, one at a time, each hand-over kept
@@ -318,11 +325,17 @@ pub fn coordinate(
     });
     // On small cells the min-max allocation too: its search is cheap there, and with few
     // robots meeting little, balanced work often ends first.
-    let balanced = (cell.tasks.len() * cell.robots.len() <= BALANCED_MAX_PAIRS).then(|| PlanSettings {
+    let mut balanced = (cell.tasks.len() * cell.robots.len() <= BALANCED_MAX_PAIRS).then(|| PlanSettings {
         allocation: plan::Allocation::Balanced,
         task_penalty: Vec::new(),
         ..settings.clone()
     });
+    let plan_first = cell.tasks.len() * cell.robots.len() > coord.plan_first_pairs;
+    // The balanced plan shares with the others only the robot graphs (and their memo of legs)
+    // and the diagrams, neither of which changes an answer: where the plans are coordinated as
+    // they come, it is planned and coordinated beside them, on what would be an idle core, and
+    // judged at its turn (the last try) as if it had been made then.
+    let aside = if plan_first { None } else { balanced.take() };
     // The strips first: where they pay, the others are then often beaten before coordination.
     let mut tries: Vec<Try> = [
         sweep.map(|s| Try::Plan(Box::new(s))),
@@ -344,7 +357,7 @@ pub fn coordinate(
     // may allow only one coordination there); the zones with the blocking penalties are left
     // out (they need a coordination to start from).
     let mut ready: Vec<(Outcome, PlanSettings)> = Vec::new();
-    if cell.tasks.len() * cell.robots.len() > coord.plan_first_pairs {
+    if plan_first {
         ready.extend(pending.take());
         let mut k = 0;
         while let Some(t) = tries.get(k) {
@@ -397,69 +410,112 @@ pub fn coordinate(
         b.as_ref()
             .map_or(f64::INFINITY, |b| cycle_and_delta(&b.2.timed).0)
     };
-    loop {
-        // Past the deadline the other tries are skipped, and the plan says the clock cut it.
-        if next < tries.len() && settings.deadline.is_some_and(|d| Instant::now() >= d) {
-            cut = true;
+    // The best cycle so far, for the plan made aside: a plan that ends no sooner even
+    // uncoordinated is not coordinated at its turn (the bar only falls), so it need not be now.
+    let bar_now = std::sync::atomic::AtomicU64::new(f64::INFINITY.to_bits());
+    let mut aside_cache = cache.graphs_only();
+    let mut aside_run: AsideRun = None;
+    rayon::in_place_scope(|scope| -> Result<(), PlanError> {
+        if let Some(more) = aside {
+            let (out, aside_cache, diagrams, bar_now) =
+                (&mut aside_run, &mut aside_cache, &diagrams, &bar_now);
+            scope.spawn(move |_| {
+                *out = plan_try(cell, table, &more, aside_cache).map(|o| {
+                    let bar = f64::from_bits(bar_now.load(std::sync::atomic::Ordering::Relaxed));
+                    let judged = (makespan(&o) < bar)
+                        .then(|| coordinate_outcome_cached(cell, table, &o, coord, diagrams));
+                    (o, more, judged)
+                });
+            });
         }
-        // Past the work budget (one more coordination would pass it) no try is planned.
-        let more = match tries.get(next) {
-            _ if cut || !affordable() => None,
-            Some(Try::Plan(t)) => Some(PlanSettings::clone(t)),
-            Some(Try::ZonesBlocking) => Some(PlanSettings {
-                task_penalty: blocking.clone(),
-                ..settings.clone()
-            }),
-            None => None,
-        };
-        if pending.is_none() && affordable() {
-            pending = ready.pop();
-        }
-        if pending.is_none() && more.is_none() {
-            break;
-        }
-        // Coordination only adds waits: a plan whose robots end no sooner than the best cycle
-        // so far even without them cannot win, and is not coordinated.
-        let bar = cycle_of(&best);
-        let first = best.is_none();
-        let may = first || affordable();
-        let (judged, planned) = rayon::join(
-            || {
-                let (o, _) = pending.as_ref()?;
-                (makespan(o) < bar && may)
-                    .then(|| coordinate_outcome_cached(cell, table, o, coord, &diagrams))
-            },
-            || plan_try(cell, table, more.as_ref()?, cache),
-        );
-        if let Some(Ok(c)) = &judged {
-            count(c);
-        }
-        if let Some((o, s)) = pending.take() {
-            match judged {
-                // The first plan's coordination is the run's: its failure is the run's.
-                Some(Err(e)) if first => return Err(e),
-                Some(Ok(c)) if first => {
-                    blocking = blocking_penalty(cell, &c);
-                    best = Some((o, s, c));
-                }
-                Some(Ok(c))
-                    if best
-                        .as_ref()
-                        .is_some_and(|b| cycle_and_delta(&c.timed) < cycle_and_delta(&b.2.timed)) =>
-                {
-                    runners_up.keep(best.replace((o, s, c)));
-                }
-                Some(Ok(c)) => runners_up.keep(Some((o, s, c))),
-                _ => {}
+        loop {
+            // Past the deadline the other tries are skipped, and the plan says the clock cut it.
+            if next < tries.len() && settings.deadline.is_some_and(|d| Instant::now() >= d) {
+                cut = true;
             }
-        }
-        if let Some(more) = more {
-            next += 1;
-            if let Some(o) = planned {
-                if let Some(again) = strips_again(cell, &more, &o) {
-                    tries.insert(next, again);
+            // Past the work budget (one more coordination would pass it) no try is planned.
+            let more = match tries.get(next) {
+                _ if cut || !affordable() => None,
+                Some(Try::Plan(t)) => Some(PlanSettings::clone(t)),
+                Some(Try::ZonesBlocking) => Some(PlanSettings {
+                    task_penalty: blocking.clone(),
+                    ..settings.clone()
+                }),
+                None => None,
+            };
+            if pending.is_none() && affordable() {
+                pending = ready.pop();
+            }
+            if pending.is_none() && more.is_none() {
+                break;
+            }
+            // Coordination only adds waits: a plan whose robots end no sooner than the best cycle
+            // so far even without them cannot win, and is not coordinated.
+            let bar = cycle_of(&best);
+            let first = best.is_none();
+            let may = first || affordable();
+            let (judged, planned) = rayon::join(
+                || {
+                    let (o, _) = pending.as_ref()?;
+                    (makespan(o) < bar && may)
+                        .then(|| coordinate_outcome_cached(cell, table, o, coord, &diagrams))
+                },
+                || plan_try(cell, table, more.as_ref()?, cache),
+            );
+            if let Some(Ok(c)) = &judged {
+                count(c);
+            }
+            if let Some((o, s)) = pending.take() {
+                match judged {
+                    // The first plan's coordination is the run's: its failure is the run's.
+                    Some(Err(e)) if first => return Err(e),
+                    Some(Ok(c)) if first => {
+                        blocking = blocking_penalty(cell, &c);
+                        best = Some((o, s, c));
+                    }
+                    Some(Ok(c))
+                        if best
+                            .as_ref()
+                            .is_some_and(|b| cycle_and_delta(&c.timed) < cycle_and_delta(&b.2.timed)) =>
+                    {
+                        runners_up.keep(best.replace((o, s, c)));
+                    }
+                    Some(Ok(c)) => runners_up.keep(Some((o, s, c))),
+                    _ => {}
                 }
-                pending = Some((o, more));
+            }
+            if let Some(more) = more {
+                next += 1;
+                if let Some(o) = planned {
+                    if let Some(again) = strips_again(cell, &more, &o) {
+                        tries.insert(next, again);
+                    }
+                    pending = Some((o, more));
+                }
+            }
+            bar_now.store(cycle_of(&best).to_bits(), std::sync::atomic::Ordering::Relaxed);
+        }
+        Ok(())
+    })?;
+    // The plan made aside at its turn, after every other try: planned unless the clock or the
+    // work budget had stopped the tries, coordinated unless it ends no sooner than the best
+    // cycle even uncoordinated or one more coordination would pass the budget.
+    if let Some((o, s, judged)) = aside_run {
+        if settings.deadline.is_some_and(|d| Instant::now() >= d) {
+            cut = true;
+        } else if !cut
+            && affordable()
+            && makespan(&o) < cycle_of(&best)
+            && let Some(Ok(c)) = judged
+        {
+            count(&c);
+            if best
+                .as_ref()
+                .is_some_and(|b| cycle_and_delta(&c.timed) < cycle_and_delta(&b.2.timed))
+            {
+                runners_up.keep(best.replace((o, s, c)));
+            } else {
+                runners_up.keep(Some((o, s, c)));
             }
         }
     }

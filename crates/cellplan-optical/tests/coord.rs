@@ -698,6 +698,40 @@ fn ours_keeps_the_shortest_of_its_plans() {
     assert!(doc.cycle_time_s <= coord::cycle_and_delta(&alone.timed).0 + 1e-9);
 }
 
+/// Ours makes its balanced plan aside (on small cells like this one), planned and coordinated
+/// beside its other plans and judged at its turn: on one thread it is made when the others are
+/// done, on two while they are made. Either way ours gives the same plan, and it verifies.
+#[test]
+fn ours_is_the_same_plan_on_one_thread_and_on_two() {
+    let f = fixture();
+    let run = |threads: usize| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap()
+            .install(|| {
+                let (zones, mut cache, outcome) = zones_plan(f);
+                let coord_settings = coord::CoordSettings::default();
+                let (o, s, c) = cellplan_core::pipeline::coordinate(
+                    &f.cell,
+                    &f.table,
+                    outcome,
+                    zones,
+                    &coord_settings,
+                    &mut cache,
+                )
+                .unwrap();
+                let mut doc = cellplan_core::document::build(&f.cell, &f.table, &o, &c, &s, 0.0, 0.0);
+                doc.compute_s = output::ComputeTimes::default();
+                doc
+            })
+    };
+    let one = run(1);
+    let report = verify(&f.cell, &one, &VerifySettings::default());
+    assert!(report.ok, "{:#?}", report.violations);
+    assert_eq!(one, run(2));
+}
+
 /// Ours within a budget of diagram work that no second coordination fits: the first plan (the
 /// zones allocation) is the only one coordinated, so ours gives what the zones plan gives
 /// coordinated alone; with the default budget ours is no longer than that.
