@@ -19,6 +19,16 @@ pub fn repo_root() -> PathBuf {
         .unwrap()
 }
 
+/// `f` run on a pool of `threads` worker threads (for tests that a result does not depend on
+/// the thread count).
+pub fn on_threads<T: Send>(threads: usize, f: impl FnOnce() -> T + Send) -> T {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .expect("a thread pool")
+        .install(f)
+}
+
 /// A fresh temporary folder `cellplan-{name}-XXXXXX`, created and kept (fixtures live as long
 /// as the test process).
 pub fn scratch_dir(name: &str) -> PathBuf {

@@ -7,7 +7,7 @@ use cellplan_core::document as output;
 use cellplan_core::plan::{self, Allocation, PlanSettings};
 use cellplan_model::{Cell, LoadOptions, TaskId};
 use cellplan_optical::load;
-use cellplan_optical::testing::{repo_root, scratch_dir};
+use cellplan_optical::testing::{on_threads, repo_root, scratch_dir};
 use common::*;
 use std::path::Path;
 
@@ -42,11 +42,7 @@ fn the_plan_does_not_depend_on_the_thread_count() {
     let f = fixture();
     let s = settings(Allocation::Balanced);
     let run = |threads: usize| {
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap();
-        pool.install(|| {
+        on_threads(threads, || {
             let outcome = plan::plan(&f.cell, &f.table, &s, &|_| {}).unwrap();
             let mut doc = build(&f.cell, &f.table, &outcome, &s);
             doc.compute_s = output::ComputeTimes::default();
