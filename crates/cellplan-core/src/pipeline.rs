@@ -261,6 +261,23 @@ impl RunnersUp {
         self.kept.insert(at, run);
         self.kept.truncate(self.room);
     }
+
+    /// A coordinated plan that is not the first: it becomes `best` if its cycle (then Δt) is
+    /// shorter, and the plan it replaces is kept as a runner-up; else it is kept as one.
+    fn offer(
+        &mut self,
+        best: &mut Option<(Outcome, PlanSettings, Coordinated)>,
+        run: (Outcome, PlanSettings, Coordinated),
+    ) {
+        if best
+            .as_ref()
+            .is_some_and(|b| cycle_and_delta(&run.2.timed) < cycle_and_delta(&b.2.timed))
+        {
+            self.keep(best.replace(run));
+        } else {
+            self.keep(Some(run));
+        }
+    }
 }
 
 /// What `cellplan plan` runs: `outcome` (planned with `settings`) coordinated with `coord`.
@@ -473,14 +490,7 @@ pub fn coordinate(
                         blocking = blocking_penalty(cell, &c);
                         best = Some((o, s, c));
                     }
-                    Some(Ok(c))
-                        if best
-                            .as_ref()
-                            .is_some_and(|b| cycle_and_delta(&c.timed) < cycle_and_delta(&b.2.timed)) =>
-                    {
-                        runners_up.keep(best.replace((o, s, c)));
-                    }
-                    Some(Ok(c)) => runners_up.keep(Some((o, s, c))),
+                    Some(Ok(c)) => runners_up.offer(&mut best, (o, s, c)),
                     _ => {}
                 }
             }
@@ -509,14 +519,7 @@ pub fn coordinate(
             && let Some(Ok(c)) = judged
         {
             count(&c);
-            if best
-                .as_ref()
-                .is_some_and(|b| cycle_and_delta(&c.timed) < cycle_and_delta(&b.2.timed))
-            {
-                runners_up.keep(best.replace((o, s, c)));
-            } else {
-                runners_up.keep(Some((o, s, c)));
-            }
+            runners_up.offer(&mut best, (o, s, c));
         }
     }
     // (Never `None`: the first plan is coordinated, or the run has failed with its error.)
