@@ -233,6 +233,9 @@ fn slowness_penalty(cell: &Cell, o: &plan::Outcome) -> Vec<Vec<f64>> {
     vec![per_task; cell.tasks.len()]
 }
 
+/// One of ours' coordinated plans: the plan, the settings it was made with, its coordination.
+type Tried = (Outcome, PlanSettings, Coordinated);
+
 /// The plan ours makes aside (see [`coordinate`]): the plan, its settings and its
 /// coordination (`None` when it ended no sooner than the best cycle so far, uncoordinated).
 type AsideRun = Option<(Outcome, PlanSettings, Option<Result<Coordinated, PlanError>>)>;
@@ -245,13 +248,13 @@ const RUNNER_UP_REACH: f64 = 0.05;
 
 /// The shortest few coordinated plans that lost (see [`RUNNERS_UP`]).
 struct RunnersUp {
-    kept: Vec<(Outcome, PlanSettings, Coordinated)>,
+    kept: Vec<Tried>,
     room: usize,
 }
 
 impl RunnersUp {
     /// Keeps `run` if it is among the `room` shortest (by cycle, then Δt, then the earlier).
-    fn keep(&mut self, run: Option<(Outcome, PlanSettings, Coordinated)>) {
+    fn keep(&mut self, run: Option<Tried>) {
         let Some(run) = run else { return };
         if self.room == 0 {
             return;
@@ -264,11 +267,7 @@ impl RunnersUp {
 
     /// A coordinated plan that is not the first: it becomes `best` if its cycle (then Δt) is
     /// shorter, and the plan it replaces is kept as a runner-up; else it is kept as one.
-    fn offer(
-        &mut self,
-        best: &mut Option<(Outcome, PlanSettings, Coordinated)>,
-        run: (Outcome, PlanSettings, Coordinated),
-    ) {
+    fn offer(&mut self, best: &mut Option<Tried>, run: Tried) {
         if best
             .as_ref()
             .is_some_and(|b| cycle_and_delta(&run.2.timed) < cycle_and_delta(&b.2.timed))
@@ -342,7 +341,7 @@ pub fn coordinate(
     });
     // On small cells the min-max allocation too: its search is cheap there, and with few
     // robots meeting little, balanced work often ends first.
-    let mut balanced = (cell.tasks.len() * cell.robots.len() <= BALANCED_MAX_PAIRS).then(|| PlanSettings {
+    let balanced = (cell.tasks.len() * cell.robots.len() <= BALANCED_MAX_PAIRS).then(|| PlanSettings {
         allocation: plan::Allocation::Balanced,
         task_penalty: Vec::new(),
         ..settings.clone()
@@ -352,7 +351,11 @@ pub fn coordinate(
     // and the diagrams, neither of which changes an answer: where the plans are coordinated as
     // they come, it is planned and coordinated beside them, on what would be an idle core, and
     // judged at its turn (the last try) as if it had been made then.
-    let aside = if plan_first { None } else { balanced.take() };
+    let (balanced, aside) = if plan_first {
+        (balanced, None)
+    } else {
+        (None, balanced)
+    };
     // The strips first: where they pay, the others are then often beaten before coordination.
     let mut tries: Vec<Try> = [
         sweep.map(|s| Try::Plan(Box::new(s))),
@@ -367,7 +370,7 @@ pub fn coordinate(
     // others' plans and coordinations are dropped as soon as they lose. Each plan is
     // coordinated while the next is planned (the plans share `cache`, the coordinations
     // nothing but the diagrams: the result is that of one after the other).
-    let mut best: Option<(Outcome, PlanSettings, Coordinated)> = None;
+    let mut best: Option<Tried> = None;
     let mut pending = Some((outcome, settings.clone()));
     // On large cells every try is planned first and the plans are coordinated in the order of
     // their robots' latest end without coordination (the most promising first: the work budget
@@ -423,7 +426,7 @@ pub fn coordinate(
             0
         },
     };
-    let cycle_of = |b: &Option<(Outcome, PlanSettings, Coordinated)>| {
+    let cycle_of = |b: &Option<Tried>| {
         b.as_ref()
             .map_or(f64::INFINITY, |b| cycle_and_delta(&b.2.timed).0)
     };
@@ -553,7 +556,7 @@ pub fn coordinate(
         ..coord.clone()
     };
     let reach = cycle_and_delta(&best.2.timed).0 * (1.0 + RUNNER_UP_REACH);
-    let mut chosen: Option<(Outcome, PlanSettings, Coordinated)> = None;
+    let mut chosen: Option<Tried> = None;
     let candidates = std::iter::once(best).chain(
         runners_up
             .kept
