@@ -206,3 +206,60 @@ fn a_task_without_a_path_is_given_up_and_the_rest_planned() {
     check_plan(&cell, &doc);
     verified(&cell, &doc);
 }
+
+/// A plan that gives up tasks is still balanced on its real times: the hand-overs move only
+/// tasks some robot measures, the tasks given up stay given up with their reasons in every
+/// plan the rebalancing makes, and a plan kept from it verifies and lists them unmeasured.
+#[test]
+fn a_plan_that_gives_up_tasks_is_still_rebalanced() {
+    use plan::rebalance::{ends, makespan, rebalance};
+    let f = fixture();
+    let mut s = settings(Allocation::Proximity);
+    s.motion.max_samples = 1;
+    s.final_max_samples = 1;
+    s.roadmap = false;
+    s.alternatives = 1;
+    let mut cache = plan::PlanCache::default();
+    let base =
+        plan::plan_cached(&f.cell, &f.table, &s, &|_| {}, &mut cache).expect("a plan despite the legs");
+    assert!(
+        !base.unreached.is_empty(),
+        "this budget must leave some task without a path"
+    );
+    let given_up: Vec<TaskId> = base.unreached.iter().map(|u| u.0).collect();
+    let judged = std::cell::Cell::new(0);
+    let mut judge = |o: &plan::Outcome| {
+        judged.set(judged.get() + 1);
+        assert_eq!(
+            o.unreached, base.unreached,
+            "the tasks given up, with their reasons"
+        );
+        for t in &given_up {
+            assert!(o.allocated.tasks.iter().all(|r| !r.contains(t)));
+        }
+        Some((makespan(o), ends(o), ()))
+    };
+    let before = makespan(&base);
+    let (found, clock) = rebalance(
+        &f.cell,
+        &f.table,
+        (&base, before, &ends(&base)),
+        &s,
+        &mut cache,
+        &|| true,
+        &mut judge,
+    )
+    .unwrap();
+    assert!(!clock);
+    assert!(judged.get() >= 1, "no hand-over was judged");
+    let (o, fixed, ()) = found.expect("the nearest robots are unbalanced here");
+    assert!(makespan(&o) < before - 1e-6);
+    let doc = build_checked(&f.cell, &f.table, &o, &fixed);
+    for t in &given_up {
+        let name = &f.cell.tasks[t.0].name;
+        let listed = doc.unmeasured.iter().find(|x| &x.task == name).expect("listed");
+        assert_eq!(listed.reason, output::NO_PATH);
+    }
+    let done: usize = doc.robots.iter().map(|r| r.tasks.len()).sum();
+    assert_eq!(done + doc.unmeasured.len(), f.cell.tasks.len());
+}

@@ -152,9 +152,11 @@ fn moves(cell: &Cell, o: &Outcome, end: &[f64]) -> Vec<Move> {
 /// no hand-over is planned once `may_judge` says no (the caller's budget of work); the
 /// first it scores below the best is kept and the next hand-overs start from it and its ends.
 /// Returns the best plan found with its settings and what the judge made of it, or `None` when
-/// no hand-over beat `base_score` (or `base` leaves tasks unreached: it is not rebalanced
-/// then), and whether the deadline stopped the search with hand-overs left to try (the plan
-/// then depends on the machine's speed). Plans that fail only lose their try.
+/// no hand-over beat `base_score`, and whether the deadline stopped the search with hand-overs
+/// left to try (the plan then depends on the machine's speed). Plans that fail only lose their
+/// try. The tasks `base` gave up (its [`Outcome::unreached`]) are in no robot's allocation, so
+/// no hand-over gives them to one: they stay given up, with their reasons, in every plan made
+/// here; a plan that gives up more is not judged.
 pub fn rebalance<J>(
     cell: &Cell,
     table: &CandidateTable,
@@ -164,7 +166,7 @@ pub fn rebalance<J>(
     may_judge: &dyn Fn() -> bool,
     judge: &mut dyn FnMut(&Outcome) -> Option<Judged<J>>,
 ) -> Result<(Option<Rebalanced<J>>, bool), PlanError> {
-    if !base.unreached.is_empty() || cell.robots.len() < 2 {
+    if cell.robots.len() < 2 {
         return Ok((None, false));
     }
     let mut best: Option<Rebalanced<J>> = None;
@@ -205,7 +207,7 @@ pub fn rebalance<J>(
                 }
                 plans += 1;
                 let prior = if keep { Some(current) } else { None };
-                let Ok(o) = plan_keeping(cell, table, &next, &|_| {}, cache, prior) else {
+                let Ok(mut o) = plan_keeping(cell, table, &next, &|_| {}, cache, prior) else {
                     continue;
                 };
                 // The judge's score is never below the robots' latest end without
@@ -214,6 +216,7 @@ pub fn rebalance<J>(
                 if same || !o.unreached.is_empty() || makespan(&o) >= score - 1e-6 {
                     continue;
                 }
+                o.unreached.clone_from(&base.unreached);
                 judged += 1;
                 if let Some((sc, e, j)) = judge(&o)
                     && sc < score - 1e-6
