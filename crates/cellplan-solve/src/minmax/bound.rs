@@ -17,7 +17,8 @@
 //!   vehicles able to do both (no vehicle: no such leg).
 //!
 //! The bound is the largest of these (each the smallest over the numbers `k` of vehicles the
-//! caps allow), of [`own_bound`] (a vehicle's route is at least the tasks only it can do) and of
+//! caps allow), of [`group_bound`] (the tasks only a group of vehicles can do are shared by
+//! that group: its longest route is at least their share) and of
 //! [`count_bound`]: the vehicles' numbers of tasks add up to `n`, and a vehicle doing `m` tasks
 //! pays at least its `m` cheapest — which, when tasks are few per vehicle, is more than the
 //! `k`-th of the sum (one of three equal vehicles does two of four tasks).
@@ -41,7 +42,7 @@ pub fn lower_bound(p: &MinMaxProblem) -> f64 {
     let legs = Legs::new(p);
     let fewest = fewest_vehicles(p);
     let most = p.vehicles.len().min(p.tasks);
-    let mut best = own_bound(p, &legs).max(count_bound(p, &legs));
+    let mut best = group_bound(p, &legs).max(count_bound(p, &legs));
     if fewest <= most {
         let service: f64 = p.service.iter().sum();
         let entries = Entries::new(p, &legs);
@@ -438,22 +439,80 @@ fn route_by_ends(
     cheapest_sums(cost, extra + other)
 }
 
-/// The bound of each vehicle alone: its route is at least the sum, over the tasks only it can
-/// do, of their service and cheapest entry (from the depot or another task), plus its cheapest
-/// way home (from any task it can do: the last need not be one of them).
-fn own_bound(p: &MinMaxProblem, legs: &Legs) -> f64 {
-    let mut best: f64 = 0.0;
-    for v in 0..p.vehicles.len() {
-        let own: Vec<usize> = (0..p.tasks).filter(|&t| p.capable(t) == [v]).collect();
-        if own.is_empty() {
-            continue;
+/// Most vehicles for which [`group_bound`] looks at every group of them (`2^m` groups);
+/// beyond, at each vehicle alone.
+const GROUP_MAX_VEHICLES: usize = 16;
+
+/// The bound of each group `S` of vehicles: the tasks only vehicles of `S` can do (`T_S`) are
+/// done by vehicles of `S`, each entered once by an arc of the vehicle that does it, so the
+/// routes of `S` take together at least the sum over `T_S` of each task's service and cheapest
+/// entry (from the depot or another task, over the vehicles able to do it). At most `|S|`
+/// vehicles share that, and each also goes home once (arcs into the depot enter no task), from
+/// any task it can do: the longest route of `S` is at least that sum over `|S|` plus the
+/// cheapest way home of a vehicle of `S`. A vehicle alone (`|S| = 1`) is the bound by the tasks
+/// only it can do. Groups are vehicles' bit sets; the sums over the groups' subsets are taken
+/// in a fixed order (the bound depends on the problem only).
+fn group_bound(p: &MinMaxProblem, legs: &Legs) -> f64 {
+    let m = p.vehicles.len();
+    let home: Vec<f64> = (0..m)
+        .map(|v| legs.home[v].iter().copied().fold(f64::INFINITY, f64::min))
+        .collect();
+    // Per task: the vehicles able to do it, and its service plus cheapest entry.
+    let tasks: Vec<(Vec<usize>, f64)> = (0..p.tasks)
+        .map(|t| {
+            let who = p.capable(t);
+            let entry = who
+                .iter()
+                .map(|&v| legs.from_task[v][t].min(legs.from_depot[v][t]))
+                .fold(f64::INFINITY, f64::min);
+            (who, p.service[t] + entry)
+        })
+        .filter(|(who, w)| !who.is_empty() && w.is_finite())
+        .collect();
+    let bound = |work: f64, size: usize, home: f64| {
+        let b = work / size as f64 + home;
+        if b.is_finite() { b } else { 0.0 }
+    };
+    if m > GROUP_MAX_VEHICLES {
+        let mut best: f64 = 0.0;
+        for (v, &h) in home.iter().enumerate() {
+            let work: f64 = tasks
+                .iter()
+                .filter(|(who, _)| who[..] == [v])
+                .map(|(_, w)| w)
+                .sum();
+            if work > 0.0 {
+                best = best.max(bound(work, 1, h));
+            }
         }
-        let entries: f64 = own
-            .iter()
-            .map(|&t| p.service[t] + legs.from_task[v][t].min(legs.from_depot[v][t]))
-            .sum();
-        let home = legs.home[v].iter().copied().fold(f64::INFINITY, f64::min);
-        best = best.max(entries + home);
+        return best;
+    }
+    let groups = 1usize << m;
+    // work[S]: the tasks whose vehicles are exactly S, then (summed over subsets) within S.
+    let mut work = vec![0.0; groups];
+    let mut any = vec![false; groups];
+    for (who, w) in &tasks {
+        let set = who.iter().fold(0usize, |s, &v| s | (1 << v));
+        work[set] += w;
+        any[set] = true;
+    }
+    for v in 0..m {
+        let bit = 1 << v;
+        for set in 0..groups {
+            if set & bit != 0 {
+                work[set] += work[set ^ bit];
+                any[set] |= any[set ^ bit];
+            }
+        }
+    }
+    let mut cheapest_home = vec![f64::INFINITY; groups];
+    let mut best: f64 = 0.0;
+    for set in 1..groups {
+        let low = set.trailing_zeros() as usize;
+        cheapest_home[set] = cheapest_home[set & (set - 1)].min(home[low]);
+        if any[set] {
+            best = best.max(bound(work[set], set.count_ones() as usize, cheapest_home[set]));
+        }
     }
     best
 }
@@ -514,5 +573,55 @@ mod tests {
         assert!(lower_bound(&p) >= counts - 1e-12);
         let service: f64 = p.service.iter().sum();
         assert!((service + Entries::new(&p, &legs).bound(3)) / 3.0 < counts - 0.5);
+    }
+
+    #[test]
+    fn a_group_shares_the_tasks_only_it_can_do() {
+        // Four long tasks (service 10) only vehicles 0 and 1 can do, six short ones (service
+        // 1) every vehicle can do, all on a line near the depot: whatever the allocation, 0 and
+        // 1 share the 40 s of long tasks, so one of them takes at least 20 s plus its legs —
+        // more than the third of all the work and more than the counts say.
+        let x: [f64; 11] = [0.0, 1.0, 1.1, 1.2, 1.3, 0.5, 0.6, 0.7, 0.8, 0.9, 0.4];
+        let vehicle = |long: bool| {
+            let costs = crate::problem::CostMatrix::from_fn(11, |i, j| (x[i] - x[j]).abs());
+            let alternatives = (1..11)
+                .map(|a| if a <= 4 && !long { vec![] } else { vec![a] })
+                .collect();
+            crate::minmax::Vehicle::new(costs, 0, 10, alternatives).unwrap()
+        };
+        let service: Vec<f64> = (0..10).map(|t| if t < 4 { 10.0 } else { 1.0 }).collect();
+        let p = MinMaxProblem::new(
+            vec![vehicle(true), vehicle(true), vehicle(false)],
+            10,
+            service,
+            None,
+        )
+        .unwrap();
+        let legs = Legs::new(&p);
+        let group = group_bound(&p, &legs);
+        // Entries: 0.1 into each long task (a neighbour 0.1 away); home from 0.4 at least.
+        assert!(
+            (group - (0.5 * (40.0 + 0.4) + 0.4)).abs() < 1e-9,
+            "group bound {group}"
+        );
+        assert!(count_bound(&p, &legs) < group - 5.0);
+        let all: f64 = p.service.iter().sum();
+        assert!((all + Entries::new(&p, &legs).bound(3)) / 3.0 < group - 2.0);
+        assert!(lower_bound(&p) >= group - 1e-12);
+        let sol = solve(
+            &p,
+            &MinMaxParams {
+                method: MinMaxMethod::Ils,
+                seed: 0,
+                max_iterations: Some(50),
+                ..MinMaxParams::default()
+            },
+        );
+        assert!(
+            lower_bound(&p) <= sol.makespan + 1e-9,
+            "{} > {}",
+            lower_bound(&p),
+            sol.makespan
+        );
     }
 }
