@@ -534,10 +534,17 @@ pub fn coordinate(
     // last, see [`plan::rebalance`]), each hand-over judged by its coordinated cycle.
     let ends = |c: &Coordinated| c.timed.iter().map(|t| t.end()).collect::<Vec<f64>>();
     let (score, base_ends) = (cycle_and_delta(&best.2.timed).0, ends(&best.2));
+    // A hand-over's tours start their search over directions where the plan it was made from
+    // ended (the best so far: the judge keeps what the rebalancing keeps, a shorter cycle).
+    let mut from = (score, crate::coord::canonical_turns(&best.0, &best.2));
     let mut judge = |o: &Outcome| {
-        let c = coordinate_outcome_cached(cell, table, o, coord, &diagrams).ok()?;
+        let c = crate::coord::coordinate_outcome_turned(cell, table, o, coord, &diagrams, &from.1).ok()?;
         count(&c);
-        Some((cycle_and_delta(&c.timed).0, ends(&c), c))
+        let cycle = cycle_and_delta(&c.timed).0;
+        if cycle < from.0 - 1e-6 {
+            from = (cycle, crate::coord::canonical_turns(o, &c));
+        }
+        Some((cycle, ends(&c), c))
     };
     let base = (&best.0, score, base_ends.as_slice());
     if let Ok((found, clock_cut)) =

@@ -230,6 +230,28 @@ fn coordination_from_kept_diagrams_is_the_same() {
     }
 }
 
+/// The directions a coordination chose, as `canonical_turns` states them (against each tour's
+/// canonical direction, the first robot's taken as canonical), and a coordination started from
+/// given directions: up to five robots every combination is searched, so where the search
+/// starts does not change the result.
+#[test]
+fn coordination_from_given_directions_up_to_five_robots_is_the_same() {
+    let f = fixture();
+    let settings = coord::CoordSettings::default();
+    let cache = coord::DiagramCache::default();
+    let plain = coord::coordinate_outcome_cached(&f.cell, &f.table, &f.outcome, &settings, &cache).unwrap();
+    let turns = coord::canonical_turns(&f.outcome, &plain);
+    assert_eq!(turns.len(), f.cell.robots.len());
+    assert!(!turns[0], "the first robot's direction is the canonical one");
+    for start in [turns.clone(), vec![false, true], vec![true, true]] {
+        let from = coord::coordinate_outcome_turned(&f.cell, &f.table, &f.outcome, &settings, &cache, &start)
+            .unwrap();
+        assert_eq!(from.programs, plain.programs);
+        assert_eq!(from.reversed, plain.reversed);
+        assert_eq!(coord::canonical_turns(&f.outcome, &from), turns);
+    }
+}
+
 /// Every robot's motion keeps the coordination's distance, and `HOME_STEP_SLACK` more, from
 /// every other robot standing at home (sampled along the uncoordinated timelines): a robot at
 /// home is never in another's way, with room for the timeline's conservative steps.

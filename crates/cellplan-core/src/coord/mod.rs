@@ -236,7 +236,7 @@ pub fn coordinate(
     programs: Vec<Program>,
     settings: &CoordSettings,
 ) -> Result<Coordinated, PlanError> {
-    coordinate_with(cell, table, programs, settings, None)
+    coordinate_with(cell, table, programs, settings, None, None)
 }
 
 /// As [`coordinate`], `best` taking the pair diagrams `diagrams` holds from earlier
@@ -247,6 +247,7 @@ fn coordinate_with(
     programs: Vec<Program>,
     settings: &CoordSettings,
     diagrams: Option<&DiagramCache>,
+    turned: Option<&[bool]>,
 ) -> Result<Coordinated, PlanError> {
     let started = Instant::now();
     let ctx = Ctx::new(cell, table, settings, diagrams);
@@ -292,7 +293,7 @@ fn coordinate_with(
                 .collect::<Result<_, _>>()?;
             // The diagram of the tours as they are certifies where they cannot meet, for the
             // resolutions below (the exact search then looks only where they may).
-            let (found, cover, asked) = scheduled(&ctx, &programs)?;
+            let (found, cover, asked) = scheduled(&ctx, &programs, turned)?;
             distances = asked;
             let first = match found {
                 Some(done) => done,
@@ -401,7 +402,39 @@ pub fn coordinate_outcome_cached(
     diagrams: &DiagramCache,
 ) -> Result<Coordinated, PlanError> {
     let programs = outcome.robots.iter().map(|r| r.program.clone()).collect();
-    coordinate_with(cell, table, programs, settings, Some(diagrams))
+    coordinate_with(cell, table, programs, settings, Some(diagrams), None)
+}
+
+/// As [`coordinate_outcome_cached`], the search over tour directions (`best`, beyond five
+/// robots, where it flips one robot at a time) starting from
+/// `turned` (per robot, whether its tour runs against its canonical direction: see
+/// [`canonical_turns`]) instead of every tour in its canonical direction. A plan made from
+/// another (a hand-over) starts where the other's coordination ended.
+pub fn coordinate_outcome_turned(
+    cell: &Cell,
+    table: &CandidateTable,
+    outcome: &crate::plan::Outcome,
+    settings: &CoordSettings,
+    diagrams: &DiagramCache,
+    turned: &[bool],
+) -> Result<Coordinated, PlanError> {
+    let programs = outcome.robots.iter().map(|r| r.program.clone()).collect();
+    coordinate_with(cell, table, programs, settings, Some(diagrams), Some(turned))
+}
+
+/// Per robot, whether `coordinated` (of `outcome`'s programs) runs its tour against the tour's
+/// canonical direction, with the first robot's direction taken as canonical (turning every
+/// tour is the same schedule run backwards): what [`coordinate_outcome_turned`] starts from.
+pub fn canonical_turns(outcome: &crate::plan::Outcome, coordinated: &Coordinated) -> Vec<bool> {
+    let programs: Vec<Program> = outcome.robots.iter().map(|r| r.program.clone()).collect();
+    let against = against_canonical(&programs);
+    let turns: Vec<bool> = against
+        .iter()
+        .enumerate()
+        .map(|(i, &a)| a != coordinated.reversed.get(i).copied().unwrap_or(false))
+        .collect();
+    let first = turns.first().copied().unwrap_or(false);
+    turns.into_iter().map(|t| t != first).collect()
 }
 
 /// Counts of a resolution.

@@ -155,6 +155,7 @@ pub(super) fn best(ctx: &Ctx, programs: Vec<Program>, cover: Option<&Cover>) -> 
 pub(super) fn scheduled(
     ctx: &Ctx,
     programs: &[Program],
+    turned: Option<&[bool]>,
 ) -> Result<(Option<Resolved>, Option<Cover>, usize), PlanError> {
     let mut programs = programs.to_vec();
     let mut round = 0;
@@ -178,7 +179,7 @@ pub(super) fn scheduled(
         let (nodes, min_wait) = (ctx.settings.schedule_nodes, ctx.settings.min_wait);
         // The reversed programs and their paths `directions` made (none after round 0).
         let (found, back) = if round == 0 {
-            let (found, back, spent) = directions(ctx, &programs, &paths, &boxes)?;
+            let (found, back, spent) = directions(ctx, &programs, &paths, &boxes, turned)?;
             searched += spent;
             (found, back)
         } else {
@@ -295,7 +296,7 @@ fn finish(
 
 /// Up to this many robots, [`directions`] tries every combination of tour directions;
 /// beyond, it flips one robot at a time.
-const ALL_DIRECTIONS_UP_TO: usize = 5;
+pub(crate) const ALL_DIRECTIONS_UP_TO: usize = 5;
 
 /// Rounds of single flips [`directions`] makes beyond [`ALL_DIRECTIONS_UP_TO`] robots.
 const FLIP_ROUNDS: usize = 2;
@@ -320,7 +321,8 @@ type Directed = (Vec<bool>, schedule::Schedule, Vec<ConflictBox>);
 /// time, so the first robot keeps its direction. (`best` hands the tours over in their
 /// canonical directions, see [`against_canonical`].) Combinations are tried all (up
 /// to [`ALL_DIRECTIONS_UP_TO`] robots) or one flip at a time (a flip kept when it shortens the
-/// schedule, [`FLIP_ROUNDS`] rounds); ties go to fewer flips, then to the earlier combination.
+/// schedule, [`FLIP_ROUNDS`] rounds, from `turned` when given — per robot, whether its tour
+/// starts turned); ties go to fewer flips, then to the earlier combination.
 ///
 /// Returns the [`DIRECTIONS_FINISHED`] best combinations by makespan (flips relative to
 /// `programs`; empty when no combination has a schedule), per robot its reversed program and
@@ -331,6 +333,7 @@ fn directions(
     programs: &[Program],
     paths: &[diagram::RobotPath],
     boxes: &[ConflictBox],
+    turned: Option<&[bool]>,
 ) -> Result<(Vec<Directed>, Vec<Option<(Program, diagram::RobotPath)>>, usize), PlanError> {
     let m = programs.len();
     let (nodes, min_wait) = (ctx.settings.schedule_nodes, ctx.settings.min_wait);
@@ -396,7 +399,12 @@ fn directions(
             }
         }
     } else {
-        let mut turn = vec![false; m];
+        // From the directions given (those of the plan this one was made from), else from
+        // every tour in its canonical direction.
+        let mut turn = match turned {
+            Some(t) if t.len() == m => t.to_vec(),
+            _ => vec![false; m],
+        };
         let mut now = try_turn(&turn)?.map(|d| {
             let span = d.1.makespan;
             keep(d, &mut found);
