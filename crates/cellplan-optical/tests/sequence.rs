@@ -154,6 +154,17 @@ fn planned_legs_join_nodes_and_unreached_nodes_are_not_searched_again() {
     assert!(!reach.is_cut_off(a) && !reach.is_cut_off(b) && !reach.is_cut_off(0));
 }
 
+/// `settings(allocation)` with one sample per leg search, no roadmap and one candidate per
+/// task: every leg that is not a straight segment fails.
+fn without_sampling(allocation: Allocation) -> plan::PlanSettings {
+    let mut s = settings(allocation);
+    s.motion.max_samples = 1;
+    s.final_max_samples = 1;
+    s.roadmap = false;
+    s.alternatives = 1;
+    s
+}
+
 /// A leg the sampler cannot solve never loses the plan: with no samples at all (and no
 /// roadmap), every leg that is not a straight segment fails; a task every order reaches only through such legs
 /// is given up by its robot, tried on the other robot, and listed unmeasured (`no-path`, with
@@ -161,11 +172,7 @@ fn planned_legs_join_nodes_and_unreached_nodes_are_not_searched_again() {
 #[test]
 fn a_task_without_a_path_is_given_up_and_the_rest_planned() {
     let f = fixture();
-    let mut s = settings(Allocation::Balanced);
-    s.motion.max_samples = 1;
-    s.final_max_samples = 1;
-    s.roadmap = false;
-    s.alternatives = 1;
+    let s = without_sampling(Allocation::Balanced);
     let outcome = plan::plan(&f.cell, &f.table, &s, &|_| {}).expect("a plan despite the legs");
     let doc = build(&f.cell, &f.table, &outcome, &s);
     assert!(
@@ -214,11 +221,7 @@ fn a_task_without_a_path_is_given_up_and_the_rest_planned() {
 fn a_plan_that_gives_up_tasks_is_still_rebalanced() {
     use plan::rebalance::{ends, makespan, rebalance};
     let f = fixture();
-    let mut s = settings(Allocation::Proximity);
-    s.motion.max_samples = 1;
-    s.final_max_samples = 1;
-    s.roadmap = false;
-    s.alternatives = 1;
+    let s = without_sampling(Allocation::Proximity);
     let mut cache = plan::PlanCache::default();
     let base =
         plan::plan_cached(&f.cell, &f.table, &s, &|_| {}, &mut cache).expect("a plan despite the legs");
