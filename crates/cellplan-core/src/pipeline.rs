@@ -534,17 +534,15 @@ pub fn coordinate(
     // last, see [`plan::rebalance`]), each hand-over judged by its coordinated cycle.
     let ends = |c: &Coordinated| c.timed.iter().map(|t| t.end()).collect::<Vec<f64>>();
     let (score, base_ends) = (cycle_and_delta(&best.2.timed).0, ends(&best.2));
-    // A hand-over's tours start their search over directions where the plan it was made from
-    // ended (the best so far: the judge keeps what the rebalancing keeps, a shorter cycle).
-    let mut from = (score, crate::coord::canonical_turns(&best.0, &best.2));
-    let mut judge = |o: &Outcome| {
-        let c = crate::coord::coordinate_outcome_turned(cell, table, o, coord, &diagrams, &from.1).ok()?;
+    // A hand-over's tours start their search over directions where the coordination of the
+    // plan it was made from ended.
+    let base_turns = crate::coord::canonical_turns(&best.0, &best.2);
+    let mut judge = |o: &Outcome, from: Option<(&Outcome, &Coordinated)>| {
+        let turns = from.map(|(f, c)| crate::coord::canonical_turns(f, c));
+        let turns = turns.as_deref().unwrap_or(&base_turns);
+        let c = crate::coord::coordinate_outcome_turned(cell, table, o, coord, &diagrams, turns).ok()?;
         count(&c);
-        let cycle = cycle_and_delta(&c.timed).0;
-        if cycle < from.0 - 1e-6 {
-            from = (cycle, crate::coord::canonical_turns(o, &c));
-        }
-        Some((cycle, ends(&c), c))
+        Some((cycle_and_delta(&c.timed).0, ends(&c), c))
     };
     let base = (&best.0, score, base_ends.as_slice());
     if let Ok((found, clock_cut)) =

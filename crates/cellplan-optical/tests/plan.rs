@@ -289,12 +289,12 @@ fn readme_nearest() -> (Cell, CandidateTable, PlanSettings, plan::PlanCache, pla
 
 #[test]
 fn rebalancing_hands_tasks_from_the_robot_ending_last_until_the_robots_end_sooner() {
-    use plan::rebalance::{REBALANCE_PLANS, ends, makespan, rebalance};
+    use plan::rebalance::{REBALANCE_PLANS, ends, makespan};
     // The nearest-robot allocation ignores how long each robot works (5 to 14 MPs here).
     let (cell, table, s, mut cache, base) = readme_nearest();
     let before = makespan(&base);
     let judged = std::cell::Cell::new(0);
-    let mut judge = |o: &plan::Outcome| {
+    let mut judge = |o: &plan::Outcome, _: Option<(&plan::Outcome, &())>| {
         judged.set(judged.get() + 1);
         Some((makespan(o), ends(o), ()))
     };
@@ -303,30 +303,12 @@ fn rebalancing_hands_tasks_from_the_robot_ending_last_until_the_robots_end_soone
         deadline: Some(std::time::Instant::now()),
         ..s.clone()
     };
-    let cut = rebalance(
-        &cell,
-        &table,
-        (&base, before, &ends(&base)),
-        &late,
-        &mut cache,
-        &|| true,
-        &mut judge,
-    )
-    .unwrap();
+    let cut = rebalanced(&cell, &table, &base, &late, &mut cache, &mut judge);
     assert!(cut.0.is_none() && cut.1, "the clock cut must show");
     assert_eq!(judged.get(), 0);
-    let (o, fixed, ()) = rebalance(
-        &cell,
-        &table,
-        (&base, before, &ends(&base)),
-        &s,
-        &mut cache,
-        &|| true,
-        &mut judge,
-    )
-    .unwrap()
-    .0
-    .expect("the nearest robots are unbalanced here");
+    let (o, fixed, ()) = rebalanced(&cell, &table, &base, &s, &mut cache, &mut judge)
+        .0
+        .expect("the nearest robots are unbalanced here");
     assert!(judged.get() >= 1);
     assert!(makespan(&o) < before - 1e-6, "{} !< {before}", makespan(&o));
     // The plan is the fixed allocation it was made with: every task once, within the caps,
@@ -403,25 +385,15 @@ fn a_hand_over_keeps_the_other_robots_programs() {
 /// plans of one allocation, the kept one first, and never the same plan twice; the budgets hold.
 #[test]
 fn a_hand_over_that_does_not_help_is_tried_with_every_robot_sequenced_again() {
-    use plan::rebalance::{REBALANCE_JUDGED, REBALANCE_PLANS, ends, makespan, rebalance};
+    use plan::rebalance::{REBALANCE_JUDGED, REBALANCE_PLANS};
     let (cell, table, s, mut cache, base) = readme_nearest();
-    let before = makespan(&base);
     let mut seen: Vec<plan::Outcome> = Vec::new();
     // A judge that no plan satisfies: every hand-over's plans are judged, none kept.
-    let mut judge = |o: &plan::Outcome| -> Option<(f64, Vec<f64>, ())> {
+    let mut judge = |o: &plan::Outcome, _: Option<(&plan::Outcome, &())>| -> Option<(f64, Vec<f64>, ())> {
         seen.push(o.clone());
         None
     };
-    let (found, clock) = rebalance(
-        &cell,
-        &table,
-        (&base, before, &ends(&base)),
-        &s,
-        &mut cache,
-        &|| true,
-        &mut judge,
-    )
-    .unwrap();
+    let (found, clock) = rebalanced(&cell, &table, &base, &s, &mut cache, &mut judge);
     assert!(found.is_none() && !clock);
     assert!(
         (2..=REBALANCE_JUDGED).contains(&seen.len()),

@@ -426,8 +426,7 @@ pub fn coordinate_outcome_turned(
 /// canonical direction, with the first robot's direction taken as canonical (turning every
 /// tour is the same schedule run backwards): what [`coordinate_outcome_turned`] starts from.
 pub fn canonical_turns(outcome: &crate::plan::Outcome, coordinated: &Coordinated) -> Vec<bool> {
-    let programs: Vec<Program> = outcome.robots.iter().map(|r| r.program.clone()).collect();
-    let against = against_canonical(&programs);
+    let against = against_canonical(outcome.robots.iter().map(|r| &r.program));
     let turns: Vec<bool> = against
         .iter()
         .enumerate()

@@ -296,7 +296,7 @@ fn finish(
 
 /// Up to this many robots, [`directions`] tries every combination of tour directions;
 /// beyond, it flips one robot at a time.
-pub(crate) const ALL_DIRECTIONS_UP_TO: usize = 5;
+const ALL_DIRECTIONS_UP_TO: usize = 5;
 
 /// Rounds of single flips [`directions`] makes beyond [`ALL_DIRECTIONS_UP_TO`] robots.
 const FLIP_ROUNDS: usize = 2;
@@ -438,9 +438,9 @@ fn directions(
 /// Per program, whether it runs against its tour's canonical direction (the first MP after
 /// the last in the cell's order): `best` turns such tours round before it starts, so that what
 /// it finds does not depend on which way the sequencer happened to write a tour.
-pub(super) fn against_canonical(programs: &[Program]) -> Vec<bool> {
+pub(super) fn against_canonical<'p>(programs: impl IntoIterator<Item = &'p Program>) -> Vec<bool> {
     programs
-        .iter()
+        .into_iter()
         .map(|p| match (p.visits.first(), p.visits.last()) {
             (Some(a), Some(b)) => a.task.0 > b.task.0,
             _ => false,

@@ -35,6 +35,10 @@ struct Move {
 /// without coordination), each robot's end under it (s), and what it made.
 pub type Judged<J> = (f64, Vec<f64>, J);
 
+/// What [`rebalance`] asks of its judge: a plan, and the hand-over plan it was made from with
+/// what the judge made of that (`None`: made from the base).
+pub type Judge<'a, J> = dyn FnMut(&Outcome, Option<(&Outcome, &J)>) -> Option<Judged<J>> + 'a;
+
 /// A rebalanced plan: the plan, the settings it was made with (its fixed allocation) and what
 /// the judge made of it.
 pub type Rebalanced<J> = (Outcome, PlanSettings, J);
@@ -148,7 +152,8 @@ fn moves(cell: &Cell, o: &Outcome, end: &[f64]) -> Vec<Move> {
 /// does not take that plan, with every robot sequenced anew (each counts as a plan; a plan the
 /// same as the one before is not judged again).
 /// A plan whose robots end, without coordination, sooner than the best score (the judge's
-/// score is never below that end) goes to `judge` — at most [`REBALANCE_JUDGED`] plans, and
+/// score is never below that end) goes to `judge`, with the hand-over plan it was made from
+/// and what the judge made of that (`None`: made from `base`) — at most [`REBALANCE_JUDGED`] plans, and
 /// no hand-over is planned once `may_judge` says no (the caller's budget of work); the
 /// first it scores below the best is kept and the next hand-overs start from it and its ends.
 /// Returns the best plan found with its settings and what the judge made of it, or `None` when
@@ -164,7 +169,7 @@ pub fn rebalance<J>(
     settings: &PlanSettings,
     cache: &mut PlanCache,
     may_judge: &dyn Fn() -> bool,
-    judge: &mut dyn FnMut(&Outcome) -> Option<Judged<J>>,
+    judge: &mut Judge<'_, J>,
 ) -> Result<(Option<Rebalanced<J>>, bool), PlanError> {
     if cell.robots.len() < 2 {
         return Ok((None, false));
@@ -218,7 +223,7 @@ pub fn rebalance<J>(
                 }
                 o.unreached.clone_from(&base.unreached);
                 judged += 1;
-                if let Some((sc, e, j)) = judge(&o)
+                if let Some((sc, e, j)) = judge(&o, best.as_ref().map(|b| (&b.0, &b.2)))
                     && sc < score - 1e-6
                 {
                     (score, judged_ends) = (sc, e);

@@ -218,3 +218,27 @@ pub fn check_plan(cell: &Cell, doc: &output::Plan) {
 pub fn dist(a: &[f64], b: &[f64]) -> f64 {
     a.iter().zip(b).map(|(x, y)| (x - y).powi(2)).sum::<f64>().sqrt()
 }
+
+/// `base` rebalanced with `settings`, its score and ends taken as its uncoordinated ones,
+/// every hand-over allowed by the work budget, `judge` judging: see
+/// [`plan::rebalance::rebalance`].
+pub fn rebalanced(
+    cell: &Cell,
+    table: &CandidateTable,
+    base: &plan::Outcome,
+    settings: &PlanSettings,
+    cache: &mut plan::PlanCache,
+    judge: &mut plan::rebalance::Judge<'_, ()>,
+) -> (Option<plan::rebalance::Rebalanced<()>>, bool) {
+    use plan::rebalance::{ends, makespan, rebalance};
+    rebalance(
+        cell,
+        table,
+        (base, makespan(base), &ends(base)),
+        settings,
+        cache,
+        &|| true,
+        judge,
+    )
+    .unwrap()
+}
