@@ -75,6 +75,15 @@ struct Search<'a> {
     /// First node of each robot.
     offset: Vec<usize>,
     choices: Vec<Choice>,
+    /// Per node, the boxes one of whose orders starts there: times only rise, so a box one of
+    /// whose orders holds can open again only where the time an order starts from rises.
+    incident: Vec<Vec<u32>>,
+    /// Per box, the mark of the last refresh that listed it (see [`Search::refresh`]).
+    seen: Vec<u32>,
+    /// The current refresh's mark.
+    mark: u32,
+    /// Nodes whose times the last [`Search::add`] or [`Search::lengthen`] raised.
+    raised: Vec<usize>,
     /// Cross edges by source node (chain edges are implicit).
     out: Vec<Vec<Edge>>,
     /// Per node, the least wait there (0, or the shortest wait allowed once a wait is needed).
@@ -149,11 +158,24 @@ impl<'a> Search<'a> {
                     first_b: first(c, b.b, b.open[3], a, b.a, b.open[0]),
                 }
             })
-            .collect();
+            .collect::<Vec<Choice>>();
+        let mut incident = vec![Vec::new(); n];
+        for (i, c) in choices.iter().enumerate() {
+            for e in [c.first_a, c.first_b].into_iter().flatten() {
+                if incident[e.from].last() != Some(&(i as u32)) {
+                    incident[e.from].push(i as u32);
+                }
+            }
+        }
+        let seen = vec![0; choices.len()];
         Search {
             paths,
             offset,
             choices,
+            incident,
+            seen,
+            mark: 0,
+            raised: Vec::new(),
             out: vec![Vec::new(); n],
             hold: vec![0.0; n],
             min_wait,
@@ -195,6 +217,7 @@ impl<'a> Search<'a> {
     /// cannot all hold).
     fn add(&mut self, e: Edge, x: &mut [f64]) -> bool {
         self.out[e.from].push(e);
+        self.raised.clear();
         if x[e.to] < x[e.from] + e.w - EPS {
             x[e.to] = x[e.from] + e.w;
             return self.propagate(e.to, x);
@@ -230,6 +253,7 @@ impl<'a> Search<'a> {
     /// then cannot hold.
     fn lengthen(&mut self, v: usize, x: &mut [f64]) -> bool {
         self.hold[v] = self.min_wait;
+        self.raised.clear();
         let r = self.robot_of(v);
         let need = self.arrival(r, v - self.offset[r], x) + self.min_wait;
         if x[v] < need - EPS {
@@ -239,9 +263,19 @@ impl<'a> Search<'a> {
         true
     }
 
-    /// Raises every time that the raised `x[start]` forces; false on a positive cycle (one
-    /// that comes back to raise `start` again).
-    fn propagate(&self, start: usize, x: &mut [f64]) -> bool {
+    /// Raises every time that the raised `x[start]` forces (each raised node, `start` too,
+    /// noted in `raised`); false on a positive cycle (one that comes back to raise `start`
+    /// again).
+    fn propagate(&mut self, start: usize, x: &mut [f64]) -> bool {
+        let mut raised = std::mem::take(&mut self.raised);
+        let holds = self.propagate_into(start, x, &mut raised);
+        self.raised = raised;
+        holds
+    }
+
+    /// [`Search::propagate`], noting the raised nodes in `raised`.
+    fn propagate_into(&self, start: usize, x: &mut [f64], raised: &mut Vec<usize>) -> bool {
+        raised.push(start);
         let mut stack = vec![start];
         while let Some(u) = stack.pop() {
             let r = self.robot_of(u);
@@ -260,6 +294,7 @@ impl<'a> Search<'a> {
                         return false;
                     }
                     x[f.to] = x[u] + f.w;
+                    raised.push(f.to);
                     stack.push(f.to);
                 }
             }
@@ -271,27 +306,72 @@ impl<'a> Search<'a> {
         e.is_some_and(|e| x[e.to] >= x[e.from] + e.w - EPS)
     }
 
-    /// The box to branch on: the earliest (by when its first robot reaches it) that neither
-    /// order satisfies at `x`.
-    fn open(&self, x: &[f64]) -> Option<usize> {
-        let mut pick: Option<(f64, usize)> = None;
-        for (i, c) in self.choices.iter().enumerate() {
-            if Self::holds(&c.first_a, x) || Self::holds(&c.first_b, x) {
-                continue;
+    /// Whether neither order of box `c` holds at `x` (the box is still to be passed).
+    fn is_open(c: &Choice, x: &[f64]) -> bool {
+        !(Self::holds(&c.first_a, x) || Self::holds(&c.first_b, x))
+    }
+
+    /// Every box open at `x` (the root's list).
+    fn all_open(&self, x: &[f64]) -> Vec<u32> {
+        (0..self.choices.len())
+            .filter(|&i| Self::is_open(&self.choices[i], x))
+            .map(|i| i as u32)
+            .collect()
+    }
+
+    /// The boxes open at `x`, given `open`, those open at times that `x` raises only at the
+    /// nodes in `raised`: whether a box is passed depends on the times of its orders' nodes
+    /// only, and an order that holds keeps holding while the time it starts from stays, so only
+    /// the boxes listed and those with an order starting at a raised node are looked at.
+    fn refresh(&mut self, open: &[u32], x: &[f64]) -> Vec<u32> {
+        if self.mark == u32::MAX {
+            self.seen.fill(0);
+            self.mark = 0;
+        }
+        self.mark += 1;
+        let (mark, choices, seen) = (self.mark, &self.choices, &mut self.seen);
+        let mut out = Vec::with_capacity(open.len());
+        for &i in open {
+            seen[i as usize] = mark;
+            if Self::is_open(&choices[i as usize], x) {
+                out.push(i);
             }
+        }
+        for &v in &self.raised {
+            for &i in &self.incident[v] {
+                if seen[i as usize] != mark {
+                    seen[i as usize] = mark;
+                    if Self::is_open(&choices[i as usize], x) {
+                        out.push(i);
+                    }
+                }
+            }
+        }
+        out
+    }
+
+    /// The box to branch on: of `open` (the boxes that neither order passes at `x`), the
+    /// earliest by when its first robot reaches it, ties to the first box.
+    fn earliest(&self, open: &[u32], x: &[f64]) -> Option<usize> {
+        let mut pick: Option<(f64, usize)> = None;
+        for &i in open {
+            let (i, c) = (i as usize, &self.choices[i as usize]);
             let when = [c.first_a, c.first_b]
                 .iter()
                 .flatten()
                 .map(|e| x[e.to])
                 .fold(f64::INFINITY, f64::min);
-            if pick.is_none_or(|(t, _)| when < t) {
+            #[allow(clippy::float_cmp)] // the same pick as a scan of the boxes in order
+            if pick.is_none_or(|(t, j)| when < t || (when == t && i < j)) {
                 pick = Some((when, i));
             }
         }
         pick.map(|p| p.1)
     }
 
-    fn dive(&mut self, x: Vec<f64>, used: usize) {
+    /// One node of the search at times `x`: `open`, the boxes open at its parent's times, and
+    /// `raised`, the nodes whose times rose since (at the root: every box open there, none).
+    fn dive(&mut self, x: Vec<f64>, open: &[u32], raised: Vec<usize>, used: usize) {
         if self.stop_at_first && self.best.is_some() {
             return;
         }
@@ -300,13 +380,21 @@ impl<'a> Search<'a> {
         if self.best.as_ref().is_some_and(|b| bound >= b.0 - EPS) {
             return;
         }
-        let Some(i) = self.open(&x) else {
+        self.raised = raised;
+        let open = self.refresh(open, &x);
+        debug_assert!({
+            let mut o = open.clone();
+            o.sort_unstable();
+            o == self.all_open(&x)
+        });
+        let Some(i) = self.earliest(&open, &x) else {
             // Every box passed: a wait too short to show becomes the shortest allowed, and
             // the search goes on from there (it may open boxes again).
             if let Some(v) = self.short_wait(&x) {
                 let mut y = x;
                 if self.lengthen(v, &mut y) {
-                    self.dive(y, used);
+                    let raised = std::mem::take(&mut self.raised);
+                    self.dive(y, &open, raised, used);
                 }
                 self.hold[v] = 0.0;
                 return;
@@ -320,12 +408,12 @@ impl<'a> Search<'a> {
         for e in [c.first_a, c.first_b].into_iter().flatten() {
             let mut y = x.clone();
             if self.add(e, &mut y) {
-                children.push((self.makespan(&y), e, y));
+                children.push((self.makespan(&y), e, y, std::mem::take(&mut self.raised)));
             }
             self.out[e.from].pop();
         }
         children.sort_by(|p, q| p.0.total_cmp(&q.0));
-        for (k, (_, e, y)) in children.into_iter().enumerate() {
+        for (k, (_, e, y, raised)) in children.into_iter().enumerate() {
             let used = used + k;
             if self.discrepancies.is_some_and(|d| used > d) {
                 self.cut = true;
@@ -343,7 +431,7 @@ impl<'a> Search<'a> {
             }
             self.out[e.from].push(e);
             self.chosen.push(e);
-            self.dive(y, used);
+            self.dive(y, &open, raised, used);
             self.chosen.pop();
             self.out[e.from].pop();
         }
@@ -439,8 +527,9 @@ fn search(paths: &[Track], boxes: &[ConflictBox], budget: usize, min_wait: f64) 
     // Depth first until the first schedule (the first dive is the greedy one; a search that
     // finds none goes on to prove there is none, as before).
     let x = s.initial();
+    let open = s.all_open(&x);
     s.stop_at_first = true;
-    s.dive(x.clone(), 0);
+    s.dive(x.clone(), &open, Vec::new(), 0);
     s.stop_at_first = false;
     // Then limited discrepancy search: dives that leave the greedy order at most `d` times,
     // d = 0, 1, 2, …, pruned by the best schedule so far. A depth-first search spends its
@@ -452,7 +541,7 @@ fn search(paths: &[Track], boxes: &[ConflictBox], budget: usize, min_wait: f64) 
         for d in 0.. {
             s.discrepancies = Some(d);
             s.cut = false;
-            s.dive(x.clone(), 0);
+            s.dive(x.clone(), &open, Vec::new(), 0);
             if !s.cut && s.nodes < s.budget {
                 proven = true;
                 break;
@@ -700,6 +789,72 @@ mod tests {
             }
         }
         assert!((s.makespan - best).abs() < 1e-9, "{} vs {best}", s.makespan);
+    }
+
+    /// The boxes still open after orders are chosen, found from the parent's open boxes and
+    /// the raised nodes, are those a scan of every box finds (random tracks and boxes, random
+    /// orders added one after another).
+    #[test]
+    fn open_boxes_are_kept_up_without_a_scan() {
+        use rand::{RngExt, SeedableRng};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(7);
+        let mut checked = 0;
+        for _ in 0..80 {
+            let tracks: Vec<Track> = (0..4)
+                .map(|r| {
+                    let mut rests = vec![0.0];
+                    for _ in 0..rng.random_range(2..9) {
+                        let last = *rests.last().unwrap();
+                        rests.push(last + rng.random_range(0.2..2.0));
+                    }
+                    track(r, rests.last().unwrap() + rng.random_range(0.5..2.0), &rests)
+                })
+                .collect();
+            let span = |rng: &mut rand_chacha::ChaCha8Rng, len: f64| {
+                let a = rng.random_range(0.0..len);
+                (a, (a + rng.random_range(0.1..1.5)).min(len))
+            };
+            let boxes: Vec<ConflictBox> = (0..60)
+                .map(|_| {
+                    let (a, b) = (rng.random_range(0..4), rng.random_range(0..3));
+                    let b = if b >= a { b + 1 } else { b };
+                    boxed(
+                        (a, b),
+                        span(&mut rng, tracks[a].len),
+                        span(&mut rng, tracks[b].len),
+                    )
+                })
+                .collect();
+            let mut search = Search::new(&tracks, &boxes, 1, 0.1);
+            let mut x = search.initial();
+            let mut open = search.all_open(&x);
+            for _ in 0..20 {
+                let Some(&i) = open.get(rng.random_range(0..open.len().max(1))) else {
+                    break;
+                };
+                let c = search.choices[i as usize];
+                let Some(e) = (if rng.random_bool(0.5) {
+                    c.first_a
+                } else {
+                    c.first_b
+                })
+                .or(c.first_a)
+                .or(c.first_b) else {
+                    break;
+                };
+                let mut y = x.clone();
+                if !search.add(e, &mut y) {
+                    break;
+                }
+                let mut next = search.refresh(&open, &y);
+                next.sort_unstable();
+                assert_eq!(next, search.all_open(&y));
+                assert!(!next.contains(&i), "the box just ordered is passed");
+                (x, open) = (y, next);
+                checked += 1;
+            }
+        }
+        assert!(checked > 200, "{checked}");
     }
 
     /// Waits shorter than the shortest allowed are lengthened to it (and the boxes still
