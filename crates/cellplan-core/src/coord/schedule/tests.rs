@@ -1,0 +1,285 @@
+//! The scheduler's tests: small diagrams with known answers, brute force, random diagrams.
+use super::*;
+
+fn track(robot: usize, len: f64, rests: &[f64]) -> Track {
+    Track {
+        robot,
+        len,
+        rests: rests.to_vec(),
+    }
+}
+
+fn boxed(robots: (usize, usize), a: (f64, f64), b: (f64, f64)) -> ConflictBox {
+    ConflictBox {
+        robots,
+        a,
+        b,
+        open: [false; 4],
+    }
+}
+
+/// Where robot `r` is at time `t` under the schedule (position), and when it ends.
+fn position(t: &Track, waits: &[(f64, Option<usize>)], time: f64) -> f64 {
+    let mut clock = 0.0;
+    for (k, &at) in t.rests.iter().enumerate() {
+        if k > 0 {
+            let d = at - t.rests[k - 1];
+            if time < clock + d {
+                return t.rests[k - 1] + (time - clock);
+            }
+            clock += d;
+        }
+        if time < clock + waits[k].0 {
+            return at;
+        }
+        clock += waits[k].0;
+    }
+    (t.rests.last().unwrap() + time - clock).min(t.len)
+}
+
+/// The schedule keeps every pair of positions out of every box (sampled every 1 ms).
+fn assert_clear(tracks: &[Track], boxes: &[ConflictBox], s: &Schedule) {
+    let mut time = 0.0;
+    while time <= s.makespan + 1e-9 {
+        for b in boxes {
+            let pa = position(&tracks[b.robots.0], &s.waits[b.robots.0], time);
+            let pb = position(&tracks[b.robots.1], &s.waits[b.robots.1], time);
+            let inside = pa > b.a.0 + 1e-6 && pa < b.a.1 - 1e-6 && pb > b.b.0 + 1e-6 && pb < b.b.1 - 1e-6;
+            assert!(!inside, "at {time}: {pa} and {pb} in {b:?}");
+        }
+        time += 1e-3;
+    }
+}
+
+/// Two robots crossing one region: the shorter wait is taken (b waits for a to leave,
+/// 1 s, rather than a for b, 3 s), at the last rest before the region (a rest on the
+/// region's edge is in it).
+#[test]
+fn one_box_waits_the_shorter_way() {
+    let tracks = [track(0, 10.0, &[0.0, 2.0, 4.0]), track(1, 10.0, &[0.0, 3.0, 5.0])];
+    // a in the region over [4, 6], b over [5, 7].
+    let boxes = [boxed((0, 1), (4.0, 6.0), (5.0, 7.0))];
+    let s = schedule(&tracks, &boxes, 1000, 0.05).unwrap();
+    assert!(s.proven);
+    // a first: b reaches 5 at 6 (waits 1 s at its rest 5); b first: a waits until b is
+    // past 7 (at 7): 3 s.
+    assert!((s.makespan - 11.0).abs() < 1e-9, "{s:?}");
+    assert_eq!(s.waits[0].iter().map(|w| w.0).sum::<f64>(), 0.0);
+    assert!((s.waits[1][1].0 - 1.0).abs() < 1e-9, "{s:?}");
+    assert_eq!(s.waits[1][1].1, Some(0));
+    assert_eq!(s.waits[1][2].0, 0.0);
+    assert_clear(&tracks, &boxes, &s);
+}
+
+/// A robot home for good in the other's way can only be passed before it gets there; one
+/// still at home, only after it has left.
+#[test]
+fn homes_fix_the_order() {
+    let tracks = [track(0, 6.0, &[0.0, 1.0]), track(1, 8.0, &[0.0, 2.0])];
+    // Robot 0's end pose (6) blocks robot 1 over [3, 4]: robot 1 must be past 4 first.
+    let boxes = [boxed((0, 1), (5.0, 6.0), (3.0, 4.0))];
+    let s = schedule(&tracks, &boxes, 1000, 0.05).unwrap();
+    // Robot 0 must not reach 5 before robot 1 is at 4 (time 4): it waits 3 s... at rest 1
+    // (position 1, reached at 1): it leaves at 4 - 4 = 0 → no wait needed? 5 is reached
+    // at 5 > 4: already clear.
+    assert_eq!(s.decisions, 0);
+    assert!((s.makespan - 8.0).abs() < 1e-9);
+    assert_clear(&tracks, &boxes, &s);
+    // Now robot 1 is late: it reaches 3 only at 6.
+    let late = [track(0, 6.0, &[0.0, 1.0]), track(1, 8.0, &[0.0, 2.0]).clone()];
+    let boxes = [boxed((0, 1), (5.0, 6.0), (3.0, 7.0))];
+    let s = schedule(&late, &boxes, 1000, 0.05).unwrap();
+    // Robot 1 passes first (robot 0 at its end blocks forever): robot 0 may reach 5 only
+    // when robot 1 is past 7 (time 7): it waits 2 s at rest 1.
+    assert!((s.waits[0][1].0 - 2.0).abs() < 1e-9, "{s:?}");
+    assert!((s.makespan - 8.0).abs() < 1e-9);
+    assert_clear(&late, &boxes, &s);
+    // Robot 1's start home in robot 0's way: robot 1 leaves first.
+    let boxes = [boxed((0, 1), (0.5, 2.0), (0.0, 1.0))];
+    let s = schedule(&late, &boxes, 1000, 0.05).unwrap();
+    assert!(
+        (s.waits[0][1].0 - 0.0).abs() < 1e-9 && s.waits[0][0].0 > 0.0,
+        "{s:?}"
+    );
+    assert_clear(&late, &boxes, &s);
+    // Both end homes in each other's way: no order exists.
+    let boxes = [boxed((0, 1), (5.0, 6.0), (7.0, 8.0))];
+    assert!(schedule(&late, &boxes, 1000, 0.05).is_none());
+}
+
+/// Three robots, boxes chained so that the greedy choice at the first box is wrong: the
+/// search finds the order a brute force over all orders finds.
+/// A robot certified clear while standing at home (`open`) may let the other pass there,
+/// at its start and at its end; without the certificate no order exists.
+#[test]
+fn a_robot_clear_at_home_may_wait_there() {
+    let tracks = [track(0, 10.0, &[0.0]), track(1, 10.0, &[0.0])];
+    // Both conflict while leaving home.
+    let mut b = boxed((0, 1), (0.0, 3.0), (0.0, 3.0));
+    assert!(schedule(&tracks, std::slice::from_ref(&b), 1000, 0.05).is_none());
+    b.open = [true, false, false, false];
+    let s = schedule(&tracks, std::slice::from_ref(&b), 1000, 0.05).unwrap();
+    assert!((s.waits[0][0].0 - 3.0).abs() < 1e-9, "{s:?}");
+    assert!((s.makespan - 13.0).abs() < 1e-9);
+    assert_clear(&tracks, std::slice::from_ref(&b), &s);
+    // Both conflict while coming home: robot 1, clear once home, may arrive first.
+    let mut b = boxed((0, 1), (8.0, 10.0), (7.0, 10.0));
+    assert!(schedule(&tracks, std::slice::from_ref(&b), 1000, 0.05).is_none());
+    b.open = [false, false, false, true];
+    let s = schedule(&tracks, std::slice::from_ref(&b), 1000, 0.05).unwrap();
+    // Robot 0 may reach 8 only when robot 1 is home (10): a 2 s wait at home.
+    assert!((s.waits[0][0].0 - 2.0).abs() < 1e-9, "{s:?}");
+    assert_clear(&tracks, std::slice::from_ref(&b), &s);
+}
+
+/// Robot 0 must be past 2 before robot 1 reaches 4 (its home blocks robot 1 there) and
+/// must not reach 3 before robot 1 is past 7 (its end home blocks robot 1 there): without
+/// a rest between 2 and 3 no order exists, and the core is exactly those two boxes (the
+/// third, far away, is not in it); with a rest at 2.5 robot 0 waits there (until 6.5:
+/// it reaches 3 when robot 1 is past 7).
+#[test]
+fn the_infeasible_core_shows_where_a_stop_is_missing() {
+    let boxes = [
+        boxed((0, 1), (0.0, 2.0), (4.0, 6.0)),
+        boxed((0, 1), (3.0, 10.0), (5.0, 7.0)),
+        boxed((0, 2), (0.0, 1.0), (8.0, 9.0)),
+    ];
+    let tracks = [
+        track(0, 10.0, &[0.0]),
+        track(1, 10.0, &[0.0]),
+        track(2, 10.0, &[0.0]),
+    ];
+    assert!(schedule(&tracks, &boxes, 1000, 0.05).is_none());
+    assert_eq!(infeasible_core(&tracks, &boxes, 1000, 0.05), vec![0, 1]);
+    let stopped = [
+        track(0, 10.0, &[0.0, 2.5]),
+        track(1, 10.0, &[0.0]),
+        track(2, 10.0, &[0.0]),
+    ];
+    let s = schedule(&stopped, &boxes, 1000, 0.05).unwrap();
+    assert!((s.waits[0][1].0 - 4.0).abs() < 1e-9, "{s:?}");
+    assert_clear(&stopped, &boxes, &s);
+    assert!(infeasible_core(&stopped, &boxes, 1000, 0.05).is_empty());
+}
+
+#[test]
+fn the_search_matches_brute_force() {
+    let tracks = [
+        track(0, 10.0, &[0.0, 1.0, 3.0, 5.0, 7.0]),
+        track(1, 10.0, &[0.0, 2.0, 4.0, 6.0]),
+        track(2, 9.0, &[0.0, 1.5, 3.5, 6.5]),
+    ];
+    let boxes = [
+        boxed((0, 1), (1.5, 3.0), (2.5, 4.5)),
+        boxed((1, 2), (4.5, 6.5), (3.0, 5.0)),
+        boxed((0, 2), (5.5, 8.0), (6.0, 8.5)),
+        boxed((0, 1), (7.5, 9.0), (7.0, 8.0)),
+    ];
+    let s = schedule(&tracks, &boxes, 100_000, 0.0).unwrap();
+    assert!(s.proven);
+    assert_clear(&tracks, &boxes, &s);
+    // Brute force: every order of the four boxes, longest paths by repeated relaxation.
+    let mut best = f64::INFINITY;
+    for mask in 0..16u32 {
+        let mut search = Search::new(&tracks, &boxes, 1, 0.0);
+        let mut x = search.initial();
+        let mut ok = true;
+        for (i, c) in search.choices.clone().iter().enumerate() {
+            let e = if mask >> i & 1 == 0 { c.first_a } else { c.first_b };
+            match e {
+                Some(e) => ok &= search.add(e, &mut x),
+                None => ok = false,
+            }
+        }
+        if ok {
+            best = best.min(search.makespan(&x));
+        }
+    }
+    assert!((s.makespan - best).abs() < 1e-9, "{} vs {best}", s.makespan);
+}
+
+/// The boxes still open after orders are chosen, found from the parent's open boxes and
+/// the raised nodes, are those a scan of every box finds (random tracks and boxes, random
+/// orders added one after another).
+#[test]
+fn open_boxes_are_kept_up_without_a_scan() {
+    use rand::{RngExt, SeedableRng};
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(7);
+    let mut checked = 0;
+    for _ in 0..80 {
+        let tracks: Vec<Track> = (0..4)
+            .map(|r| {
+                let mut rests = vec![0.0];
+                for _ in 0..rng.random_range(2..9) {
+                    let last = *rests.last().unwrap();
+                    rests.push(last + rng.random_range(0.2..2.0));
+                }
+                track(r, rests.last().unwrap() + rng.random_range(0.5..2.0), &rests)
+            })
+            .collect();
+        let span = |rng: &mut rand_chacha::ChaCha8Rng, len: f64| {
+            let a = rng.random_range(0.0..len);
+            (a, (a + rng.random_range(0.1..1.5)).min(len))
+        };
+        let boxes: Vec<ConflictBox> = (0..60)
+            .map(|_| {
+                let (a, b) = (rng.random_range(0..4), rng.random_range(0..3));
+                let b = if b >= a { b + 1 } else { b };
+                boxed(
+                    (a, b),
+                    span(&mut rng, tracks[a].len),
+                    span(&mut rng, tracks[b].len),
+                )
+            })
+            .collect();
+        let mut search = Search::new(&tracks, &boxes, 1, 0.1);
+        let mut x = search.initial();
+        let mut open = search.all_open(&x);
+        for _ in 0..20 {
+            let Some(&i) = open.get(rng.random_range(0..open.len().max(1))) else {
+                break;
+            };
+            let c = search.choices[i as usize];
+            let Some(e) = (if rng.random_bool(0.5) {
+                c.first_a
+            } else {
+                c.first_b
+            })
+            .or(c.first_a)
+            .or(c.first_b) else {
+                break;
+            };
+            let mut y = x.clone();
+            if !search.add(e, &mut y) {
+                break;
+            }
+            let mut next = search.refresh(&open, &y);
+            next.sort_unstable();
+            assert_eq!(next, search.all_open(&y));
+            assert!(!next.contains(&i), "the box just ordered is passed");
+            (x, open) = (y, next);
+            checked += 1;
+        }
+    }
+    assert!(checked > 200, "{checked}");
+}
+
+/// Waits shorter than the shortest allowed are lengthened to it (and the boxes still
+/// hold); with a budget of one node the first dive's schedule comes back, not proven.
+#[test]
+fn short_waits_are_lengthened_and_the_budget_binds() {
+    let tracks = [track(0, 10.0, &[0.0, 2.0, 4.0]), track(1, 10.0, &[0.0, 3.0, 4.9])];
+    let boxes = [boxed((0, 1), (4.0, 5.0), (5.0, 6.0))];
+    // b reaches 5 at 5.0 ≥ a's exit at 5.0: no wait at all.
+    let s = schedule(&tracks, &boxes, 1000, 0.2).unwrap();
+    assert!(s.waits.iter().flatten().all(|w| w.0 == 0.0 || w.0 >= 0.2 - 1e-9));
+    assert_clear(&tracks, &boxes, &s);
+    let boxes = [boxed((0, 1), (4.0, 5.05), (5.0, 6.0))];
+    let s = schedule(&tracks, &boxes, 1000, 0.2).unwrap();
+    // 0.05 s would do; 0.2 s is the shortest allowed.
+    let w: f64 = s.waits.iter().flatten().map(|w| w.0).sum();
+    assert!((w - 0.2).abs() < 1e-9, "{s:?}");
+    assert_clear(&tracks, &boxes, &s);
+    let s = schedule(&tracks, &boxes, 1, 0.2).unwrap();
+    assert!(!s.proven);
+}
