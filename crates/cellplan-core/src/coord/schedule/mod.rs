@@ -265,16 +265,9 @@ impl<'a> Search<'a> {
 
     /// Raises every time that the raised `x[start]` forces (each raised node, `start` too,
     /// noted in `raised`); false on a positive cycle (one that comes back to raise `start`
-    /// again).
+    /// again; `x` and `raised` are then left unfinished).
     fn propagate(&mut self, start: usize, x: &mut [f64]) -> bool {
         let mut raised = std::mem::take(&mut self.raised);
-        let holds = self.propagate_into(start, x, &mut raised);
-        self.raised = raised;
-        holds
-    }
-
-    /// [`Search::propagate`], noting the raised nodes in `raised`.
-    fn propagate_into(&self, start: usize, x: &mut [f64], raised: &mut Vec<usize>) -> bool {
         raised.push(start);
         let mut stack = vec![start];
         while let Some(u) = stack.pop() {
@@ -299,6 +292,7 @@ impl<'a> Search<'a> {
                 }
             }
         }
+        self.raised = raised;
         true
     }
 
@@ -323,7 +317,7 @@ impl<'a> Search<'a> {
     /// nodes in `raised`: whether a box is passed depends on the times of its orders' nodes
     /// only, and an order that holds keeps holding while the time it starts from stays, so only
     /// the boxes listed and those with an order starting at a raised node are looked at.
-    fn refresh(&mut self, open: &[u32], x: &[f64]) -> Vec<u32> {
+    fn refresh(&mut self, open: &[u32], raised: &[usize], x: &[f64]) -> Vec<u32> {
         if self.mark == u32::MAX {
             self.seen.fill(0);
             self.mark = 0;
@@ -337,7 +331,7 @@ impl<'a> Search<'a> {
                 out.push(i);
             }
         }
-        for &v in &self.raised {
+        for &v in raised {
             for &i in &self.incident[v] {
                 if seen[i as usize] != mark {
                     seen[i as usize] = mark;
@@ -380,8 +374,7 @@ impl<'a> Search<'a> {
         if self.best.as_ref().is_some_and(|b| bound >= b.0 - EPS) {
             return;
         }
-        self.raised = raised;
-        let open = self.refresh(open, &x);
+        let open = self.refresh(open, &raised, &x);
         debug_assert!({
             let mut o = open.clone();
             o.sort_unstable();

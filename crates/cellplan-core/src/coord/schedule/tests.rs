@@ -253,7 +253,8 @@ fn open_boxes_are_kept_up_without_a_scan() {
             if !search.add(e, &mut y) {
                 break;
             }
-            let mut next = search.refresh(&open, &y);
+            let raised = std::mem::take(&mut search.raised);
+            let mut next = search.refresh(&open, &raised, &y);
             next.sort_unstable();
             assert_eq!(next, search.all_open(&y));
             assert!(!next.contains(&i), "the box just ordered is passed");
