@@ -37,7 +37,7 @@
 //! (`bench/motion/README.md`). Pairs proven apart everywhere are not checked at all
 //! ([`apart_everywhere`]).
 use crate::plan::{Clearance, JointSpace, SegmentMotion, StateValidity, narrow_step};
-use cellplan_geom::{BroadPhase, CollisionWorld, GroupId, PlacedCovers, Pose};
+use cellplan_geom::{BroadPhase, CollisionWorld, DVec3, GroupId, PlacedCovers, Pose};
 use cellplan_kin::Chain;
 use std::cell::{Cell, RefCell};
 use std::ops::Range;
@@ -128,11 +128,15 @@ impl Arm<'_> {
         links.resize(self.chain.links.len(), Pose::IDENTITY);
         self.chain.fk_all(q, links);
         out.clear();
-        // A body on the same link as the one before shares its pose: composed once.
+        // A body on the same link as the one before shares its pose: composed once (and not at
+        // all on a base at the world's origin, whose composition changes no value but the sign
+        // of a zero).
+        let at_origin = self.base.rotation == Pose::IDENTITY.rotation && self.base.translation == DVec3::ZERO;
         let mut last: Option<(usize, Pose)> = None;
         for &l in self.body_links {
             let pose = match last {
                 Some((k, pose)) if k == l => pose,
+                _ if at_origin => links.get(l).copied().unwrap_or(Pose::IDENTITY),
                 _ => self.base * links.get(l).copied().unwrap_or(Pose::IDENTITY),
             };
             last = Some((l, pose));
@@ -381,7 +385,8 @@ impl<'a> ArmValidity<'a> {
 
     /// Distance between bodies `i` and `j` at `q` (posed in `bodies`), capped at `cap` (as
     /// [`Self::scene_part`]); with the broad phase, the pair's table over one joint
-    /// ([`PairTables`]) comes after the covers and before the exact query.
+    /// ([`PairTables`]) comes after the outer spheres and before the exact query: after the
+    /// covers, or before them when `enough >= cap` ([`BroadPhase::pair_distance_or`]).
     fn pair_part(
         &self,
         i: usize,

@@ -5,8 +5,8 @@
 //! the lookups of shapes, covers and poses once:
 //!
 //! - each body's cover (see [`crate::spheres`]) is kept in one flat array;
-//!   [`BroadPhase::place`] puts every body's outer sphere in the world at once (one rotation
-//!   matrix per body) and a body's cover the first time a query needs it;
+//!   [`BroadPhase::place`] keeps the poses; a body's outer sphere is put in the world (one
+//!   rotation matrix per body) when a query first needs it, and its cover likewise;
 //! - each object — a static object, or a body of another group parked at a fixed pose — gets
 //!   its world box and, for boxes, cylinders and balls, its inverse pose, so that a sphere's
 //!   distance to it is a few lines of arithmetic (meshes and other shapes fall back to a point
@@ -77,22 +77,32 @@ struct Object {
 }
 
 /// The world covers of a group's bodies at one set of poses (see [`BroadPhase::place`]).
-/// The outer spheres are placed at once; a body's cover only when a query first needs it
-/// (most queries settle most bodies by their outer spheres).
+/// Nothing is placed at once: a body's frame and outer sphere when a query first needs them,
+/// its cover when a query first needs that (most queries settle most bodies by their outer
+/// spheres, and an invalid configuration stops at its first failing part).
 #[derive(Clone, Debug, Default)]
 pub struct PlacedCovers {
-    /// Every body's cover in the world; body `i`'s spheres are `spheres[ranges[i]]`, valid
-    /// once `placed[i]` is set.
+    /// The poses placed, one per body of the group.
+    poses: Vec<Pose>,
+    /// Per body: nothing placed (0), or [`FRAMED`] with [`COVERED`], [`SHAPED`] and
+    /// [`FINITE`] as they hold.
+    state: Vec<Cell<u8>>,
+    /// Every body's cover in the world; body `i`'s spheres are `spheres[ranges[i]]`.
     spheres: Vec<Cell<Sphere>>,
-    /// Whether each body's cover is in `spheres` yet.
-    placed: Vec<Cell<bool>>,
     /// Each body's rotation and translation, to place its cover.
-    frames: Vec<(DMat3, DVec3)>,
-    /// Each body's outer sphere in the world (`None`: no shape).
-    outer: Vec<Option<Sphere>>,
-    /// Whether each body's pose is finite.
-    finite: Vec<bool>,
+    frames: Vec<Cell<(DMat3, DVec3)>>,
+    /// Each body's outer sphere in the world (when [`SHAPED`]).
+    outer: Vec<Cell<Sphere>>,
 }
+
+/// A body of [`PlacedCovers`] whose frame and outer sphere are placed.
+const FRAMED: u8 = 1;
+/// A body of [`PlacedCovers`] whose cover is placed too.
+const COVERED: u8 = 2;
+/// A body of [`PlacedCovers`] with a shape (and an outer sphere).
+const SHAPED: u8 = 4;
+/// A body of [`PlacedCovers`] at a finite pose.
+const FINITE: u8 = 8;
 
 /// The broad phase of one group against the static scene and parked groups (see the module
 /// documentation). Built for a world and its current objects: rebuild it when they change.
@@ -245,48 +255,83 @@ impl BroadPhase {
         self.objects.len()
     }
 
-    /// Places the group at `poses` (world frame, one per body of the group) into `out`: every
-    /// body's outer sphere now, its cover when a query first asks for it.
+    /// Places the group at `poses` (world frame, one per body of the group; a missing pose is
+    /// the identity) into `out`: each body's frame and outer sphere when a query first asks for
+    /// them, its cover when a query first asks for that.
     pub fn place(&self, poses: &[Pose], out: &mut PlacedCovers) {
-        out.outer.clear();
-        out.finite.clear();
-        out.frames.clear();
-        out.spheres.resize(
-            self.local.len(),
-            Cell::new(Sphere {
-                centre: DVec3::ZERO,
-                radius: 0.0,
-            }),
-        );
-        out.placed.clear();
-        out.placed.resize(self.ranges.len(), Cell::new(false));
-        for i in 0..self.ranges.len() {
-            let pose = poses.get(i).copied().unwrap_or(Pose::IDENTITY);
-            let finite = pose.is_finite();
-            out.finite.push(finite);
-            let rot = DMat3::from_quat(pose.rotation);
-            let t = pose.translation;
-            out.frames.push((rot, t));
-            out.outer.push(self.outer[i].map(|s| Sphere {
-                centre: rot * s.centre + t,
-                radius: s.radius,
-            }));
+        let n = self.ranges.len();
+        out.poses.clear();
+        out.poses.extend_from_slice(&poses[..n.min(poses.len())]);
+        out.poses.resize(n, Pose::IDENTITY);
+        out.state.clear();
+        out.state.resize(n, Cell::new(0));
+        let zero = Sphere {
+            centre: DVec3::ZERO,
+            radius: 0.0,
+        };
+        if out.spheres.len() != self.local.len() {
+            out.spheres.resize(self.local.len(), Cell::new(zero));
         }
+        if out.frames.len() != n {
+            out.frames.resize(n, Cell::new((DMat3::IDENTITY, DVec3::ZERO)));
+            out.outer.resize(n, Cell::new(zero));
+        }
+    }
+
+    /// Body `i`'s outer sphere in the world (`None`: no shape, or no such body) and whether its
+    /// pose is finite; placed now with its frame if no query has needed them yet.
+    #[inline(always)]
+    fn outer_placed(&self, placed: &PlacedCovers, i: usize) -> (Option<Sphere>, bool) {
+        let Some(state) = placed.state.get(i) else {
+            return (None, true);
+        };
+        let mut s = state.get();
+        if s & FRAMED == 0 {
+            s = self.frame(placed, i);
+        }
+        let outer = (s & SHAPED != 0).then(|| placed.outer[i].get());
+        (outer, s & FINITE != 0)
+    }
+
+    /// Places body `i`'s frame and outer sphere; its new state.
+    #[inline(never)]
+    fn frame(&self, placed: &PlacedCovers, i: usize) -> u8 {
+        let pose = placed.poses[i];
+        let rot = DMat3::from_quat(pose.rotation);
+        let t = pose.translation;
+        placed.frames[i].set((rot, t));
+        let mut s = FRAMED;
+        if let Some(o) = self.outer[i] {
+            placed.outer[i].set(Sphere {
+                centre: rot * o.centre + t,
+                radius: o.radius,
+            });
+            s |= SHAPED;
+        }
+        if pose.is_finite() {
+            s |= FINITE;
+        }
+        placed.state[i].set(s);
+        s
     }
 
     /// Body `i`'s cover in the world, placed now if no query has needed it yet.
     fn cover<'p>(&self, placed: &'p PlacedCovers, i: usize) -> &'p [Cell<Sphere>] {
         let range = self.ranges[i].clone();
         let out = &placed.spheres[range.clone()];
-        if !placed.placed[i].get() {
-            let (rot, t) = placed.frames[i];
-            for (o, s) in out.iter().zip(&self.local[range]) {
+        let mut s = placed.state[i].get();
+        if s & COVERED == 0 {
+            if s & FRAMED == 0 {
+                s = self.frame(placed, i);
+            }
+            let (rot, t) = placed.frames[i].get();
+            for (o, l) in out.iter().zip(&self.local[range]) {
                 o.set(Sphere {
-                    centre: rot * s.centre + t,
-                    radius: s.radius,
+                    centre: rot * l.centre + t,
+                    radius: l.radius,
                 });
             }
-            placed.placed[i].set(true);
+            placed.state[i].set(s | COVERED);
         }
         out
     }
@@ -367,13 +412,13 @@ impl BroadPhase {
     /// when there is nothing to measure: `best` for a body without shapes, 0 at a non-finite
     /// pose (when there is an object).
     fn placed_body(&self, i: usize, placed: &PlacedCovers, best: f64) -> Result<Sphere, f64> {
-        let Some(Some(outer)) = placed.outer.get(i) else {
+        let (Some(outer), finite) = self.outer_placed(placed, i) else {
             return Err(best);
         };
-        if !placed.finite[i] {
+        if !finite {
             return Err(if self.objects.is_empty() { best } else { 0.0 });
         }
-        Ok(*outer)
+        Ok(outer)
     }
 
     /// A sphere holding the outer spheres of `bodies` (bodies that share one frame, as the
@@ -454,8 +499,9 @@ impl BroadPhase {
     }
 
     /// [`BroadPhase::pair_distance`] with another lower bound on the pair's distance, `other`,
-    /// asked only when the covers fall short: where it reaches the cap, the exact query is
-    /// skipped too (the same answer, when `other` never exceeds the distance). Of `(cap,
+    /// asked only when the outer spheres fall short — after the covers, or before them when
+    /// `enough >= cap` —: where it reaches the cap, the exact query is skipped too (the same
+    /// answer, when `other` never exceeds the distance). Of `(cap,
     /// enough)`, a bound reaching `enough` is answered without the exact query (a lower bound
     /// of the distance; with `enough >= cap`, the same answer as [`BroadPhase::pair_distance`]).
     #[allow(clippy::too_many_arguments)]
@@ -470,7 +516,24 @@ impl BroadPhase {
         other: impl FnOnce() -> f64,
     ) -> f64 {
         let best = sanitize_margin(cap);
-        let (bound, towards) = self.pair_bound_towards(i, j, placed, best);
+        let (bound, towards) = match self.outer_pair(i, j, placed, best) {
+            Some(settled) => settled,
+            None if enough >= best => {
+                // Only whether a bound reaches `best` matters now (one that falls short is never
+                // the answer): `other` first, a few lines where it is there, while the covers
+                // of two close bodies compare every sphere with every sphere.
+                let other = other();
+                if other >= best {
+                    return best;
+                }
+                let (bound, towards) = spheres_bound(self.cover(placed, i), self.cover(placed, j), best);
+                if bound.max(other) >= best {
+                    return best;
+                }
+                return world.pair_distance_hinted(self.group, i, j, poses, best, towards);
+            }
+            None => spheres_bound(self.cover(placed, i), self.cover(placed, j), best),
+        };
         if bound >= best {
             return best;
         }
@@ -492,19 +555,30 @@ impl BroadPhase {
     /// [`BroadPhase::pair_bound`] with the direction from `i` towards `j` that gives it.
     fn pair_bound_towards(&self, i: usize, j: usize, placed: &PlacedCovers, cap: f64) -> (f64, DVec3) {
         let best = sanitize_margin(cap);
-        let (Some(Some(oa)), Some(Some(ob))) = (placed.outer.get(i), placed.outer.get(j)) else {
-            return (best, DVec3::ZERO);
+        self.outer_pair(i, j, placed, best)
+            .unwrap_or_else(|| spheres_bound(self.cover(placed, i), self.cover(placed, j), best))
+    }
+
+    /// [`BroadPhase::pair_bound_towards`] capped at `best` (sanitized) where the covers are not
+    /// needed: a body without shapes, the same body twice or two outer spheres `best` apart
+    /// (`best`), a pose not finite (0); `None` where the covers are.
+    #[inline]
+    fn outer_pair(&self, i: usize, j: usize, placed: &PlacedCovers, best: f64) -> Option<(f64, DVec3)> {
+        let ((Some(oa), finite_a), (Some(ob), finite_b)) =
+            (self.outer_placed(placed, i), self.outer_placed(placed, j))
+        else {
+            return Some((best, DVec3::ZERO));
         };
         if i == j {
-            return (best, DVec3::ZERO);
+            return Some((best, DVec3::ZERO));
         }
-        if !placed.finite[i] || !placed.finite[j] {
-            return (0.0, DVec3::ZERO);
+        if !finite_a || !finite_b {
+            return Some((0.0, DVec3::ZERO));
         }
         if (oa.centre - ob.centre).length() - oa.radius - ob.radius >= best {
-            return (best, DVec3::ZERO);
+            return Some((best, DVec3::ZERO));
         }
-        spheres_bound(self.cover(placed, i), self.cover(placed, j), best)
+        None
     }
 
     /// Lower bound on the distance from `spheres` to `object`, capped at `best`, with the

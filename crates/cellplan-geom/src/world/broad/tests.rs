@@ -192,6 +192,25 @@ fn broad_phase_distances_equal_the_exact_ones() {
         assert!(close(fast, exact), "pair: {fast} vs {exact} (cap {cap})");
         let bound = broad.pair_bound(0, 1, &placed, cap);
         assert!(bound <= exact + 1e-9, "pair bound {bound} above {exact}");
+        // Another lower bound (asked before the covers when `enough >= cap`) changes no
+        // answer: anywhere from nothing to the distance itself, with the cap far or just
+        // above the distance.
+        let share = if rng.random_bool(0.5) {
+            1.0
+        } else {
+            rng.random_range(0.0..1.0)
+        };
+        for cap in [cap, exact + 5e-4] {
+            let exact = world.pair_distance(g, 0, 1, &poses, cap);
+            let other = || exact * share;
+            for enough in [cap, cap + 1.0] {
+                let with = broad.pair_distance_or(&world, 0, 1, &poses, &placed, (cap, enough), other);
+                assert!(
+                    close(with, exact),
+                    "pair with another bound: {with} vs {exact} (cap {cap})"
+                );
+            }
+        }
     }
     assert!(
         near > 50 && touching > 50,
