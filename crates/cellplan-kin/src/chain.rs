@@ -79,6 +79,29 @@ impl Chain {
             parent = pose;
         }
     }
+    /// [`Chain::fk_all`] for the links from `start` on, the links before it already in `out`
+    /// (as `fk_all` gives them): the same poses as `fk_all` over the whole chain, the first
+    /// `start` computed once.
+    pub fn fk_rest(&self, q: &[f64], out: &mut [Pose], start: usize) {
+        let mut parent = match start.checked_sub(1) {
+            None => Pose::IDENTITY,
+            Some(k) => match out.get(k) {
+                Some(&pose) => pose,
+                None => return,
+            },
+        };
+        for (link, slot) in self.links.iter().zip(out.iter_mut()).skip(start) {
+            let mut pose = parent * link.origin;
+            if let Some(j) = link.joint {
+                let value = q.get(j).copied().unwrap_or(0.0);
+                if let Some(joint) = self.joints.get(j) {
+                    pose = joint.apply(pose, value);
+                }
+            }
+            *slot = pose;
+            parent = pose;
+        }
+    }
     /// Pose of the tip (last link) in the root frame.
     pub fn fk_tip(&self, q: &[f64]) -> Pose {
         let mut pose = Pose::IDENTITY;
@@ -472,6 +495,20 @@ mod tests {
         for j in arm().joints {
             let (dp, dr) = pose_error(&j.apply(frame, 0.37), &(frame * j.motion(0.37)));
             assert!(dp < 1e-15 && dr < 1e-15, "{:?}", j.kind);
+        }
+    }
+
+    #[test]
+    fn the_rest_of_a_chain_continues_its_first_links() {
+        let c = arm();
+        let q = [0.3, -1.1, 0.15];
+        let mut all = vec![Pose::IDENTITY; c.links.len()];
+        c.fk_all(&q, &mut all);
+        for start in 0..=c.links.len() {
+            let mut split = vec![Pose::from_parts(DVec3::splat(9.0), DQuat::IDENTITY); c.links.len()];
+            c.fk_all(&q, &mut split[..start]);
+            c.fk_rest(&q, &mut split, start);
+            assert_eq!(split, all, "split at {start}");
         }
     }
 

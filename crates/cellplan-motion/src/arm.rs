@@ -125,23 +125,51 @@ thread_local! {
 impl Arm<'_> {
     /// World poses of the arm's bodies at `q` into `out` (cleared first); `links` is scratch.
     pub fn body_poses(&self, q: &[f64], links: &mut Vec<Pose>, out: &mut Vec<Pose>) {
-        links.resize(self.chain.links.len(), Pose::IDENTITY);
-        self.chain.fk_all(q, links);
+        self.body_poses_before(q, links, out, usize::MAX);
+    }
+
+    /// [`Arm::body_poses`] for the bodies on the chain's links before `end` only: the others
+    /// get the identity, to be posed by [`Arm::body_poses_from`]; `links` holds the first
+    /// `end` link poses. Whether some body was left out.
+    fn body_poses_before(&self, q: &[f64], links: &mut Vec<Pose>, out: &mut Vec<Pose>, end: usize) -> bool {
+        let n = self.chain.links.len();
+        links.resize(n, Pose::IDENTITY);
+        self.chain.fk_all(q, &mut links[..end.min(n)]);
         out.clear();
+        out.resize(self.body_links.len(), Pose::IDENTITY);
+        self.compose(links, out, ..end)
+    }
+
+    /// The rest of [`Arm::body_poses_before`] with the same `end`: the link poses from `end` on
+    /// and the poses of the bodies on them.
+    fn body_poses_from(&self, q: &[f64], links: &mut [Pose], out: &mut [Pose], end: usize) {
+        self.chain.fk_rest(q, links, end);
+        self.compose(links, out, end..);
+    }
+
+    /// Each body on a link within `range` posed in `out`: the world pose of its link (`links`,
+    /// root frame). Whether some body's link lies outside `range`.
+    fn compose(&self, links: &[Pose], out: &mut [Pose], range: impl std::ops::RangeBounds<usize>) -> bool {
         // A body on the same link as the one before shares its pose: composed once (and not at
         // all on a base at the world's origin, whose composition changes no value but the sign
         // of a zero).
         let at_origin = self.base.rotation == Pose::IDENTITY.rotation && self.base.translation == DVec3::ZERO;
         let mut last: Option<(usize, Pose)> = None;
-        for &l in self.body_links {
+        let mut outside = false;
+        for (&l, slot) in self.body_links.iter().zip(out.iter_mut()) {
+            if !range.contains(&l) {
+                outside = true;
+                continue;
+            }
             let pose = match last {
                 Some((k, pose)) if k == l => pose,
                 _ if at_origin => links.get(l).copied().unwrap_or(Pose::IDENTITY),
                 _ => self.base * links.get(l).copied().unwrap_or(Pose::IDENTITY),
             };
             last = Some((l, pose));
-            out.push(pose);
+            *slot = pose;
         }
+        outside
     }
 }
 
@@ -244,6 +272,9 @@ pub struct ArmValidity<'a> {
     body_radii: Vec<Vec<f64>>,
     /// The part that last proved a configuration invalid (asked first next time).
     last_failed: PartHint,
+    /// Per part (the moving bodies, then the pairs): the chain links it needs posed, `0..end`
+    /// (its bodies', which hold its clusters' too).
+    part_links: Vec<usize>,
     /// Other groups standing still (obstacles like the scene), with their body poses.
     parked: Vec<(GroupId, Vec<Pose>)>,
     /// Distance (m) kept from the parked groups beyond the margin.
@@ -286,7 +317,14 @@ impl<'a> ArmValidity<'a> {
         let broad = BroadPhase::new(arm.world, arm.group, &parked);
         let pair_bodies: Vec<(usize, usize)> = pairs.iter().map(|&(i, j, _, _)| (i, j)).collect();
         let clusters = Clusters::new(&arm, &broad, &moving, &pair_bodies);
+        let end = |i: usize| arm.body_links.get(i).map_or(usize::MAX, |&l| l.saturating_add(1));
+        let part_links = moving
+            .iter()
+            .map(|&(i, _)| end(i))
+            .chain(pairs.iter().map(|&(i, j, _, _)| end(i).max(end(j))))
+            .collect();
         ArmValidity {
+            part_links,
             broad,
             clusters,
             arm,
@@ -418,7 +456,29 @@ impl<'a> ArmValidity<'a> {
         if !self.arm.chain.within_limits(q, 1e-9) {
             return false;
         }
-        self.posed(q, |bodies, placed| self.valid_posed(q, bodies, placed))
+        // The part that failed last is asked first (see [`Self::valid_posed`]) with the arm
+        // posed up to the links it needs: a configuration it proves invalid is not posed further.
+        let first = self.last_failed.get();
+        let end = self.part_links.get(first).copied().unwrap_or(usize::MAX);
+        LINKS.with_borrow_mut(|(links, bodies)| {
+            let partial = self.arm.body_poses_before(q, links, bodies, end);
+            COVERS.with_borrow_mut(|placed| {
+                if self.broad_phase {
+                    self.broad.place(bodies, placed);
+                }
+                let sets = Settled::pair();
+                if !self.part_clear(first, q, bodies, placed, &sets) {
+                    return false;
+                }
+                if partial {
+                    self.arm.body_poses_from(q, links, bodies, end);
+                    if self.broad_phase {
+                        self.broad.repose(bodies, placed);
+                    }
+                }
+                self.other_parts_clear(first, q, bodies, placed, &sets)
+            })
+        })
     }
 
     /// [`Self::is_valid`] for a caller that has posed the arm at `q` already: `bodies` are its
@@ -435,59 +495,81 @@ impl<'a> ArmValidity<'a> {
     }
 
     /// The parts of [`Self::is_valid`] at `q`, posed at body poses `bodies` (covers placed in
-    /// `placed`).
+    /// `placed`). The part that failed last is asked first: samples near each other usually
+    /// fail on the same part. Only the work depends on it, never the answer.
     fn valid_posed(&self, q: &[f64], bodies: &[Pose], placed: &PlacedCovers) -> bool {
+        let first = self.last_failed.get();
+        let sets = Settled::pair();
+        self.part_clear(first, q, bodies, placed, &sets)
+            && self.other_parts_clear(first, q, bodies, placed, &sets)
+    }
+
+    /// Whether every part of [`Self::is_valid`] but `first` is clear; the first that is not
+    /// becomes the part asked first next time.
+    fn other_parts_clear(
+        &self,
+        first: usize,
+        q: &[f64],
+        bodies: &[Pose],
+        placed: &PlacedCovers,
+        sets: &[Cell<Settled>; 2],
+    ) -> bool {
+        let parts = self.moving.len() + self.pairs.len();
+        match (0..parts).find(|&k| k != first && !self.part_clear(k, q, bodies, placed, sets)) {
+            Some(k) => {
+                self.last_failed.set(k);
+                false
+            }
+            None => true,
+        }
+    }
+
+    /// Whether part `k` of [`Self::is_valid`] at `q` is clear (posed at `bodies`, covers
+    /// placed in `placed`): a moving body against the scene (`k` below the number of moving
+    /// bodies), else a self pair; a body of a cluster clear of the scene, or a pair of two
+    /// clusters apart, is clear without its own query (see [`Clusters`]; `sets`: the clusters
+    /// and the groups tested within this check). Parts beyond the last are clear.
+    #[inline]
+    fn part_clear(
+        &self,
+        k: usize,
+        q: &[f64],
+        bodies: &[Pose],
+        placed: &PlacedCovers,
+        sets: &[Cell<Settled>; 2],
+    ) -> bool {
         // Strictly farther than the margin, as the clearance (> 0) requires.
         let need = measured_for(self.margin.max(0.0));
         let apart = measured_for(0.0);
         let tiny = 1e-9;
         let m = self.moving.len();
-        // Part `k`: a moving body against the scene (k < m), else a self pair; a body of a
-        // cluster clear of the scene, or a pair of two clusters apart, is clear without its
-        // own query (see [`Clusters`]).
-        let (scene_sets, pair_sets) = (Cell::new(Settled::default()), Cell::new(Settled::default()));
         let settled = |sets: &Cell<Settled>, c: usize, test: &dyn Fn() -> bool| {
             let mut s = sets.get();
             let clear = s.clear(c, test);
             sets.set(s);
             clear
         };
-        let clear = |k: usize, bodies: &[Pose], placed: &PlacedCovers| {
-            if let Some((i, _)) = self.moving.get(k) {
-                if let Some(c) = self.scene_cluster(k)
-                    && settled(&scene_sets, c, &|| {
-                        self.broad
-                            .sphere_clears_scene(self.clusters.placed(c, bodies), need + tiny)
-                    })
-                {
-                    return true;
-                }
-                self.scene_part(*i, bodies, placed, (need + tiny, need + tiny)) > need
-            } else if let Some(&(i, j, _, _)) = self.pairs.get(k - m) {
-                if self.pair_groups(k - m).any(|&g| {
-                    settled(&pair_sets, g, &|| {
-                        self.clusters.group_apart(g, bodies, apart + tiny)
-                    })
-                }) {
-                    return true;
-                }
-                self.pair_part(i, j, q, bodies, placed, (apart + tiny, apart + tiny)) > apart
-            } else {
-                true
+        if let Some((i, _)) = self.moving.get(k) {
+            if let Some(c) = self.scene_cluster(k)
+                && settled(&sets[0], c, &|| {
+                    self.broad
+                        .sphere_clears_scene(self.clusters.placed(c, bodies), need + tiny)
+                })
+            {
+                return true;
             }
-        };
-        // The part that failed last is asked first: samples near each other usually fail on
-        // the same part. Only the work depends on it, never the answer.
-        let first = self.last_failed.get();
-        if !clear(first, bodies, placed) {
-            return false;
-        }
-        match (0..m + self.pairs.len()).find(|&k| k != first && !clear(k, bodies, placed)) {
-            Some(k) => {
-                self.last_failed.set(k);
-                false
+            self.scene_part(*i, bodies, placed, (need + tiny, need + tiny)) > need
+        } else if let Some(&(i, j, _, _)) = self.pairs.get(k - m) {
+            if self.pair_groups(k - m).any(|&g| {
+                settled(&sets[1], g, &|| {
+                    self.clusters.group_apart(g, bodies, apart + tiny)
+                })
+            }) {
+                return true;
             }
-            None => true,
+            self.pair_part(i, j, q, bodies, placed, (apart + tiny, apart + tiny)) > apart
+        } else {
+            true
         }
     }
 

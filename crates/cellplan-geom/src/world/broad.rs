@@ -278,6 +278,19 @@ impl BroadPhase {
         }
     }
 
+    /// The placement in `out` with the poses `poses` in place of those it was made with, for
+    /// the bodies no query has asked for yet: a caller that placed some bodies' poses before it
+    /// knew the others' ([`BroadPhase::place`] with placeholders) gives them here. The bodies
+    /// a query has asked for must keep their poses.
+    pub fn repose(&self, poses: &[Pose], out: &mut PlacedCovers) {
+        let n = out.poses.len().min(poses.len());
+        debug_assert!(
+            (0..n).all(|i| out.state[i].get() == 0 || out.poses[i] == poses[i]),
+            "a body placed already keeps its pose"
+        );
+        out.poses[..n].copy_from_slice(&poses[..n]);
+    }
+
     /// Body `i`'s outer sphere in the world (`None`: no shape, or no such body) and whether its
     /// pose is finite; placed now with its frame if no query has needed them yet.
     #[inline(always)]

@@ -150,6 +150,11 @@ pub(super) struct Settled {
 }
 
 impl Settled {
+    /// The clusters against the scene and the groups of pairs, none tested yet.
+    pub(super) fn pair() -> [std::cell::Cell<Settled>; 2] {
+        Default::default()
+    }
+
     /// Whether group `k` is clear: `test()` asked the first time only.
     #[inline]
     pub(super) fn clear(&mut self, k: usize, test: impl FnOnce() -> bool) -> bool {
