@@ -1,5 +1,6 @@
-//! A planning problem without a cell: a robot (URDF, optional SRDF, where its root stands),
-//! obstacles, a start, one or more goals and a margin — the motion-problem format of
+//! A planning problem without a cell: a robot (URDF, optional SRDF, the folders of its ROS
+//! packages, where its root stands), obstacles (primitives, and meshes read from STL or OBJ
+//! files), a start, one or more goals and a margin — the motion-problem format of
 //! `docs/motion-problems.md` (one JSON file per scene, many problems in it) — and the arm set up
 //! in a collision world to solve them ([`ArmSetup`]).
 //!
@@ -15,7 +16,7 @@
 use crate::arm::{Arm, ArmValidity, pairs_that_may_touch};
 use cellplan_geom::pieces::convex_pieces;
 use cellplan_geom::read::{LimitedReadError, read_limited, show_bytes, utf8_text};
-use cellplan_geom::{CollisionWorld, DQuat, DVec3, GroupBody, GroupId, Mesh, Pose, ShapeSpec};
+use cellplan_geom::{CollisionWorld, DQuat, DVec3, GroupBody, GroupId, Mesh, Pose, ShapeSpec, load_mesh};
 use std::sync::Arc;
 
 /// A convex piece (its points) as a mesh shape (its hull's triangles).
@@ -112,6 +113,8 @@ struct RobotDoc {
     srdf: Option<String>,
     #[serde(default)]
     base: Option<PoseDoc>,
+    #[serde(default)]
+    packages: BTreeMap<String, String>,
 }
 
 #[derive(Deserialize)]
@@ -125,6 +128,10 @@ struct ObstacleDoc {
     radius: Option<f64>,
     #[serde(default)]
     length: Option<f64>,
+    #[serde(default)]
+    file: Option<String>,
+    #[serde(default)]
+    scale: Option<f64>,
     pose: PoseDoc,
 }
 
@@ -159,11 +166,14 @@ pub struct RobotRef {
     pub urdf: PathBuf,
     /// The SRDF, if given.
     pub srdf: Option<PathBuf>,
+    /// The folders of the ROS packages its `package://` paths name (resolved against the
+    /// problem file's folder).
+    pub packages: BTreeMap<String, PathBuf>,
     /// Where the URDF's root link stands in the world.
     pub base: Pose,
 }
 
-/// An obstacle: a solid primitive at a world pose.
+/// An obstacle: a solid primitive, or a triangle mesh (its surface), at a world pose.
 #[derive(Clone, Debug)]
 pub struct Obstacle {
     /// Name (informative).
@@ -244,7 +254,10 @@ fn length(v: f64, what: &str, zero_ok: bool) -> Result<f64, String> {
     Ok(v)
 }
 
-fn obstacle(doc: &ObstacleDoc, what: &str) -> Result<Obstacle, String> {
+/// The meshes of a problem file's obstacles, each read once: by file and scale (bits).
+type Meshes = BTreeMap<(PathBuf, u64), Arc<Mesh>>;
+
+fn obstacle(doc: &ObstacleDoc, what: &str, dir: &Path, meshes: &mut Meshes) -> Result<Obstacle, String> {
     let pose = pose_of(&doc.pose, what)?;
     let need = |v: Option<f64>, key: &str| v.ok_or_else(|| format!("{what}: a {} needs `{key}`", doc.shape));
     let shape = match doc.shape.as_str() {
@@ -266,9 +279,44 @@ fn obstacle(doc: &ObstacleDoc, what: &str) -> Result<Obstacle, String> {
         "sphere" => ShapeSpec::Sphere {
             radius: length(need(doc.radius, "radius")?, &format!("{what}: radius"), false)?,
         },
+        "mesh" => {
+            let file = doc
+                .file
+                .as_ref()
+                .ok_or_else(|| format!("{what}: a mesh needs `file` (an STL or OBJ file)"))?;
+            let scale = doc.scale.unwrap_or(1.0);
+            if !(scale.is_finite() && scale > 0.0 && scale <= MAX_LENGTH_M) {
+                return Err(format!("{what}: scale = {scale} is not in (0, {MAX_LENGTH_M}]"));
+            }
+            let path = dir.join(file);
+            let mesh = match meshes.entry((path.clone(), scale.to_bits())) {
+                std::collections::btree_map::Entry::Occupied(e) => e.get().clone(),
+                std::collections::btree_map::Entry::Vacant(e) => {
+                    let mut mesh = load_mesh(&path).map_err(|err| format!("{what}: {err}"))?;
+                    if mesh.triangles.is_empty() {
+                        return Err(format!("{what}: {} has no triangles", path.display()));
+                    }
+                    for v in &mut mesh.vertices {
+                        *v *= scale;
+                    }
+                    if let Some(v) = mesh
+                        .vertices
+                        .iter()
+                        .find(|v| !v.is_finite() || v.abs().max_element() > MAX_LENGTH_M)
+                    {
+                        return Err(format!(
+                            "{what}: {} has the vertex {v} (scaled), beyond {MAX_LENGTH_M} m",
+                            path.display()
+                        ));
+                    }
+                    e.insert(Arc::new(mesh)).clone()
+                }
+            };
+            ShapeSpec::Mesh(mesh)
+        }
         other => {
             return Err(format!(
-                "{what}: unknown shape \"{other}\" (box, cylinder or sphere)"
+                "{what}: unknown shape \"{other}\" (box, cylinder, sphere or mesh)"
             ));
         }
     };
@@ -356,12 +404,19 @@ pub fn read_problems(path: &Path) -> Result<ProblemSet, ProblemError> {
     let robot = RobotRef {
         urdf: dir.join(&doc.robot.urdf),
         srdf: doc.robot.srdf.as_ref().map(|s| dir.join(s)),
+        packages: doc
+            .robot
+            .packages
+            .iter()
+            .map(|(name, folder)| (name.clone(), dir.join(folder)))
+            .collect(),
         base,
     };
     let mut problems = Vec::with_capacity(doc.problems.len());
+    let mut meshes = Meshes::new();
     for (k, p) in doc.problems.iter().enumerate() {
         let what = format!("problem {} (\"{}\")", k + 1, p.name);
-        let check = || -> Result<Problem, String> {
+        let mut check = || -> Result<Problem, String> {
             if p.goals.is_empty() || p.goals.len() > MAX_GOALS {
                 return Err(format!("{what} has {} goals (1 to {MAX_GOALS})", p.goals.len()));
             }
@@ -383,7 +438,14 @@ pub fn read_problems(path: &Path) -> Result<ProblemSet, ProblemError> {
                 .obstacles
                 .iter()
                 .enumerate()
-                .map(|(o, d)| obstacle(d, &format!("{what}: obstacle {} (\"{}\")", o + 1, d.name)))
+                .map(|(o, d)| {
+                    obstacle(
+                        d,
+                        &format!("{what}: obstacle {} (\"{}\")", o + 1, d.name),
+                        dir,
+                        &mut meshes,
+                    )
+                })
                 .collect::<Result<Vec<_>, _>>()?;
             Ok(Problem {
                 name: p.name.clone(),
@@ -436,7 +498,7 @@ impl ArmSetup {
     /// Loads the robot of `set`: the URDF (whose movable joints must be exactly the file's
     /// `joints`), one body per collision shape, the SRDF's rules.
     pub fn load(set: &ProblemSet) -> Result<ArmSetup, ProblemError> {
-        let model = load_urdf(&set.robot.urdf, &BTreeMap::new(), None)?;
+        let model = load_urdf(&set.robot.urdf, &set.robot.packages, None)?;
         let chain = &model.chain;
         let order = chain
             .joints

@@ -194,6 +194,24 @@ fn broken_files_are_refused_with_the_place() {
             ),
             "not a unit quaternion",
         ),
+        (
+            &format!(
+                "{head}{{\"name\": \"p\", \"start\": [0, 0], \"goals\": [[0, 0]], \"obstacles\": [{{\"shape\": \"mesh\", \"pose\": {{\"xyz\": [0,0,0]}}}}]}}]}}"
+            ),
+            "a mesh needs `file`",
+        ),
+        (
+            &format!(
+                "{head}{{\"name\": \"p\", \"start\": [0, 0], \"goals\": [[0, 0]], \"obstacles\": [{{\"name\": \"car\", \"shape\": \"mesh\", \"file\": \"none.stl\", \"pose\": {{\"xyz\": [0,0,0]}}}}]}}]}}"
+            ),
+            "obstacle 1 (\"car\"): ",
+        ),
+        (
+            &format!(
+                "{head}{{\"name\": \"p\", \"start\": [0, 0], \"goals\": [[0, 0]], \"obstacles\": [{{\"shape\": \"mesh\", \"file\": \"m.obj\", \"scale\": 0, \"pose\": {{\"xyz\": [0,0,0]}}}}]}}]}}"
+            ),
+            "scale = 0",
+        ),
     ];
     for (text, expect) in cases {
         let f = write(tmp.path(), text);
@@ -242,4 +260,38 @@ fn the_tool_retracts_along_its_axis() {
     assert!(arm::tool_retract(chain, &tcp, &q, f64::NAN, 0.01).is_none());
     // Far beyond the arm's reach: the line cannot be followed.
     assert!(arm::tool_retract(chain, &tcp, &q, 5.0, 0.01).is_none());
+}
+
+#[test]
+fn a_robot_by_its_packages_among_mesh_obstacles() {
+    // The car-body scene: a URDF with `package://` paths, the car body as a scaled OBJ mesh.
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../bench/motion/autobody-r2000/autobody.json");
+    let set = read_problems(&path).unwrap();
+    let body = &set.problems[0].obstacles[0];
+    let cellplan_geom::ShapeSpec::Mesh(mesh) = &body.shape else {
+        panic!("the car body is a mesh")
+    };
+    // Millimetres scaled to metres: the body is 4.4 m long.
+    let length = mesh.vertices.iter().map(|v| v.y).fold(f64::MIN, f64::max)
+        - mesh.vertices.iter().map(|v| v.y).fold(f64::MAX, f64::min);
+    assert!((4.3..4.5).contains(&length), "{length}");
+    // Every problem holds the same mesh, read once.
+    let cellplan_geom::ShapeSpec::Mesh(again) = &set.problems[2].obstacles[0].shape else {
+        panic!("the car body is a mesh")
+    };
+    assert!(std::sync::Arc::ptr_eq(mesh, again));
+    let mut setup = ArmSetup::load(&set).unwrap();
+    setup.set_obstacles(&set.problems[0].obstacles);
+    let validity = setup.validity(0.01);
+    assert!(validity.is_valid(&set.problems[0].start));
+    // Reaching into the car body (joint 2 forward, the arm stretched down over it) collides
+    // with its surface, the car body alone in the scene.
+    setup.set_obstacles(&set.problems[0].obstacles[..1]);
+    let validity = setup.validity(0.01);
+    let mut exact = setup.validity(0.01);
+    exact.broad_phase = false;
+    let into = [0.0, 1.2, 0.6, 0.0, 0.0, 0.0];
+    assert!(!validity.is_valid(&into), "the arm inside the car body's frame");
+    assert!(!exact.is_valid(&into));
+    assert!(validity.is_valid(&set.problems[0].start));
 }
