@@ -66,18 +66,7 @@ impl Chain {
     /// Does not allocate. Missing joint values (a `q` shorter than [`Chain::dof`]) count as
     /// zero; when `out` is shorter than the chain only its first links are written.
     pub fn fk_all(&self, q: &[f64], out: &mut [Pose]) {
-        let mut parent = Pose::IDENTITY;
-        for (link, slot) in self.links.iter().zip(out.iter_mut()) {
-            let mut pose = parent * link.origin;
-            if let Some(j) = link.joint {
-                let value = q.get(j).copied().unwrap_or(0.0);
-                if let Some(joint) = self.joints.get(j) {
-                    pose = joint.apply(pose, value);
-                }
-            }
-            *slot = pose;
-            parent = pose;
-        }
+        self.fk_rest(q, out, 0);
     }
     /// [`Chain::fk_all`] for the links from `start` on, the links before it already in `out`
     /// (as `fk_all` gives them): the same poses as `fk_all` over the whole chain, the first
