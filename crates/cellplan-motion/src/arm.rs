@@ -382,7 +382,7 @@ impl<'a> ArmValidity<'a> {
                 if self.broad_phase {
                     self.broad.place(bodies, placed);
                 }
-                let sets = Settled::pair();
+                let sets = Settled::untested();
                 if !self.part_clear(first, q, bodies, placed, &sets) {
                     return false;
                 }
@@ -415,7 +415,7 @@ impl<'a> ArmValidity<'a> {
     /// fail on the same part. Only the work depends on it, never the answer.
     fn valid_posed(&self, q: &[f64], bodies: &[Pose], placed: &PlacedCovers) -> bool {
         let first = self.last_failed.get();
-        let sets = Settled::pair();
+        let sets = Settled::untested();
         self.part_clear(first, q, bodies, placed, &sets)
             && self.other_parts_clear(first, q, bodies, placed, &sets)
     }

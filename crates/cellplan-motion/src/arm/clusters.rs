@@ -151,7 +151,7 @@ pub(super) struct Settled {
 
 impl Settled {
     /// The clusters against the scene and the groups of pairs, none tested yet.
-    pub(super) fn pair() -> [std::cell::Cell<Settled>; 2] {
+    pub(super) fn untested() -> [std::cell::Cell<Settled>; 2] {
         Default::default()
     }
 
