@@ -44,6 +44,9 @@ pub const MAX_OBSTACLES: usize = 100_000;
 pub const MAX_GOALS: usize = 10_000;
 /// Largest length accepted (m): positions, sizes, margins.
 pub const MAX_LENGTH_M: f64 = 1e4;
+/// Bytes of mesh files one problem file may have read, in all (each file counted once): many
+/// large meshes are refused before they fill the memory.
+pub const MAX_MESH_BYTES: u64 = 2 << 30;
 
 /// Why a problem file cannot be used.
 #[derive(Debug, thiserror::Error)]
@@ -254,8 +257,12 @@ fn length(v: f64, what: &str, zero_ok: bool) -> Result<f64, String> {
     Ok(v)
 }
 
-/// The meshes of a problem file's obstacles, each read once: by file and scale (bits).
-type Meshes = BTreeMap<(PathBuf, u64), Arc<Mesh>>;
+/// The meshes of a problem file's obstacles, each read once (by file and scale bits), and the
+/// bytes of files left to read ([`MAX_MESH_BYTES`] at first).
+struct Meshes {
+    read: BTreeMap<(PathBuf, u64), Arc<Mesh>>,
+    budget: u64,
+}
 
 fn obstacle(doc: &ObstacleDoc, what: &str, dir: &Path, meshes: &mut Meshes) -> Result<Obstacle, String> {
     let pose = pose_of(&doc.pose, what)?;
@@ -289,9 +296,18 @@ fn obstacle(doc: &ObstacleDoc, what: &str, dir: &Path, meshes: &mut Meshes) -> R
                 return Err(format!("{what}: scale = {scale} is not in (0, {MAX_LENGTH_M}]"));
             }
             let path = dir.join(file);
-            let mesh = match meshes.entry((path.clone(), scale.to_bits())) {
+            let mesh = match meshes.read.entry((path.clone(), scale.to_bits())) {
                 std::collections::btree_map::Entry::Occupied(e) => e.get().clone(),
                 std::collections::btree_map::Entry::Vacant(e) => {
+                    let bytes = std::fs::metadata(&path).map_or(0, |m| m.len());
+                    if bytes > meshes.budget {
+                        return Err(format!(
+                            "{what}: reading {} would take the mesh files of this problem file past {} in all",
+                            path.display(),
+                            show_bytes(MAX_MESH_BYTES)
+                        ));
+                    }
+                    meshes.budget -= bytes;
                     let mut mesh = load_mesh(&path).map_err(|err| format!("{what}: {err}"))?;
                     if mesh.triangles.is_empty() {
                         return Err(format!("{what}: {} has no triangles", path.display()));
@@ -413,7 +429,10 @@ pub fn read_problems(path: &Path) -> Result<ProblemSet, ProblemError> {
         base,
     };
     let mut problems = Vec::with_capacity(doc.problems.len());
-    let mut meshes = Meshes::new();
+    let mut meshes = Meshes {
+        read: BTreeMap::new(),
+        budget: MAX_MESH_BYTES,
+    };
     for (k, p) in doc.problems.iter().enumerate() {
         let what = format!("problem {} (\"{}\")", k + 1, p.name);
         let mut check = || -> Result<Problem, String> {
@@ -647,5 +666,50 @@ impl ArmSetup {
     /// The validity checker keeping `margin` from the obstacles.
     pub fn validity(&self, margin: f64) -> ArmValidity<'_> {
         ArmValidity::new(self.arm(), margin, Vec::new())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn mesh_files_are_read_once_within_a_byte_budget() {
+        let tmp = tempfile::tempdir().unwrap();
+        let stl = "solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\nendloop\nendfacet\nendsolid t\n";
+        for name in ["a.stl", "b.stl"] {
+            std::fs::write(tmp.path().join(name), stl).unwrap();
+        }
+        let doc = |file: &str| ObstacleDoc {
+            name: String::new(),
+            shape: "mesh".into(),
+            half_extents: None,
+            radius: None,
+            length: None,
+            file: Some(file.into()),
+            scale: Some(0.5),
+            pose: PoseDoc {
+                xyz: [0.0; 3],
+                quat_xyzw: None,
+                rpy: None,
+            },
+        };
+        let size = stl.len() as u64;
+        let mut meshes = Meshes {
+            read: BTreeMap::new(),
+            budget: size + size / 2,
+        };
+        let first = obstacle(&doc("a.stl"), "o", tmp.path(), &mut meshes).unwrap();
+        // Read again: the same mesh, nothing spent.
+        let again = obstacle(&doc("a.stl"), "o", tmp.path(), &mut meshes).unwrap();
+        let (ShapeSpec::Mesh(m1), ShapeSpec::Mesh(m2)) = (&first.shape, &again.shape) else {
+            panic!("meshes")
+        };
+        assert!(Arc::ptr_eq(m1, m2));
+        assert_eq!(m1.vertices[1], DVec3::new(0.5, 0.0, 0.0), "scaled");
+        assert_eq!(meshes.budget, size / 2);
+        // A second file does not fit in what is left.
+        let e = obstacle(&doc("b.stl"), "o", tmp.path(), &mut meshes).unwrap_err();
+        assert!(e.contains("b.stl") && e.contains("in all"), "{e}");
     }
 }
