@@ -42,6 +42,8 @@ pub const MAX_PROBLEMS: usize = 100_000;
 pub const MAX_OBSTACLES: usize = 100_000;
 /// Most goals in one problem.
 pub const MAX_GOALS: usize = 10_000;
+/// Shapes a tool may have, at most.
+pub const MAX_TOOL_SHAPES: usize = 1_000;
 /// Largest length accepted (m): positions, sizes, margins.
 pub const MAX_LENGTH_M: f64 = 1e4;
 /// Bytes of mesh files one problem file may have read, in all (each file counted once): many
@@ -118,6 +120,19 @@ struct RobotDoc {
     base: Option<PoseDoc>,
     #[serde(default)]
     packages: BTreeMap<String, String>,
+    #[serde(default)]
+    tool: Option<ToolDoc>,
+}
+
+#[derive(Deserialize)]
+struct ToolDoc {
+    #[serde(default = "default_tool_name")]
+    name: String,
+    shapes: Vec<ObstacleDoc>,
+}
+
+fn default_tool_name() -> String {
+    "tool".into()
 }
 
 #[derive(Deserialize)]
@@ -174,6 +189,18 @@ pub struct RobotRef {
     pub packages: BTreeMap<String, PathBuf>,
     /// Where the URDF's root link stands in the world.
     pub base: Pose,
+    /// The tool on the chain's tip, if given.
+    pub tool: Option<ToolRef>,
+}
+
+/// A tool mounted on the chain's tip link (`tool0` where the URDF has one): its shapes move
+/// with that link.
+#[derive(Clone, Debug)]
+pub struct ToolRef {
+    /// Its name: the link name its bodies take (SRDF rules may name it).
+    pub name: String,
+    /// Its shapes, each posed in the tip link's frame.
+    pub shapes: Vec<(ShapeSpec, Pose)>,
 }
 
 /// An obstacle: a solid primitive, or a triangle mesh (its surface), at a world pose.
@@ -343,6 +370,33 @@ fn obstacle(doc: &ObstacleDoc, what: &str, dir: &Path, meshes: &mut Meshes) -> R
     })
 }
 
+/// The tool of `robot.tool`: a name that is a link name and one to [`MAX_TOOL_SHAPES`] shapes,
+/// each read as an obstacle is (its pose in the tip link's frame).
+fn tool(doc: &ToolDoc, dir: &Path, meshes: &mut Meshes) -> Result<ToolRef, String> {
+    let name = doc.name.trim();
+    if name.is_empty() || name.chars().any(char::is_control) {
+        return Err(format!("robot.tool: name {:?} is not a link name", doc.name));
+    }
+    if doc.shapes.is_empty() || doc.shapes.len() > MAX_TOOL_SHAPES {
+        return Err(format!(
+            "robot.tool has {} shapes (1 to {MAX_TOOL_SHAPES})",
+            doc.shapes.len()
+        ));
+    }
+    let shapes = doc
+        .shapes
+        .iter()
+        .enumerate()
+        .map(|(k, d)| {
+            obstacle(d, &format!("robot.tool: shape {}", k + 1), dir, meshes).map(|o| (o.shape, o.pose))
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    Ok(ToolRef {
+        name: name.to_string(),
+        shapes,
+    })
+}
+
 fn configuration(q: &[f64], n: usize, what: &str) -> Result<Vec<f64>, String> {
     if q.len() != n {
         return Err(format!("{what} has {} values for {n} joints", q.len()));
@@ -417,7 +471,16 @@ pub fn read_problems(path: &Path) -> Result<ProblemSet, ProblemError> {
         Some(b) => pose_of(b, "robot.base").map_err(|m| invalid(m, hint))?,
         None => Pose::IDENTITY,
     };
+    let mut meshes = Meshes {
+        read: BTreeMap::new(),
+        budget: MAX_MESH_BYTES,
+    };
+    let tool = match &doc.robot.tool {
+        Some(t) => Some(tool(t, dir, &mut meshes).map_err(|m| invalid(m, hint))?),
+        None => None,
+    };
     let robot = RobotRef {
+        tool,
         urdf: dir.join(&doc.robot.urdf),
         srdf: doc.robot.srdf.as_ref().map(|s| dir.join(s)),
         packages: doc
@@ -429,10 +492,6 @@ pub fn read_problems(path: &Path) -> Result<ProblemSet, ProblemError> {
         base,
     };
     let mut problems = Vec::with_capacity(doc.problems.len());
-    let mut meshes = Meshes {
-        read: BTreeMap::new(),
-        budget: MAX_MESH_BYTES,
-    };
     for (k, p) in doc.problems.iter().enumerate() {
         let what = format!("problem {} (\"{}\")", k + 1, p.name);
         let mut check = || -> Result<Problem, String> {
@@ -517,7 +576,32 @@ impl ArmSetup {
     /// Loads the robot of `set`: the URDF (whose movable joints must be exactly the file's
     /// `joints`), one body per collision shape, the SRDF's rules.
     pub fn load(set: &ProblemSet) -> Result<ArmSetup, ProblemError> {
-        let model = load_urdf(&set.robot.urdf, &set.robot.packages, None)?;
+        let mut model = load_urdf(&set.robot.urdf, &set.robot.packages, None)?;
+        // The tool's bodies hang on the tip link, under the tool's name; the link it is mounted
+        // on (the nearest one from the tip towards the root that has shapes) always touches it.
+        let mut mount = None;
+        if let Some(tool) = &set.robot.tool {
+            if model.collision_links.iter().flatten().any(|l| *l == tool.name)
+                || model.chain.links.iter().any(|l| l.name == tool.name)
+            {
+                return Err(ProblemError::Invalid {
+                    path: set.path.clone(),
+                    message: format!("robot.tool is named \"{}\", as a link of the URDF", tool.name),
+                    hint: "give the tool a name no link of the URDF has".into(),
+                });
+            }
+            let tip = model.collision.len().saturating_sub(1);
+            mount = (0..=tip)
+                .rev()
+                .find(|&l| !model.collision[l].is_empty())
+                .map(|l| model.collision_links[l].clone());
+            for (shape, pose) in &tool.shapes {
+                model.collision[tip].push((shape.clone(), *pose));
+                model.collision_links[tip].push(tool.name.clone());
+            }
+        }
+        let mount: BTreeSet<String> = mount.into_iter().flatten().collect();
+        let tool_name = set.robot.tool.as_ref().map(|t| t.name.as_str());
         let chain = &model.chain;
         let order = chain
             .joints
@@ -581,6 +665,11 @@ impl ArmSetup {
             for j in i + 1..n {
                 let (si, sj) = (&body_sources[i], &body_sources[j]);
                 if si == sj || disabled.contains(&(si.clone(), sj.clone())) {
+                    continue;
+                }
+                // The tool and the link it is mounted on.
+                let on_tool = |a: &String, b: &String| Some(a.as_str()) == tool_name && mount.contains(b);
+                if on_tool(si, sj) || on_tool(sj, si) {
                     continue;
                 }
                 if set.robot.srdf.is_none() {

@@ -212,6 +212,16 @@ fn broken_files_are_refused_with_the_place() {
             ),
             "scale = 0",
         ),
+        (
+            r#"{"format": "cellplan-motion-problems", "version": 1, "joints": ["a"], "problems": [],
+ "robot": {"urdf": "r.urdf", "tool": {"name": "probe", "shapes": []}}}"#,
+            "robot.tool has 0 shapes",
+        ),
+        (
+            r#"{"format": "cellplan-motion-problems", "version": 1, "joints": ["a"], "problems": [],
+ "robot": {"urdf": "r.urdf", "tool": {"shapes": [{"shape": "box", "half_extents": [1, -1, 1], "pose": {"xyz": [0, 0, 0]}}]}}}"#,
+            "robot.tool: shape 1: half_extents[1] = -1",
+        ),
     ];
     for (text, expect) in cases {
         let f = write(tmp.path(), text);
@@ -294,4 +304,75 @@ fn a_robot_by_its_packages_among_mesh_obstacles() {
     assert!(!validity.is_valid(&into), "the arm inside the car body's frame");
     assert!(!exact.is_valid(&into));
     assert!(validity.is_valid(&set.problems[0].start));
+}
+
+#[test]
+fn the_tool_moves_with_the_tip_and_is_checked() {
+    // The car-body scene's robot carries the README cell's probe: two bodies on the tip link
+    // under the tool's name, never checked against the flange link it is mounted on, checked
+    // against the links before it and the scene, and seen by the exact re-check too.
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../bench/motion/autobody-r2000/autobody.json");
+    let set = read_problems(&path).unwrap();
+    let tool = set.robot.tool.as_ref().expect("the scene has a tool");
+    assert_eq!((tool.name.as_str(), tool.shapes.len()), ("probe", 2));
+    let mut bare = set.clone();
+    bare.robot.tool = None;
+    let with = ArmSetup::load(&set).unwrap();
+    let without = ArmSetup::load(&bare).unwrap();
+    let probes: Vec<usize> = (0..with.body_sources.len())
+        .filter(|&i| with.body_sources[i] == "probe")
+        .collect();
+    assert_eq!(probes.len(), 2);
+    assert_eq!(with.body_links.len(), without.body_links.len() + 2);
+    let tip = with.model.chain.links.len() - 1;
+    assert!(probes.iter().all(|&i| with.body_links[i] == tip));
+    let checked = |setup: &ArmSetup, a: &str, b: &str| {
+        setup.self_pairs.iter().any(|&(i, j)| {
+            let (x, y) = (&setup.body_sources[i], &setup.body_sources[j]);
+            (x == a && y == b) || (x == b && y == a)
+        })
+    };
+    assert!(
+        !checked(&with, "probe", "link_6"),
+        "the probe is checked against its flange"
+    );
+    assert!(checked(&with, "probe", "link_2") && checked(&with, "probe", "link_1"));
+    // With an SRDF, its rules replace the adjacency rule, but the tool's mount still holds it.
+    let tmp = tempfile::tempdir().unwrap();
+    let srdf = tmp.path().join("r.srdf");
+    std::fs::write(
+        &srdf,
+        r#"<robot name="r"><disable_collisions link1="base_link" link2="link_1" reason="Adjacent"/></robot>"#,
+    )
+    .unwrap();
+    let mut ruled = set.clone();
+    ruled.robot.srdf = Some(srdf);
+    let ruled = ArmSetup::load(&ruled).unwrap();
+    assert!(checked(&ruled, "link_5", "link_6") && checked(&ruled, "probe", "link_5"));
+    assert!(
+        !checked(&ruled, "probe", "link_6"),
+        "the probe is checked against its flange"
+    );
+    // A tool named as a link of the URDF is refused: its pairs could not be told apart.
+    let mut named = set.clone();
+    named.robot.tool.as_mut().unwrap().name = "link_6".into();
+    let e = ArmSetup::load(&named).err().expect("refused");
+    assert!(e.to_string().contains("as a link of the URDF"), "{e}");
+    // A ball where the probe's housing is at the start, clear of the arm without the tool.
+    let chain = &with.model.chain;
+    let q = with.to_chain(&set.problems[0].start);
+    let housing = set.robot.base * chain.fk_tip(&q) * tool.shapes[1].1;
+    let ball = cellplan_motion::problem::Obstacle {
+        name: "ball".into(),
+        shape: cellplan_geom::ShapeSpec::Sphere { radius: 0.02 },
+        pose: cellplan_geom::Pose::from_translation(housing.translation),
+    };
+    let (mut with, mut without) = (with, without);
+    with.set_obstacles(std::slice::from_ref(&ball));
+    without.set_obstacles(std::slice::from_ref(&ball));
+    assert!(!with.validity(0.0).is_valid(&q), "the probe holds the ball");
+    assert!(without.validity(0.0).is_valid(&q), "the arm alone is clear of it");
+    let mut exact = with.validity(0.0);
+    exact.broad_phase = false;
+    assert!(!exact.is_valid(&q));
 }

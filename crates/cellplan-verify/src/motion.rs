@@ -28,6 +28,9 @@ pub const LIMIT_TOLERANCE: f64 = 1e-5;
 struct Part {
     /// Chain link it hangs on.
     link: usize,
+    /// What the contact report calls it: the chain link, with the URDF link (a gripper's
+    /// finger) or tool the shape belongs to where that is another.
+    label: String,
     shape: SharedShape,
     /// Pose of `shape` in the link frame.
     local: Pose,
@@ -96,13 +99,21 @@ impl<'a> ExactRobot<'a> {
         for (link, shapes) in model.collision.iter().enumerate() {
             for (k, (spec, pose)) in shapes.iter().enumerate() {
                 if let Some((shape, local, r)) = exact_shape(spec) {
-                    sources.push(model.collision_links[link].get(k).map_or("", String::as_str));
+                    let source = model.collision_links[link].get(k).map_or("", String::as_str);
+                    sources.push(source);
+                    let name = &model.chain.links[link].name;
+                    let label = if source.is_empty() || source == name {
+                        format!("link {name}")
+                    } else {
+                        format!("link {name} ({source})")
+                    };
                     let hull = match spec {
                         ShapeSpec::Mesh(m) => SharedShape::convex_hull(&m.vertices),
                         _ => None,
                     };
                     parts.push(Part {
                         link,
+                        label,
                         aabb: shape.compute_local_aabb(),
                         hull,
                         shape,
@@ -261,10 +272,7 @@ impl ExactRobot<'_> {
                     }
                 };
                 if d <= 0.0 {
-                    return Some(format!(
-                        "link {} with obstacle {}",
-                        self.chain.links[p.link].name, o.name
-                    ));
+                    return Some(format!("{} with obstacle {}", p.label, o.name));
                 }
                 schedule.slack[slot] = d;
             }
@@ -298,10 +306,7 @@ impl ExactRobot<'_> {
                 }
             };
             if d <= 0.0 {
-                return Some(format!(
-                    "link {} with link {} (parts {i}, {j})",
-                    self.chain.links[a.link].name, self.chain.links[b.link].name
-                ));
+                return Some(format!("{} with {} (parts {i}, {j})", a.label, b.label));
             }
             schedule.slack[slot] = if schedule.joints[slot].is_empty() {
                 f64::INFINITY
