@@ -29,6 +29,9 @@ def load_problems(path):
     if doc.get("format") != FORMAT or doc.get("version") != 1:
         raise ValueError(f"{path}: not a {FORMAT} version 1 file")
     robot = doc["robot"]
+    if robot.get("tool"):
+        # The robot would be checked without its tool: refuse rather than check another robot.
+        raise ValueError(f"{path}: robot.tool is not supported here (cellplan bench motion checks it)")
     doc["urdf_path"] = (path.parent / robot["urdf"]).resolve()
     doc["srdf_path"] = (path.parent / robot["srdf"]).resolve() if robot.get("srdf") else None
     base = robot.get("base", {})

@@ -212,16 +212,45 @@ fn recheck_rows(set: &ProblemSet, setup: &ArmSetup, rows: &mut [Row], step: f64)
     });
 }
 
+/// Why a peer's run could not be re-checked: a problem file, or the run file itself.
+#[derive(Debug)]
+pub enum RecheckError {
+    /// A problem file could not be read or set up.
+    Problem(ProblemError),
+    /// The run file could not be read, or is not a run (`line`: where, when known).
+    Run {
+        path: PathBuf,
+        line: Option<usize>,
+        message: String,
+    },
+}
+
 /// Re-checks a peer's run file (`[{problem, planner, solved, time_s, path_length,
 /// validity_checks, path}]`) against the problems of `files`.
-pub fn recheck(files: &[PathBuf], run_file: &Path, step: f64) -> Result<Vec<Row>, String> {
+pub fn recheck(files: &[PathBuf], run_file: &Path, step: f64) -> Result<Vec<Row>, RecheckError> {
+    use cellplan_geom::read::{LimitedReadError, read_limited, show_bytes, utf8_text};
+    let limit = cellplan_motion::problem::MAX_FILE_BYTES;
+    let run = |line: Option<usize>, message: String| RecheckError::Run {
+        path: run_file.to_path_buf(),
+        line,
+        message,
+    };
+    let bytes = read_limited(run_file, limit).map_err(|e| match e {
+        LimitedReadError::Io(e) => run(None, format!("cannot read it: {e}")),
+        LimitedReadError::TooLarge { size } => run(
+            None,
+            format!(
+                "it is {size}, larger than the {} a run file may have",
+                show_bytes(limit)
+            ),
+        ),
+    })?;
     let text =
-        std::fs::read_to_string(run_file).map_err(|e| format!("cannot read {}: {e}", run_file.display()))?;
-    let peers: Vec<PeerRow> = serde_json::from_str(&text)
-        .map_err(|e| format!("{}:{}:{}: {e}", run_file.display(), e.line(), e.column()))?;
+        utf8_text(bytes).map_err(|e| run(Some(e.line), format!("byte {} is not UTF-8 text", e.offset)))?;
+    let peers: Vec<PeerRow> = serde_json::from_str(&text).map_err(|e| run(Some(e.line()), e.to_string()))?;
     let mut rows = Vec::new();
     for file in files {
-        let (set, setup) = load(file).map_err(|e| e.to_string())?;
+        let (set, setup) = load(file).map_err(RecheckError::Problem)?;
         let mut file_rows: Vec<Row> = peers
             .iter()
             .filter(|p| set.problems.iter().any(|q| q.name == p.problem))

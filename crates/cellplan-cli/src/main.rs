@@ -491,7 +491,15 @@ fn run_bench_motion(args: &bench::BenchArgs) -> Result<(), Failure> {
     }
     let step = args.exact_step_mm * 1e-3;
     let mut rows = match &args.recheck {
-        Some(run) => bench_motion::recheck(&args.files, run, step).map_err(Failure::Other)?,
+        Some(run) => bench_motion::recheck(&args.files, run, step).map_err(|e| match e {
+            bench_motion::RecheckError::Problem(e) => problem_failure(e),
+            bench_motion::RecheckError::Run { path, line, message } => Failure::Input(Box::new(
+                InputError::at_line(&path, line, message).hint(
+                    "give a JSON list of {problem, planner, solved, time_s, path_length, validity_checks, path}, \
+                     as bench/peers/motion_vamp.py and motion_ompl.py write it",
+                ),
+            )),
+        })?,
         None => bench_motion::run(&bench_motion::Request {
             files: &args.files,
             planner: &args.planner,

@@ -27,6 +27,9 @@ pub struct RobotModel {
     /// belongs to (the chain link itself, or a link rigidly attached off the chain, such as a
     /// gripper finger). SRDF collision rules name these links.
     pub collision_links: Vec<Vec<String>>,
+    /// The name of every link of the URDF, on the chain or not, with shapes or not, in the
+    /// file's order.
+    pub link_names: Vec<String>,
     /// Inertial parameters per chain link (same index as `chain.links`), in the link frame:
     /// the link's own `<inertial>` with those of links rigidly attached off the chain lumped in;
     /// `None` where no `<inertial>` with a positive mass was given.
@@ -126,6 +129,7 @@ impl Loader<'_> {
         let (collision, collision_links) = self.collision(&doc, &robot, &attach, chain.links.len())?;
         let inertia = inertias(&robot, &attach, chain.links.len());
         Ok(RobotModel {
+            link_names: robot.links.iter().map(|l| l.name.clone()).collect(),
             inertia,
             name: robot.name.clone(),
             path: self.path.to_path_buf(),

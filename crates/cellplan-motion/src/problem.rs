@@ -12,7 +12,9 @@
 //! gripper fingers keep one hull per mesh), the SRDF's `disable_collisions` pairs left out of the self checks (without an SRDF:
 //! every pair of bodies on different links that are not parent and child). Of the remaining
 //! pairs, those proven apart in every configuration within the joint limits are not asked by
-//! the validity check ([`crate::arm::pairs_that_may_touch`]).
+//! the validity check ([`crate::arm::pairs_that_may_touch`]). An optional tool ([`ToolRef`])
+//! adds one body per shape on the chain's tip link under the tool's name, checked against every
+//! link but the one it is mounted on, with or without an SRDF.
 use crate::arm::{Arm, ArmValidity, pairs_that_may_touch};
 use cellplan_geom::pieces::convex_pieces;
 use cellplan_geom::read::{LimitedReadError, read_limited, show_bytes, utf8_text};
@@ -44,6 +46,9 @@ pub const MAX_OBSTACLES: usize = 100_000;
 pub const MAX_GOALS: usize = 10_000;
 /// Shapes a tool may have, at most.
 pub const MAX_TOOL_SHAPES: usize = 1_000;
+/// How far a tool's points may lie from the tip link's origin (m): the exact re-check samples
+/// a path more densely the farther the robot's points reach.
+pub const MAX_TOOL_REACH_M: f64 = 10.0;
 /// Largest length accepted (m): positions, sizes, margins.
 pub const MAX_LENGTH_M: f64 = 1e4;
 /// Bytes of mesh files one problem file may have read, in all (each file counted once): many
@@ -370,8 +375,9 @@ fn obstacle(doc: &ObstacleDoc, what: &str, dir: &Path, meshes: &mut Meshes) -> R
     })
 }
 
-/// The tool of `robot.tool`: a name that is a link name and one to [`MAX_TOOL_SHAPES`] shapes,
-/// each read as an obstacle is (its pose in the tip link's frame).
+/// The tool of `robot.tool`: a name that can be a link name and one to [`MAX_TOOL_SHAPES`]
+/// shapes, each read as an obstacle is (its pose in the tip link's frame), none reaching
+/// farther than [`MAX_TOOL_REACH_M`] from that frame's origin.
 fn tool(doc: &ToolDoc, dir: &Path, meshes: &mut Meshes) -> Result<ToolRef, String> {
     let name = doc.name.trim();
     if name.is_empty() || name.chars().any(char::is_control) {
@@ -388,13 +394,31 @@ fn tool(doc: &ToolDoc, dir: &Path, meshes: &mut Meshes) -> Result<ToolRef, Strin
         .iter()
         .enumerate()
         .map(|(k, d)| {
-            obstacle(d, &format!("robot.tool: shape {}", k + 1), dir, meshes).map(|o| (o.shape, o.pose))
+            let what = format!("robot.tool: shape {}", k + 1);
+            let o = obstacle(d, &what, dir, meshes)?;
+            let reach = o.pose.translation.length() + shape_reach(&o.shape);
+            if reach > MAX_TOOL_REACH_M {
+                return Err(format!(
+                    "{what} reaches {reach:.3} m from the tip link, beyond the {MAX_TOOL_REACH_M} m a tool may"
+                ));
+            }
+            Ok((o.shape, o.pose))
         })
         .collect::<Result<Vec<_>, _>>()?;
     Ok(ToolRef {
         name: name.to_string(),
         shapes,
     })
+}
+
+/// The farthest a shape's points lie from its own origin (m).
+fn shape_reach(shape: &ShapeSpec) -> f64 {
+    match shape {
+        ShapeSpec::Box { half_extents } => half_extents.length(),
+        ShapeSpec::Cylinder { radius, half_height } => radius.hypot(*half_height),
+        ShapeSpec::Sphere { radius } => *radius,
+        ShapeSpec::Mesh(m) => m.vertices.iter().map(|v| v.length()).fold(0.0, f64::max),
+    }
 }
 
 fn configuration(q: &[f64], n: usize, what: &str) -> Result<Vec<f64>, String> {
@@ -559,7 +583,8 @@ pub struct ArmSetup {
     /// The URDF link each body's shape belongs to.
     pub body_sources: Vec<String>,
     /// The body pairs to keep apart: every pair on different links but those the SRDF
-    /// disables (what an exact re-check checks).
+    /// disables (without an SRDF, but those on one chain link or on parent and child), and but
+    /// the tool with the link it is mounted on (what an exact re-check checks).
     pub self_pairs: Vec<(usize, usize)>,
     /// The pairs of `self_pairs` that the validity check asks: those not proven apart in
     /// every configuration within the joint limits ([`crate::arm::pairs_that_may_touch`]).
@@ -574,16 +599,15 @@ pub struct ArmSetup {
 
 impl ArmSetup {
     /// Loads the robot of `set`: the URDF (whose movable joints must be exactly the file's
-    /// `joints`), one body per collision shape, the SRDF's rules.
+    /// `joints`), one body per collision shape, the tool's shapes on the tip link (refused when
+    /// the tool has the name of a link of the URDF), the SRDF's rules.
     pub fn load(set: &ProblemSet) -> Result<ArmSetup, ProblemError> {
         let mut model = load_urdf(&set.robot.urdf, &set.robot.packages, None)?;
         // The tool's bodies hang on the tip link, under the tool's name; the link it is mounted
         // on (the nearest one from the tip towards the root that has shapes) always touches it.
         let mut mount = None;
         if let Some(tool) = &set.robot.tool {
-            if model.collision_links.iter().flatten().any(|l| *l == tool.name)
-                || model.chain.links.iter().any(|l| l.name == tool.name)
-            {
+            if model.link_names.contains(&tool.name) {
                 return Err(ProblemError::Invalid {
                     path: set.path.clone(),
                     message: format!("robot.tool is named \"{}\", as a link of the URDF", tool.name),
@@ -672,9 +696,10 @@ impl ArmSetup {
                 if on_tool(si, sj) || on_tool(sj, si) {
                     continue;
                 }
-                if set.robot.srdf.is_none() {
+                let tool_pair = tool_name.is_some_and(|t| si == t || sj == t);
+                if set.robot.srdf.is_none() && !tool_pair {
                     // No rules: links that never move relative to each other, and parent and
-                    // child, are left out.
+                    // child, are left out (the tool only from its mount, above).
                     let (a, b) = (body_links[i].min(body_links[j]), body_links[i].max(body_links[j]));
                     if b - a <= 1 {
                         continue;

@@ -222,6 +222,11 @@ fn broken_files_are_refused_with_the_place() {
  "robot": {"urdf": "r.urdf", "tool": {"shapes": [{"shape": "box", "half_extents": [1, -1, 1], "pose": {"xyz": [0, 0, 0]}}]}}}"#,
             "robot.tool: shape 1: half_extents[1] = -1",
         ),
+        (
+            r#"{"format": "cellplan-motion-problems", "version": 1, "joints": ["a"], "problems": [],
+ "robot": {"urdf": "r.urdf", "tool": {"shapes": [{"shape": "sphere", "radius": 0.1, "pose": {"xyz": [20, 0, 0]}}]}}}"#,
+            "robot.tool: shape 1 reaches 20.100 m",
+        ),
     ];
     for (text, expect) in cases {
         let f = write(tmp.path(), text);
@@ -353,11 +358,14 @@ fn the_tool_moves_with_the_tip_and_is_checked() {
         !checked(&ruled, "probe", "link_6"),
         "the probe is checked against its flange"
     );
-    // A tool named as a link of the URDF is refused: its pairs could not be told apart.
-    let mut named = set.clone();
-    named.robot.tool.as_mut().unwrap().name = "link_6".into();
-    let e = ArmSetup::load(&named).err().expect("refused");
-    assert!(e.to_string().contains("as a link of the URDF"), "{e}");
+    // A tool named as a link of the URDF is refused, a link without shapes off the chain too
+    // (the flange): SRDF rules naming it would apply to the tool.
+    for link in ["link_6", "flange"] {
+        let mut named = set.clone();
+        named.robot.tool.as_mut().unwrap().name = link.into();
+        let e = ArmSetup::load(&named).err().expect("refused");
+        assert!(e.to_string().contains("as a link of the URDF"), "{e}");
+    }
     // A ball where the probe's housing is at the start, clear of the arm without the tool.
     let chain = &with.model.chain;
     let q = with.to_chain(&set.problems[0].start);
@@ -368,6 +376,11 @@ fn the_tool_moves_with_the_tip_and_is_checked() {
         pose: cellplan_geom::Pose::from_translation(housing.translation),
     };
     let (mut with, mut without) = (with, without);
+    with.set_obstacles(&[]);
+    assert!(
+        with.validity(0.0).is_valid(&q),
+        "the arm with its probe is clear of itself"
+    );
     with.set_obstacles(std::slice::from_ref(&ball));
     without.set_obstacles(std::slice::from_ref(&ball));
     assert!(!with.validity(0.0).is_valid(&q), "the probe holds the ball");

@@ -38,12 +38,12 @@ fn the_exact_recheck_checks_the_tool() {
             .valid
     );
     // The problems as given are clear with the tool too (start and goals).
-    let obstacles: Vec<ExactObstacle> = set.problems[0]
-        .obstacles
-        .iter()
-        .filter_map(|o| ExactObstacle::new(&o.name, &o.shape, o.pose))
-        .collect();
     for p in &set.problems {
+        let obstacles: Vec<ExactObstacle> = p
+            .obstacles
+            .iter()
+            .filter_map(|o| ExactObstacle::new(&o.name, &o.shape, o.pose))
+            .collect();
         for c in std::iter::once(&p.start).chain(&p.goals) {
             let c = with.to_chain(c);
             let check = robot.check_path(&[c.clone(), c], &obstacles, p.margin, 1e-3);

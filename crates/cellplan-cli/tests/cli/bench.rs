@@ -276,4 +276,14 @@ fn bench_motion_plans_and_rechecks_exactly() {
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "{stderr}");
     assert!(stderr.contains("bad.json"), "{stderr}");
+    // A peer's run that is not a run: exit 2, the run file and its line, what to give.
+    std::fs::write(&run, "[{\"problem\": \"x\",\n \"solved\": \"yes\"}]").unwrap();
+    let out = cellplan(
+        &["bench", "motion", scene, "--recheck", run.to_str().unwrap()],
+        &dir,
+    );
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(stderr.contains("peer.json:2:"), "{stderr}");
+    assert!(stderr.contains("motion_vamp.py"), "{stderr}");
 }
