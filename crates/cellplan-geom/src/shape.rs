@@ -117,6 +117,19 @@ impl ShapeSpec {
         out
     }
 
+    /// The farthest any point of the shape lies from its own origin (m): a box's half
+    /// diagonal, a cylinder's rim, a sphere's radius, a mesh's farthest vertex.
+    pub fn reach(&self) -> f64 {
+        match self {
+            ShapeSpec::Box { half_extents } => half_extents.length(),
+            ShapeSpec::Cylinder { radius, half_height } => {
+                (radius * radius + half_height * half_height).sqrt()
+            }
+            ShapeSpec::Sphere { radius } => radius.abs(),
+            ShapeSpec::Mesh(m) => m.vertices.iter().map(|v| v.length()).fold(0.0, f64::max),
+        }
+    }
+
     /// Whether the shape has a finite, non-empty geometry (finite parameters; a mesh with at
     /// least one triangle). Shapes that are not valid never collide.
     pub fn is_valid(&self) -> bool {
@@ -340,6 +353,28 @@ pub(crate) fn shape_as_mesh(shape: &dyn Shape, local: &Pose) -> Option<Mesh> {
 mod tests {
     use super::*;
     use parry3d_f64::query::PointQuery;
+
+    #[test]
+    fn reach_is_the_farthest_point_from_the_origin() {
+        let b = ShapeSpec::Box {
+            half_extents: DVec3::new(1.0, 2.0, -2.0),
+        };
+        assert_eq!(b.reach(), 3.0);
+        let c = ShapeSpec::Cylinder {
+            radius: 3.0,
+            half_height: 4.0,
+        };
+        assert_eq!(c.reach(), 5.0);
+        assert_eq!(ShapeSpec::Sphere { radius: 0.5 }.reach(), 0.5);
+        // A mesh: its farthest vertex, not its box's corner.
+        let m = ShapeSpec::Box {
+            half_extents: DVec3::splat(1.0),
+        }
+        .to_mesh();
+        let far = m.vertices.iter().map(|v| v.length()).fold(0.0, f64::max);
+        assert_eq!(ShapeSpec::Mesh(std::sync::Arc::new(m)).reach(), far);
+        assert!((far - 3f64.sqrt()).abs() < 1e-12);
+    }
 
     #[test]
     fn tessellated_primitives_are_closed_and_sized() {

@@ -391,7 +391,7 @@ fn tool(doc: &ToolDoc, dir: &Path, meshes: &mut Meshes) -> Result<ToolRef, Strin
         .map(|(k, d)| {
             let what = format!("robot.tool: shape {}", k + 1);
             let o = obstacle(d, &what, dir, meshes)?;
-            let reach = o.pose.translation.length() + shape_reach(&o.shape);
+            let reach = o.pose.translation.length() + o.shape.reach();
             if reach > MAX_TOOL_REACH_M {
                 return Err(format!(
                     "{what} reaches {reach:.3} m from the tip link, beyond the {MAX_TOOL_REACH_M} m a tool may"
@@ -404,16 +404,6 @@ fn tool(doc: &ToolDoc, dir: &Path, meshes: &mut Meshes) -> Result<ToolRef, Strin
         name: name.to_string(),
         shapes,
     })
-}
-
-/// The farthest a shape's points lie from its own origin (m).
-fn shape_reach(shape: &ShapeSpec) -> f64 {
-    match shape {
-        ShapeSpec::Box { half_extents } => half_extents.length(),
-        ShapeSpec::Cylinder { radius, half_height } => radius.hypot(*half_height),
-        ShapeSpec::Sphere { radius } => *radius,
-        ShapeSpec::Mesh(m) => m.vertices.iter().map(|v| v.length()).fold(0.0, f64::max),
-    }
 }
 
 fn configuration(q: &[f64], n: usize, what: &str) -> Result<Vec<f64>, String> {

@@ -132,7 +132,7 @@ impl Scene {
         let b = &cell.bodies;
         let reach = h.l1 + h.l2;
         let make = |spec: ShapeSpec, at: Pose, turns: bool| -> Option<Body> {
-            let (shape, local, _) = exact_shape(&spec)?;
+            let (shape, local) = exact_shape(&spec)?;
             Some(Body {
                 shape,
                 local: at * local,
@@ -181,7 +181,7 @@ impl Scene {
             .statics
             .iter()
             .filter_map(|(_, spec, pose)| {
-                let (shape, local, _) = exact_shape(spec)?;
+                let (shape, local) = exact_shape(spec)?;
                 let pose = *pose * local;
                 Some(Obstacle {
                     aabb: shape.compute_aabb(&pose),

@@ -56,28 +56,20 @@ pub struct ExactRobot<'a> {
     part_joints: Vec<usize>,
 }
 
-/// A parry shape for a shape spec, with its pose in the spec's frame, and the farthest distance
-/// of its points from that frame's origin. Meshes keep their triangles.
-pub(crate) fn exact_shape(spec: &ShapeSpec) -> Option<(SharedShape, Pose, f64)> {
+/// A parry shape for a shape spec, with its pose in the spec's frame (how far its points reach
+/// from that frame's origin is [`ShapeSpec::reach`]). Meshes keep their triangles.
+pub(crate) fn exact_shape(spec: &ShapeSpec) -> Option<(SharedShape, Pose)> {
     match spec {
-        ShapeSpec::Box { half_extents } => Some((
-            SharedShape::new(Cuboid::new(half_extents.abs())),
-            Pose::IDENTITY,
-            half_extents.length(),
-        )),
+        ShapeSpec::Box { half_extents } => {
+            Some((SharedShape::new(Cuboid::new(half_extents.abs())), Pose::IDENTITY))
+        }
         ShapeSpec::Cylinder { radius, half_height } => Some((
             SharedShape::new(Cylinder::new(half_height.abs(), radius.abs())),
             // parry's cylinder axis is y; the spec's is z.
             Pose::from_rotation(DQuat::from_rotation_x(std::f64::consts::FRAC_PI_2)),
-            (radius * radius + half_height * half_height).sqrt(),
         )),
-        ShapeSpec::Sphere { radius } => Some((
-            SharedShape::new(Ball::new(radius.abs())),
-            Pose::IDENTITY,
-            radius.abs(),
-        )),
+        ShapeSpec::Sphere { radius } => Some((SharedShape::new(Ball::new(radius.abs())), Pose::IDENTITY)),
         ShapeSpec::Mesh(m) => {
-            let reach = m.vertices.iter().map(|v| v.length()).fold(0.0, f64::max);
             let tris: Vec<[u32; 3]> = m
                 .triangles
                 .iter()
@@ -85,7 +77,7 @@ pub(crate) fn exact_shape(spec: &ShapeSpec) -> Option<(SharedShape, Pose, f64)> 
                 .filter(|t| t.iter().all(|&i| (i as usize) < m.vertices.len()))
                 .collect();
             let mesh = TriMesh::new(m.vertices.clone(), tris).ok()?;
-            Some((SharedShape::new(mesh), Pose::IDENTITY, reach))
+            Some((SharedShape::new(mesh), Pose::IDENTITY))
         }
     }
 }
@@ -98,7 +90,8 @@ impl<'a> ExactRobot<'a> {
         let mut sources: Vec<&str> = Vec::new();
         for (link, shapes) in model.collision.iter().enumerate() {
             for (k, (spec, pose)) in shapes.iter().enumerate() {
-                if let Some((shape, local, r)) = exact_shape(spec) {
+                if let Some((shape, local)) = exact_shape(spec) {
+                    let r = spec.reach();
                     let source = model.collision_links[link].get(k).map_or("", String::as_str);
                     sources.push(source);
                     let name = &model.chain.links[link].name;
@@ -180,7 +173,7 @@ pub struct ExactObstacle {
 impl ExactObstacle {
     /// The obstacle `spec` at `pose`; `None` for a degenerate shape.
     pub fn new(name: &str, spec: &ShapeSpec, pose: Pose) -> Option<Self> {
-        let (shape, local, _) = exact_shape(spec)?;
+        let (shape, local) = exact_shape(spec)?;
         let pose = pose * local;
         Some(ExactObstacle {
             name: name.to_string(),

@@ -50,7 +50,7 @@ impl ArmSetup {
         let mut model = load_urdf(&set.robot.urdf, &set.robot.packages, None)?;
         // The tool's bodies hang on the tip link, under the tool's name; the link it is mounted
         // on (the nearest one from the tip towards the root that has shapes) always touches it.
-        let mut mount = None;
+        let mut mount = BTreeSet::new();
         if let Some(tool) = &set.robot.tool {
             if model.link_names.contains(&tool.name) {
                 return Err(ProblemError::Invalid {
@@ -60,16 +60,14 @@ impl ArmSetup {
                 });
             }
             let tip = model.collision.len().saturating_sub(1);
-            mount = (0..=tip)
-                .rev()
-                .find(|&l| !model.collision[l].is_empty())
-                .map(|l| model.collision_links[l].clone());
+            if let Some(l) = (0..=tip).rev().find(|&l| !model.collision[l].is_empty()) {
+                mount.extend(model.collision_links[l].iter().cloned());
+            }
             for (shape, pose) in &tool.shapes {
                 model.collision[tip].push((shape.clone(), *pose));
                 model.collision_links[tip].push(tool.name.clone());
             }
         }
-        let mount: BTreeSet<String> = mount.into_iter().flatten().collect();
         let tool_name = set.robot.tool.as_ref().map(|t| t.name.as_str());
         let chain = &model.chain;
         let order = chain
@@ -136,15 +134,15 @@ impl ArmSetup {
                 if si == sj || disabled.contains(&(si.clone(), sj.clone())) {
                     continue;
                 }
-                // The tool and the link it is mounted on.
-                let on_tool = |a: &String, b: &String| Some(a.as_str()) == tool_name && mount.contains(b);
-                if on_tool(si, sj) || on_tool(sj, si) {
-                    continue;
-                }
-                let tool_pair = tool_name.is_some_and(|t| si == t || sj == t);
-                if set.robot.srdf.is_none() && !tool_pair {
+                if tool_name.is_some_and(|t| si == t || sj == t) {
+                    // The tool: never with the link it is mounted on (no link has the tool's
+                    // name), with every other link, SRDF or not.
+                    if mount.contains(si) || mount.contains(sj) {
+                        continue;
+                    }
+                } else if set.robot.srdf.is_none() {
                     // No rules: links that never move relative to each other, and parent and
-                    // child, are left out (the tool only from its mount, above).
+                    // child, are left out.
                     let (a, b) = (body_links[i].min(body_links[j]), body_links[i].max(body_links[j]));
                     if b - a <= 1 {
                         continue;
