@@ -154,6 +154,81 @@ fn planned_legs_join_nodes_and_unreached_nodes_are_not_searched_again() {
     assert!(!reach.is_cut_off(a) && !reach.is_cut_off(b) && !reach.is_cut_off(0));
 }
 
+/// A candidate a full search did not reach takes with it the candidates planned legs join to
+/// it (a path from home to them would reach it too), and `sibling_joins` gives those legs: the
+/// straight segments from it to the other candidates of its task that it sees, each clear of
+/// the scene at the clearance (re-sampled at 1 mrad). Candidates it does not see are still
+/// searched, and one search with the candidates cut off with it does not give the task up.
+#[test]
+fn candidates_that_see_an_unreached_one_are_cut_off_with_it() {
+    use cellplan_motion::plan::PlanError as Motion;
+    use plan::sequence::{Planned, Reach, sibling_joins};
+    let f = fixture();
+    let cell = &f.cell;
+    let s = settings(Allocation::Balanced);
+    let robot = &cell.robots[0];
+    let graph = plan::graph::RobotGraph::new(cell, robot, &f.table, plan::MoveModel::Trapezoid, 8, s.roomy);
+    let full = s.final_max_samples;
+    let task_nodes = |n: usize| graph.alternatives[graph.node_task[n].unwrap().0.0].clone();
+    let failed = Err(plan::LegError::Motion(Motion::NoPath {
+        samples: full,
+        validity_calls: 10 * full,
+    }));
+    // Every task with several candidates: the first one's search from home fails.
+    let mut checked = 0;
+    let mut some_unseen = false;
+    for t in 0..cell.tasks.len() {
+        let siblings = graph.alternatives[t].clone();
+        if siblings.len() < 3 {
+            continue;
+        }
+        let c = siblings[0];
+        let mut planned = Planned::new();
+        planned.insert((0, c), failed.clone());
+        let joins = sibling_joins(cell, robot, &graph, &planned, &[(0, c)], &s);
+        let mut scratch = Scratch::default();
+        for ((a, b), leg) in &joins {
+            assert!(
+                a < b && (*a == c || *b == c),
+                "a join of {c} and a sibling: {a}, {b}"
+            );
+            assert!(task_nodes(*a) == siblings && task_nodes(*b) == siblings);
+            assert!(leg.straight && leg.waypoints.len() == 2 && leg.duration > 0.0);
+            assert!(dist(&leg.waypoints[0], &graph.q[*a]) < 1e-12);
+            assert!(dist(&leg.waypoints[1], &graph.q[*b]) < 1e-12);
+            let w = &leg.waypoints;
+            let steps = (dist(&w[0], &w[1]) / 1e-3).ceil().max(1.0) as usize;
+            for k in 0..=steps {
+                let x = k as f64 / steps as f64;
+                let q: Vec<f64> = w[0].iter().zip(&w[1]).map(|(p, r)| p + x * (r - p)).collect();
+                robot.body_poses(&q, &mut scratch);
+                assert!(
+                    robot
+                        .contact_at(&cell.world, &scratch, cell.planning.clearance - 1e-6)
+                        .is_none(),
+                    "a join comes closer than the clearance at {q:?}"
+                );
+            }
+        }
+        for ((a, b), leg) in joins.iter().cloned() {
+            planned.insert((a, b), Ok(leg));
+        }
+        let reach = Reach::of(&graph, &planned, full);
+        let joined: Vec<usize> = joins
+            .iter()
+            .map(|((a, b), _)| if *a == c { *b } else { *a })
+            .collect();
+        for &n in &siblings {
+            let expected = n == c || joined.contains(&n);
+            assert_eq!(reach.is_cut_off(n), expected, "task {t}, candidate {n}");
+            some_unseen |= !expected;
+        }
+        checked += joins.len();
+    }
+    assert!(checked > 0, "some candidate sees a sibling");
+    assert!(some_unseen, "some candidate is still searched");
+}
+
 /// `settings(allocation)` with one sample per leg search, no roadmap and one candidate per
 /// task: every leg that is not a straight segment fails.
 fn without_sampling(allocation: Allocation) -> plan::PlanSettings {
