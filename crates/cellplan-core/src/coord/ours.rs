@@ -188,15 +188,6 @@ pub(super) fn scheduled(
             let found = s.map(|s| vec![(vec![false; m], s, boxes.clone())]);
             (found.unwrap_or_default(), Vec::new())
         };
-        // A schedule local search shortened comes with the one it started from: both are
-        // finished (the shorter through the boxes first).
-        let found: Vec<Directed> = found
-            .into_iter()
-            .flat_map(|(flip, mut s, boxes)| {
-                let before = s.before.take().map(|b| (flip.clone(), *b, boxes.clone()));
-                std::iter::once((flip, s, boxes)).chain(before)
-            })
-            .collect();
         // Each combination of directions found, finished (waits cut on the exact clock; in
         // parallel, each on its own); the shortest cycle (then Δt) wins, ties to the earlier.
         let finished: Vec<((f64, f64), Resolved)> = found

@@ -22,10 +22,7 @@
 //! Ginsberg): rounds of dives that leave the greedy order at most 0, 1, 2, … times, pruned by
 //! the best schedule so far — on a large diagram the greedy schedule's first orders are the
 //! costly ones, and depth first would spend its budget on the last. Exact when a round cuts
-//! nothing within the node budget; the best schedule found otherwise, improved by local
-//! search on [`IMPROVE_SHARE`] of the budget more ([`Search::improve`]: a box on the critical
-//! path passed the other way, as the job-shop neighbourhoods of van Laarhoven et al. reverse a
-//! critical arc, every other box as before where that still holds). Work is counted in
+//! nothing within the node budget; the best schedule found otherwise. Work is counted in
 //! nodes, so the result does not depend on the machine.
 use super::diagram::ConflictBox;
 
@@ -56,10 +53,6 @@ pub(crate) struct Schedule {
     pub decisions: usize,
     /// Whether the search ended within its budget (the schedule is then the shortest).
     pub proven: bool,
-    /// When local search shortened the schedule ([`Search::improve`]): the one it started
-    /// from (a schedule through the boxes is not the cycle its waits give once cut on the
-    /// exact clock, so coordination finishes both).
-    pub before: Option<Box<Schedule>>,
 }
 
 /// A constraint `X[to] ≥ X[from] + w`.
@@ -101,18 +94,6 @@ struct Search<'a> {
     nodes: usize,
     best: Option<(f64, Vec<f64>, Vec<Edge>)>,
     chosen: Vec<Edge>,
-    /// Per chosen edge, its box and whether it is the box's `first_a` order.
-    chosen_boxes: Vec<(u32, bool)>,
-    /// The boxes and orders of `best`'s edges.
-    best_boxes: Vec<(u32, bool)>,
-    /// Schedules found so far (each better than the one before).
-    found: usize,
-    /// Stop the search once `found` reaches this.
-    stop_at_found: Option<usize>,
-    /// A guided dive ([`Search::improve`]): per box, the order to try first (`Some(true)`:
-    /// `first_a`); the box `flip` the other way first.
-    guide: Vec<Option<bool>>,
-    flip: Option<usize>,
     /// Most discrepancies (second children taken) of a dive; `None`: depth first, all.
     discrepancies: Option<usize>,
     /// Whether a dive left a child out for the discrepancy limit.
@@ -202,12 +183,6 @@ impl<'a> Search<'a> {
             nodes: 0,
             best: None,
             chosen: Vec::new(),
-            chosen_boxes: Vec::new(),
-            best_boxes: Vec::new(),
-            found: 0,
-            stop_at_found: None,
-            guide: Vec::new(),
-            flip: None,
             discrepancies: None,
             cut: false,
             stop_at_first: false,
@@ -391,8 +366,7 @@ impl<'a> Search<'a> {
     /// One node of the search at times `x`: `open`, the boxes open at its parent's times, and
     /// `raised`, the nodes whose times rose since (at the root: every box open there, none).
     fn dive(&mut self, x: Vec<f64>, open: &[u32], raised: Vec<usize>, used: usize) {
-        if (self.stop_at_first && self.best.is_some()) || self.stop_at_found.is_some_and(|n| self.found >= n)
-        {
+        if self.stop_at_first && self.best.is_some() {
             return;
         }
         self.nodes += 1;
@@ -419,30 +393,20 @@ impl<'a> Search<'a> {
                 return;
             }
             self.best = Some((bound, x, self.chosen.clone()));
-            self.best_boxes = self.chosen_boxes.clone();
-            self.found += 1;
             return;
         };
         // Each order applied to a copy; the one finishing earlier explored first.
         let c = self.choices[i];
         let mut children = Vec::new();
-        for (e, is_a) in [(c.first_a, true), (c.first_b, false)] {
-            let Some(e) = e else { continue };
+        for e in [c.first_a, c.first_b].into_iter().flatten() {
             let mut y = x.clone();
             if self.add(e, &mut y) {
-                children.push((self.makespan(&y), e, y, std::mem::take(&mut self.raised), is_a));
+                children.push((self.makespan(&y), e, y, std::mem::take(&mut self.raised)));
             }
             self.out[e.from].pop();
         }
         children.sort_by(|p, q| p.0.total_cmp(&q.0));
-        // A guided dive takes the guide's order first (the other one at the flipped box).
-        if let Some(Some(a)) = self.guide.get(i) {
-            let first = if self.flip == Some(i) { !*a } else { *a };
-            if children.len() == 2 && children[1].4 == first {
-                children.swap(0, 1);
-            }
-        }
-        for (k, (_, e, y, raised, is_a)) in children.into_iter().enumerate() {
+        for (k, (_, e, y, raised)) in children.into_iter().enumerate() {
             let used = used + k;
             if self.discrepancies.is_some_and(|d| used > d) {
                 self.cut = true;
@@ -460,114 +424,12 @@ impl<'a> Search<'a> {
             }
             self.out[e.from].push(e);
             self.chosen.push(e);
-            self.chosen_boxes.push((i as u32, is_a));
             self.dive(y, &open, raised, used);
-            self.chosen_boxes.pop();
             self.chosen.pop();
             self.out[e.from].pop();
         }
     }
 }
-
-impl Search<'_> {
-    /// The boxes whose chosen orders hold with equality on a critical path of the schedule at
-    /// `x` (`chosen` its edges, `boxes` their boxes): from the robot that ends last back
-    /// through the tight chosen edges and the robots' own chains, latest first.
-    fn critical_boxes(&self, x: &[f64], chosen: &[Edge], boxes: &[(u32, bool)]) -> Vec<usize> {
-        let ends: Vec<f64> = (0..self.paths.len())
-            .map(|r| {
-                let p = &self.paths[r];
-                x[self.offset[r] + p.rests.len() - 1] + p.len - p.rests.last().copied().unwrap_or(0.0)
-            })
-            .collect();
-        let Some(r) = (0..ends.len()).max_by(|&a, &b| ends[a].total_cmp(&ends[b]).then(b.cmp(&a))) else {
-            return Vec::new();
-        };
-        let mut v = self.offset[r] + self.paths[r].rests.len() - 1;
-        let mut out = Vec::new();
-        // Each step follows a chosen edge that holds with equality into the node, else the
-        // chain; at most as many steps as there are nodes and edges.
-        for _ in 0..x.len() + chosen.len() {
-            if let Some(k) = chosen
-                .iter()
-                .position(|e| e.to == v && (x[e.from] + e.w - x[v]).abs() <= 1e-6)
-            {
-                let b = boxes[k].0 as usize;
-                if !out.contains(&b) {
-                    out.push(b);
-                }
-                v = chosen[k].from;
-                continue;
-            }
-            if v == self.offset[self.robot_of(v)] {
-                break;
-            }
-            v -= 1;
-        }
-        out
-    }
-
-    /// Local search from the best schedule, within `extra` more nodes: for each box on its
-    /// critical path ([`Search::critical_boxes`]), one guided dive that passes that box the
-    /// other way and every other box the way the best schedule does where that still holds
-    /// (greedy where the best schedule did not decide it), pruned by the best makespan and cut
-    /// at [`GUIDED_DIVE_NODES`] plus twice the decisions; the first dive that finds a shorter
-    /// schedule makes it the best, and the search starts again from there. Ends when no flip
-    /// of a critical box shortens the schedule or the nodes run out.
-    fn improve(&mut self, x0: &[f64], open: &[u32], extra: usize) {
-        let limit = self.nodes.saturating_add(extra);
-        let budget = self.budget;
-        self.discrepancies = None;
-        while let Some((_, x, chosen)) = &self.best {
-            let critical = self.critical_boxes(x, chosen, &self.best_boxes);
-            self.guide = vec![None; self.choices.len()];
-            for &(b, a) in &self.best_boxes {
-                self.guide[b as usize] = Some(a);
-            }
-            let cap = GUIDED_DIVE_NODES + 2 * self.best_boxes.len();
-            let mut improved = false;
-            for b in critical {
-                if self.nodes >= limit {
-                    break;
-                }
-                // Only boxes that can be passed the other way.
-                let c = self.choices[b];
-                let other = match self.guide[b] {
-                    Some(true) => c.first_b,
-                    Some(false) => c.first_a,
-                    None => None,
-                };
-                if other.is_none() {
-                    continue;
-                }
-                self.flip = Some(b);
-                self.budget = limit.min(self.nodes + cap);
-                self.stop_at_found = Some(self.found + 1);
-                let before = self.found;
-                self.dive(x0.to_vec(), open, Vec::new(), 0);
-                if self.found > before {
-                    improved = true;
-                    break;
-                }
-            }
-            if !improved || self.nodes >= limit {
-                break;
-            }
-        }
-        self.budget = budget;
-        self.flip = None;
-        self.guide.clear();
-        self.stop_at_found = None;
-    }
-}
-
-/// Nodes of one guided dive of [`Search::improve`], besides twice the decisions of the best
-/// schedule (a dive that keeps the orders takes one node per decision).
-const GUIDED_DIVE_NODES: usize = 200;
-
-/// The local search after a search its budget cut ([`Search::improve`]) gets this share of the
-/// budget on top.
-const IMPROVE_SHARE: f64 = 0.5;
 
 /// How many times its budget the search may spend while it has no schedule at all.
 const NO_SCHEDULE_FACTOR: usize = 10;
@@ -648,18 +510,6 @@ pub(crate) fn infeasible_core(
 
 /// The search, and the nodes it took.
 fn search(paths: &[Track], boxes: &[ConflictBox], budget: usize, min_wait: f64) -> (Found, usize) {
-    search_with(paths, boxes, budget, min_wait, IMPROVE_SHARE)
-}
-
-/// [`search`] with `improve_share` of the budget for the local search after a search the
-/// budget cut.
-fn search_with(
-    paths: &[Track],
-    boxes: &[ConflictBox],
-    budget: usize,
-    min_wait: f64,
-    improve_share: f64,
-) -> (Found, usize) {
     let mut s = Search::new(paths, boxes, budget.max(1), min_wait.max(0.0));
     if s.choices
         .iter()
@@ -694,16 +544,6 @@ fn search_with(
             }
         }
     }
-    // A search the budget cut: local search from its best schedule, on more nodes.
-    let mut before = None;
-    if s.best.is_some() && !proven {
-        let (start, found) = (s.best.clone(), s.found);
-        let extra = (budget as f64 * improve_share) as usize;
-        s.improve(&x, &open, extra);
-        if s.found > found {
-            before = start;
-        }
-    }
     let Some((makespan, x, chosen)) = s.best.take() else {
         let found = if s.nodes >= s.budget.saturating_mul(NO_SCHEDULE_FACTOR) {
             Found::Unknown
@@ -712,45 +552,35 @@ fn search_with(
         };
         return (found, s.nodes);
     };
-    let nodes = s.nodes;
-    let mut found = s.schedule_of(makespan, &x, &chosen, proven);
-    found.before = before.map(|(m, x, c)| Box::new(s.schedule_of(m, &x, &c, proven)));
-    (Found::Schedule(found), nodes)
-}
-
-impl Search<'_> {
-    /// The schedule of the leave times `x` under the `chosen` orders (its makespan given).
-    fn schedule_of(&self, makespan: f64, x: &[f64], chosen: &[Edge], proven: bool) -> Schedule {
-        let (s, paths) = (self, self.paths);
-        let mut waits = Vec::with_capacity(paths.len());
-        for (r, p) in paths.iter().enumerate() {
-            let o = s.offset[r];
-            let mut w = Vec::with_capacity(p.rests.len());
-            for k in 0..p.rests.len() {
-                let arrive = if k == 0 {
-                    0.0
-                } else {
-                    x[o + k - 1] + p.rests[k] - p.rests[k - 1]
-                };
-                let d = (x[o + k] - arrive).max(0.0);
-                // Whom: the robot of a chosen constraint that holds with equality here.
-                let by = chosen
-                    .iter()
-                    .find(|e| e.to == o + k && (x[e.from] + e.w - x[o + k]).abs() <= 1e-6)
-                    .map(|e| paths[s.robot_of(e.from)].robot);
-                w.push((if d > 1e-9 { d } else { 0.0 }, by));
-            }
-            waits.push(w);
+    let mut waits = Vec::with_capacity(paths.len());
+    for (r, p) in paths.iter().enumerate() {
+        let o = s.offset[r];
+        let mut w = Vec::with_capacity(p.rests.len());
+        for k in 0..p.rests.len() {
+            let arrive = if k == 0 {
+                0.0
+            } else {
+                x[o + k - 1] + p.rests[k] - p.rests[k - 1]
+            };
+            let d = (x[o + k] - arrive).max(0.0);
+            // Whom: the robot of a chosen constraint that holds with equality here.
+            let by = chosen
+                .iter()
+                .find(|e| e.to == o + k && (x[e.from] + e.w - x[o + k]).abs() <= 1e-6)
+                .map(|e| paths[s.robot_of(e.from)].robot);
+            w.push((if d > 1e-9 { d } else { 0.0 }, by));
         }
-        Schedule {
-            waits,
-            makespan,
-            nodes: s.nodes,
-            decisions: chosen.len(),
-            proven,
-            before: None,
-        }
+        waits.push(w);
     }
+    let nodes = s.nodes;
+    let found = Found::Schedule(Schedule {
+        waits,
+        makespan,
+        nodes,
+        decisions: chosen.len(),
+        proven,
+    });
+    (found, nodes)
 }
 
 #[cfg(test)]
