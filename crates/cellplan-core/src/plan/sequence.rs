@@ -16,7 +16,7 @@ use std::time::Instant;
 mod order;
 mod reach;
 pub use order::{SWEEP_GROUPS, best_order, best_order_with};
-pub use reach::{Reach, sibling_joins};
+pub use reach::Reach;
 
 /// A planned leg between two nodes of a robot graph.
 #[derive(Clone, Debug)]
@@ -316,11 +316,6 @@ fn attempt(
             }
             retry.remove(&k);
             planned.insert(k, r);
-        }
-        // The candidates that see a candidate this phase did not reach join it (and are cut
-        // off with it in the next phase's `Reach`).
-        for (k, leg) in sibling_joins(cell, robot, graph, planned, &phase, settings) {
-            planned.insert(k, Ok(leg));
         }
     }
     let mut legs = Vec::new();

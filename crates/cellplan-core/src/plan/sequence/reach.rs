@@ -5,9 +5,7 @@ use crate::plan::graph::RobotGraph;
 use crate::plan::{LegError, PlanSettings};
 use cellplan_model::Cell;
 use cellplan_model::robot::Robot;
-use cellplan_motion::plan::{Key, check_segment};
-use cellplan_motion::timing::time_path_exact;
-use rayon::prelude::*;
+use cellplan_motion::plan::Key;
 use std::collections::BTreeMap;
 use std::time::Instant;
 
@@ -68,30 +66,11 @@ impl Reach {
                 e.insert((inside, *samples));
             }
         }
-        // A node that planned legs join to a node cut off is cut off too, citing the same
-        // search: a path from home to it would, through those legs, reach the node the search
-        // did not reach (see [`sibling_joins`], which joins a task's candidates that see each
-        // other, so that one full search settles all of them).
-        // (The nodes the searches themselves did not reach, for the task rule below.)
-        let searched: Vec<usize> = cut_off.keys().copied().collect();
-        let mut by_root: BTreeMap<usize, (usize, usize)> = BTreeMap::new();
-        for (&n, &citation) in &cut_off {
-            by_root.entry(parent[n]).or_insert(citation);
-        }
-        for (n, &root) in parent.iter().enumerate() {
-            if root != home
-                && !cut_off.contains_key(&n)
-                && let Some(&citation) = by_root.get(&root)
-            {
-                cut_off.insert(n, citation);
-            }
-        }
-        // A task with two candidates that searches did not reach (not counting those cut off
-        // with them) is given up on this robot: its other candidates outside home's component
-        // are cut off too (citing the first search), so that a task in pockets costs two full
-        // searches, not one per candidate.
+        // A task with two candidates cut off is given up on this robot: its other candidates
+        // outside home's component are cut off too (citing the first search), so that a task
+        // in a pocket costs two full searches, not one per candidate.
         let mut per_task: BTreeMap<usize, Vec<usize>> = BTreeMap::new();
-        for &n in &searched {
+        for &n in cut_off.keys() {
             if let Some((t, _)) = graph.node_task[n] {
                 per_task.entry(t.0).or_default().push(n);
             }
@@ -230,86 +209,4 @@ fn joined_leg(
         validity_calls: 0,
         compute_s: started.elapsed().as_secs_f64(),
     })
-}
-
-/// After a phase of full-budget searches (`phase`, its results in `planned`): for each end
-/// that a search from home's component did not reach, the straight segments from it to the
-/// other candidates of its task outside home's component, as legs (`a < b`), those that are
-/// clear at the leg clearance. [`Reach`] then cuts those candidates off with it: a task whose
-/// candidates lie in one pocket (the same pose spun about the probe's axis, another IK branch
-/// of the wrist next to it) costs one full search instead of one per candidate, while
-/// candidates the pocket does not hold are still searched. Deterministic: the segments are
-/// checked in parallel but returned in the order of `phase` and the task's candidates.
-pub fn sibling_joins(
-    cell: &Cell,
-    robot: &Robot,
-    graph: &RobotGraph,
-    planned: &Planned,
-    phase: &[(usize, usize)],
-    settings: &PlanSettings,
-) -> Vec<((usize, usize), Leg)> {
-    let reach = Reach::of(graph, planned, settings.final_max_samples);
-    let mut asked: Vec<(usize, usize)> = Vec::new();
-    for &(a, b) in phase {
-        let Some(Err(LegError::Motion(cellplan_motion::plan::PlanError::NoPath { .. }))) =
-            planned.get(&(a, b))
-        else {
-            continue;
-        };
-        for c in [a, b] {
-            if reach.joined(c, 0) || !reach.is_cut_off(c) {
-                continue;
-            }
-            let Some((task, _)) = graph.node_task[c] else {
-                continue;
-            };
-            for &n in &graph.alternatives[task.0] {
-                let k = key(c, n);
-                if n != c
-                    && !reach.joined(n, 0)
-                    && !reach.joined(n, c)
-                    && !planned.contains_key(&k)
-                    && !asked.contains(&k)
-                {
-                    asked.push(k);
-                }
-            }
-        }
-    }
-    if asked.is_empty() {
-        return Vec::new();
-    }
-    let space = crate::motion::joint_space(cell, robot);
-    let validity = crate::motion::robot_validity(cell, robot, cell.planning.clearance);
-    let min_clearance = settings.motion.min_clearance;
-    asked
-        .par_iter()
-        .map(|&(a, b)| {
-            let started = Instant::now();
-            let (qa, qb) = (&graph.q[a], &graph.q[b]);
-            let check = check_segment(&space, &validity, qa, qb, min_clearance);
-            if !check.valid {
-                return None;
-            }
-            let waypoints = vec![qa.clone(), qb.clone()];
-            let duration = time_path_exact(&waypoints, &graph.limits)
-                .ok()?
-                .trajectory
-                .duration();
-            Some((
-                (a, b),
-                Leg {
-                    waypoints,
-                    duration,
-                    straight: true,
-                    samples: 0,
-                    validity_calls: check.calls,
-                    compute_s: started.elapsed().as_secs_f64(),
-                },
-            ))
-        })
-        .collect::<Vec<_>>()
-        .into_iter()
-        .flatten()
-        .collect()
 }
