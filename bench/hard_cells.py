@@ -23,6 +23,8 @@ only):
                                                 # owes to one seed (a row per cell and seed,
                                                 # then each cell's spread and each seed's mean)
     python3 bench/hard_cells.py --cells examples/autobody-4r --seeds 0,1,2,3 --no-threads1
+    python3 bench/hard_cells.py --all --seeds 0,1,2 --no-threads1 --json --bin /tmp/old/cellplan > old.json
+                                                # another build, for bench/paired.py
 
 A cell is a folder of bench/cells (by name) or any folder holding a cell.toml (by path from the
 repository root, e.g. the examples).
@@ -300,7 +302,11 @@ def main():
     ap.add_argument("--no-threads1", action="store_true", help="skip the --threads 1 comparison")
     ap.add_argument("--seeds", default="0",
                     help="comma-separated seeds (default 0): each cell is planned with each")
+    ap.add_argument("--bin", help="the cellplan binary to run (default target/release/cellplan)")
     args = ap.parse_args()
+    global BIN
+    if args.bin:
+        BIN = pathlib.Path(args.bin).resolve()
     try:
         seeds = [int(x) for x in args.seeds.split(",") if x.strip()]
     except ValueError:
@@ -308,7 +314,7 @@ def main():
     if not seeds or any(x < 0 for x in seeds):
         sys.exit(f"--seeds takes one or more seeds of 0 or more, not {args.seeds!r}")
     if not BIN.exists():
-        sys.exit(f"{BIN} is missing: run `cargo build --release` first")
+        sys.exit(f"{BIN} is missing: run `cargo build --release` first (or give --bin)")
     known = [c for c, _ in CELLS]
     if args.cells:
         names = [c.strip() for c in args.cells.split(",") if c.strip()]
@@ -341,7 +347,8 @@ def main():
     else:
         print(table(rows))
         runs = f"{len(names)} cell(s) × {len(seeds)} seeds" if len(seeds) > 1 else f"{len(rows)} cell(s)"
-        print(f"\n{runs} in {time.monotonic() - t0:.0f} s; binary {BIN.relative_to(ROOT)}")
+        shown = BIN.relative_to(ROOT) if BIN.is_relative_to(ROOT) else BIN
+        print(f"\n{runs} in {time.monotonic() - t0:.0f} s; binary {shown}")
     if tmp:
         tmp.cleanup()
     sys.exit(0 if all(r["ok"] for r in rows) else 1)
