@@ -15,6 +15,8 @@ import json
 import math
 import sys
 
+from hard_cells import counted
+
 
 def fail(message):
     print(f"error: {message}", file=sys.stderr)
@@ -33,7 +35,7 @@ def load(path):
     for r in rows:
         if not isinstance(r, dict) or "cell" not in r:
             fail(f"{path}: a row without a cell; give the output of `bench/hard_cells.py --json`")
-        if r.get("exit") in (0, 3) and r.get("verify_exit") == 0 and r.get("ratio") is not None:
+        if counted(r):
             out[(r["cell"], r.get("seed", 0))] = r
     return out
 
