@@ -9,7 +9,8 @@ usage: python3 bench/paired.py BEFORE.json AFTER.json   (standard library only)
 
 On the long cells the seed alone moves a ratio by 0.1-0.3 (bench/cells/README.md,
 twenty-first session): judge a change to legs, allocation or coordination over several seeds,
-not one. Exit 2 when the files cannot be read or share no planned and verified pair.
+not one. A (cell, seed) that failed or was not verified in either run is listed. Exit 2 when
+the files cannot be read or share no planned and verified pair.
 """
 import json
 import math
@@ -24,6 +25,8 @@ def fail(message):
 
 
 def load(path):
+    """The rows of `path` that count (planned and verified), by (cell, seed), and the (cell,
+    seed) of those that do not (failed, timed out or not verified)."""
     try:
         with open(path, encoding="utf-8") as f:
             rows = json.load(f)
@@ -31,13 +34,19 @@ def load(path):
         fail(f"{path}: {e}; give the output of `bench/hard_cells.py --json`")
     if not isinstance(rows, list):
         fail(f"{path}: not a list of rows; give the output of `bench/hard_cells.py --json`")
-    out = {}
+    out, failed = {}, []
     for r in rows:
         if not isinstance(r, dict) or "cell" not in r:
             fail(f"{path}: a row without a cell; give the output of `bench/hard_cells.py --json`")
-        if counted(r):
-            out[(r["cell"], r.get("seed", 0))] = r
-    return out
+        key = (r["cell"], r.get("seed", 0))
+        if not counted(r):
+            failed.append(key)
+        elif isinstance(r.get("ratio"), (int, float)) and isinstance(r.get("wall_s"), (int, float)):
+            out[key] = r
+        else:
+            fail(f"{path}: {key[0]} (seed {key[1]}) has no numeric ratio or wall_s; "
+                 "give the output of `bench/hard_cells.py --json`")
+    return out, failed
 
 
 def sign_test(wins, losses):
@@ -54,7 +63,7 @@ def main(argv):
     if len(argv) != 3:
         print(__doc__.split("\n\n")[1], file=sys.stderr)
         sys.exit(2)
-    a, b = load(argv[1]), load(argv[2])
+    (a, failed_a), (b, failed_b) = load(argv[1]), load(argv[2])
     keys = [k for k in a if k in b]
     if not keys:
         fail(f"{argv[1]} and {argv[2]} share no planned and verified (cell, seed)")
@@ -76,9 +85,14 @@ def main(argv):
     print()
     print(f"{len(keys)} pairs: mean ratio {ma:.3f} → {mb:.3f} ({mb - ma:+.3f}); after shorter on {wins}, "
           f"longer on {losses}, within 0.001 on {ties}; sign test p = {sign_test(wins, losses):.3f}")
+    # A (cell, seed) that failed in one run is a result, not a row to drop quietly.
+    for name, failed in ((argv[1], failed_a), (argv[2], failed_b)):
+        if failed:
+            print(f"not planned or not verified in {name}: "
+                  + ", ".join(f"{c} (seed {s})" for c, s in failed))
     unpaired = len(a) + len(b) - 2 * len(keys)
     if unpaired:
-        print(f"({unpaired} rows without a partner left out)")
+        print(f"({unpaired} planned and verified rows without a partner left out)")
 
 
 if __name__ == "__main__":
