@@ -8,7 +8,7 @@ use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
 use super::search::{Queue, local_search};
-use super::{GtspParams, Inst, State, construct, layer};
+use super::{GtspParams, Inst, State, layer};
 
 /// Kicked segments are up to a quarter of the tour long, but at least this many items may be
 /// moved (when the tour has them)...
@@ -24,13 +24,13 @@ const ACCEPT: f64 = 1.0;
 
 /// The best state found and the number of kicks.
 pub(super) fn run(inst: &Inst, params: &GtspParams, deadline: Instant) -> (State, usize) {
-    let order = construct::nearest_neighbour(inst);
-    let mut cur = State::new(inst, order);
+    let mut cur = State::new(inst, inst.first_order.clone());
     let mut queue = Queue::default();
+    let mut memo = layer::LayerMemo::default();
     for &x in &cur.t.clone() {
         queue.push(x);
     }
-    local_search(inst, &mut cur, &mut queue);
+    local_search(inst, &mut cur, &mut queue, &mut memo);
     let mut cur_cost = inst.cost(&cur);
     let m = cur.t.len();
     let lo = usize::from(inst.depot);
@@ -77,10 +77,10 @@ pub(super) fn run(inst: &Inst, params: &GtspParams, deadline: Instant) -> (State
             queue.push(e);
         }
         // Let the nodes follow the new order before improving it.
-        for x in layer::layer_pass(inst, &mut trial) {
+        for x in layer::layer_pass(inst, &mut trial, &mut memo) {
             queue.push(x);
         }
-        local_search(inst, &mut trial, &mut queue);
+        local_search(inst, &mut trial, &mut queue, &mut memo);
         let cost = inst.cost(&trial);
         let threshold = accept * best_cost / movable as f64 * rng.random::<f64>();
         if cost <= cur_cost + threshold {

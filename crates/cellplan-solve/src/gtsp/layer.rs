@@ -17,9 +17,22 @@ pub(super) fn layers<'a>(inst: &'a Inst, st: &State) -> (usize, Vec<&'a [usize]>
     (first, layers)
 }
 
+/// What the last layer pass of a search with depots computed: its layers' items in order and
+/// their shortest-path table. A layer's values depend only on the layers before it, so the
+/// next pass recomputes only from the first layer whose item differs (a kick or a local move
+/// changes part of the order): the same arithmetic on the same numbers, the same choice.
+#[derive(Clone, Debug, Default)]
+pub(super) struct LayerMemo {
+    items: Vec<usize>,
+    value: Vec<f64>,
+    parent: Vec<usize>,
+}
+
 /// Re-choose every cluster's node optimally for the current order. Returns the items whose node
-/// changed (empty when the tour did not improve).
-pub(super) fn layer_pass(inst: &Inst, st: &mut State) -> Vec<usize> {
+/// changed (empty when the tour did not improve). `memo` carries the table from one pass to the
+/// next on instances with depots (a cycle's first layer is the smallest cluster, each of whose
+/// nodes starts a pass of its own: nothing is kept there).
+pub(super) fn layer_pass(inst: &Inst, st: &mut State, memo: &mut LayerMemo) -> Vec<usize> {
     let m = st.t.len();
     if m == 0 || inst.clusters.iter().all(|c| c.len() == 1) {
         return Vec::new();
@@ -31,19 +44,30 @@ pub(super) fn layer_pass(inst: &Inst, st: &mut State) -> Vec<usize> {
         offset.push(offset.last().copied().unwrap_or(0) + l.len());
     }
     let total = offset[m];
-    let mut value = vec![0.0; total];
-    let mut parent = vec![0usize; total];
+    // Layers `..keep` are those of the last pass (with depots only).
+    let keep = if inst.depot && memo.items.len() == m {
+        (0..m)
+            .take_while(|&i| memo.items[i] == st.t[(first + i) % m])
+            .count()
+    } else {
+        0
+    };
+    memo.items.clear();
+    if inst.depot {
+        memo.items.extend((0..m).map(|i| st.t[(first + i) % m]));
+    }
+    let LayerMemo { value, parent, .. } = memo;
+    value.resize(total, 0.0);
+    parent.resize(total, 0);
     let mut best = (f64::INFINITY, 0usize, 0usize); // (cost, start index, last index)
     let mut best_parent = Vec::new();
     let mut columns = Vec::new();
     for (si, &s) in layers[0].iter().enumerate() {
-        value[si] = inst.s(s);
-        for l in 0..m {
-            if l == 0 {
-                value[..layers[0].len()].fill(f64::INFINITY);
-                value[si] = inst.s(s);
-                continue;
-            }
+        if keep == 0 {
+            value[..layers[0].len()].fill(f64::INFINITY);
+            value[si] = inst.s(s);
+        }
+        for l in keep.max(1)..m {
             let (prev, cur) = (layers[l - 1], layers[l]);
             // Row by row of the cost table (each `u` of the layer before, in order, so every
             // `v` keeps the first cheapest `u` as before).
@@ -73,7 +97,7 @@ pub(super) fn layer_pass(inst: &Inst, st: &mut State) -> Vec<usize> {
             let x = value[offset[m - 1] + j] + inst.w(v, s);
             if x < best.0 {
                 best = (x, si, j);
-                best_parent.clone_from(&parent);
+                best_parent.clone_from(parent);
             }
         }
     }

@@ -118,6 +118,8 @@ pub(crate) struct Inst<'a> {
     sym: bool,
     /// Nearest items of every item (clusters and the depot item).
     neigh: Vec<Vec<usize>>,
+    /// The nearest-neighbour order of the items (the search's first tour).
+    first_order: Vec<usize>,
     /// Service of the depots, constant.
     fixed: f64,
     /// Per cluster, the cheapest arcs into and out of it (see [`ClusterBounds`]); `None` when
@@ -171,10 +173,11 @@ impl<'a> Inst<'a> {
             end,
             sym: p.costs.is_symmetric(0.0),
             neigh: Vec::new(),
+            first_order: Vec::new(),
             fixed,
             bounds: None,
         };
-        inst.neigh = construct::neighbours(&inst, 12);
+        (inst.neigh, inst.first_order) = construct::neighbours_and_order(&inst, 12);
         inst.bounds = inst.cluster_bounds();
         inst
     }
@@ -521,12 +524,45 @@ pub(crate) mod tests {
                 }
                 st.refresh(&inst);
                 let mut plain = st.clone();
-                let changed = layer::layer_pass(&inst, &mut st);
+                let changed = layer::layer_pass(&inst, &mut st, &mut layer::LayerMemo::default());
                 let expected = layer_pass_plain(&inst, &mut plain);
                 assert_eq!(changed, expected);
                 assert_eq!(st.choice, plain.choice);
             }
         }
+    }
+
+    /// A layer pass that reuses the last pass's table (the orders here share prefixes, as a
+    /// kick's or a local move's do) chooses as one computed afresh.
+    #[test]
+    fn the_layer_memo_changes_no_choice() {
+        let mut rng = ChaCha8Rng::seed_from_u64(5);
+        let mut reused_some = false;
+        for g in shaped_instances() {
+            let inst = Inst::new(&g);
+            let m = inst.items();
+            let mut order: Vec<usize> = (0..m).collect();
+            let mut memo = layer::LayerMemo::default();
+            for _ in 0..20 {
+                // Swap two adjacent segments after a random point (the depot item stays first).
+                let p = rng.random_range(1..m - 1);
+                let l = rng.random_range(1..m - p);
+                order[p..].rotate_left(l);
+                let mut st = State::new(&inst, order.clone());
+                for (x, c) in inst.clusters.iter().enumerate() {
+                    st.choice[x] = c[rng.random_range(0..c.len())];
+                }
+                st.refresh(&inst);
+                let mut fresh = st.clone();
+                reused_some |= inst.depot && p > 1;
+                let changed = layer::layer_pass(&inst, &mut st, &mut memo);
+                let expected = layer::layer_pass(&inst, &mut fresh, &mut layer::LayerMemo::default());
+                assert_eq!(changed, expected);
+                assert_eq!(st.choice, fresh.choice);
+                assert_eq!(inst.cost(&st).to_bits(), inst.cost(&fresh).to_bits());
+            }
+        }
+        assert!(reused_some, "no pass reused a table");
     }
 
     #[test]

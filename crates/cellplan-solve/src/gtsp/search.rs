@@ -106,9 +106,9 @@ fn best_move(inst: &Inst, st: &State, x: usize) -> Best {
 }
 
 /// Improve until no move around a queued item helps and the layer pass finds nothing.
-pub(super) fn local_search(inst: &Inst, st: &mut State, queue: &mut Queue) {
+pub(super) fn local_search(inst: &Inst, st: &mut State, queue: &mut Queue, memo: &mut layer::LayerMemo) {
     if st.t.len() < 3 {
-        layer::layer_pass(inst, st);
+        layer::layer_pass(inst, st, memo);
         return;
     }
     loop {
@@ -137,7 +137,7 @@ pub(super) fn local_search(inst: &Inst, st: &mut State, queue: &mut Queue) {
                 }
             }
         }
-        let changed = layer::layer_pass(inst, st);
+        let changed = layer::layer_pass(inst, st, memo);
         if changed.is_empty() {
             return;
         }
