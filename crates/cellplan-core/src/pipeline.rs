@@ -102,8 +102,12 @@ pub fn run<R>(
     progress(Step::Coordination {
         zones_too: ours_tries_zones(settings, coord),
     });
-    let (outcome, settings, coordinated) =
+    // The run's stages are its first plan's: ours' other plans (its tries and hand-overs, the
+    // winner among them) are planned inside the coordination stage, whose time counts them.
+    let first_stages = outcome.compute.clone();
+    let (mut outcome, settings, coordinated) =
         coordinate(cell, &table, outcome, settings.clone(), coord, &mut cache)?;
+    outcome.compute = first_stages;
     let mut plan = document::build(
         cell,
         &table,

@@ -433,9 +433,9 @@ pub struct ComputeTimes {
     pub candidates: f64,
     /// Lower-bound move times.
     pub costs: f64,
-    /// Allocation.
+    /// Allocation (of the run's first plan: ours' other plans count under `coordination`).
     pub allocation: f64,
-    /// Sequencing with lazy motion planning.
+    /// Sequencing with lazy motion planning (of the run's first plan, as `allocation`).
     pub sequencing_motion: f64,
     /// Timing and assembly.
     pub timing: f64,
