@@ -26,6 +26,9 @@ pub(super) struct LayerMemo {
     items: Vec<usize>,
     value: Vec<f64>,
     parent: Vec<usize>,
+    /// Layers taken from the last pass, over every pass (for the tests).
+    #[cfg(test)]
+    pub(super) reused: usize,
 }
 
 /// Re-choose every cluster's node optimally for the current order. Returns the items whose node
@@ -52,6 +55,10 @@ pub(super) fn layer_pass(inst: &Inst, st: &mut State, memo: &mut LayerMemo) -> V
     } else {
         0
     };
+    #[cfg(test)]
+    {
+        memo.reused += keep;
+    }
     memo.items.clear();
     if inst.depot {
         memo.items.extend((0..m).map(|i| st.t[(first + i) % m]));
