@@ -67,6 +67,9 @@ pub(super) fn layer_pass(inst: &Inst, st: &mut State, memo: &mut LayerMemo) -> V
     value.resize(total, 0.0);
     parent.resize(total, 0);
     let mut best = (f64::INFINITY, 0usize, 0usize); // (cost, start index, last index)
+    // With one start (the depot item), the table's parents at the end are the best start's;
+    // with several, each start's are kept when it leads.
+    let single = layers[0].len() == 1;
     let mut best_parent = Vec::new();
     let mut columns = Vec::new();
     for (si, &s) in layers[0].iter().enumerate() {
@@ -104,7 +107,9 @@ pub(super) fn layer_pass(inst: &Inst, st: &mut State, memo: &mut LayerMemo) -> V
             let x = value[offset[m - 1] + j] + inst.w(v, s);
             if x < best.0 {
                 best = (x, si, j);
-                best_parent.clone_from(parent);
+                if !single {
+                    best_parent.clone_from(parent);
+                }
             }
         }
     }
@@ -112,6 +117,7 @@ pub(super) fn layer_pass(inst: &Inst, st: &mut State, memo: &mut LayerMemo) -> V
     if best.0 >= now - EPS {
         return Vec::new();
     }
+    let parents: &[usize] = if single { parent } else { &best_parent };
     let mut changed = Vec::new();
     let mut j = best.2;
     for l in (0..m).rev() {
@@ -122,7 +128,7 @@ pub(super) fn layer_pass(inst: &Inst, st: &mut State, memo: &mut LayerMemo) -> V
             changed.push(item);
         }
         if l > 0 {
-            j = best_parent[offset[l] + j];
+            j = parents[offset[l] + j];
         }
     }
     st.refresh(inst);
