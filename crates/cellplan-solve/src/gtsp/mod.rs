@@ -567,6 +567,53 @@ pub(crate) mod tests {
         assert!(reused > 0, "no pass reused a layer");
     }
 
+    /// Every Or-opt move's stated change (segment's shared sums made once, each place then
+    /// costed) is the tour's change once the move is applied.
+    #[test]
+    fn or_opt_changes_are_the_tour_changes() {
+        let mut rng = ChaCha8Rng::seed_from_u64(17);
+        let mut moves = 0;
+        for g in shaped_instances() {
+            let inst = Inst::new(&g);
+            let m = inst.items();
+            if m < 5 {
+                continue;
+            }
+            for _ in 0..30 {
+                let mut order: Vec<usize> = (0..m).collect();
+                for i in (1..order.len()).rev() {
+                    order.swap(i, rng.random_range(0..=i));
+                }
+                let mut st = State::new(&inst, order);
+                for (x, c) in inst.clusters.iter().enumerate() {
+                    st.choice[x] = c[rng.random_range(0..c.len())];
+                }
+                st.refresh(&inst);
+                let l = rng.random_range(0..m);
+                let r = (l + rng.random_range(0..3)).min(m - 1);
+                let Some(seg) = or_opt::segment(&inst, &st, l, r) else {
+                    continue;
+                };
+                let before = inst.cost(&st);
+                for q in 0..m {
+                    let Some((d, mv)) = or_opt::best_at(&inst, &st, &seg, q, f64::INFINITY) else {
+                        continue;
+                    };
+                    let mut after = st.clone();
+                    or_opt::apply(&inst, &mut after, mv);
+                    after.refresh(&inst);
+                    let got = inst.cost(&after) - before;
+                    assert!(
+                        (got - d).abs() <= 1e-9 * (1.0 + before.abs()),
+                        "{mv:?}: {d} vs {got}"
+                    );
+                    moves += 1;
+                }
+            }
+        }
+        assert!(moves > 1000, "{moves} moves");
+    }
+
     #[test]
     fn the_cluster_bounds_change_no_move() {
         let mut pruned_some = false;

@@ -26,31 +26,68 @@ fn inner(inst: &Inst, st: &State, l: usize, r: usize) -> (f64, f64) {
     (f, b)
 }
 
-/// The best move of segment `l..=r` to between `q` and its successor (both orientations, and
-/// the best node for a single cluster), with its cost change; `None` if illegal. The caller
-/// takes the move only if its change is below `bar`: a single cluster's nodes are not scanned
-/// when their bound shows none can be (the change returned is then that of the cluster's
-/// current node, no smaller than the scan's and no smaller than `bar` either).
-pub(super) fn best_at(
-    inst: &Inst,
-    st: &State,
-    (l, r): (usize, usize),
-    q: usize,
-    bar: f64,
-) -> Option<(f64, Move)> {
-    let m = st.t.len();
-    let qn = st.next(q);
-    if (l..=r).contains(&q) || (l..=r).contains(&qn) || (inst.depot && l == 0) {
+/// A segment `l..=r` about to be moved: what its moves share, whatever the place (the same
+/// sums [`best_at`] would form for each place, in the same order).
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Segment {
+    l: usize,
+    r: usize,
+    /// Its first and last nodes.
+    f: usize,
+    e: usize,
+    /// `w(p, f) + w(e, n) − w(p, n)`, with `p` and `n` the nodes around it.
+    cut: f64,
+    /// Reversing its inner arcs: their cost backwards less forwards (0 for symmetric costs).
+    turn: f64,
+}
+
+/// The segment `l..=r` of `st`; `None` when it may not move (it holds the depot item).
+pub(super) fn segment(inst: &Inst, st: &State, l: usize, r: usize) -> Option<Segment> {
+    if inst.depot && l == 0 {
         return None;
     }
+    debug_assert!(r < st.t.len());
     let p = st.node(st.prev(l));
     let n = st.node(st.next(r));
     let f = st.node(l);
     let e = st.node(r);
+    let turn = if l < r && !inst.sym {
+        let (fi, bi) = inner(inst, st, l, r);
+        bi - fi
+    } else {
+        0.0
+    };
+    Some(Segment {
+        l,
+        r,
+        f,
+        e,
+        cut: inst.w(p, f) + inst.w(e, n) - inst.w(p, n),
+        turn,
+    })
+}
+
+/// The best move of segment `seg` to between `q` and its successor (both orientations, and
+/// the best node for a single cluster), with its cost change; `None` if illegal. The caller
+/// takes the move only if its change is below `bar`: a single cluster's nodes are not scanned
+/// when their bound shows none can be (the change returned is then that of the cluster's
+/// current node, no smaller than the scan's and no smaller than `bar` either).
+pub(super) fn best_at(inst: &Inst, st: &State, seg: &Segment, q: usize, bar: f64) -> Option<(f64, Move)> {
+    let Segment {
+        l,
+        r,
+        f,
+        e,
+        cut,
+        turn,
+    } = *seg;
+    let qn = st.next(q);
+    if (l..=r).contains(&q) || (l..=r).contains(&qn) {
+        return None;
+    }
     let u = st.node(q);
     let v = st.node(qn);
-    debug_assert!(r < m);
-    let removed = inst.w(p, f) + inst.w(e, n) - inst.w(p, n) + inst.w(u, v);
+    let removed = cut + inst.w(u, v);
     if l == r {
         let cluster = &inst.clusters[st.t[l]];
         let mut best = (inst.w(u, f) + inst.w(f, v), f);
@@ -80,8 +117,7 @@ pub(super) fn best_at(
     let fwd = inst.w(u, f) + inst.w(e, v);
     let mut rev = inst.w(u, e) + inst.w(f, v);
     if !inst.sym {
-        let (fi, bi) = inner(inst, st, l, r);
-        rev += bi - fi;
+        rev += turn;
     }
     let reversed = rev < fwd;
     let mv = Move {

@@ -90,10 +90,13 @@ fn best_move(inst: &Inst, st: &State, x: usize) -> Best {
             if l == usize::MAX {
                 continue;
             }
+            let Some(seg) = or_opt::segment(inst, st, l, r) else {
+                continue;
+            };
             for &y in &inst.neigh[x] {
                 let py = st.pos[y];
                 for q in [py, st.prev(py)] {
-                    if let Some((d, mv)) = or_opt::best_at(inst, st, (l, r), q, best.0)
+                    if let Some((d, mv)) = or_opt::best_at(inst, st, &seg, q, best.0)
                         && d < best.0
                     {
                         best = (d, Best::Or(mv));
