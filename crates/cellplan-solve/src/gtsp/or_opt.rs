@@ -72,6 +72,7 @@ pub(super) fn segment(inst: &Inst, st: &State, l: usize, r: usize) -> Option<Seg
 /// takes the move only if its change is below `bar`: a single cluster's nodes are not scanned
 /// when their bound shows none can be (the change returned is then that of the cluster's
 /// current node, no smaller than the scan's and no smaller than `bar` either).
+#[inline]
 pub(super) fn best_at(inst: &Inst, st: &State, seg: &Segment, q: usize, bar: f64) -> Option<(f64, Move)> {
     let Segment {
         l,
