@@ -52,6 +52,20 @@ impl CostMatrix {
         CostMatrix { n, data }
     }
 
+    /// The matrix of the nodes `nodes` (indices into this one, repeats allowed): entry
+    /// `(i, j)` is `get(nodes[i], nodes[j])`. Its entries were checked when this one was made.
+    ///
+    /// # Panics
+    /// If a node is not below [`CostMatrix::n`].
+    pub fn sub(&self, nodes: &[usize]) -> Self {
+        let mut data = Vec::with_capacity(nodes.len() * nodes.len());
+        for &i in nodes {
+            let row = &self.data[i * self.n..(i + 1) * self.n];
+            data.extend(nodes.iter().map(|&j| row[j]));
+        }
+        CostMatrix { n: nodes.len(), data }
+    }
+
     /// Number of nodes.
     pub fn n(&self) -> usize {
         self.n
@@ -365,6 +379,19 @@ mod tests {
         assert!(!m.is_symmetric(0.0));
         assert!(CostMatrix::from_fn(4, |i, j| i.abs_diff(j) as f64).is_symmetric(0.0));
         assert_eq!(m.try_get(3, 0), None);
+    }
+
+    #[test]
+    fn a_sub_matrix_reads_the_nodes_given() {
+        let m = m3();
+        let s = m.sub(&[2, 0, 2]);
+        assert_eq!(s.n(), 3);
+        for (i, &a) in [2, 0, 2].iter().enumerate() {
+            for (j, &b) in [2, 0, 2].iter().enumerate() {
+                assert_eq!(s.get(i, j), m.get(a, b));
+            }
+        }
+        assert_eq!(m.sub(&[]).n(), 0);
     }
 
     #[test]

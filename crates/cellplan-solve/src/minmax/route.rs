@@ -4,7 +4,7 @@ use std::time::Duration;
 
 use super::MinMaxProblem;
 use crate::gtsp::{self, GtspParams};
-use crate::problem::{CostMatrix, Gtsp};
+use crate::problem::Gtsp;
 
 /// A visit: (task, node).
 pub(crate) type Visit = (usize, usize);
@@ -72,7 +72,7 @@ pub(crate) fn optimise(p: &MinMaxProblem, v: usize, tour: &[Visit], seed: u64, i
         }
         clusters.push(cl);
     }
-    let costs = CostMatrix::from_fn(nodes.len(), |i, j| veh.costs.get(nodes[i], nodes[j]));
+    let costs = veh.costs.sub(&nodes);
     let service = task_of
         .iter()
         .map(|&t| if t == usize::MAX { 0.0 } else { p.service[t] })
