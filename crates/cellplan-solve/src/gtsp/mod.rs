@@ -485,6 +485,25 @@ pub(crate) mod tests {
         changed
     }
 
+    /// The items `0..m` in a random order.
+    fn shuffled(m: usize, rng: &mut ChaCha8Rng) -> Vec<usize> {
+        let mut order: Vec<usize> = (0..m).collect();
+        for i in (1..order.len()).rev() {
+            order.swap(i, rng.random_range(0..=i));
+        }
+        order
+    }
+
+    /// A state of `order` with a random node chosen in every cluster.
+    fn random_state(inst: &Inst, order: Vec<usize>, rng: &mut ChaCha8Rng) -> State {
+        let mut st = State::new(inst, order);
+        for (x, c) in inst.clusters.iter().enumerate() {
+            st.choice[x] = c[rng.random_range(0..c.len())];
+        }
+        st.refresh(inst);
+        st
+    }
+
     /// Random instances of every shape the sequencer and the benchmarks use: closed or with a
     /// start depot, symmetric or not, with service times, clusters of 1–6 nodes, consecutive
     /// or interleaved.
@@ -514,15 +533,8 @@ pub(crate) mod tests {
         for g in shaped_instances() {
             let inst = Inst::new(&g);
             for _ in 0..5 {
-                let mut order: Vec<usize> = (0..inst.items()).collect();
-                for i in (1..order.len()).rev() {
-                    order.swap(i, rng.random_range(0..=i));
-                }
-                let mut st = State::new(&inst, order);
-                for (x, c) in inst.clusters.iter().enumerate() {
-                    st.choice[x] = c[rng.random_range(0..c.len())];
-                }
-                st.refresh(&inst);
+                let order = shuffled(inst.items(), &mut rng);
+                let mut st = random_state(&inst, order, &mut rng);
                 let mut plain = st.clone();
                 let changed = layer::layer_pass(&inst, &mut st, &mut layer::LayerMemo::default());
                 let expected = layer_pass_plain(&inst, &mut plain);
@@ -550,11 +562,7 @@ pub(crate) mod tests {
                 let p = rng.random_range(1..m - 1);
                 let l = rng.random_range(1..m - p);
                 order[p..].rotate_left(l);
-                let mut st = State::new(&inst, order.clone());
-                for (x, c) in inst.clusters.iter().enumerate() {
-                    st.choice[x] = c[rng.random_range(0..c.len())];
-                }
-                st.refresh(&inst);
+                let mut st = random_state(&inst, order.clone(), &mut rng);
                 let mut fresh = st.clone();
                 let changed = layer::layer_pass(&inst, &mut st, &mut memo);
                 let expected = layer::layer_pass(&inst, &mut fresh, &mut layer::LayerMemo::default());
@@ -580,15 +588,8 @@ pub(crate) mod tests {
                 continue;
             }
             for _ in 0..30 {
-                let mut order: Vec<usize> = (0..m).collect();
-                for i in (1..order.len()).rev() {
-                    order.swap(i, rng.random_range(0..=i));
-                }
-                let mut st = State::new(&inst, order);
-                for (x, c) in inst.clusters.iter().enumerate() {
-                    st.choice[x] = c[rng.random_range(0..c.len())];
-                }
-                st.refresh(&inst);
+                let order = shuffled(m, &mut rng);
+                let st = random_state(&inst, order, &mut rng);
                 let l = rng.random_range(0..m);
                 let r = (l + rng.random_range(0..3)).min(m - 1);
                 let Some(seg) = or_opt::segment(&inst, &st, l, r) else {
