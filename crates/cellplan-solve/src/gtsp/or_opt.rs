@@ -116,10 +116,8 @@ pub(super) fn best_at(inst: &Inst, st: &State, seg: &Segment, q: usize, bar: f64
         return Some((best.0 - removed, mv));
     }
     let fwd = inst.w(u, f) + inst.w(e, v);
-    let mut rev = inst.w(u, e) + inst.w(f, v);
-    if !inst.sym {
-        rev += turn;
-    }
+    // `turn` is 0 for symmetric costs (the sum unchanged).
+    let rev = inst.w(u, e) + inst.w(f, v) + turn;
     let reversed = rev < fwd;
     let mv = Move {
         l,
