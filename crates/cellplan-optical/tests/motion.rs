@@ -377,7 +377,9 @@ fn capped_segment_step_agrees_with_the_default() {
     let (mut checked, mut shorter, mut fast_sum, mut slow_sum) = (0, 0, 0.0, 0.0);
     for robot in &f.cell.robots {
         let mut v = robot_validity(&f.cell, robot, margin(&f.cell));
+        // The default steps by the space's radii alone: so must the capped one here.
         v.own_radii = false;
+        v.posed_radii = false;
         let plain = Plain(&v);
         let mut qs = f.candidates[robot.id.0].clone();
         qs.extend((0..40).map(|_| random_q(robot, &mut rng)));

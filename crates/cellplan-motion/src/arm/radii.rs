@@ -1,7 +1,9 @@
 //! How far an arm's bodies can move: bounds per joint, per body and per self pair (the motion
 //! bounds of [`super::ArmValidity`]'s segment steps), and paper 002's point-speed weights.
-use super::Arm;
-use cellplan_geom::Pose;
+use super::{Arm, ArmValidity};
+use crate::plan::SegmentMotion;
+use cellplan_geom::{DVec3, Pose};
+use std::ops::Range;
 
 /// For each joint, an upper bound (m) on the distance from its axis of any point of any body it
 /// moves, valid in every configuration (1 for a prismatic joint).
@@ -135,4 +137,62 @@ pub fn point_speed_weights(arm: &Arm, q: &[f64]) -> Vec<f64> {
                 .fold(0.0, f64::max)
         })
         .collect()
+}
+
+/// Where the joint axes stand at one sample ([`ArmValidity::posed_bound`]).
+#[derive(Clone, Debug, Default)]
+pub(super) struct PosedAxes {
+    /// Per joint: a point on its axis and its unit direction, in the world (`None` for a
+    /// sliding joint). Empty when the checker's `posed_radii` is off.
+    axes: Vec<Option<(DVec3, DVec3)>>,
+}
+
+impl PosedAxes {
+    /// The axes of `v`'s arm at the link poses `links` (root frame).
+    pub(super) fn place(&mut self, v: &ArmValidity, links: &[Pose]) {
+        self.axes.clear();
+        if !v.posed_radii {
+            return;
+        }
+        self.axes.extend(v.axes.iter().map(|axis| {
+            let &(link, local) = axis.as_ref()?;
+            let frame = v.arm.base * *links.get(link)?;
+            Some((frame.translation, frame.rotation * local))
+        }));
+    }
+}
+
+impl ArmValidity<'_> {
+    /// A part's motion bound over a step of up to `t`, from where body `body` stands at the
+    /// sample (posed in `bodies`; the axes in `posed`): `static_bound`, or the smaller
+    /// [`SegmentMotion::bound_at`] with the reach of the body's outer sphere from each axis and
+    /// the part's `drift` ([`SegmentMotion::drift_with`] over its joints and radii). The arm
+    /// folded, its tool lies much nearer the first axes than the whole chain's length, which
+    /// the radii that hold everywhere must allow for.
+    #[allow(clippy::too_many_arguments)]
+    #[inline]
+    pub(super) fn posed_bound(
+        &self,
+        static_bound: f64,
+        drift: f64,
+        body: usize,
+        joints: &Range<usize>,
+        bodies: &[Pose],
+        posed: &PosedAxes,
+        motion: &SegmentMotion,
+        t: f64,
+    ) -> f64 {
+        if posed.axes.is_empty() || static_bound <= 0.0 {
+            return static_bound;
+        }
+        let (Some(Some(sphere)), Some(pose)) = (self.outer.get(body), bodies.get(body)) else {
+            return static_bound;
+        };
+        let centre = pose.rotation * sphere.centre + pose.translation;
+        let reach = |j: usize| match posed.axes.get(j) {
+            Some(Some((point, dir))) => (centre - *point).cross(*dir).length() + sphere.radius,
+            _ => f64::INFINITY,
+        };
+        motion.bound_at(joints, reach, drift, t).min(static_bound)
+    }
 }

@@ -176,6 +176,51 @@ impl SegmentMotion {
             .sum()
     }
 
+    /// `E = Σ_{j in joints} |Δq_j|·Σ_{i>j in joints} R_i·|Δq_i|`, with `R_i`
+    /// [`Self::bound_with`]'s radii: how much the points of one body can add, over the parameter
+    /// length 1, to [`Self::bound_at`]'s first term as the joints move them farther from the axes
+    /// of the joints before (see there). It depends on the segment alone.
+    pub fn drift_with(&self, joints: &Range<usize>, own: &[f64]) -> f64 {
+        let n = self.delta.len();
+        let (lo, hi) = (joints.start.min(n), joints.end.min(n));
+        let (mut later, mut sum) = (0.0, 0.0);
+        for j in (lo..hi).rev() {
+            let d = self.delta[j];
+            if d == 0.0 {
+                continue;
+            }
+            sum += later * d;
+            later += own.get(j).map_or(self.radii[j], |&r| r.min(self.radii[j])) * d;
+        }
+        sum
+    }
+
+    /// A bound on how far the points of one body move, over any part of the segment of
+    /// parameter length up to `t`, from where they stand at a sample: `Σ_{j in joints} ρ_j·|Δq_j|
+    /// + t·drift`, where `ρ_j = reach(j)` is the body's largest distance from joint `j`'s axis at
+    /// the sample (infinite for a sliding joint) and `drift` is [`Self::drift_with`]. Moving
+    /// one joint at a time through the box the step spans, joint `j` moves the body's points no
+    /// faster than their distance from its axis there, which exceeds `ρ_j` by at most how far
+    /// the later joints carry them in the frame of `j`'s link (where its axis stands still):
+    /// `t·Σ_{i>j} R_i·|Δq_i|`. The bound holds for every `t' ≤ t` as `t'·bound_at(t)`.
+    pub fn bound_at(&self, joints: &Range<usize>, reach: impl Fn(usize) -> f64, drift: f64, t: f64) -> f64 {
+        let n = self.delta.len();
+        let (lo, hi) = (joints.start.min(n), joints.end.min(n));
+        let mut sum = t * drift;
+        for j in lo..hi {
+            let d = self.delta[j];
+            if d != 0.0 {
+                sum += reach(j) * d;
+            }
+        }
+        sum
+    }
+
+    /// The number of joints.
+    pub fn dof(&self) -> usize {
+        self.delta.len()
+    }
+
     /// The bound over every joint.
     pub fn total(&self) -> f64 {
         self.prefix.last().copied().unwrap_or(0.0)

@@ -488,3 +488,50 @@ fn structured_clearances_step_by_the_joints_that_matter() {
 }
 
 mod planners;
+
+/// [`SegmentMotion::bound_at`] on a planar arm of two unit links, folded so that its tip sits
+/// on the first axis: turning the first joint far and the second a little carries the tip away
+/// from that axis, and the first joint then sweeps it around. The bound holds (the tip's path
+/// measured in small pieces) only with the growth of the tip's distance from the first axis
+/// counted; at the sample alone that distance is 0.
+#[test]
+fn a_posed_bound_counts_how_far_a_reach_grows() {
+    let tip = |q: &[f64]| {
+        let (a, b) = (q[0], q[0] + q[1]);
+        (a.cos() + b.cos(), a.sin() + b.sin())
+    };
+    let q = [0.3, std::f64::consts::PI];
+    let delta = [10.0, 0.1];
+    // Radii that hold everywhere: the tip lies within 2 of the first axis, 1 of the second.
+    let motion = SegmentMotion::new(&[2.0, 1.0], &delta);
+    let at = tip(&q);
+    // The tip's distance from each axis at the sample: the first axis is at the origin, the
+    // second at the elbow.
+    let elbow = (q[0].cos(), q[0].sin());
+    let reach = |j: usize| match j {
+        0 => at.0.hypot(at.1),
+        _ => (at.0 - elbow.0).hypot(at.1 - elbow.1),
+    };
+    assert!(reach(0) < 1e-12);
+    for t in [0.05, 0.2, 1.0] {
+        let bound = motion.bound_at(&(0..2), reach, motion.drift_with(&(0..2), &[]), t);
+        let mut path = 0.0;
+        let mut prev = at;
+        for k in 1..=10_000 {
+            let s = t * k as f64 / 10_000.0;
+            let p = tip(&[q[0] + s * delta[0], q[1] + s * delta[1]]);
+            path += (p.0 - prev.0).hypot(p.1 - prev.1);
+            prev = p;
+        }
+        assert!(path <= t * bound + 1e-9, "t {t}: path {path} > {}", t * bound);
+        // The reach at the sample alone would not do: the drift is needed.
+        assert!(
+            path > t * motion.bound_at(&(0..2), reach, 0.0, t),
+            "t {t}: path {path}"
+        );
+        // It is also tighter than the bound that holds everywhere, for short steps.
+        if t <= 0.05 {
+            assert!(bound < 0.5 * motion.bound(&(0..2)), "{bound}");
+        }
+    }
+}
