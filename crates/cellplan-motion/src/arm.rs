@@ -175,6 +175,10 @@ impl Clone for PartHint {
     }
 }
 
+/// A checked self pair `(i, j)` with the joints between its bodies and the radii that bound
+/// their relative motion ([`pair_radii`]).
+type CheckedPair = (usize, usize, Range<usize>, Vec<f64>);
+
 /// The clearance of an arm's configurations (see the module documentation).
 ///
 /// [`StateValidity::clearances`] splits it by the joints that can reduce each part: the
@@ -203,7 +207,7 @@ pub struct ArmValidity<'a> {
     moving: Vec<(usize, Range<usize>)>,
     /// Checked self pairs with the joints between them and the radii that bound their
     /// relative motion ([`pair_radii`]).
-    pairs: Vec<(usize, usize, Range<usize>, Vec<f64>)>,
+    pairs: Vec<CheckedPair>,
     /// Each body's radii ([`body_radii`]).
     body_radii: Vec<Vec<f64>>,
     /// Each body's outer sphere in its own frame (none for a body without shapes).
@@ -244,31 +248,22 @@ impl<'a> ArmValidity<'a> {
         let mut poses = Vec::new();
         arm.body_poses(&arm.chain.mid_configuration(), &mut links, &mut poses);
         let body_radii: Vec<Vec<f64>> = (0..arm.body_links.len()).map(|i| body_radii(&arm, i)).collect();
-        let pairs: Vec<(usize, usize, Range<usize>, Vec<f64>)> = arm
+        // Each pair with its distal body (the one whose radii bound the pair's motion).
+        let (pairs, pair_far): (Vec<CheckedPair>, Vec<usize>) = arm
             .self_pairs
             .iter()
             .map(|&(i, j)| {
                 let (a, b) = (moved_by(&arm, i), moved_by(&arm, j));
                 let (near, far) = if b >= a { (i, j) } else { (j, i) };
                 let radii = pair_radii(&arm, near, a.min(b), &body_radii[far]);
-                (i, j, a.min(b)..a.max(b), radii)
+                ((i, j, a.min(b)..a.max(b), radii), far)
             })
-            .filter(|(i, j, r, _)| {
+            .filter(|((i, j, r, _), _)| {
                 !r.is_empty() || arm.world.pair_distance(arm.group, *i, *j, &poses, 1.0) <= DISTANCE_SLACK
             })
-            .collect();
+            .unzip();
         let broad = BroadPhase::new(arm.world, arm.group, &parked);
         let outer = (0..arm.body_links.len()).map(|i| broad.outer_of(&[i])).collect();
-        let pair_far = pairs
-            .iter()
-            .map(|&(i, j, _, _)| {
-                if moved_by(&arm, j) >= moved_by(&arm, i) {
-                    j
-                } else {
-                    i
-                }
-            })
-            .collect();
         let axes = (0..arm.chain.dof())
             .map(|j| {
                 let joint = arm.chain.joints.get(j).filter(|joint| joint.is_rotational())?;

@@ -24,16 +24,22 @@ impl ArmValidity<'_> {
     /// then the largest of each cluster's moving bodies' and of each group's pairs' (see
     /// [`Clusters`]).
     pub(super) fn part_bounds(&self, motion: &SegmentMotion) -> Vec<f64> {
-        let scene: Vec<f64> = self
-            .moving
-            .iter()
-            .map(|(i, joints)| self.part_bound(motion, joints, self.body_radii.get(*i).map_or(&[], |r| r)))
+        // Every part with its joints and radii: the moving bodies, then the pairs.
+        let parts = || {
+            let scene = self
+                .moving
+                .iter()
+                .map(|(i, joints)| (joints, self.body_radii.get(*i).map_or(&[][..], |r| r)));
+            let pairs = self
+                .pairs
+                .iter()
+                .map(|(_, _, joints, radii)| (joints, &radii[..]));
+            scene.chain(pairs)
+        };
+        let mut scene: Vec<f64> = parts()
+            .map(|(joints, radii)| self.part_bound(motion, joints, radii))
             .collect();
-        let pairs: Vec<f64> = self
-            .pairs
-            .iter()
-            .map(|(_, _, joints, radii)| self.part_bound(motion, joints, radii))
-            .collect();
+        let pairs = scene.split_off(self.moving.len());
         let largest = |n: usize, of: &[Option<usize>], bounds: &[f64]| {
             let mut out = vec![0.0f64; n];
             for (c, b) in of.iter().zip(bounds) {
@@ -50,21 +56,10 @@ impl ArmValidity<'_> {
                 groups[*g] = groups[*g].max(*b);
             }
         }
-        // Each part's drift (see [`Self::posed_bound`]): the moving bodies', then the pairs'.
-        fn own(on: bool, radii: &[f64]) -> &[f64] {
-            if on { radii } else { &[] }
-        }
-        let scene_drift = self.moving.iter().map(|(i, joints)| {
-            motion.drift_with(
-                joints,
-                own(self.own_radii, self.body_radii.get(*i).map_or(&[], |r| r)),
-            )
-        });
-        let pair_drift = self
-            .pairs
-            .iter()
-            .map(|(_, _, joints, radii)| motion.drift_with(joints, own(self.own_radii, radii)));
-        let drifts: Vec<f64> = scene_drift.chain(pair_drift).collect();
+        // Each part's drift (see [`Self::posed_bound`]), by the radii its bound uses.
+        let drifts: Vec<f64> = parts()
+            .map(|(joints, radii)| motion.drift_with(joints, if self.own_radii { radii } else { &[] }))
+            .collect();
         [scene, pairs, clusters, groups, drifts].concat()
     }
 

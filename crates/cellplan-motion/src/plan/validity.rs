@@ -216,11 +216,6 @@ impl SegmentMotion {
         sum
     }
 
-    /// The number of joints.
-    pub fn dof(&self) -> usize {
-        self.delta.len()
-    }
-
     /// The bound over every joint.
     pub fn total(&self) -> f64 {
         self.prefix.last().copied().unwrap_or(0.0)
