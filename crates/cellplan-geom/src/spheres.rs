@@ -60,7 +60,7 @@ impl Cover {
 }
 
 /// A sphere containing every sphere of `spheres`.
-fn enclosing(spheres: &[Sphere]) -> Option<Sphere> {
+pub(crate) fn enclosing(spheres: &[Sphere]) -> Option<Sphere> {
     let first = spheres.first()?;
     let (lo, hi) = spheres.iter().fold(
         (first.centre - first.radius, first.centre + first.radius),

@@ -392,7 +392,8 @@ impl BroadPhase {
                 if point_box_distance(outer.centre, object.mins, object.maxs) - outer.radius >= best {
                     continue;
                 }
-                let (bound, towards) = self.object_bound(world, object, self.cover(placed, i), best);
+                let (bound, towards) =
+                    self.object_bound(world, object, (self.cover(placed, i), Some(outer)), best);
                 if bound >= best {
                     continue;
                 }
@@ -487,7 +488,10 @@ impl BroadPhase {
                 if point_box_distance(outer.centre, object.mins, object.maxs) - outer.radius >= best {
                     continue;
                 }
-                best = best.min(self.object_bound(world, object, self.cover(placed, i), best).0);
+                best = best.min(
+                    self.object_bound(world, object, (self.cover(placed, i), Some(outer)), best)
+                        .0,
+                );
                 if best <= 0.0 {
                     return 0.0;
                 }
@@ -539,13 +543,14 @@ impl BroadPhase {
                 if other >= best {
                     return best;
                 }
-                let (bound, towards) = spheres_bound(self.cover(placed, i), self.cover(placed, j), best);
+                let (bound, towards) =
+                    spheres_bound(self.cover(placed, i), None, self.cover(placed, j), best);
                 if bound.max(other) >= best {
                     return best;
                 }
                 return world.pair_distance_hinted(self.group, i, j, poses, best, towards);
             }
-            None => spheres_bound(self.cover(placed, i), self.cover(placed, j), best),
+            None => spheres_bound(self.cover(placed, i), None, self.cover(placed, j), best),
         };
         if bound >= best {
             return best;
@@ -569,7 +574,7 @@ impl BroadPhase {
     fn pair_bound_towards(&self, i: usize, j: usize, placed: &PlacedCovers, cap: f64) -> (f64, DVec3) {
         let best = sanitize_margin(cap);
         self.outer_pair(i, j, placed, best)
-            .unwrap_or_else(|| spheres_bound(self.cover(placed, i), self.cover(placed, j), best))
+            .unwrap_or_else(|| spheres_bound(self.cover(placed, i), None, self.cover(placed, j), best))
     }
 
     /// [`BroadPhase::pair_bound_towards`] capped at `best` (sanitized) where the covers are not
@@ -601,7 +606,7 @@ impl BroadPhase {
         &self,
         world: &CollisionWorld,
         object: &Object,
-        spheres: &[Cell<Sphere>],
+        (spheres, holder): (&[Cell<Sphere>], Option<Sphere>),
         best: f64,
     ) -> (f64, DVec3) {
         let mut b = best;
@@ -687,20 +692,38 @@ impl BroadPhase {
                 }
             }
             Kind::Body { spheres: range, .. } => {
-                return spheres_bound(spheres, &self.parked[range.clone()], b);
+                return spheres_bound(spheres, holder, &self.parked[range.clone()], b);
             }
         }
         (b.max(0.0), towards)
     }
 }
 
+/// How much farther than the bound so far a sphere of `b` must be from the sphere holding
+/// `a` for [`spheres_bound`] to pass over it: far more than the rounding of a containment or a
+/// distance (~1e-15 m), so that no pair that could lower the bound is passed over.
+const HOLDER_SLACK: f64 = 1e-9;
+
 /// Lower bound on the distance between two sphere sets, capped at `best`, with the direction
 /// from the sphere of `a` towards the sphere of `b` that give it (zero when no pair does).
-#[inline]
-fn spheres_bound<B: SphereRead>(a: &[Cell<Sphere>], b: &[B], best: f64) -> (f64, DVec3) {
+/// `holder`, a sphere holding every sphere of `a` (its outer sphere), lets a sphere of `b`
+/// that is farther from it than the bound so far be passed over: no sphere of `a` comes
+/// closer, so the answer is that of every pair.
+#[inline(always)]
+fn spheres_bound<B: SphereRead>(
+    a: &[Cell<Sphere>],
+    holder: Option<Sphere>,
+    b: &[B],
+    best: f64,
+) -> (f64, DVec3) {
     let mut least = best;
     let mut arg = (usize::MAX, usize::MAX);
     for (kb, sb) in b.iter().map(SphereRead::read).enumerate() {
+        if let Some(h) = holder
+            && (sb.centre - h.centre).length() - h.radius - sb.radius >= least + HOLDER_SLACK
+        {
+            continue;
+        }
         for (ka, sa) in a.iter().map(Cell::get).enumerate() {
             let d = (sb.centre - sa.centre).length() - sa.radius - sb.radius;
             if d < least {

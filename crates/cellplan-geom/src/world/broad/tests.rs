@@ -223,3 +223,65 @@ fn broad_phase_distances_equal_the_exact_ones() {
     assert_eq!(broad.scene_distance(&world, 0, &bad, &placed, 1.0), 0.0);
     assert_eq!(broad.pair_bound(0, 1, &placed, 1.0), 0.0);
 }
+
+/// A sphere holding the first set lets `spheres_bound` pass over spheres of the second, and
+/// changes neither the bound nor its direction: random sets placed by random poses, with caps
+/// at which a pair is just within reach, just beyond it, or far.
+#[test]
+fn a_holding_sphere_changes_no_bound() {
+    use super::{Sphere, spheres_bound};
+    use std::cell::Cell;
+    let mut rng = ChaCha8Rng::seed_from_u64(11);
+    let (mut passed, mut asked) = (0, 0);
+    for _ in 0..300 {
+        let local = |rng: &mut ChaCha8Rng| -> Vec<Sphere> {
+            (0..rng.random_range(1..9))
+                .map(|_| Sphere {
+                    centre: DVec3::new(
+                        rng.random_range(-0.5..0.5),
+                        rng.random_range(-0.5..0.5),
+                        rng.random_range(-0.5..0.5),
+                    ),
+                    radius: rng.random_range(0.01..0.2),
+                })
+                .collect()
+        };
+        let (la, lb) = (local(&mut rng), local(&mut rng));
+        let holder_local = crate::spheres::enclosing(&la).expect("one sphere at least");
+        let (pa, pb) = (random_pose(&mut rng, 1.0), random_pose(&mut rng, 1.0));
+        let place = |l: &[Sphere], p: &Pose| -> Vec<Sphere> {
+            l.iter()
+                .map(|s| Sphere {
+                    centre: p.transform_point(s.centre),
+                    radius: s.radius,
+                })
+                .collect()
+        };
+        let a: Vec<Cell<Sphere>> = place(&la, &pa).into_iter().map(Cell::new).collect();
+        let b = place(&lb, &pb);
+        let holder = Sphere {
+            centre: pa.transform_point(holder_local.centre),
+            radius: holder_local.radius,
+        };
+        let mut caps = vec![0.0, 0.1, 1.0, f64::INFINITY];
+        for sa in a.iter().map(Cell::get).take(2) {
+            for sb in b.iter().take(2) {
+                let d = (sb.centre - sa.centre).length() - sa.radius - sb.radius;
+                caps.extend([d, d.next_up(), d.next_down()]);
+            }
+        }
+        for cap in caps {
+            let want = spheres_bound(&a, None, &b, cap);
+            let got = spheres_bound(&a, Some(holder), &b, cap);
+            assert_eq!(got.0.to_bits(), want.0.to_bits(), "cap {cap}");
+            assert_eq!(got.1, want.1, "cap {cap}");
+            // How often the holder let a sphere of `b` be passed over.
+            asked += b.len();
+            passed += b
+                .iter()
+                .filter(|sb| (sb.centre - holder.centre).length() - holder.radius - sb.radius >= cap + 1e-9)
+                .count();
+        }
+    }
+    assert!(passed > 1000 && passed < asked, "{passed} of {asked} passed over");
+}
