@@ -116,7 +116,7 @@ impl CollisionWorld {
             if let ((Placement::At(x), cover_x, outer_x), (Placement::At(y), cover_y, outer_y)) =
                 (&pa[i], &pb[j])
                 && !outers_apart(*outer_x, *outer_y, *best)
-                && covers_within(cover_x, cover_y, *best)
+                && covers_within(cover_x, *outer_x, cover_y, *best)
             {
                 let d = placed_distance(x, y, *best);
                 if d < *best {
@@ -379,14 +379,17 @@ fn outers_apart(oa: Option<Sphere>, ob: Option<Sphere>, d: f64) -> bool {
 const OUTER_SLACK: f64 = 1e-9;
 
 /// Whether two sphere covers may come closer than `d`: false when every sphere pair is at
-/// least `d` apart (empty covers: true, nothing is known).
-fn covers_within(a: &[Sphere], b: &[Sphere], d: f64) -> bool {
+/// least `d` apart (empty covers: true, nothing is known). `outer_a`, a sphere holding every
+/// sphere of `a`, passes over the spheres of `b` at least `d` (and [`OUTER_SLACK`]) from it:
+/// no sphere of `a` comes closer to them, so the answer is that of every pair.
+fn covers_within(a: &[Sphere], outer_a: Option<Sphere>, b: &[Sphere], d: f64) -> bool {
     if a.is_empty() || b.is_empty() {
         return true;
     }
-    a.iter().any(|p| {
-        b.iter()
-            .any(|q| (p.centre - q.centre).length() - p.radius - q.radius < d)
+    b.iter().any(|q| {
+        !outer_a.is_some_and(|o| (o.centre - q.centre).length() - o.radius - q.radius >= d + OUTER_SLACK)
+            && a.iter()
+                .any(|p| (p.centre - q.centre).length() - p.radius - q.radius < d)
     })
 }
 
@@ -407,4 +410,61 @@ pub fn convex_distance(pa: &Pose, a: &dyn SupportMap, pb: &Pose, b: &dyn Support
         return 0.0;
     }
     hinted_distance(&pa.inv_mul(pb), a, b, sanitize_margin(cap), DVec3::ZERO)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{Sphere, covers_within};
+    use crate::DVec3;
+    use rand::{RngExt, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
+
+    /// A sphere holding the first cover changes no answer of `covers_within`, and passes over
+    /// spheres of the second: random covers, with distances at which a pair is just within or
+    /// just beyond.
+    #[test]
+    fn a_holding_sphere_changes_no_answer_of_covers_within() {
+        let mut rng = ChaCha8Rng::seed_from_u64(5);
+        let cover = |rng: &mut ChaCha8Rng, at: DVec3| -> Vec<Sphere> {
+            (0..rng.random_range(1..9))
+                .map(|_| Sphere {
+                    centre: at
+                        + DVec3::new(
+                            rng.random_range(-0.4..0.4),
+                            rng.random_range(-0.4..0.4),
+                            rng.random_range(-0.4..0.4),
+                        ),
+                    radius: rng.random_range(0.01..0.2),
+                })
+                .collect()
+        };
+        let (mut yes, mut no) = (0, 0);
+        for _ in 0..500 {
+            let a = cover(&mut rng, DVec3::ZERO);
+            let at = DVec3::new(rng.random_range(-1.5..1.5), rng.random_range(-1.5..1.5), 0.0);
+            let b = cover(&mut rng, at);
+            let outer = crate::spheres::enclosing(&a);
+            let mut ds = vec![0.0, 0.2, 1.0];
+            for p in a.iter().take(2) {
+                for q in b.iter().take(2) {
+                    let d = (p.centre - q.centre).length() - p.radius - q.radius;
+                    ds.extend([d, d.next_up(), d.next_down()]);
+                }
+            }
+            for d in ds {
+                let want = a.iter().any(|p| {
+                    b.iter()
+                        .any(|q| (p.centre - q.centre).length() - p.radius - q.radius < d)
+                });
+                assert_eq!(covers_within(&a, outer, &b, d), want, "d {d}");
+                assert_eq!(covers_within(&a, None, &b, d), want, "d {d}");
+                if want {
+                    yes += 1;
+                } else {
+                    no += 1;
+                }
+            }
+        }
+        assert!(yes > 500 && no > 500, "{yes} within, {no} apart");
+    }
 }
