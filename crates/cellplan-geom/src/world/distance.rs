@@ -73,52 +73,23 @@ impl CollisionWorld {
         closest: &mut Option<(usize, usize)>,
     ) -> f64 {
         let mut best = sanitize_margin(cap);
-        // Each body placed once, with its sphere cover in the world; a body pair whose covers
-        // are already at least `best` apart needs no exact query (the covers hold the bodies).
-        // With each cover, the sphere around it (placed too): a body pair whose outer spheres
-        // are `best` apart has no cover spheres within `best` either.
-        let placed = |g: GroupId, poses: &[Pose]| -> Vec<PlacedBody<'_>> {
-            self.group(g)
-                .bodies
-                .iter()
-                .zip(poses)
-                .map(|(body, pose)| {
-                    let p = place(body, pose);
-                    let (cover, outer) = match (&p, body.convex.as_ref()) {
-                        (Placement::At(_), Some(c)) => (
-                            c.cover
-                                .spheres
-                                .iter()
-                                .map(|s| Sphere {
-                                    centre: pose.transform_point(s.centre),
-                                    radius: s.radius,
-                                })
-                                .collect(),
-                            c.cover.outer.map(|s| Sphere {
-                                centre: pose.transform_point(s.centre),
-                                radius: s.radius,
-                            }),
-                        ),
-                        _ => (Vec::new(), None),
-                    };
-                    (p, cover, outer)
-                })
-                .collect()
-        };
-        let pa = placed(a, poses_a);
-        let pb = placed(b, poses_b);
-        let invalid = |p: &[PlacedBody<'_>]| p.iter().any(|(x, _, _)| matches!(x, Placement::Invalid));
-        if invalid(&pa) || invalid(&pb) {
+        // Each body's outer sphere placed first; its placement and sphere cover in the world
+        // only when a pair's outer spheres come within `best` (most do not), once. A body
+        // pair whose covers are already at least `best` apart needs no exact query (the
+        // covers hold the bodies), nor one whose outer spheres are `best` apart.
+        let (Some(pa), Some(pb)) = (LazyBody::of(self, a, poses_a), LazyBody::of(self, b, poses_b)) else {
             return 0.0;
-        }
+        };
         let mut found = None;
         let mut ask = |i: usize, j: usize, best: &mut f64| {
-            if let ((Placement::At(x), cover_x, outer_x), (Placement::At(y), cover_y, outer_y)) =
-                (&pa[i], &pb[j])
-                && !outers_apart(*outer_x, *outer_y, *best)
-                && covers_within(cover_x, *outer_x, cover_y, *best)
+            let (x, y) = (&pa[i], &pb[j]);
+            if outers_apart(x.outer, y.outer, *best) {
+                return;
+            }
+            if let ((Placement::At(px), cover_x), (Placement::At(py), cover_y)) = (x.placed(), y.placed())
+                && covers_within(cover_x, x.outer, cover_y, *best)
             {
-                let d = placed_distance(x, y, *best);
+                let d = placed_distance(px, py, *best);
                 if d < *best {
                     *best = d;
                     found = Some((i, j));
@@ -363,7 +334,59 @@ impl CollisionWorld {
 
 /// A body placed for a group–group query: its placement, its cover in the world and the
 /// sphere around that cover (`None` exactly when the cover is empty: `Cover::outer`).
-type PlacedBody<'a> = (Placement<'a>, Vec<Sphere>, Option<Sphere>);
+/// A body of [`CollisionWorld::group_group_distance_from`]: its outer sphere in the world
+/// (`None` without a shape), its placement and cover placed on first use.
+struct LazyBody<'a> {
+    body: &'a super::Body,
+    pose: &'a Pose,
+    outer: Option<Sphere>,
+    placed: std::cell::OnceCell<(Placement<'a>, Vec<Sphere>)>,
+}
+
+impl<'a> LazyBody<'a> {
+    /// The bodies of group `g` at `poses`, their outer spheres placed; `None` when a body
+    /// with a shape is at a pose that is not finite (touching).
+    fn of(world: &'a CollisionWorld, g: GroupId, poses: &'a [Pose]) -> Option<Vec<LazyBody<'a>>> {
+        let mut out = Vec::new();
+        for (body, pose) in world.group(g).bodies.iter().zip(poses) {
+            let outer = match body.convex.as_ref() {
+                Some(_) if !pose.is_finite() => return None,
+                Some(c) => c.cover.outer.map(|s| Sphere {
+                    centre: pose.transform_point(s.centre),
+                    radius: s.radius,
+                }),
+                None => None,
+            };
+            out.push(LazyBody {
+                body,
+                pose,
+                outer,
+                placed: std::cell::OnceCell::new(),
+            });
+        }
+        Some(out)
+    }
+
+    /// The body placed with its sphere cover in the world (empty without a shape).
+    fn placed(&self) -> &(Placement<'a>, Vec<Sphere>) {
+        self.placed.get_or_init(|| {
+            let p = place(self.body, self.pose);
+            let cover = match (&p, self.body.convex.as_ref()) {
+                (Placement::At(_), Some(c)) => c
+                    .cover
+                    .spheres
+                    .iter()
+                    .map(|s| Sphere {
+                        centre: self.pose.transform_point(s.centre),
+                        radius: s.radius,
+                    })
+                    .collect(),
+                _ => Vec::new(),
+            };
+            (p, cover)
+        })
+    }
+}
 
 /// Whether the spheres around two covers show that no sphere of one comes within `d` of a
 /// sphere of the other (so [`covers_within`] would say no); a nanometre of slack for the
