@@ -332,10 +332,9 @@ impl CollisionWorld {
     }
 }
 
-/// A body placed for a group–group query: its placement, its cover in the world and the
-/// sphere around that cover (`None` exactly when the cover is empty: `Cover::outer`).
-/// A body of [`CollisionWorld::group_group_distance_from`]: its outer sphere in the world
-/// (`None` without a shape), its placement and cover placed on first use.
+/// A body of [`CollisionWorld::group_group_distance_from`]: the sphere around its cover in
+/// the world (`None` without a shape or with an empty cover: `Cover::outer`), its placement
+/// and cover placed on first use.
 struct LazyBody<'a> {
     body: &'a super::Body,
     pose: &'a Pose,
