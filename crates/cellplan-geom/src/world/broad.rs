@@ -20,6 +20,7 @@
 //!
 //! Bounds never exceed exact distances (the covers contain the bodies), so skipping an exact
 //! query whose bound already reaches the cap changes no answer.
+use super::distance::outers_apart;
 use super::{CollisionWorld, GroupId, sanitize_margin};
 use crate::spheres::Sphere;
 use crate::{DMat3, DVec3, Pose};
@@ -392,8 +393,7 @@ impl BroadPhase {
                 if point_box_distance(outer.centre, object.mins, object.maxs) - outer.radius >= best {
                     continue;
                 }
-                let (bound, towards) =
-                    self.object_bound(world, object, (self.cover(placed, i), Some(outer)), best);
+                let (bound, towards) = self.object_bound(world, object, self.cover(placed, i), outer, best);
                 if bound >= best {
                     continue;
                 }
@@ -489,7 +489,7 @@ impl BroadPhase {
                     continue;
                 }
                 best = best.min(
-                    self.object_bound(world, object, (self.cover(placed, i), Some(outer)), best)
+                    self.object_bound(world, object, self.cover(placed, i), outer, best)
                         .0,
                 );
                 if best <= 0.0 {
@@ -599,14 +599,16 @@ impl BroadPhase {
         None
     }
 
-    /// Lower bound on the distance from `spheres` to `object`, capped at `best`, with the
-    /// direction (world) from the sphere that gives it towards the object (zero when none
-    /// does, or when it is inside): a guess of the separating direction for the exact query.
+    /// Lower bound on the distance from `spheres` (held by the sphere `outer`) to `object`,
+    /// capped at `best`, with the direction (world) from the sphere that gives it towards the
+    /// object (zero when none does, or when it is inside): a guess of the separating direction
+    /// for the exact query.
     fn object_bound(
         &self,
         world: &CollisionWorld,
         object: &Object,
-        (spheres, holder): (&[Cell<Sphere>], Option<Sphere>),
+        spheres: &[Cell<Sphere>],
+        outer: Sphere,
         best: f64,
     ) -> (f64, DVec3) {
         let mut b = best;
@@ -692,23 +694,19 @@ impl BroadPhase {
                 }
             }
             Kind::Body { spheres: range, .. } => {
-                return spheres_bound(spheres, holder, &self.parked[range.clone()], b);
+                return spheres_bound(spheres, Some(outer), &self.parked[range.clone()], b);
             }
         }
         (b.max(0.0), towards)
     }
 }
 
-/// How much farther than the bound so far a sphere of `b` must be from the sphere holding
-/// `a` for [`spheres_bound`] to pass over it: far more than the rounding of a containment or a
-/// distance (~1e-15 m), so that no pair that could lower the bound is passed over.
-const HOLDER_SLACK: f64 = 1e-9;
-
 /// Lower bound on the distance between two sphere sets, capped at `best`, with the direction
 /// from the sphere of `a` towards the sphere of `b` that give it (zero when no pair does).
 /// `holder`, a sphere holding every sphere of `a` (its outer sphere), lets a sphere of `b`
-/// that is farther from it than the bound so far be passed over: no sphere of `a` comes
-/// closer, so the answer is that of every pair.
+/// that is farther from it than the bound so far be passed over ([`outers_apart`], with its
+/// nanometre of slack against rounding): no sphere of `a` comes closer, so the answer is that
+/// of every pair.
 #[inline(always)]
 fn spheres_bound<B: SphereRead>(
     a: &[Cell<Sphere>],
@@ -719,9 +717,7 @@ fn spheres_bound<B: SphereRead>(
     let mut least = best;
     let mut arg = (usize::MAX, usize::MAX);
     for (kb, sb) in b.iter().map(SphereRead::read).enumerate() {
-        if let Some(h) = holder
-            && (sb.centre - h.centre).length() - h.radius - sb.radius >= least + HOLDER_SLACK
-        {
+        if outers_apart(holder, Some(sb), least) {
             continue;
         }
         for (ka, sa) in a.iter().map(Cell::get).enumerate() {

@@ -390,7 +390,9 @@ impl<'a> LazyBody<'a> {
 /// Whether the spheres around two covers show that no sphere of one comes within `d` of a
 /// sphere of the other (so [`covers_within`] would say no); a nanometre of slack for the
 /// rounding of the placed centres. False when either cover is empty (has no outer sphere).
-fn outers_apart(oa: Option<Sphere>, ob: Option<Sphere>, d: f64) -> bool {
+/// A single sphere of a cover is the sphere around itself, so this also says that no sphere
+/// held by `oa` comes within `d` of the sphere `ob`.
+pub(super) fn outers_apart(oa: Option<Sphere>, ob: Option<Sphere>, d: f64) -> bool {
     match (oa, ob) {
         (Some(oa), Some(ob)) => (oa.centre - ob.centre).length() - oa.radius - ob.radius >= d + OUTER_SLACK,
         _ => false,
@@ -409,7 +411,7 @@ fn covers_within(a: &[Sphere], outer_a: Option<Sphere>, b: &[Sphere], d: f64) ->
         return true;
     }
     b.iter().any(|q| {
-        !outer_a.is_some_and(|o| (o.centre - q.centre).length() - o.radius - q.radius >= d + OUTER_SLACK)
+        !outers_apart(outer_a, Some(*q), d)
             && a.iter()
                 .any(|p| (p.centre - q.centre).length() - p.radius - q.radius < d)
     })
