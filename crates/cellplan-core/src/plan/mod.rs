@@ -355,7 +355,11 @@ pub fn plan(
 /// What runs of [`plan_cached`] on one cell share: the robot graphs (they depend on the cell,
 /// the move model, `alternatives` and `roomy` only) and every leg planned so far. Each leg is
 /// a function of its robot, its two nodes and the settings, so a later run with the same
-/// settings plans only the legs no run planned before.
+/// settings plans only the legs no run planned before. The planned legs are also what the
+/// lazy sequencing knows (their real times replace the bounds), so a run's plan depends on
+/// the legs the cache holds: runs that share one give the plans of one after the other only
+/// in that order (a run made ahead, to be dropped if not needed, takes a copy). The graphs'
+/// memo of legs ([`PlanCache::graphs_only`]) changes no plan.
 #[derive(Clone, Debug, Default)]
 pub struct PlanCache {
     graphs: Option<(MoveModel, usize, u64, Arc<Vec<RobotGraph>>)>,
