@@ -548,10 +548,18 @@ pub fn coordinate(
         count(&c);
         Some((cycle_and_delta(&c.timed).0, ends(&c), c))
     };
-    let base = (&best.0, score, base_ends.as_slice());
-    if let Ok((found, clock_cut)) =
-        plan::rebalance::rebalance(cell, table, base, &best.1, cache, &affordable, &mut judge)
-    {
+    let base_waits = best.2.waits_for();
+    let base = (&best.0, score, base_ends.as_slice(), base_waits.as_slice());
+    let waits_of = |c: &Coordinated| c.waits_for();
+    if let Ok((found, clock_cut)) = plan::rebalance::rebalance(
+        cell,
+        table,
+        base,
+        &best.1,
+        cache,
+        &affordable,
+        (&mut judge, &waits_of),
+    ) {
         if let Some(found) = found {
             runners_up.keep(Some(std::mem::replace(&mut best, found)));
         }

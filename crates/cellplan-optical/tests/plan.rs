@@ -380,6 +380,79 @@ fn a_hand_over_keeps_the_other_robots_programs() {
     build_checked(&cell, &table, &o, &fixed);
 }
 
+/// Once the direct hand-overs are spent without help, a robot the last one waits for is
+/// relieved: one of its tasks goes to a third robot (never to the waiting one), within a budget
+/// of its own; without waits there is no relief (the test below).
+#[test]
+fn a_robot_the_last_one_waits_for_is_relieved_when_the_hand_overs_do_not_help() {
+    use plan::rebalance::{REBALANCE_JUDGED, RELIEF_JUDGED, RELIEF_PLANS, ends, makespan, rebalance};
+    let (cell, table, s, mut cache, base) = readme_nearest();
+    let m = cell.robots.len();
+    // As if coordination had made the robot that ends last wait 5 s for the busiest other one.
+    let mut end = ends(&base);
+    let stuck = (0..m)
+        .max_by(|&a, &b| end[a].total_cmp(&end[b]).then(b.cmp(&a)))
+        .unwrap();
+    let waited = (0..m)
+        .filter(|&r| r != stuck)
+        .max_by_key(|&r| base.allocated.tasks[r].len())
+        .unwrap();
+    end[stuck] += 5.0;
+    let mut waits = vec![vec![0.0; m]; m];
+    waits[stuck][waited] = 5.0;
+    // A judge that no plan satisfies: every hand-over is tried, then every relief.
+    let mut seen: Vec<plan::Outcome> = Vec::new();
+    let mut judge = |o: &plan::Outcome, _: Option<(&plan::Outcome, &())>| -> Option<(f64, Vec<f64>, ())> {
+        seen.push(o.clone());
+        None
+    };
+    let (found, clock) = rebalance(
+        &cell,
+        &table,
+        (&base, makespan(&base) + 5.0, &end, &waits),
+        &s,
+        &mut cache,
+        &|| true,
+        (&mut judge, &|_| unreachable!("no plan is taken")),
+    )
+    .unwrap();
+    assert!(found.is_none() && !clock);
+    // Which robot gave a task to which, in each plan judged.
+    let moved = |o: &plan::Outcome| -> (usize, usize) {
+        let (mut from, mut to) = (None, None);
+        for r in 0..m {
+            let (now, was) = (&o.allocated.tasks[r], &base.allocated.tasks[r]);
+            if was.iter().any(|t| !now.contains(t)) {
+                assert!(from.replace(r).is_none(), "two robots gave tasks");
+            }
+            if now.iter().any(|t| !was.contains(t)) {
+                assert!(to.replace(r).is_none(), "two robots took tasks");
+            }
+        }
+        (from.expect("a task given"), to.expect("a task taken"))
+    };
+    let kinds: Vec<(usize, usize)> = seen.iter().map(moved).collect();
+    let direct = kinds.iter().take_while(|k| k.0 == stuck).count();
+    let relief = &kinds[direct..];
+    assert!(direct <= REBALANCE_JUDGED, "{direct} direct hand-overs judged");
+    assert!(
+        (1..=RELIEF_JUDGED.min(RELIEF_PLANS)).contains(&relief.len()),
+        "{} reliefs judged: {kinds:?}",
+        relief.len()
+    );
+    for &(from, to) in relief {
+        assert_eq!(from, waited, "{kinds:?}");
+        assert!(to != stuck && to != waited, "{kinds:?}");
+    }
+    for o in &seen[direct..] {
+        let fixed = PlanSettings {
+            tasks: Some(o.allocated.tasks.clone()),
+            ..s.clone()
+        };
+        build_checked(&cell, &table, o, &fixed);
+    }
+}
+
 /// A hand-over whose plan keeping the other robots' programs does not help is planned again
 /// with every robot sequenced anew (other paths, which may meet less): the judge gets the two
 /// plans of one allocation, the kept one first, and never the same plan twice; the budgets hold.

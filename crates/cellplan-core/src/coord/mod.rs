@@ -136,6 +136,23 @@ pub struct Coordinated {
     pub compute_s: f64,
 }
 
+impl Coordinated {
+    /// `w[r][s]`: the seconds robot `r` waits for robot `s` in all (its waits that name the
+    /// robot they wait for), one row and column per program.
+    pub fn waits_for(&self) -> Vec<Vec<f64>> {
+        let n = self.programs.len();
+        let mut w = vec![vec![0.0; n]; n];
+        for (r, p) in self.programs.iter().enumerate() {
+            for wait in &p.waits {
+                if let Some(s) = wait.for_robot.filter(|&s| s < n) {
+                    w[r][s] += wait.duration;
+                }
+            }
+        }
+        w
+    }
+}
+
 /// Shared state of a coordination run.
 pub(crate) struct Ctx<'a> {
     pub cell: &'a Cell,

@@ -7,7 +7,9 @@
 //! keeps its program unless the new one is shorter — and when that plan does not end sooner,
 //! every robot is sequenced anew: other paths, which may meet less) and keeps the change when
 //! the robots end sooner. Spensieri et al. (2016) iterate routing and scheduling the same way, one level
-//! down.
+//! down. Where those hand-overs do not help and the last robot waits for another, a task of the
+//! robot it waits for goes to a third one (a relief): the shared space is then held for less
+//! time.
 use super::{Outcome, PlanCache, PlanError, PlanSettings, dwell, plan_keeping};
 use crate::candidates::CandidateTable;
 use cellplan_model::Cell;
@@ -20,6 +22,16 @@ pub const REBALANCE_PLANS: usize = 10;
 
 /// Plans [`rebalance`] hands its judge at most (a coordination each: the costly part).
 pub const REBALANCE_JUDGED: usize = 5;
+
+/// Plans [`rebalance`] makes at most for hand-overs that lighten a robot the last one waits
+/// for, once the direct hand-overs are spent (a budget of its own: see [`rebalance`]).
+pub const RELIEF_PLANS: usize = 4;
+
+/// Of those, plans it hands its judge at most.
+pub const RELIEF_JUDGED: usize = 2;
+
+/// A robot the last one waits for at least this long (s) in all is one a relief may lighten.
+const RELIEF_MIN_WAIT: f64 = 0.5;
 
 /// One hand-over: the task, from which robot, to which, and the ends it is expected to give
 /// the two (s).
@@ -38,6 +50,10 @@ pub type Judged<J> = (f64, Vec<f64>, J);
 /// What [`rebalance`] asks of its judge: a plan, and the hand-over plan it was made from with
 /// what the judge made of that (`None`: made from the base).
 pub type Judge<'a, J> = dyn FnMut(&Outcome, Option<(&Outcome, &J)>) -> Option<Judged<J>> + 'a;
+
+/// What [`rebalance`] reads off what its judge made of a plan: `w[r][s]`, the seconds robot `r`
+/// waits for robot `s` (see `coord::Coordinated::waits_for`).
+pub type WaitsOf<'a, J> = dyn Fn(&J) -> Vec<Vec<f64>> + 'a;
 
 /// A rebalanced plan: the plan, the settings it was made with (its fixed allocation) and what
 /// the judge made of it.
@@ -62,6 +78,95 @@ pub fn makespan(o: &Outcome) -> f64 {
     ends(o).into_iter().fold(0.0, f64::max)
 }
 
+/// The robot that ends last by `end` (the higher index on a tie: as the moves have always
+/// taken it).
+fn last(end: &[f64]) -> Option<usize> {
+    (0..end.len()).max_by(|&a, &b| end[a].total_cmp(&end[b]).then(b.cmp(&a)))
+}
+
+/// What hand-overs are ranked on: each robot's tour as graph nodes (home at both ends) and its
+/// slowness (its legs' time over their bounds, at least 1).
+struct Tours {
+    nodes: Vec<Vec<usize>>,
+    slowness: Vec<f64>,
+}
+
+impl Tours {
+    fn new(o: &Outcome) -> Tours {
+        let nodes: Vec<Vec<usize>> = o
+            .robots
+            .iter()
+            .map(|r| {
+                let mut t = vec![0];
+                t.extend(&r.sequence.nodes);
+                t.push(0);
+                t
+            })
+            .collect();
+        let slowness = (0..o.robots.len())
+            .map(|r| {
+                let g = &o.graphs[r];
+                let bound: f64 = nodes[r].windows(2).map(|w| g.costs.get(w[0], w[1])).sum();
+                let real = o.robots[r].program.motion();
+                if bound > 1e-9 {
+                    (real / bound).max(1.0)
+                } else {
+                    1.0
+                }
+            })
+            .collect();
+        Tours { nodes, slowness }
+    }
+
+    /// Each task of robot `from` with the time its removal is expected to save: its two legs
+    /// and dwell, less the bound of the leg that replaces them times the robot's slowness.
+    fn removals(&self, cell: &Cell, o: &Outcome, from: usize) -> Vec<(TaskId, f64)> {
+        let g = &o.graphs[from];
+        let legs = &o.robots[from].sequence.legs;
+        self.nodes[from]
+            .windows(3)
+            .enumerate()
+            .filter_map(|(i, w)| {
+                let (task, _) = g.node_task[w[1]]?;
+                let saved = legs[i].duration + legs[i + 1].duration + dwell(cell, task)
+                    - self.slowness[from] * g.costs.get(w[0], w[2]);
+                Some((task, saved))
+            })
+            .collect()
+    }
+
+    /// What robot `to` is expected to take longer with `task` added: the dwell plus its
+    /// cheapest insertion (on bounds) times the robot's slowness; `None` when it cannot do the
+    /// task or has no room under the cap.
+    fn addition(&self, cell: &Cell, o: &Outcome, to: usize, task: TaskId) -> Option<f64> {
+        let h = &o.graphs[to];
+        let nodes = &h.alternatives[task.0];
+        if nodes.is_empty() || o.robots[to].sequence.nodes.len() >= cell.planning.task_cap {
+            return None;
+        }
+        let insertion = self.nodes[to]
+            .windows(2)
+            .flat_map(|p| {
+                nodes
+                    .iter()
+                    .map(move |&n| h.costs.get(p[0], n) + h.costs.get(n, p[1]) - h.costs.get(p[0], p[1]))
+            })
+            .fold(f64::INFINITY, f64::min);
+        Some(dwell(cell, task) + self.slowness[to] * insertion)
+    }
+}
+
+/// Best expected first, then by task and receiving robot.
+fn ranked(mut out: Vec<Move>) -> Vec<Move> {
+    out.sort_by(|a, b| {
+        a.expected
+            .total_cmp(&b.expected)
+            .then(a.task.0.cmp(&b.task.0))
+            .then(a.to.cmp(&b.to))
+    });
+    out
+}
+
 /// The hand-overs from the robot of `o` that ends last by `end` (each robot's end as judged:
 /// coordinated, waits included), best expected first: each of its tasks
 /// to each other robot able to do it with room under the cap. A robot's real legs are slower
@@ -72,59 +177,21 @@ pub fn makespan(o: &Outcome) -> f64 {
 /// sooner than the last one ends now are returned.
 fn moves(cell: &Cell, o: &Outcome, end: &[f64]) -> Vec<Move> {
     let free = ends(o);
-    let Some(from) = (0..end.len()).max_by(|&a, &b| end[a].total_cmp(&end[b]).then(b.cmp(&a))) else {
+    let Some(from) = last(end) else {
         return Vec::new();
     };
-    // Per robot: its tour as graph nodes (home at both ends) and its slowness factor.
-    let tours: Vec<Vec<usize>> = o
-        .robots
-        .iter()
-        .map(|r| {
-            let mut t = vec![0];
-            t.extend(&r.sequence.nodes);
-            t.push(0);
-            t
-        })
-        .collect();
-    let slowness: Vec<f64> = (0..o.robots.len())
-        .map(|r| {
-            let g = &o.graphs[r];
-            let bound: f64 = tours[r].windows(2).map(|w| g.costs.get(w[0], w[1])).sum();
-            let real = o.robots[r].program.motion();
-            if bound > 1e-9 {
-                (real / bound).max(1.0)
-            } else {
-                1.0
-            }
-        })
-        .collect();
-    let g = &o.graphs[from];
-    let legs = &o.robots[from].sequence.legs;
+    let tours = Tours::new(o);
     let mut out = Vec::new();
-    for (i, w) in tours[from].windows(3).enumerate() {
-        let (prev, node, next) = (w[0], w[1], w[2]);
-        let Some((task, _)) = g.node_task[node] else {
-            continue;
-        };
-        let saved = legs[i].duration + legs[i + 1].duration + dwell(cell, task)
-            - slowness[from] * g.costs.get(prev, next);
+    for (task, saved) in tours.removals(cell, o, from) {
         let from_end = free[from] - saved;
         for (to, &to_free) in free.iter().enumerate() {
-            let h = &o.graphs[to];
-            let nodes = &h.alternatives[task.0];
-            if to == from || nodes.is_empty() || o.robots[to].sequence.nodes.len() >= cell.planning.task_cap {
+            if to == from {
                 continue;
             }
-            let insertion = tours[to]
-                .windows(2)
-                .flat_map(|p| {
-                    nodes
-                        .iter()
-                        .map(move |&n| h.costs.get(p[0], n) + h.costs.get(n, p[1]) - h.costs.get(p[0], p[1]))
-                })
-                .fold(f64::INFINITY, f64::min);
-            let to_end = to_free + dwell(cell, task) + slowness[to] * insertion;
-            let expected = from_end.max(to_end);
+            let Some(added) = tours.addition(cell, o, to, task) else {
+                continue;
+            };
+            let expected = from_end.max(to_free + added);
             if expected < end[from] - 1e-6 {
                 out.push(Move {
                     task,
@@ -135,13 +202,51 @@ fn moves(cell: &Cell, o: &Outcome, end: &[f64]) -> Vec<Move> {
             }
         }
     }
-    out.sort_by(|a, b| {
-        a.expected
-            .total_cmp(&b.expected)
-            .then(a.task.0.cmp(&b.task.0))
-            .then(a.to.cmp(&b.to))
-    });
-    out
+    ranked(out)
+}
+
+/// The reliefs of `o` (Spensieri et al.'s loop one step further): where the robot that ends
+/// last by `end` waits, in all, at least [`RELIEF_MIN_WAIT`] for another (`waits[r][s]`: the
+/// seconds robot `r` waits for robot `s`, as judged), a task of the robot it waits for handed to
+/// a third robot. The waited-for robot's path then holds the shared space for less time: the
+/// last robot is expected to end sooner by what the task saved its holder, up to what it
+/// waited for it, and the third robot to end (as judged) later by the task's addition. Ranked
+/// as [`moves`]; only reliefs expected to end sooner than the last robot ends now.
+fn reliefs(cell: &Cell, o: &Outcome, end: &[f64], waits: &[Vec<f64>]) -> Vec<Move> {
+    let Some(stuck) = last(end) else {
+        return Vec::new();
+    };
+    let Some(waited) = waits.get(stuck) else {
+        return Vec::new();
+    };
+    let tours = Tours::new(o);
+    let mut out = Vec::new();
+    for (from, &wait) in waited.iter().enumerate() {
+        if from == stuck || from >= end.len() || wait < RELIEF_MIN_WAIT {
+            continue;
+        }
+        for (task, saved) in tours.removals(cell, o, from) {
+            let stuck_end = end[stuck] - saved.clamp(0.0, wait);
+            for (to, &to_end) in end.iter().enumerate() {
+                if to == from || to == stuck {
+                    continue;
+                }
+                let Some(added) = tours.addition(cell, o, to, task) else {
+                    continue;
+                };
+                let expected = stuck_end.max(to_end + added);
+                if expected < end[stuck] - 1e-6 {
+                    out.push(Move {
+                        task,
+                        from,
+                        to,
+                        expected,
+                    });
+                }
+            }
+        }
+    }
+    ranked(out)
 }
 
 /// `base` (planned with `settings`; `judge` said `base_score` and `base_ends` of it) balanced
@@ -156,6 +261,11 @@ fn moves(cell: &Cell, o: &Outcome, end: &[f64]) -> Vec<Move> {
 /// and what the judge made of that (`None`: made from `base`) — at most [`REBALANCE_JUDGED`] plans, and
 /// no hand-over is planned once `may_judge` says no (the caller's budget of work); the
 /// first it scores below the best is kept and the next hand-overs start from it and its ends.
+/// When a round's hand-overs are spent (or their budget is) without help, its reliefs are
+/// tried the same way on a budget of their own ([`RELIEF_PLANS`], [`RELIEF_JUDGED`]): they need
+/// the judged waits, `base_waits` for `base` and `waits_of` for what the judge made of a plan
+/// (`w[r][s]`: seconds robot `r` waits for robot `s`; none given, no relief). A relief taken
+/// starts a new round, its hand-overs first while their budget lasts.
 /// Returns the best plan found with its settings and what the judge made of it, or `None` when
 /// no hand-over beat `base_score`, and whether the deadline stopped the search with hand-overs
 /// left to try (the plan then depends on the machine's speed). Plans that fail only lose their
@@ -165,76 +275,115 @@ fn moves(cell: &Cell, o: &Outcome, end: &[f64]) -> Vec<Move> {
 pub fn rebalance<J>(
     cell: &Cell,
     table: &CandidateTable,
-    (base, base_score, base_ends): (&Outcome, f64, &[f64]),
+    (base, base_score, base_ends, base_waits): (&Outcome, f64, &[f64], &[Vec<f64>]),
     settings: &PlanSettings,
     cache: &mut PlanCache,
     may_judge: &dyn Fn() -> bool,
-    judge: &mut Judge<'_, J>,
+    (judge, waits_of): (&mut Judge<'_, J>, &WaitsOf<'_, J>),
 ) -> Result<(Option<Rebalanced<J>>, bool), PlanError> {
     if cell.robots.len() < 2 {
         return Ok((None, false));
     }
     let mut best: Option<Rebalanced<J>> = None;
     let (mut score, mut judged_ends) = (base_score, base_ends.to_vec());
+    let mut waits = base_waits.to_vec();
     let mut tried: Vec<Vec<Vec<TaskId>>> = vec![base.allocated.tasks.clone()];
-    let (mut plans, mut judged) = (0, 0);
-    'rounds: while plans < REBALANCE_PLANS && judged < REBALANCE_JUDGED {
+    // The direct hand-overs' budget, then the reliefs' (each its own).
+    let mut budgets = [
+        Budget::new(REBALANCE_PLANS, REBALANCE_JUDGED),
+        Budget::new(RELIEF_PLANS, RELIEF_JUDGED),
+    ];
+    'rounds: loop {
         let current = best.as_ref().map_or(base, |b| &b.0);
-        let (from_tasks, hand_overs) = (
-            current.allocated.tasks.clone(),
-            moves(cell, current, &judged_ends),
-        );
-        for mv in hand_overs {
-            if plans >= REBALANCE_PLANS || judged >= REBALANCE_JUDGED {
-                break 'rounds;
-            }
-            if settings.deadline.is_some_and(|d| Instant::now() >= d) {
-                return Ok((best, true));
-            }
-            let mut tasks = from_tasks.clone();
-            tasks[mv.from].retain(|&t| t != mv.task);
-            tasks[mv.to].push(mv.task);
-            if tried.contains(&tasks) {
+        let from_tasks = current.allocated.tasks.clone();
+        for (phase, budget) in budgets.iter_mut().enumerate() {
+            if budget.spent() {
                 continue;
             }
-            tried.push(tasks.clone());
-            let next = PlanSettings {
-                tasks: Some(tasks),
-                ..settings.clone()
+            let list = if phase == 0 {
+                moves(cell, current, &judged_ends)
+            } else {
+                reliefs(cell, current, &judged_ends, &waits)
             };
-            // First the robots whose tasks did not change keep their programs unless the new
-            // ones are shorter (and so, mostly, the diagrams of their pairs); when that does
-            // not help, every robot is sequenced again: other paths, which may meet less.
-            let mut kept: Option<Outcome> = None;
-            for keep in [true, false] {
-                if plans >= REBALANCE_PLANS || judged >= REBALANCE_JUDGED || !may_judge() {
-                    break 'rounds;
+            for mv in list {
+                if budget.spent() {
+                    break;
                 }
-                plans += 1;
-                let prior = if keep { Some(current) } else { None };
-                let Ok(mut o) = plan_keeping(cell, table, &next, &|_| {}, cache, prior) else {
+                if settings.deadline.is_some_and(|d| Instant::now() >= d) {
+                    return Ok((best, true));
+                }
+                let mut tasks = from_tasks.clone();
+                tasks[mv.from].retain(|&t| t != mv.task);
+                tasks[mv.to].push(mv.task);
+                if tried.contains(&tasks) {
                     continue;
+                }
+                tried.push(tasks.clone());
+                let next = PlanSettings {
+                    tasks: Some(tasks),
+                    ..settings.clone()
                 };
-                // The judge's score is never below the robots' latest end without
-                // coordination; a plan the same as the one just judged is not judged again.
-                let same = kept.as_ref().is_some_and(|k| same_programs(k, &o));
-                if same || !o.unreached.is_empty() || makespan(&o) >= score - 1e-6 {
-                    continue;
+                // First the robots whose tasks did not change keep their programs unless the
+                // new ones are shorter (and so, mostly, the diagrams of their pairs); when that
+                // does not help, every robot is sequenced again: other paths, which may meet
+                // less.
+                let mut kept: Option<Outcome> = None;
+                for keep in [true, false] {
+                    if !may_judge() {
+                        break 'rounds;
+                    }
+                    if budget.spent() {
+                        break;
+                    }
+                    budget.plans += 1;
+                    let prior = if keep { Some(current) } else { None };
+                    let Ok(mut o) = plan_keeping(cell, table, &next, &|_| {}, cache, prior) else {
+                        continue;
+                    };
+                    // The judge's score is never below the robots' latest end without
+                    // coordination; a plan the same as the one just judged is not judged again.
+                    let same = kept.as_ref().is_some_and(|k| same_programs(k, &o));
+                    if same || !o.unreached.is_empty() || makespan(&o) >= score - 1e-6 {
+                        continue;
+                    }
+                    o.unreached.clone_from(&base.unreached);
+                    budget.judged += 1;
+                    if let Some((sc, e, j)) = judge(&o, best.as_ref().map(|b| (&b.0, &b.2)))
+                        && sc < score - 1e-6
+                    {
+                        (score, judged_ends, waits) = (sc, e, waits_of(&j));
+                        best = Some((o, next, j));
+                        continue 'rounds;
+                    }
+                    kept = Some(o);
                 }
-                o.unreached.clone_from(&base.unreached);
-                judged += 1;
-                if let Some((sc, e, j)) = judge(&o, best.as_ref().map(|b| (&b.0, &b.2)))
-                    && sc < score - 1e-6
-                {
-                    (score, judged_ends) = (sc, e);
-                    best = Some((o, next, j));
-                    continue 'rounds;
-                }
-                kept = Some(o);
             }
         }
-        // No hand-over of the robot ending last helped.
+        // No hand-over of the robot ending last, and no relief of one it waits for, helped.
         break;
     }
     Ok((best, false))
+}
+
+/// Plans made and judged against their caps.
+struct Budget {
+    plans: usize,
+    judged: usize,
+    max_plans: usize,
+    max_judged: usize,
+}
+
+impl Budget {
+    fn new(max_plans: usize, max_judged: usize) -> Budget {
+        Budget {
+            plans: 0,
+            judged: 0,
+            max_plans,
+            max_judged,
+        }
+    }
+
+    fn spent(&self) -> bool {
+        self.plans >= self.max_plans || self.judged >= self.max_judged
+    }
 }

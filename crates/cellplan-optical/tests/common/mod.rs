@@ -234,11 +234,11 @@ pub fn rebalanced(
     rebalance(
         cell,
         table,
-        (base, makespan(base), &ends(base)),
+        (base, makespan(base), &ends(base), &[]),
         settings,
         cache,
         &|| true,
-        judge,
+        (judge, &|_| Vec::new()),
     )
     .unwrap()
 }
