@@ -25,10 +25,10 @@ pub const REBALANCE_JUDGED: usize = 5;
 
 /// Plans [`rebalance`] makes at most for hand-overs that lighten a robot the last one waits
 /// for, once the direct hand-overs are spent (a budget of its own: see [`rebalance`]).
-pub const RELIEF_PLANS: usize = 4;
+pub const RELIEF_PLANS: usize = 8;
 
 /// Of those, plans it hands its judge at most.
-pub const RELIEF_JUDGED: usize = 2;
+pub const RELIEF_JUDGED: usize = 4;
 
 /// A robot the last one waits for at least this long (s) in all is one a relief may lighten.
 const RELIEF_MIN_WAIT: f64 = 0.5;
