@@ -412,7 +412,7 @@ fn a_robot_the_last_one_waits_for_is_relieved_when_the_hand_overs_do_not_help() 
         (&base, makespan(&base) + 5.0, &end, &waits),
         &s,
         &mut cache,
-        &|| true,
+        &|_| true,
         (&mut judge, &|_| unreachable!("no plan is taken")),
     )
     .unwrap();
@@ -451,6 +451,32 @@ fn a_robot_the_last_one_waits_for_is_relieved_when_the_hand_overs_do_not_help() 
         };
         build_checked(&cell, &table, o, &fixed);
     }
+    // The caller's work budget is asked before every plan, with `true` for a relief (which may
+    // go beyond it) and `false` for a hand-over: the hand-overs' asks first, then the reliefs'.
+    let asked = std::cell::RefCell::new(Vec::new());
+    let mut judge =
+        |_: &plan::Outcome, _: Option<(&plan::Outcome, &())>| -> Option<(f64, Vec<f64>, ())> { None };
+    let mut cache = plan::PlanCache::default();
+    rebalance(
+        &cell,
+        &table,
+        (&base, makespan(&base) + 5.0, &end, &waits),
+        &s,
+        &mut cache,
+        &|relief| {
+            asked.borrow_mut().push(relief);
+            true
+        },
+        (&mut judge, &|_| unreachable!("no plan is taken")),
+    )
+    .unwrap();
+    let asked = asked.into_inner();
+    let hand_overs = asked.iter().take_while(|r| !**r).count();
+    assert!(hand_overs >= direct, "{asked:?}");
+    assert!(
+        asked[hand_overs..].iter().all(|r| *r) && asked.len() - hand_overs >= relief.len(),
+        "{asked:?}"
+    );
 }
 
 /// A hand-over whose plan keeping the other robots' programs does not help is planned again

@@ -259,7 +259,9 @@ fn reliefs(cell: &Cell, o: &Outcome, end: &[f64], waits: &[Vec<f64>]) -> Vec<Mov
 /// A plan whose robots end, without coordination, sooner than the best score (the judge's
 /// score is never below that end) goes to `judge`, with the hand-over plan it was made from
 /// and what the judge made of that (`None`: made from `base`) — at most [`REBALANCE_JUDGED`] plans, and
-/// no hand-over is planned once `may_judge` says no (the caller's budget of work); the
+/// the search ends once `may_judge` says no before a plan (the caller's budget of work, asked
+/// with `true` before a relief's plans, which it may allow beyond, `false` before a
+/// hand-over's); the
 /// first it scores below the best is kept and the next hand-overs start from it and its ends.
 /// When a round's hand-overs are spent (or their budget is) without help, its reliefs are
 /// tried the same way on a budget of their own ([`RELIEF_PLANS`], [`RELIEF_JUDGED`]): they need
@@ -278,7 +280,7 @@ pub fn rebalance<J>(
     (base, base_score, base_ends, base_waits): (&Outcome, f64, &[f64], &[Vec<f64>]),
     settings: &PlanSettings,
     cache: &mut PlanCache,
-    may_judge: &dyn Fn() -> bool,
+    may_judge: &dyn Fn(bool) -> bool,
     (judge, waits_of): (&mut Judge<'_, J>, &WaitsOf<'_, J>),
 ) -> Result<(Option<Rebalanced<J>>, bool), PlanError> {
     if cell.robots.len() < 2 {
@@ -329,7 +331,7 @@ pub fn rebalance<J>(
                 // less.
                 let mut kept: Option<Outcome> = None;
                 for keep in [true, false] {
-                    if !may_judge() {
+                    if !may_judge(phase == 1) {
                         break 'rounds;
                     }
                     if budget.spent() {

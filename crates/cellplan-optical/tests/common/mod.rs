@@ -237,7 +237,7 @@ pub fn rebalanced(
         (base, makespan(base), &ends(base), &[]),
         settings,
         cache,
-        &|| true,
+        &|_| true,
         (judge, &|_| Vec::new()),
     )
     .unwrap()
