@@ -156,6 +156,41 @@ impl Tours {
     }
 }
 
+/// A task handed from robot `from` to any robot but `from` and `skip`: expected to end at
+/// `floor` or at the receiving robot's end plus the task's addition, whichever is later, and
+/// offered when that is below `bar`.
+struct Hand {
+    task: TaskId,
+    from: usize,
+    skip: Option<usize>,
+    floor: f64,
+    bar: f64,
+}
+
+impl Tours {
+    /// Each robot that can take `hand`'s task (its end in `ends`), as a [`Move`] into `out`
+    /// when it is expected to end below the bar.
+    fn offer(&self, cell: &Cell, o: &Outcome, hand: Hand, ends: &[f64], out: &mut Vec<Move>) {
+        for (to, &to_end) in ends.iter().enumerate() {
+            if to == hand.from || Some(to) == hand.skip {
+                continue;
+            }
+            let Some(added) = self.addition(cell, o, to, hand.task) else {
+                continue;
+            };
+            let expected = hand.floor.max(to_end + added);
+            if expected < hand.bar {
+                out.push(Move {
+                    task: hand.task,
+                    from: hand.from,
+                    to,
+                    expected,
+                });
+            }
+        }
+    }
+}
+
 /// Best expected first, then by task and receiving robot.
 fn ranked(mut out: Vec<Move>) -> Vec<Move> {
     out.sort_by(|a, b| {
@@ -183,24 +218,14 @@ fn moves(cell: &Cell, o: &Outcome, end: &[f64]) -> Vec<Move> {
     let tours = Tours::new(o);
     let mut out = Vec::new();
     for (task, saved) in tours.removals(cell, o, from) {
-        let from_end = free[from] - saved;
-        for (to, &to_free) in free.iter().enumerate() {
-            if to == from {
-                continue;
-            }
-            let Some(added) = tours.addition(cell, o, to, task) else {
-                continue;
-            };
-            let expected = from_end.max(to_free + added);
-            if expected < end[from] - 1e-6 {
-                out.push(Move {
-                    task,
-                    from,
-                    to,
-                    expected,
-                });
-            }
-        }
+        let hand = Hand {
+            task,
+            from,
+            skip: None,
+            floor: free[from] - saved,
+            bar: end[from] - 1e-6,
+        };
+        tours.offer(cell, o, hand, &free, &mut out);
     }
     ranked(out)
 }
@@ -226,24 +251,14 @@ fn reliefs(cell: &Cell, o: &Outcome, end: &[f64], waits: &[Vec<f64>]) -> Vec<Mov
             continue;
         }
         for (task, saved) in tours.removals(cell, o, from) {
-            let stuck_end = end[stuck] - saved.clamp(0.0, wait);
-            for (to, &to_end) in end.iter().enumerate() {
-                if to == from || to == stuck {
-                    continue;
-                }
-                let Some(added) = tours.addition(cell, o, to, task) else {
-                    continue;
-                };
-                let expected = stuck_end.max(to_end + added);
-                if expected < end[stuck] - 1e-6 {
-                    out.push(Move {
-                        task,
-                        from,
-                        to,
-                        expected,
-                    });
-                }
-            }
+            let hand = Hand {
+                task,
+                from,
+                skip: Some(stuck),
+                floor: end[stuck] - saved.clamp(0.0, wait),
+                bar: end[stuck] - 1e-6,
+            };
+            tours.offer(cell, o, hand, end, &mut out);
         }
     }
     ranked(out)
