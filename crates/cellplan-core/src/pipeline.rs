@@ -305,9 +305,10 @@ impl RunnersUp {
 /// end no sooner than the best cycle so far even uncoordinated is not coordinated. The shortest
 /// coordinated cycle (then Δt, then the earlier) wins; then [`plan::rebalance::rebalance`]
 /// hands tasks from the robot that ends last to others, one at a time, each hand-over kept
-/// when its plan, coordinated, ends sooner still (then the reliefs: tasks of a robot the last
-/// one waits for handed to a third, on [`RELIEF_EXTRA_DISTANCES`] beyond the work budget). Plans are compared with every leg stopping
-/// at every waypoint; the winner and the [`RUNNERS_UP`] shortest plans that lost (within
+/// when its plan, coordinated, ends sooner still, and then the reliefs (a task of a robot the
+/// last one waits for handed to a third), which may go beyond the work budget by the share
+/// [`RELIEF_EXTRA_DISTANCES`] sets. Plans are compared with every leg stopping at every
+/// waypoint; the winner and the [`RUNNERS_UP`] shortest plans that lost (within
 /// [`RUNNER_UP_REACH`] of it, on cells of at most `plan_first_pairs` MPs × robots) are then
 /// blended ([`crate::coord::blend`]) and the shortest blended cycle is the plan. The
 /// coordination compute of all is counted.

@@ -84,6 +84,17 @@ fn last(end: &[f64]) -> Option<usize> {
     (0..end.len()).max_by(|&a, &b| end[a].total_cmp(&end[b]).then(b.cmp(&a)))
 }
 
+/// A task handed from robot `from` to any robot but `from` and `skip`: expected to end at
+/// `floor` or at the receiving robot's end plus the task's addition, whichever is later, and
+/// offered when that is below `bar`.
+struct Hand {
+    task: TaskId,
+    from: usize,
+    skip: Option<usize>,
+    floor: f64,
+    bar: f64,
+}
+
 /// What hand-overs are ranked on: each robot's tour as graph nodes (home at both ends) and its
 /// slowness (its legs' time over their bounds, at least 1).
 struct Tours {
@@ -154,20 +165,7 @@ impl Tours {
             .fold(f64::INFINITY, f64::min);
         Some(dwell(cell, task) + self.slowness[to] * insertion)
     }
-}
 
-/// A task handed from robot `from` to any robot but `from` and `skip`: expected to end at
-/// `floor` or at the receiving robot's end plus the task's addition, whichever is later, and
-/// offered when that is below `bar`.
-struct Hand {
-    task: TaskId,
-    from: usize,
-    skip: Option<usize>,
-    floor: f64,
-    bar: f64,
-}
-
-impl Tours {
     /// Each robot that can take `hand`'s task (its end in `ends`), as a [`Move`] into `out`
     /// when it is expected to end below the bar.
     fn offer(&self, cell: &Cell, o: &Outcome, hand: Hand, ends: &[f64], out: &mut Vec<Move>) {
