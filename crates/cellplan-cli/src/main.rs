@@ -86,6 +86,12 @@ struct CheckArgs {
     /// Do not read or write the cache.
     #[arg(long)]
     no_cache: bool,
+    /// Also write the cell's allocation problem into this file (inspection cells): each robot's
+    /// lower-bound move times between home and its candidates, the MPs' measuring times, the
+    /// task cap and γ, in the min-max format (docs/minmax-format.md), for `cellplan bench
+    /// minmax` and the peers. Its lower bound is the one `cellplan plan` states.
+    #[arg(long, value_name = "FILE")]
+    minmax_out: Option<PathBuf>,
 }
 
 #[derive(Subcommand)]
@@ -287,10 +293,22 @@ fn load_options(no_cache: bool, cache_dir: &Option<PathBuf>) -> LoadOptions {
 }
 
 fn run_check(args: &CheckArgs) -> Result<(), Failure> {
+    let inspection_only = || {
+        Failure::Usage(format!(
+            "--minmax-out writes an inspection cell's allocation problem; {} is not an inspection cell",
+            args.cell.display()
+        ))
+    };
     if pcb_cmd::is_pcb(&args.cell)? {
+        if args.minmax_out.is_some() {
+            return Err(inspection_only());
+        }
         return pcb_cmd::check_cell(&args.cell, args.json);
     }
     if cmm_cmd::is_cmm(&args.cell)? {
+        if args.minmax_out.is_some() {
+            return Err(inspection_only());
+        }
         return cmm_cmd::check_cell(&args.cell, args.json);
     }
     let start = Instant::now();
@@ -315,6 +333,12 @@ fn run_check(args: &CheckArgs) -> Result<(), Failure> {
         write_atomic(path, drawing.as_bytes())
             .map_err(|e| Failure::Other(format!("cannot write {}: {e}", path.display())))?;
     }
+    if let Some(path) = &args.minmax_out {
+        let note = write_allocation_problem(&cell, &table, path)?;
+        if !args.quiet {
+            eprintln!("{note}");
+        }
+    }
     if args.json {
         let text = serde_json::to_string_pretty(&report).map_err(|e| Failure::Other(e.to_string()))?;
         println!("{text}");
@@ -330,6 +354,30 @@ fn run_check(args: &CheckArgs) -> Result<(), Failure> {
     } else {
         Err(Failure::Infeasible)
     }
+}
+
+/// Writes `cell`'s allocation problem ([`cellplan_core::plan::allocation_problem`], with the
+/// default planning settings) to `path` in the min-max format; says what it wrote.
+fn write_allocation_problem(
+    cell: &Cell,
+    table: &candidates::CandidateTable,
+    path: &std::path::Path,
+) -> Result<String, Failure> {
+    let settings = cellplan_core::plan::PlanSettings::default();
+    let (problem, _) = cellplan_core::plan::allocation_problem(cell, table, &settings)
+        .map_err(|e| Failure::Other(e.to_string()))?;
+    let mut buf = Vec::new();
+    cellplan_solve::io::write_minmax(&problem, &cell.name, &mut buf)
+        .map_err(|e| Failure::Other(e.to_string()))?;
+    write_atomic(path, &buf).map_err(|e| Failure::Other(format!("cannot write {}: {e}", path.display())))?;
+    let nodes: usize = problem.vehicles.iter().map(|v| v.costs.n()).sum();
+    Ok(format!(
+        "wrote {}: {} robots, {} MPs, {nodes} nodes in all; lower bound {:.2} s",
+        path.display(),
+        problem.vehicles.len(),
+        problem.tasks,
+        cellplan_solve::minmax::lower_bound(&problem)
+    ))
 }
 
 fn run_gen_tasks(args: &GenTasksArgs) -> Result<(), Failure> {

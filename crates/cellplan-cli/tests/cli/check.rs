@@ -471,3 +471,59 @@ fn robot_without_joints_is_refused() {
     std::fs::write(dir.join("cell.toml"), cell).unwrap();
     refused(&dir, &dir, "cell.toml", Some(19), "has no movable joint");
 }
+
+/// `check --minmax-out` writes the cell's allocation problem in the min-max format: it reads
+/// back, has the cell's robots and MPs, its lower bound is the one `plan` states (every MP is
+/// measured here), and `bench minmax` solves it no shorter than that bound. On a PCB cell the
+/// option is refused (exit 2).
+#[test]
+fn check_writes_the_allocation_problem() {
+    let (dir, cell, _, summary) = plan_small_cell("check-minmax");
+    let file = dir.join("allocation.txt");
+    let out = cellplan(
+        &[
+            "check",
+            cell.to_str().unwrap(),
+            "--minmax-out",
+            file.to_str().unwrap(),
+            "--json",
+        ],
+        &dir,
+    );
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let p = cellplan_solve::io::read_minmax(&file).expect("the file reads back");
+    assert_eq!((p.vehicles.len(), p.tasks), (1, 3));
+    assert!(p.service.iter().all(|&s| s == 1.5), "{:?}", p.service);
+    assert_eq!(summary["unmeasured"].as_array().map(Vec::len), Some(0));
+    let stated = summary["lower_bound_s"].as_f64().unwrap();
+    let bound = cellplan_solve::minmax::lower_bound(&p);
+    assert!(
+        (bound - stated).abs() <= 1e-9 * stated,
+        "{bound} against {stated}"
+    );
+    let out = cellplan(&["bench", "minmax", file.to_str().unwrap(), "--json"], &dir);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let rows: Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert!(rows[0]["cost"].as_f64().unwrap() >= bound - 1e-9, "{rows}");
+    let pcb = root().join("examples/pcb-paper-6/cell.toml");
+    let out = cellplan(
+        &[
+            "check",
+            pcb.to_str().unwrap(),
+            "--minmax-out",
+            file.to_str().unwrap(),
+        ],
+        &dir,
+    );
+    assert_eq!(
+        out.status.code(),
+        Some(2),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}

@@ -423,7 +423,7 @@ pub fn lower_bound(
 }
 
 /// The min-max problem over the measurable tasks, and the cell task of each of its tasks.
-fn min_max_problem(
+pub(crate) fn min_max_problem(
     cell: &Cell,
     graphs: &[RobotGraph],
     capable: &[Vec<usize>],

@@ -386,6 +386,38 @@ impl PlanCache {
     }
 }
 
+/// The min-max problem the allocations of `cell` work on with `settings` (its move model,
+/// alternatives and room): per robot its graph's lower-bound move times between home and its
+/// candidates, per measurable task the robots' candidates for it and its measuring time, the
+/// task cap and γ; with the cell task of each of its tasks. Its lower bound is the plan's
+/// ([`allocate::Allocated::lower_bound`]). `cellplan check --minmax-out` writes it in the min-max format
+/// (docs/minmax-format.md), so that the allocation can be studied with `cellplan bench minmax`
+/// and the peers.
+pub fn allocation_problem(
+    cell: &Cell,
+    table: &CandidateTable,
+    settings: &PlanSettings,
+) -> Result<(cellplan_solve::minmax::MinMaxProblem, Vec<usize>), PlanError> {
+    let graphs: Vec<RobotGraph> = cell
+        .robots
+        .par_iter()
+        .map(|r| {
+            RobotGraph::new(
+                cell,
+                r,
+                table,
+                settings.move_model,
+                settings.alternatives,
+                settings.roomy,
+            )
+        })
+        .collect();
+    let capable: Vec<Vec<usize>> = (0..cell.tasks.len())
+        .map(|t| table.robots_for(TaskId(t)).into_iter().map(|r| r.0).collect())
+        .collect();
+    allocate::min_max_problem(cell, &graphs, &capable)
+}
+
 /// [`plan`], sharing graphs and planned legs with earlier runs through `cache`.
 pub fn plan_cached(
     cell: &Cell,
