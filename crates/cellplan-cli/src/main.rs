@@ -366,10 +366,23 @@ fn write_allocation_problem(
     let settings = cellplan_core::plan::PlanSettings::default();
     let (problem, _) = cellplan_core::plan::allocation_problem(cell, table, &settings)
         .map_err(|e| Failure::Other(e.to_string()))?;
-    let mut buf = Vec::new();
-    cellplan_solve::io::write_minmax(&problem, &cell.name, &mut buf)
-        .map_err(|e| Failure::Other(e.to_string()))?;
-    write_atomic(path, &buf).map_err(|e| Failure::Other(format!("cannot write {}: {e}", path.display())))?;
+    // The matrices are dense: a large cell's would pass what the reader takes (and fill the
+    // memory first), so writing stops there.
+    let mut out = Capped {
+        buf: Vec::new(),
+        cap: cellplan_solve::io::MAX_FILE_BYTES as usize,
+    };
+    if cellplan_solve::io::write_minmax(&problem, &cell.name, &mut out).is_err() {
+        let largest = problem.vehicles.iter().map(|v| v.costs.n()).max().unwrap_or(0);
+        return Err(Failure::Usage(format!(
+            "the allocation problem of {} passes the {} MiB a min-max file may hold (its matrices are dense; the largest robot has {largest} nodes): nothing written to {}; write it for a smaller task list",
+            cell.path.display(),
+            cellplan_solve::io::MAX_FILE_BYTES >> 20,
+            path.display()
+        )));
+    }
+    write_atomic(path, &out.buf)
+        .map_err(|e| Failure::Other(format!("cannot write {}: {e}", path.display())))?;
     let nodes: usize = problem.vehicles.iter().map(|v| v.costs.n()).sum();
     Ok(format!(
         "wrote {}: {} robots, {} MPs, {nodes} nodes in all; lower bound {:.2} s",
@@ -378,6 +391,26 @@ fn write_allocation_problem(
         problem.tasks,
         cellplan_solve::minmax::lower_bound(&problem)
     ))
+}
+
+/// A byte buffer that refuses to grow past `cap` (the write fails instead).
+struct Capped {
+    buf: Vec<u8>,
+    cap: usize,
+}
+
+impl std::io::Write for Capped {
+    fn write(&mut self, bytes: &[u8]) -> std::io::Result<usize> {
+        if self.buf.len() + bytes.len() > self.cap {
+            return Err(std::io::Error::other("past the cap"));
+        }
+        self.buf.extend_from_slice(bytes);
+        Ok(bytes.len())
+    }
+
+    fn flush(&mut self) -> std::io::Result<()> {
+        Ok(())
+    }
 }
 
 fn run_gen_tasks(args: &GenTasksArgs) -> Result<(), Failure> {
