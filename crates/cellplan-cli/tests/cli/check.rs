@@ -480,22 +480,8 @@ fn robot_without_joints_is_refused() {
 fn check_writes_the_allocation_problem() {
     let (dir, cell, _, summary) = plan_small_cell("check-minmax");
     let file = dir.join("allocation.txt");
-    let out = cellplan(
-        &[
-            "check",
-            cell.to_str().unwrap(),
-            "--minmax-out",
-            file.to_str().unwrap(),
-            "--json",
-        ],
-        &dir,
-    );
-    assert_eq!(
-        out.status.code(),
-        Some(0),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let (cell, file_arg) = (cell.to_str().unwrap(), file.to_str().unwrap());
+    run_ok(&["check", cell, "--minmax-out", file_arg, "--json"], &dir);
     let p = cellplan_solve::io::read_minmax(&file).expect("the file reads back");
     assert_eq!((p.vehicles.len(), p.tasks), (1, 3));
     assert!(p.service.iter().all(|&s| s == 1.5), "{:?}", p.service);
@@ -506,20 +492,10 @@ fn check_writes_the_allocation_problem() {
         (bound - stated).abs() <= 1e-9 * stated,
         "{bound} against {stated}"
     );
-    let out = cellplan(&["bench", "minmax", file.to_str().unwrap(), "--json"], &dir);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-    let rows: Value = serde_json::from_slice(&out.stdout).unwrap();
+    let rows = json_ok(&["bench", "minmax", file_arg, "--json"], &dir);
     assert!(rows[0]["cost"].as_f64().unwrap() >= bound - 1e-9, "{rows}");
     let pcb = root().join("examples/pcb-paper-6/cell.toml");
-    let out = cellplan(
-        &[
-            "check",
-            pcb.to_str().unwrap(),
-            "--minmax-out",
-            file.to_str().unwrap(),
-        ],
-        &dir,
-    );
+    let out = cellplan(&["check", pcb.to_str().unwrap(), "--minmax-out", file_arg], &dir);
     assert_eq!(
         out.status.code(),
         Some(2),

@@ -398,8 +398,17 @@ pub fn allocation_problem(
     table: &CandidateTable,
     settings: &PlanSettings,
 ) -> Result<(cellplan_solve::minmax::MinMaxProblem, Vec<usize>), PlanError> {
-    let graphs: Vec<RobotGraph> = cell
-        .robots
+    let graphs = robot_graphs(cell, table, settings);
+    let capable: Vec<Vec<usize>> = (0..cell.tasks.len())
+        .map(|t| table.robots_for(TaskId(t)).into_iter().map(|r| r.0).collect())
+        .collect();
+    allocate::min_max_problem(cell, &graphs, &capable)
+}
+
+/// Each robot's move-time graph with `settings`' move model, alternatives and room (in
+/// parallel; each graph depends on its robot only).
+fn robot_graphs(cell: &Cell, table: &CandidateTable, settings: &PlanSettings) -> Vec<RobotGraph> {
+    cell.robots
         .par_iter()
         .map(|r| {
             RobotGraph::new(
@@ -411,11 +420,7 @@ pub fn allocation_problem(
                 settings.roomy,
             )
         })
-        .collect();
-    let capable: Vec<Vec<usize>> = (0..cell.tasks.len())
-        .map(|t| table.robots_for(TaskId(t)).into_iter().map(|r| r.0).collect())
-        .collect();
-    allocate::min_max_problem(cell, &graphs, &capable)
+        .collect()
 }
 
 /// [`plan`], sharing graphs and planned legs with earlier runs through `cache`.
@@ -461,21 +466,7 @@ pub fn plan_keeping(
     let graphs: Arc<Vec<RobotGraph>> = match &cache.graphs {
         Some((m, a, r, g)) if (*m, *a, *r) == key => Arc::clone(g),
         _ => {
-            let g: Vec<RobotGraph> = cell
-                .robots
-                .par_iter()
-                .map(|r| {
-                    RobotGraph::new(
-                        cell,
-                        r,
-                        table,
-                        settings.move_model,
-                        settings.alternatives,
-                        settings.roomy,
-                    )
-                })
-                .collect();
-            let g = Arc::new(g);
+            let g = Arc::new(robot_graphs(cell, table, settings));
             cache.graphs = Some((key.0, key.1, key.2, Arc::clone(&g)));
             cache.planned = vec![Default::default(); cell.robots.len()];
             g
