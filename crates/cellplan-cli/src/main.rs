@@ -364,7 +364,7 @@ fn write_allocation_problem(
     path: &std::path::Path,
 ) -> Result<String, Failure> {
     let settings = cellplan_core::plan::PlanSettings::default();
-    let (problem, _) = cellplan_core::plan::allocation_problem(cell, table, &settings)
+    let (problem, tasks) = cellplan_core::plan::allocation_problem(cell, table, &settings)
         .map_err(|e| Failure::Other(e.to_string()))?;
     // The matrices are dense: a large cell's would pass what the reader takes (and fill the
     // memory first), so writing stops there.
@@ -385,10 +385,12 @@ fn write_allocation_problem(
         .map_err(|e| Failure::Other(format!("cannot write {}: {e}", path.display())))?;
     let nodes: usize = problem.vehicles.iter().map(|v| v.costs.n()).sum();
     Ok(format!(
-        "wrote {}: {} robots, {} MPs, {nodes} nodes in all; lower bound {:.2} s",
+        "wrote {}: {} robots, {} of the cell's {} MPs as tasks 0..{} (those some robot can measure, in the cell's order), {nodes} nodes in all; lower bound {:.2} s",
         path.display(),
         problem.vehicles.len(),
-        problem.tasks,
+        tasks.len(),
+        cell.tasks.len(),
+        tasks.len().saturating_sub(1),
         cellplan_solve::minmax::lower_bound(&problem)
     ))
 }
