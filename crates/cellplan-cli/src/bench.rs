@@ -146,6 +146,26 @@ pub struct Row {
     /// Min-max: number of tasks.
     #[serde(skip_serializing_if = "Option::is_none")]
     tasks: Option<usize>,
+    /// Min-max: the lower bounds of the makespan.
+    #[serde(skip_serializing_if = "Option::is_none", flatten)]
+    bounds: Option<MinMaxBounds>,
+}
+
+/// The two lower bounds of a min-max instance's makespan (`cellplan bench minmax`).
+#[derive(Debug, Serialize)]
+pub struct MinMaxBounds {
+    /// `minmax::lower_bound`: legs one at a time (the bound `cellplan plan` states).
+    lower_bound: f64,
+    /// `minmax::route_bound`: column generation over ng-routes (at least `lower_bound`).
+    route_bound: f64,
+    /// Whether the route relaxation was solved (else the bound is that of the last round).
+    route_bound_converged: bool,
+    route_bound_rounds: usize,
+    /// Arcs its pricings looked at (its work; `RouteBoundSettings::max_work` at most, give or
+    /// take a round).
+    route_bound_work: u64,
+    /// Time of both bounds, in seconds.
+    bounds_time_s: f64,
 }
 
 fn optimum_for(file: &Path, name: &str) -> Option<f64> {
@@ -290,6 +310,7 @@ pub fn run(args: &BenchArgs) -> Result<Vec<Row>, BenchError> {
             total: None,
             vehicles: None,
             tasks: None,
+            bounds: None,
         });
     }
     Ok(rows)
@@ -320,6 +341,7 @@ fn run_minmax(args: &BenchArgs, limit: Duration) -> Result<Vec<Row>, BenchError>
         let inst = read_minmax_instance(file).map_err(BenchError::Input)?;
         let p = &inst.problem;
         let mut runs: Vec<(f64, f64)> = Vec::new();
+        let mut best_routes: Option<(f64, minmax::Routes)> = None;
         let start = Instant::now();
         for seed in 0..args.runs.max(1) {
             let params = minmax::MinMaxParams {
@@ -344,8 +366,23 @@ fn run_minmax(args: &BenchArgs, limit: Duration) -> Result<Vec<Row>, BenchError>
                 )));
             }
             runs.push((makespan, sol.routes.times(p).iter().sum()));
+            if best_routes.as_ref().is_none_or(|b| makespan < b.0) {
+                best_routes = Some((makespan, sol.routes));
+            }
         }
         let elapsed = start.elapsed().as_secs_f64();
+        let bounds = best_routes.map(|(_, routes)| {
+            let began = Instant::now();
+            let routes = minmax::route_bound(p, &routes, &minmax::RouteBoundSettings::default());
+            MinMaxBounds {
+                lower_bound: routes.legs,
+                route_bound: routes.bound,
+                route_bound_converged: routes.converged,
+                route_bound_rounds: routes.rounds,
+                route_bound_work: routes.work,
+                bounds_time_s: began.elapsed().as_secs_f64(),
+            }
+        });
         let (best, total) =
             runs.iter().copied().fold(
                 (f64::INFINITY, f64::INFINITY),
@@ -366,6 +403,7 @@ fn run_minmax(args: &BenchArgs, limit: Duration) -> Result<Vec<Row>, BenchError>
             total: Some(total),
             vehicles: Some(p.vehicles.len()),
             tasks: Some(p.tasks),
+            bounds,
         });
     }
     Ok(rows)
@@ -439,6 +477,21 @@ pub fn render(rows: &[Row]) -> String {
             r.total.map_or(String::new(), |t| format!("  total {t:.3}")),
             prec = if r.total.is_some() { 3 } else { 1 }
         ));
+        if let Some(b) = &r.bounds {
+            s.push_str(&format!(
+                "  lower bounds: legs {:.3}, routes {:.3} ({}, {} rounds, {:.1} s): the cost is at most {:.1} % above\n",
+                b.lower_bound,
+                b.route_bound,
+                if b.route_bound_converged {
+                    "relaxation solved"
+                } else {
+                    "cut by its work budget"
+                },
+                b.route_bound_rounds,
+                b.bounds_time_s,
+                100.0 * (r.cost / b.route_bound - 1.0),
+            ));
+        }
     }
     if !rows.is_empty() {
         let gaps: Vec<f64> = rows.iter().filter_map(|r| r.gap_percent).collect();

@@ -19,11 +19,13 @@ mod construct;
 mod generate;
 mod ils;
 mod route;
+mod routes_bound;
 #[cfg(test)]
 mod tests;
 
 pub use bound::lower_bound;
 pub use generate::generate;
+pub use routes_bound::{RouteBound, RouteBoundSettings, route_bound};
 
 /// One vehicle (robot).
 #[derive(Clone, Debug, PartialEq)]

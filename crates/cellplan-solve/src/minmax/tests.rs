@@ -353,3 +353,92 @@ fn assignment_within_caps_moves_tasks_along_augmenting_paths() {
     let can3 = |v: usize, t: usize| t == 0 || v == 0;
     assert_eq!(super::assign_within_caps(3, &[1, 1], can3), Err(2));
 }
+
+/// The route bound of `p` from an ILS solution.
+fn route_bound_of(p: &MinMaxProblem, settings: &RouteBoundSettings) -> RouteBound {
+    let start = solve(
+        p,
+        &MinMaxParams {
+            max_iterations: Some(30),
+            ..MinMaxParams::default()
+        },
+    );
+    route_bound(p, &start.routes, settings)
+}
+
+#[test]
+fn route_bound_is_between_the_leg_bound_and_the_optimum() {
+    let mut tighter = 0;
+    let mut closest: f64 = 0.0;
+    let problems = (0..40)
+        .map(|seed| generate(2, 2 + seed as usize % 5, (1, 3), seed))
+        .chain((0..40).map(|seed| random_asymmetric(3, 2 + seed as usize % 5, seed)));
+    for (i, p) in problems.enumerate() {
+        let legs = lower_bound(&p);
+        let rb = route_bound_of(&p, &RouteBoundSettings::default());
+        let opt = brute_force(&p);
+        assert!(rb.converged, "problem {i}: not converged ({rb:?})");
+        assert!(
+            legs <= rb.bound + 1e-12 && rb.bound <= opt + 1e-7,
+            "problem {i}: leg bound {legs}, route bound {}, optimum {opt}",
+            rb.bound
+        );
+        // The relaxation's value (the last restricted problem's, up to the solver's accuracy),
+        // unless the leg bound is above it.
+        let relaxation = rb.master + 1e-6 * rb.master.max(1.0);
+        assert!(rb.bound <= relaxation.max(legs), "problem {i}: {rb:?}");
+        tighter += usize::from(rb.bound > legs + 1e-6);
+        closest = closest.max(rb.bound / opt);
+    }
+    // Not vacuous: the routes see what the legs do not, and close the gap on some.
+    assert!(tighter >= 40, "tighter than the leg bound on {tighter} of 80");
+    assert!(closest > 0.999, "best route bound/optimum {closest}");
+}
+
+#[test]
+fn route_bound_of_one_vehicle_remembering_every_task_is_its_shortest_route() {
+    // One vehicle: every route the relaxation weighs must cover every task, so with elementary
+    // routes (a memory as large as the tasks) its value is the shortest route.
+    for seed in 0..12 {
+        let n = 2 + seed as usize % 5;
+        let mut p = random_asymmetric(1, n, seed);
+        p.vehicles[0].cap = n;
+        let settings = RouteBoundSettings {
+            ng: n,
+            ..RouteBoundSettings::default()
+        };
+        let rb = route_bound_of(&p, &settings);
+        let opt = brute_force(&p);
+        assert!(rb.converged, "seed {seed}: {rb:?}");
+        assert!(
+            (rb.bound - opt).abs() <= 1e-6 * opt,
+            "seed {seed}: route bound {} against the shortest route {opt}",
+            rb.bound
+        );
+    }
+}
+
+#[test]
+fn route_bound_cut_by_its_budget_is_still_a_bound() {
+    for seed in 0..10 {
+        let p = random_asymmetric(3, 3 + seed as usize % 4, seed);
+        let settings = RouteBoundSettings {
+            max_work: 1,
+            ..RouteBoundSettings::default()
+        };
+        let rb = route_bound_of(&p, &settings);
+        let opt = brute_force(&p);
+        assert!(rb.rounds <= 2, "seed {seed}: {rb:?}");
+        // Too large to price: the leg bound alone, no round made.
+        let large = RouteBoundSettings {
+            max_arcs: 1,
+            ..RouteBoundSettings::default()
+        };
+        let alone = route_bound_of(&p, &large);
+        assert_eq!((alone.bound, alone.rounds), (lower_bound(&p), 0), "seed {seed}");
+        assert!(
+            lower_bound(&p) <= rb.bound + 1e-12 && rb.bound <= opt + 1e-7,
+            "seed {seed}: {rb:?} against {opt}"
+        );
+    }
+}
