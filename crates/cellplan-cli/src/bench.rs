@@ -435,7 +435,15 @@ pub fn generate(args: &BenchArgs) -> Result<String, BenchError> {
     if m == 0 {
         return Err(BenchError::Usage("`--vehicles` must be at least 1".into()));
     }
-    let mut p = minmax::generate(m, n, (lo, hi), args.seed);
+    // The matrices are dense: refused before they are made when they could pass what the
+    // reader takes back (and fill the memory first).
+    let limit = cellplan_solve::io::MAX_FILE_BYTES;
+    let mut p = minmax::generate_within(m, n, (lo, hi), args.seed, limit).map_err(|e| {
+        BenchError::Usage(format!(
+            "`--generate --vehicles {m} --tasks {n} --alternatives {lo}..{hi}`: {e}; nothing written to {}; ask for fewer tasks or alternatives",
+            out.display()
+        ))
+    })?;
     let scale = 10f64.powi(args.decimals.min(12) as i32);
     let round = |x: f64| (x * scale).round() / scale;
     for v in &mut p.vehicles {
@@ -445,8 +453,18 @@ pub fn generate(args: &BenchArgs) -> Result<String, BenchError> {
     }
     p.service.iter_mut().for_each(|s| *s = round(*s));
     p.validate().map_err(|e| BenchError::Failed(e.to_string()))?;
-    let mut buf = Vec::new();
-    write_minmax(&p, &stem(out), &mut buf).map_err(|e| BenchError::Failed(e.to_string()))?;
+    let mut capped = crate::Capped {
+        buf: Vec::new(),
+        cap: limit as usize,
+    };
+    if write_minmax(&p, &stem(out), &mut capped).is_err() {
+        return Err(BenchError::Usage(format!(
+            "the instance passes the {} MiB a min-max file may hold: nothing written to {}; ask for fewer tasks or alternatives, or fewer `--decimals`",
+            limit >> 20,
+            out.display()
+        )));
+    }
+    let buf = capped.buf;
     cellplan_model::io::write_atomic(out, &buf)
         .map_err(|e| BenchError::Failed(format!("cannot write {}: {e}", out.display())))?;
     let nodes: usize = p.vehicles.iter().map(|v| v.costs.n()).sum();

@@ -396,9 +396,9 @@ fn write_allocation_problem(
 }
 
 /// A byte buffer that refuses to grow past `cap` (the write fails instead).
-struct Capped {
-    buf: Vec<u8>,
-    cap: usize,
+pub(crate) struct Capped {
+    pub(crate) buf: Vec<u8>,
+    pub(crate) cap: usize,
 }
 
 impl std::io::Write for Capped {

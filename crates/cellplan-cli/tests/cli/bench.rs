@@ -287,3 +287,58 @@ fn bench_motion_plans_and_rechecks_exactly() {
     assert!(stderr.contains("peer.json:2:"), "{stderr}");
     assert!(stderr.contains("motion_vamp.py"), "{stderr}");
 }
+
+#[test]
+fn bench_minmax_refuses_to_generate_an_instance_past_the_memory_allowed() {
+    let dir = scratch("bench-minmax-large");
+    let file = dir.join("mm.txt");
+    let generate = |vehicles: &str, tasks: &str, alternatives: &str| {
+        cellplan(
+            &[
+                "bench",
+                "minmax",
+                "--generate",
+                "--vehicles",
+                vehicles,
+                "--tasks",
+                tasks,
+                "--alternatives",
+                alternatives,
+                "-o",
+                file.to_str().unwrap(),
+            ],
+            &dir,
+        )
+    };
+    // Absurd counts are refused before the points are made, large alternatives before the
+    // matrices: both within a moment and without the memory they would take.
+    for (vehicles, tasks, alternatives, says) in [
+        ("4", "100000000000", "1..4", "before any cost is stored"),
+        ("100000000", "1000", "1..4", "before any cost is stored"),
+        (
+            "2",
+            "20000",
+            "1..40",
+            "cost matrices could take more than the 512 MiB",
+        ),
+    ] {
+        let out = generate(vehicles, tasks, alternatives);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(
+            out.status.code(),
+            Some(2),
+            "{vehicles} {tasks} {alternatives}: {stderr}"
+        );
+        assert!(stderr.contains(says), "{stderr}");
+        assert!(stderr.contains("nothing written"), "{stderr}");
+        assert!(!file.exists(), "nothing is written");
+    }
+    let out = generate("2", "30", "1..4");
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(file.exists());
+}

@@ -20,13 +20,49 @@ use crate::problem::CostMatrix;
 /// # Panics
 /// If `vehicles == 0`, or `alternatives.0 == 0` or `alternatives.0 > alternatives.1`.
 pub fn generate(vehicles: usize, tasks: usize, alternatives: (usize, usize), seed: u64) -> MinMaxProblem {
+    match generate_within(vehicles, tasks, alternatives, seed, u64::MAX) {
+        Ok(p) => p,
+        Err(e) => panic!("{e}"),
+    }
+}
+
+/// An instance [`generate`] would have made, refused because it could pass the memory allowed.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[error("{0}")]
+pub struct TooLarge(pub String);
+
+/// [`generate`], but refused before anything large is allocated when the instance's dense cost
+/// matrices could take more than `max_matrix_bytes` (8 bytes per entry, every reachable task
+/// counted with `alternatives.1` nodes, the most it can get). The tasks' points are made first
+/// (32 bytes per task, refused beyond `max_matrix_bytes` too), then the reach of every robot
+/// counted, then the matrices; the instance is the one [`generate`] makes.
+///
+/// # Panics
+/// As [`generate`].
+pub fn generate_within(
+    vehicles: usize,
+    tasks: usize,
+    alternatives: (usize, usize),
+    seed: u64,
+    max_matrix_bytes: u64,
+) -> Result<MinMaxProblem, TooLarge> {
     assert!(vehicles > 0, "at least one vehicle");
     assert!(
         alternatives.0 >= 1 && alternatives.0 <= alternatives.1,
         "alternatives must be a range lo..=hi with lo >= 1"
     );
-    let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let m = vehicles;
+    // Every robot has a depot and a matrix of its own; every task a point, a service time and
+    // a place in each robot's list of alternatives.
+    let fixed = (m as u128) * 8 + (tasks as u128) * 32 + (m as u128) * (tasks as u128) * 24;
+    if fixed > u128::from(max_matrix_bytes) {
+        return Err(TooLarge(format!(
+            "{m} robots and {tasks} tasks take {} MiB before any cost is stored, more than the {} MiB allowed",
+            fixed >> 20,
+            max_matrix_bytes >> 20
+        )));
+    }
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let pts: Vec<[f64; 3]> = (0..tasks)
         .map(|_| {
             let x = -0.4 + rng.random::<f64>() * (m as f64 - 0.2);
@@ -36,6 +72,23 @@ pub fn generate(vehicles: usize, tasks: usize, alternatives: (usize, usize), see
         })
         .collect();
     let service: Vec<f64> = (0..tasks).map(|_| 0.2 + 0.4 * rng.random::<f64>()).collect();
+    let reaches = |v: usize, pt: &[f64; 3]| {
+        let nearest = (pt[0].round().clamp(0.0, (m - 1) as f64)) as usize;
+        (pt[0] - v as f64).abs() <= 1.0 || nearest == v
+    };
+    let mut bytes = 0u128;
+    for v in 0..m {
+        let reached = pts.iter().filter(|pt| reaches(v, pt)).count() as u128;
+        let nodes = 1 + reached * alternatives.1 as u128;
+        bytes = bytes.saturating_add(nodes.saturating_mul(nodes).saturating_mul(8));
+        if bytes > u128::from(max_matrix_bytes) {
+            return Err(TooLarge(format!(
+                "robot {v} alone reaches {reached} tasks; with up to {} nodes each, the cost matrices could take more than the {} MiB allowed",
+                alternatives.1,
+                max_matrix_bytes >> 20
+            )));
+        }
+    }
     let mut vs = Vec::with_capacity(m);
     for v in 0..m {
         let speed = 0.8 + 0.4 * rng.random::<f64>();
@@ -43,8 +96,7 @@ pub fn generate(vehicles: usize, tasks: usize, alternatives: (usize, usize), see
         let mut nodes = vec![depot_pt];
         let mut alts = vec![Vec::new(); tasks];
         for (t, pt) in pts.iter().enumerate() {
-            let nearest = (pt[0].round().clamp(0.0, (m - 1) as f64)) as usize;
-            if (pt[0] - v as f64).abs() > 1.0 && nearest != v {
+            if !reaches(v, pt) {
                 continue;
             }
             let k = rng.random_range(alternatives.0..=alternatives.1);
@@ -80,7 +132,7 @@ pub fn generate(vehicles: usize, tasks: usize, alternatives: (usize, usize), see
             balance_limit: None,
         };
         if p.validate().is_ok() {
-            return p;
+            return Ok(p);
         }
         vs = p.vehicles;
         cap += 1;

@@ -24,7 +24,7 @@ mod routes_bound;
 mod tests;
 
 pub use bound::lower_bound;
-pub use generate::generate;
+pub use generate::{TooLarge, generate, generate_within};
 pub use routes_bound::{RouteBound, RouteBoundSettings, route_bound};
 
 /// One vehicle (robot).
