@@ -46,6 +46,8 @@ import time
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 BIN = ROOT / "target" / "release" / "cellplan"
+# Extra arguments of every `plan` (from --route-bound).
+EXTRA = []
 CELLS_DIR = ROOT / "bench" / "cells"
 
 # Cells, in table order. `long`: left out of the default run (minutes per plan; run with --all
@@ -161,7 +163,7 @@ def bench_cell(name, out_root, timeout, threads1, seed=0):
            "ok": True, "problems": []}
     label = name.strip("/").replace("/", "_") + f"-seed{seed}"
     out = out_root / label
-    seeded = ["--seed", str(seed)]
+    seeded = ["--seed", str(seed)] + EXTRA
     rc, so, se, wall, rss = run([str(BIN), "plan", str(cell), "-o", str(out), "--json", "--no-report"]
                                 + seeded, timeout)
     row.update(exit=rc, wall_s=wall, peak_rss_mb=rss)
@@ -185,6 +187,11 @@ def bench_cell(name, out_root, timeout, threads1, seed=0):
                ratio=s["ratio_to_lower_bound"], delta_t_s=s["delta_t_s"],
                robots=len(s["robots"]), unmeasured=len(s["unmeasured"]),
                mps=sum(r["tasks"] for r in s["robots"]) + len(s["unmeasured"]))
+    if s.get("route_bound"):
+        rb = s["route_bound"]
+        row.update(leg_bound_s=rb["legs_s"], route_bound_s=rb["bound_s"],
+                   route_bound_converged=rb["converged"], route_bound_rounds=rb["rounds"],
+                   route_bound_work=rb["work"])
     try:
         stats = json.loads((out / "plan.json").read_text())["stats"]
         row.update(legs_failed=stats["legs_failed"], legs_planned=stats["legs_planned"])
@@ -303,8 +310,13 @@ def main():
     ap.add_argument("--seeds", default="0",
                     help="comma-separated seeds (default 0): each cell is planned with each")
     ap.add_argument("--bin", help="the cellplan binary to run (default target/release/cellplan)")
+    ap.add_argument("--route-bound", type=float, metavar="G",
+                    help="plan with --route-bound G: the plans state the route bound too (its "
+                         "pricings look at up to G billion arcs) and the ratio is to the larger bound")
     args = ap.parse_args()
     global BIN
+    if args.route_bound is not None:
+        EXTRA.extend(["--route-bound", str(args.route_bound)])
     if args.bin:
         BIN = pathlib.Path(args.bin).resolve()
     try:

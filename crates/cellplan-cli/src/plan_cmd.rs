@@ -59,6 +59,12 @@ pub struct PlanArgs {
     /// stops at every waypoint.
     #[arg(long, value_name = "RAD", default_value_t = cellplan_core::coord::BLEND_DEVIATION)]
     blend_deviation: f64,
+    /// Inspection cells: also prove a tighter lower bound from whole routes (column
+    /// generation over the allocation problem), its pricings looking at up to this many
+    /// billion arcs (the README cell's converges within 1, the bench gives 20). The plan
+    /// states the larger bound; `verify` derives it again, taking as long again.
+    #[arg(long, value_name = "G_ARCS")]
+    route_bound: Option<f64>,
     /// Write the plan even if `cellplan verify` rejects it.
     #[arg(long)]
     pub no_verify: bool,
@@ -112,6 +118,10 @@ struct Summary<'a> {
     time_limit_hit: bool,
     lower_bound_s: f64,
     ratio_to_lower_bound: f64,
+    /// With `--route-bound`: the route bound (`lower_bound_s` is the larger of it and the leg
+    /// bound).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    route_bound: Option<&'a output::RouteBoundOut>,
     robots: Vec<RobotSummary<'a>>,
     unmeasured: Vec<&'a str>,
     legs_planned: usize,
@@ -161,6 +171,14 @@ pub fn run(args: &PlanArgs) -> Result<(), Failure> {
             "--blend-deviation must be an angle in radians between 0 (no blends) and 1".into(),
         ));
     }
+    if args
+        .route_bound
+        .is_some_and(|g| !(g.is_finite() && g > 0.0 && g <= 1000.0))
+    {
+        return Err(Failure::Usage(
+            "--route-bound must be a number of billion arcs above 0 and at most 1000 (20 is the bench's budget)".into(),
+        ));
+    }
     if args.lazy_rounds > 1000 || args.reallocation_rounds > 1000 {
         return Err(Failure::Usage(
             "--lazy-rounds and --reallocation-rounds must be at most 1000".into(),
@@ -184,6 +202,7 @@ pub fn run(args: &PlanArgs) -> Result<(), Failure> {
         local_set_radius: args.local_set_radius,
         lazy_rounds: args.lazy_rounds.max(1),
         reallocation_rounds: args.reallocation_rounds,
+        route_bound_work: args.route_bound.map(|g| (g * 1e9).round() as u64),
         ..PlanSettings::default()
     };
     let coord_settings = CoordSettings {
@@ -273,6 +292,7 @@ pub fn run(args: &PlanArgs) -> Result<(), Failure> {
             time_limit_hit: doc.stats.time_limit_hit,
             lower_bound_s: doc.lower_bound_s,
             ratio_to_lower_bound: doc.ratio_to_lower_bound,
+            route_bound: doc.route_bound.as_ref(),
             robots: doc
                 .robots
                 .iter()
@@ -390,6 +410,20 @@ fn render(doc: &output::Plan, working: &str) -> String {
         "\ncycle time {:.2} s   Δt {:.2} s   lower bound {:.2} s (ratio {:.3})\n",
         doc.cycle_time_s, doc.delta_t_s, doc.lower_bound_s, doc.ratio_to_lower_bound
     );
+    if let Some(r) = &doc.route_bound {
+        s += &format!(
+            "route bound {:.2} s (the leg bound {:.2} s; {} rounds, {:.2} G arcs, {})\n",
+            r.bound_s,
+            r.legs_s,
+            r.rounds,
+            r.work as f64 * 1e-9,
+            if r.converged {
+                "the relaxation solved".to_string()
+            } else {
+                format!("cut by its budget of {:.2} G arcs", r.max_work as f64 * 1e-9)
+            }
+        );
+    }
     if !balance_met(doc)
         && let Some(g) = doc.settings.balance_limit_s
     {
@@ -432,6 +466,12 @@ fn render(doc: &output::Plan, working: &str) -> String {
         c.verification,
         c.total
     );
+    if c.route_bound > 0.0 {
+        s += &format!(
+            "  (of which the route bound {:.2} s; verification derives it again)\n",
+            c.route_bound
+        );
+    }
     s += if doc.verified {
         "verified: every MP once, probe constraints, limits, clearance to the scene and between robots\n"
     } else {

@@ -91,7 +91,49 @@ fn lower_bound(cell: &Cell, table: &CandidateTable, plan: &Plan, totals: &mut dy
         .map(|t| t.id)
         .collect();
     match allocate::lower_bound(cell, table, &graphs, &left_out) {
-        Ok(lb) => {
+        Ok(legs) => {
+            // The route bound, where stated, derived again under its budget: the same
+            // problem, start and work give the same rounds, work and value.
+            let lb = match &plan.route_bound {
+                None => legs,
+                Some(stated) => match allocate::route_bound(cell, table, &graphs, &left_out, stated.max_work)
+                {
+                    Ok(rb) => {
+                        let again = (rb.bound, rb.legs, rb.work, rb.rounds, rb.converged);
+                        let said = (
+                            stated.bound_s,
+                            stated.legs_s,
+                            stated.work,
+                            stated.rounds,
+                            stated.converged,
+                        );
+                        if (said.0 - again.0).abs() > 1e-6 * (1.0 + again.0)
+                            || (said.1 - again.1).abs() > 1e-6 * (1.0 + again.1)
+                            || (said.2, said.3, said.4) != (again.2, again.3, again.4)
+                        {
+                            totals(format!(
+                                "states the route bound {:.6} s (from the leg bound {:.6} s, {} rounds, {} arcs, converged {}); derived again under {} arcs: {:.6} s (from {:.6} s, {} rounds, {} arcs, converged {})",
+                                said.0,
+                                said.1,
+                                said.3,
+                                said.2,
+                                said.4,
+                                stated.max_work,
+                                again.0,
+                                again.1,
+                                again.3,
+                                again.2,
+                                again.4
+                            ));
+                        }
+                        legs.max(rb.bound)
+                    }
+                    Err(e) => {
+                        totals(format!("the route bound cannot be derived again: {e}"));
+                        legs
+                    }
+                },
+            };
             if (plan.lower_bound_s - lb).abs() > 1e-6 * (1.0 + lb) {
                 totals(format!(
                     "states the lower bound {:.6} s; recomputed {lb:.6} s",

@@ -340,3 +340,87 @@ fn plan_refuses_an_absurd_blend_deviation() {
         assert!(!dir.join("out").join("plan.json").exists());
     }
 }
+
+#[test]
+fn plan_states_the_route_bound_and_verify_derives_it_again() {
+    let dir = scratch("route-bound");
+    small_cell(&dir);
+    let cell = dir.join("cell.toml");
+    let out_dir = dir.join("out");
+    let summary = json_ok(
+        &[
+            "plan",
+            cell.to_str().unwrap(),
+            "-o",
+            out_dir.to_str().unwrap(),
+            "--json",
+            "--no-report",
+            "--route-bound",
+            "0.01",
+        ],
+        &dir,
+    );
+    assert_eq!(summary["verified"], true);
+    let rb = &summary["route_bound"];
+    let (bound, legs) = (rb["bound_s"].as_f64().unwrap(), rb["legs_s"].as_f64().unwrap());
+    let lb = summary["lower_bound_s"].as_f64().unwrap();
+    assert!(bound >= legs - 1e-9 && legs > 0.0, "{rb}");
+    assert_eq!(
+        lb.to_bits(),
+        bound.max(legs).to_bits(),
+        "the larger bound is stated"
+    );
+    assert!(summary["cycle_time_s"].as_f64().unwrap() >= lb - 1e-9);
+    // One robot, three MPs, each remembered: the relaxation is its shortest program, solved.
+    assert_eq!(rb["converged"], true, "{rb}");
+    assert_eq!(rb["max_work"], 10_000_000u64);
+    assert!(
+        rb["rounds"].as_u64().unwrap() >= 1 && rb["work"].as_u64().unwrap() > 0,
+        "{rb}"
+    );
+    let plan_file = out_dir.join("plan.json");
+    let plan: Value = serde_json::from_slice(&std::fs::read(&plan_file).unwrap()).unwrap();
+    assert_eq!(&plan["route_bound"], rb);
+    let verify = |doc: &Value| {
+        let file = dir.join("tampered.json");
+        std::fs::write(&file, serde_json::to_string(doc).unwrap()).unwrap();
+        let out = cellplan(
+            &["verify", file.to_str().unwrap(), cell.to_str().unwrap(), "--json"],
+            &dir,
+        );
+        serde_json::from_slice::<Value>(&out.stdout).unwrap()
+    };
+    assert_eq!(verify(&plan)["ok"], true);
+    // A bound raised, with the lower bound and ratio made to agree with it, is caught; so is
+    // a round too many, and a route bound taken away with the lower bound left at its value.
+    let cycle = plan["cycle_time_s"].as_f64().unwrap();
+    let mut raised = plan.clone();
+    raised["route_bound"]["bound_s"] = Value::from(bound + 0.5);
+    raised["lower_bound_s"] = Value::from(bound + 0.5);
+    raised["ratio_to_lower_bound"] = Value::from(cycle / (bound + 0.5));
+    let mut rounds = plan.clone();
+    rounds["route_bound"]["rounds"] = Value::from(rb["rounds"].as_u64().unwrap() + 1);
+    let mut dropped = plan.clone();
+    dropped.as_object_mut().unwrap().remove("route_bound");
+    for (what, doc) in [("raised", &raised), ("rounds", &rounds)] {
+        let verdict = verify(doc);
+        assert_eq!(verdict["ok"], false, "{what}");
+        let details: Vec<&str> = verdict["violations"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|v| v["detail"].as_str().unwrap())
+            .collect();
+        assert!(
+            details.iter().any(|d| d.contains("states the route bound")),
+            "{what}: {details:?}"
+        );
+    }
+    if bound > legs + 1e-6 {
+        assert_eq!(verify(&dropped)["ok"], false, "the leg bound alone is smaller");
+    }
+    // An absurd budget is refused before anything runs.
+    let out = cellplan(&["plan", cell.to_str().unwrap(), "--route-bound", "5000"], &dir);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--route-bound"));
+}

@@ -2,7 +2,8 @@
 //! coordination record; the unmeasured tasks; the search's counts and times.
 use super::{
     ActivityOut, BlendOut, ComputeTimes, ConflictOut, CoordinationOut, FORMAT, LegOut, PROBE_TRACK_DT, Plan,
-    PoseOut, ProbeTrack, RobotPlan, Sample, SettingsOut, Stats, UnmeasuredTask, VERSION, Visit, WaitOut,
+    PoseOut, ProbeTrack, RobotPlan, RouteBoundOut, Sample, SettingsOut, Stats, UnmeasuredTask, VERSION,
+    Visit, WaitOut,
 };
 use crate::candidates::CandidateTable;
 use crate::coord::{Activity, Conflict, Coordinated, Program, Timed};
@@ -45,6 +46,25 @@ pub fn build(
         crate::plan::allocate::lower_bound(cell, table, &outcome.graphs, &left_out)
             .unwrap_or(outcome.allocated.lower_bound)
     };
+    let began = std::time::Instant::now();
+    let route_bound = settings.route_bound_work.and_then(|max_work| {
+        let rb =
+            crate::plan::allocate::route_bound(cell, table, &outcome.graphs, &left_out, max_work).ok()?;
+        Some(RouteBoundOut {
+            bound_s: rb.bound,
+            legs_s: rb.legs,
+            max_work,
+            work: rb.work,
+            rounds: rb.rounds,
+            converged: rb.converged,
+        })
+    });
+    let lb = route_bound.as_ref().map_or(lb, |r| lb.max(r.bound_s));
+    let route_bound_s = if route_bound.is_some() {
+        began.elapsed().as_secs_f64()
+    } else {
+        0.0
+    };
     Plan {
         format: FORMAT.to_string(),
         version: VERSION,
@@ -55,12 +75,13 @@ pub fn build(
         delta_t_s: delta,
         lower_bound_s: lb,
         ratio_to_lower_bound: ratio(cycle, lb),
+        route_bound,
         verified: false,
         coordination: coordination_out(cell, outcome, coordinated),
         robots,
         unmeasured: unmeasured(cell, table, &outcome.unreached),
         stats: stats(table, outcome, coordinated),
-        compute_s: compute_times(outcome, coordinated, load_s, candidates_s),
+        compute_s: compute_times(outcome, coordinated, load_s, candidates_s, route_bound_s),
     }
 }
 
@@ -269,11 +290,13 @@ fn compute_times(
     coordinated: &Coordinated,
     load_s: f64,
     candidates_s: f64,
+    route_bound_s: f64,
 ) -> ComputeTimes {
     let mut compute = ComputeTimes {
         load: load_s,
         candidates: candidates_s,
         coordination: coordinated.compute_s,
+        route_bound: route_bound_s,
         ..ComputeTimes::default()
     };
     for &(stage, s) in &outcome.compute {
@@ -284,8 +307,11 @@ fn compute_times(
             Stage::Timing => compute.timing = s,
         }
     }
-    compute.total =
-        load_s + candidates_s + outcome.compute.iter().map(|x| x.1).sum::<f64>() + coordinated.compute_s;
+    compute.total = load_s
+        + candidates_s
+        + outcome.compute.iter().map(|x| x.1).sum::<f64>()
+        + coordinated.compute_s
+        + route_bound_s;
     compute
 }
 

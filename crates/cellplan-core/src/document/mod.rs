@@ -43,10 +43,14 @@ pub struct Plan {
     pub delta_t_s: f64,
     /// A lower bound of the cycle time over the candidates the planner considered (s): the
     /// min-max bound of paper 000's allocation problem on lower-bound move times, over the
-    /// tasks the plan measures.
+    /// tasks the plan measures — its leg bound, or the route bound where `route_bound` is
+    /// given and larger.
     pub lower_bound_s: f64,
     /// `cycle_time_s / lower_bound_s` (1 when the bound is 0).
     pub ratio_to_lower_bound: f64,
+    /// The route bound of the same problem (`plan --route-bound`; absent without it).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub route_bound: Option<RouteBoundOut>,
     /// Whether `cellplan verify` accepted the plan before it was written (false only when
     /// written with `--no-verify`).
     pub verified: bool,
@@ -60,6 +64,27 @@ pub struct Plan {
     pub stats: Stats,
     /// Wall-clock seconds per stage.
     pub compute_s: ComputeTimes,
+}
+
+/// The route bound: column generation over whole routes of the allocation problem
+/// (`cellplan_solve::minmax::route_bound`), every number re-derived by the verifier under
+/// `max_work`.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct RouteBoundOut {
+    /// The bound (s); `lower_bound_s` is the larger of it and the leg bound.
+    pub bound_s: f64,
+    /// The leg bound it started from (s).
+    pub legs_s: f64,
+    /// The budget: arcs its pricings may look at (no round starts beyond it).
+    pub max_work: u64,
+    /// Arcs its pricings looked at.
+    pub work: u64,
+    /// Rounds of column generation.
+    pub rounds: usize,
+    /// Whether the relaxation was solved (else the bound is that of the last round, cut by the
+    /// budget).
+    pub converged: bool,
 }
 
 /// The settings of the run.
@@ -444,6 +469,9 @@ pub struct ComputeTimes {
     pub coordination: f64,
     /// The verifier.
     pub verification: f64,
+    /// The route bound (`plan --route-bound`; 0 without it).
+    #[serde(default)]
+    pub route_bound: f64,
     /// Everything, including writing.
     pub total: f64,
 }

@@ -410,7 +410,41 @@ pub fn lower_bound(
     graphs: &[RobotGraph],
     left_out: &[TaskId],
 ) -> Result<f64, PlanError> {
-    let capable: Vec<Vec<usize>> = (0..cell.tasks.len())
+    let capable = capable_except(cell, table, left_out);
+    Ok(minmax::lower_bound(&min_max_problem(cell, graphs, &capable)?.0))
+}
+
+/// The route bound ([`minmax::route_bound`]) of the problem [`lower_bound`] bounds: column
+/// generation over whole routes, started from the routes of Algorithm 1 (seed 0, a
+/// construction: the verifier starts from the same ones) and stopped once its pricings have
+/// looked at `max_work` arcs. Every round's value is a proof, so a cut run still bounds every
+/// plan that measures these tasks; it is never below the leg bound.
+pub fn route_bound(
+    cell: &Cell,
+    table: &CandidateTable,
+    graphs: &[RobotGraph],
+    left_out: &[TaskId],
+    max_work: u64,
+) -> Result<minmax::RouteBound, PlanError> {
+    let capable = capable_except(cell, table, left_out);
+    let (p, _) = min_max_problem(cell, graphs, &capable)?;
+    let params = MinMaxParams {
+        method: MinMaxMethod::Algorithm1,
+        seed: 0,
+        max_iterations: Some(0),
+        time_limit: Duration::from_secs(3600),
+    };
+    let start = minmax::solve(&p, &params).routes;
+    let settings = minmax::RouteBoundSettings {
+        max_work,
+        ..minmax::RouteBoundSettings::default()
+    };
+    Ok(minmax::route_bound(&p, &start, &settings))
+}
+
+/// Per task the robots able to do it, none for the tasks `left_out`.
+fn capable_except(cell: &Cell, table: &CandidateTable, left_out: &[TaskId]) -> Vec<Vec<usize>> {
+    (0..cell.tasks.len())
         .map(|t| {
             if left_out.contains(&TaskId(t)) {
                 Vec::new()
@@ -418,8 +452,7 @@ pub fn lower_bound(
                 table.robots_for(TaskId(t)).into_iter().map(|r| r.0).collect()
             }
         })
-        .collect();
-    Ok(minmax::lower_bound(&min_max_problem(cell, graphs, &capable)?.0))
+        .collect()
 }
 
 /// The min-max problem over the measurable tasks, and the cell task of each of its tasks.

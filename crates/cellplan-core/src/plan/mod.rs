@@ -90,6 +90,10 @@ pub struct PlanSettings {
     /// caller keeps it within the caps and to robots able to do each task; see
     /// [`rebalance::rebalance`].
     pub tasks: Option<Vec<Vec<TaskId>>>,
+    /// Also prove the route bound ([`allocate::route_bound`]) with this work budget, in arcs
+    /// its pricings look at (`None`: the leg bound alone, as by default). The plan states the
+    /// larger bound, and the verifier derives the route bound again under the same budget.
+    pub route_bound_work: Option<u64>,
 }
 
 impl PlanSettings {
@@ -133,6 +137,7 @@ impl Default for PlanSettings {
             task_penalty: Vec::new(),
             sweep: None,
             tasks: None,
+            route_bound_work: None,
             deadline: None,
         }
     }
