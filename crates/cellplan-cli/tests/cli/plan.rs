@@ -354,7 +354,6 @@ fn plan_states_the_route_bound_and_verify_derives_it_again() {
             "-o",
             out_dir.to_str().unwrap(),
             "--json",
-            "--no-report",
             "--route-bound",
             "0.01",
         ],
@@ -381,6 +380,11 @@ fn plan_states_the_route_bound_and_verify_derives_it_again() {
     let plan_file = out_dir.join("plan.json");
     let plan: Value = serde_json::from_slice(&std::fs::read(&plan_file).unwrap()).unwrap();
     assert_eq!(&plan["route_bound"], rb);
+    // The report says which bound it shows.
+    let report = std::fs::read_to_string(out_dir.join("report.html")).unwrap();
+    let from_routes = report.contains("lower bound from whole programs (legs alone:");
+    assert_eq!(from_routes, bound > legs, "{rb}");
+    assert!(from_routes || report.contains("lower bound (cycle ×"));
     let verify = |doc: &Value| {
         let file = dir.join("tampered.json");
         std::fs::write(&file, serde_json::to_string(doc).unwrap()).unwrap();
