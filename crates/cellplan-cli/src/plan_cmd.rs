@@ -60,9 +60,10 @@ pub struct PlanArgs {
     #[arg(long, value_name = "RAD", default_value_t = cellplan_core::coord::BLEND_DEVIATION)]
     blend_deviation: f64,
     /// Inspection cells: also prove a tighter lower bound from whole routes (column
-    /// generation over the allocation problem), its pricings looking at up to this many
-    /// billion arcs (the README cell's converges within 1, the bench gives 20). The plan
-    /// states the larger bound; `verify` derives it again, taking as long again.
+    /// generation over the allocation problem), no round starting once its pricings have
+    /// looked at this many billion arcs (a round may take it past; the README cell's
+    /// converges within 1, the bench gives 20). The plan states the larger bound; `verify`
+    /// derives it again, taking as long again. Bounded by this budget, not by `--time-limit`.
     #[arg(long, value_name = "G_ARCS")]
     route_bound: Option<f64>,
     /// Write the plan even if `cellplan verify` rejects it.
@@ -173,10 +174,10 @@ pub fn run(args: &PlanArgs) -> Result<(), Failure> {
     }
     if args
         .route_bound
-        .is_some_and(|g| !(g.is_finite() && g > 0.0 && g <= 1000.0))
+        .is_some_and(|g| !(g.is_finite() && (1e-9..=1000.0).contains(&g)))
     {
         return Err(Failure::Usage(
-            "--route-bound must be a number of billion arcs above 0 and at most 1000 (20 is the bench's budget)".into(),
+            "--route-bound must be a number of billion arcs from 1e-9 (one arc) to 1000 (20 is the bench's budget)".into(),
         ));
     }
     if args.lazy_rounds > 1000 || args.reallocation_rounds > 1000 {
@@ -419,8 +420,13 @@ fn render(doc: &output::Plan, working: &str) -> String {
             r.work as f64 * 1e-9,
             if r.converged {
                 "the relaxation solved".to_string()
-            } else {
+            } else if r.rounds == 0 {
+                "not run: the problem passes its size limits (1,000 MPs, 60 M arcs), so the leg bound stands"
+                    .to_string()
+            } else if r.work >= r.max_work {
                 format!("cut by its budget of {:.2} G arcs", r.max_work as f64 * 1e-9)
+            } else {
+                "stopped before the relaxation was solved (its round limit or the linear solver)".to_string()
             }
         );
     }

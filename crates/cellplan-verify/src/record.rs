@@ -69,6 +69,9 @@ fn settings(cell: &Cell, plan: &Plan, totals: &mut dyn FnMut(String)) {
     }
 }
 
+/// The most arcs a stated route bound's budget may be (`plan --route-bound 1000`).
+const MAX_ROUTE_BOUND_WORK: u64 = 1_000_000_000_000;
+
 /// The lower bound, recomputed on the graphs the settings name, and its ratio.
 fn lower_bound(cell: &Cell, table: &CandidateTable, plan: &Plan, totals: &mut dyn FnMut(String)) {
     let s = &plan.settings;
@@ -96,6 +99,14 @@ fn lower_bound(cell: &Cell, table: &CandidateTable, plan: &Plan, totals: &mut dy
             // problem, start and work give the same rounds, work and value.
             let lb = match &plan.route_bound {
                 None => legs,
+                // `plan --route-bound` allows 1000 G arcs at most: a larger budget is not run.
+                Some(stated) if stated.max_work > MAX_ROUTE_BOUND_WORK => {
+                    totals(format!(
+                        "states a route-bound budget of {} arcs, more than the {MAX_ROUTE_BOUND_WORK} `plan --route-bound` allows: not derived again",
+                        stated.max_work
+                    ));
+                    legs
+                }
                 Some(stated) => match allocate::route_bound(cell, table, &graphs, &left_out, stated.max_work)
                 {
                     Ok(rb) => {

@@ -384,7 +384,6 @@ fn plan_states_the_route_bound_and_verify_derives_it_again() {
     let report = std::fs::read_to_string(out_dir.join("report.html")).unwrap();
     let from_routes = report.contains("lower bound from whole programs (legs alone:");
     assert_eq!(from_routes, bound > legs, "{rb}");
-    assert!(from_routes || report.contains("lower bound (cycle ×"));
     let verify = |doc: &Value| {
         let file = dir.join("tampered.json");
         std::fs::write(&file, serde_json::to_string(doc).unwrap()).unwrap();
@@ -404,6 +403,11 @@ fn plan_states_the_route_bound_and_verify_derives_it_again() {
     raised["ratio_to_lower_bound"] = Value::from(cycle / (bound + 0.5));
     let mut rounds = plan.clone();
     rounds["route_bound"]["rounds"] = Value::from(rb["rounds"].as_u64().unwrap() + 1);
+    let mut huge = plan.clone();
+    huge["route_bound"]["max_work"] = Value::from(u64::MAX);
+    let verdict = verify(&huge);
+    assert_eq!(verdict["ok"], false);
+    assert!(verdict.to_string().contains("route-bound budget"), "{verdict}");
     let mut dropped = plan.clone();
     dropped.as_object_mut().unwrap().remove("route_bound");
     for (what, doc) in [("raised", &raised), ("rounds", &rounds)] {

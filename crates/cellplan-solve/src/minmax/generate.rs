@@ -52,9 +52,9 @@ pub fn generate_within(
         "alternatives must be a range lo..=hi with lo >= 1"
     );
     let m = vehicles;
-    // Every robot has a depot and a matrix of its own; every task a point, a service time and
-    // a place in each robot's list of alternatives.
-    let fixed = (m as u128) * 8 + (tasks as u128) * 32 + (m as u128) * (tasks as u128) * 24;
+    // Every robot has a record, a depot and a matrix of its own (256 bytes, generously); every
+    // task a point, a service time and a place in each robot's list of alternatives.
+    let fixed = (m as u128) * 256 + (tasks as u128) * 32 + (m as u128) * (tasks as u128) * 24;
     if fixed > u128::from(max_matrix_bytes) {
         return Err(TooLarge(format!(
             "{m} robots and {tasks} tasks take {} MiB before any cost is stored, more than the {} MiB allowed",
@@ -76,14 +76,14 @@ pub fn generate_within(
         let nearest = (pt[0].round().clamp(0.0, (m - 1) as f64)) as usize;
         (pt[0] - v as f64).abs() <= 1.0 || nearest == v
     };
-    let mut bytes = 0u128;
+    let mut bytes = fixed;
     for v in 0..m {
         let reached = pts.iter().filter(|pt| reaches(v, pt)).count() as u128;
         let nodes = 1 + reached * alternatives.1 as u128;
         bytes = bytes.saturating_add(nodes.saturating_mul(nodes).saturating_mul(8));
         if bytes > u128::from(max_matrix_bytes) {
             return Err(TooLarge(format!(
-                "robot {v} alone reaches {reached} tasks; with up to {} nodes each, the cost matrices could take more than the {} MiB allowed",
+                "robot {v} reaches {reached} tasks; with up to {} nodes each, the cost matrices of the robots up to it could take more than the {} MiB allowed",
                 alternatives.1,
                 max_matrix_bytes >> 20
             )));
