@@ -166,6 +166,9 @@ pub struct MinMaxBounds {
     route_bound_work: u64,
     /// Time of both bounds, in seconds.
     bounds_time_s: f64,
+    /// How the route bound's run ended, in words (the table's; the JSON has the fields).
+    #[serde(skip)]
+    ending: String,
 }
 
 fn optimum_for(file: &Path, name: &str) -> Option<f64> {
@@ -373,8 +376,10 @@ fn run_minmax(args: &BenchArgs, limit: Duration) -> Result<Vec<Row>, BenchError>
         let elapsed = start.elapsed().as_secs_f64();
         let bounds = best_routes.map(|(_, routes)| {
             let began = Instant::now();
-            let routes = minmax::route_bound(p, &routes, &minmax::RouteBoundSettings::default());
+            let settings = minmax::RouteBoundSettings::default();
+            let routes = minmax::route_bound(p, &routes, &settings);
             MinMaxBounds {
+                ending: cellplan_core::document::RouteBoundOut::new(&routes, settings.max_work).ending(),
                 lower_bound: routes.legs,
                 route_bound: routes.bound,
                 route_bound_converged: routes.converged,
@@ -500,11 +505,7 @@ pub fn render(rows: &[Row]) -> String {
                 "  lower bounds: legs {:.3}, routes {:.3} ({}, {} rounds, {:.1} s): the cost is at most {:.1} % above\n",
                 b.lower_bound,
                 b.route_bound,
-                if b.route_bound_converged {
-                    "relaxation solved"
-                } else {
-                    "cut by its work budget"
-                },
+                b.ending,
                 b.route_bound_rounds,
                 b.bounds_time_s,
                 100.0 * (r.cost / b.route_bound - 1.0),

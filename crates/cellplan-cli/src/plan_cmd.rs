@@ -418,16 +418,7 @@ fn render(doc: &output::Plan, working: &str) -> String {
             r.legs_s,
             r.rounds,
             r.work as f64 * 1e-9,
-            if r.converged {
-                "the relaxation solved".to_string()
-            } else if r.rounds == 0 {
-                "not run: the problem passes its size limits (1,000 MPs, 60 M arcs), so the leg bound stands"
-                    .to_string()
-            } else if r.work >= r.max_work {
-                format!("cut by its budget of {:.2} G arcs", r.max_work as f64 * 1e-9)
-            } else {
-                "stopped before the relaxation was solved (its round limit or the linear solver)".to_string()
-            }
+            r.ending()
         );
     }
     if !balance_met(doc)

@@ -4,7 +4,7 @@
 //! coordination and the conflicts met on them).
 use super::{Violation, ViolationKind};
 use cellplan_core::candidates::CandidateTable;
-use cellplan_core::document::{self, ActivityOut, ConflictOut, Plan, ProbeTrack, RobotPlan};
+use cellplan_core::document::{self, ActivityOut, ConflictOut, Plan, ProbeTrack, RobotPlan, RouteBoundOut};
 use cellplan_core::plan::allocate;
 use cellplan_core::plan::graph::RobotGraph;
 use cellplan_geom::DVec3;
@@ -110,31 +110,10 @@ fn lower_bound(cell: &Cell, table: &CandidateTable, plan: &Plan, totals: &mut dy
                 Some(stated) => match allocate::route_bound(cell, table, &graphs, &left_out, stated.max_work)
                 {
                     Ok(rb) => {
-                        let again = (rb.bound, rb.legs, rb.work, rb.rounds, rb.converged);
-                        let said = (
-                            stated.bound_s,
-                            stated.legs_s,
-                            stated.work,
-                            stated.rounds,
-                            stated.converged,
-                        );
-                        if (said.0 - again.0).abs() > 1e-6 * (1.0 + again.0)
-                            || (said.1 - again.1).abs() > 1e-6 * (1.0 + again.1)
-                            || (said.2, said.3, said.4) != (again.2, again.3, again.4)
-                        {
+                        let again = RouteBoundOut::new(&rb, stated.max_work);
+                        if !stated.agrees(&again) {
                             totals(format!(
-                                "states the route bound {:.6} s (from the leg bound {:.6} s, {} rounds, {} arcs, converged {}); derived again under {} arcs: {:.6} s (from {:.6} s, {} rounds, {} arcs, converged {})",
-                                said.0,
-                                said.1,
-                                said.3,
-                                said.2,
-                                said.4,
-                                stated.max_work,
-                                again.0,
-                                again.1,
-                                again.3,
-                                again.2,
-                                again.4
+                                "states the route bound {stated:?}; derived again under its budget: {again:?}"
                             ));
                         }
                         legs.max(rb.bound)

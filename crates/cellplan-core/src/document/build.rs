@@ -50,14 +50,7 @@ pub fn build(
     let route_bound = settings.route_bound_work.and_then(|max_work| {
         let rb =
             crate::plan::allocate::route_bound(cell, table, &outcome.graphs, &left_out, max_work).ok()?;
-        Some(RouteBoundOut {
-            bound_s: rb.bound,
-            legs_s: rb.legs,
-            max_work,
-            work: rb.work,
-            rounds: rb.rounds,
-            converged: rb.converged,
-        })
+        Some(RouteBoundOut::new(&rb, max_work))
     });
     let lb = route_bound.as_ref().map_or(lb, |r| lb.max(r.bound_s));
     let route_bound_s = if route_bound.is_some() {

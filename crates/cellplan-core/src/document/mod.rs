@@ -76,15 +76,55 @@ pub struct RouteBoundOut {
     pub bound_s: f64,
     /// The leg bound it started from (s).
     pub legs_s: f64,
-    /// The budget: arcs its pricings may look at (no round starts beyond it).
+    /// The budget: no round starts once its pricings have looked at this many arcs (a round
+    /// may pass it).
     pub max_work: u64,
     /// Arcs its pricings looked at.
     pub work: u64,
-    /// Rounds of column generation.
+    /// Rounds of column generation (0: the problem passes the size limits, and the bound is
+    /// the leg bound).
     pub rounds: usize,
-    /// Whether the relaxation was solved (else the bound is that of the last round, cut by the
-    /// budget).
+    /// Whether the relaxation was solved (else the bound is that of the last round; see
+    /// [`RouteBoundOut::ending`]).
     pub converged: bool,
+}
+
+impl RouteBoundOut {
+    /// The record of `rb`, found under `max_work`.
+    pub fn new(rb: &cellplan_solve::minmax::RouteBound, max_work: u64) -> Self {
+        RouteBoundOut {
+            bound_s: rb.bound,
+            legs_s: rb.legs,
+            max_work,
+            work: rb.work,
+            rounds: rb.rounds,
+            converged: rb.converged,
+        }
+    }
+
+    /// Whether `other` states the same run: the same budget, work, rounds and outcome, the
+    /// bounds within 10⁻⁶ (relative).
+    pub fn agrees(&self, other: &RouteBoundOut) -> bool {
+        let close = |a: f64, b: f64| (a - b).abs() <= 1e-6 * (1.0 + b.abs());
+        close(self.bound_s, other.bound_s)
+            && close(self.legs_s, other.legs_s)
+            && (self.max_work, self.work, self.rounds, self.converged)
+                == (other.max_work, other.work, other.rounds, other.converged)
+    }
+
+    /// How the run ended, in words.
+    pub fn ending(&self) -> String {
+        if self.converged {
+            "the relaxation solved".to_string()
+        } else if self.rounds == 0 {
+            "not run: the problem passes its size limits (1,000 MPs, 60 M arcs), so the leg bound stands"
+                .to_string()
+        } else if self.work >= self.max_work {
+            format!("cut by its budget of {:.2} G arcs", self.max_work as f64 * 1e-9)
+        } else {
+            "stopped before the relaxation was solved (its round limit or the linear solver)".to_string()
+        }
+    }
 }
 
 /// The settings of the run.
