@@ -180,15 +180,13 @@ pub fn route_bound(p: &MinMaxProblem, start: &Routes, settings: &RouteBoundSetti
             out.converged = true;
             break;
         }
-        if added == 0 {
-            if quick {
-                quick = false;
-                continue;
-            }
+        if added == 0 && !quick {
             out.converged = exact;
             break;
         }
-        quick = true;
+        // A quick round that found nothing is followed by an exact one, a round that found
+        // routes by a quick one; past the budget, by none.
+        quick = added > 0;
         if out.work >= settings.max_work {
             break;
         }

@@ -419,6 +419,22 @@ fn route_bound_of_one_vehicle_remembering_every_task_is_its_shortest_route() {
 }
 
 #[test]
+fn no_round_starts_past_the_budget() {
+    // With no work allowed, the first round is the last, also when it prices quickly and
+    // finds nothing (an exact round used to follow it: two rounds on two vehicles × six
+    // tasks, seed 139).
+    for seed in 0..160 {
+        let p = random_asymmetric(2, 1 + seed as usize % 6, seed);
+        let settings = RouteBoundSettings {
+            max_work: 0,
+            ..RouteBoundSettings::default()
+        };
+        let rb = route_bound_of(&p, &settings);
+        assert_eq!(rb.rounds, 1, "seed {seed}: {rb:?}");
+    }
+}
+
+#[test]
 fn route_bound_cut_by_its_budget_is_still_a_bound() {
     for seed in 0..10 {
         let p = random_asymmetric(3, 3 + seed as usize % 4, seed);
