@@ -63,7 +63,9 @@ pub struct PlanArgs {
     /// generation over the allocation problem), no round starting once its pricings have
     /// looked at this many billion arcs (a round may take it past; the README cell's
     /// converges within 1, the bench gives 20). The plan states the larger bound; `verify`
-    /// derives it again, taking as long again. Bounded by this budget, not by `--time-limit`.
+    /// derives it again, taking as long again. `--time-limit` bounds it too: no round starts
+    /// past it (the output then says the clock cut it, and `verify` derives it for the rounds
+    /// made).
     #[arg(long, value_name = "G_ARCS")]
     route_bound: Option<f64>,
     /// Write the plan even if `cellplan verify` rejects it.

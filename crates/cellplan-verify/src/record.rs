@@ -107,10 +107,25 @@ fn lower_bound(cell: &Cell, table: &CandidateTable, plan: &Plan, totals: &mut dy
                     ));
                     legs
                 }
-                Some(stated) => match allocate::route_bound(cell, table, &graphs, &left_out, stated.max_work)
-                {
+                // A run the clock cut is derived again for the rounds it made: without a
+                // clock, that is where the same run stops. Its claim holds where the rounds
+                // neither solved the relaxation nor spent the budget (else the clock did not
+                // stop it).
+                Some(stated) => match allocate::route_bound(
+                    cell,
+                    table,
+                    &graphs,
+                    &left_out,
+                    (
+                        stated.max_work,
+                        stated.cut_by_clock.then_some(stated.rounds),
+                        None,
+                    ),
+                ) {
                     Ok(rb) => {
-                        let again = RouteBoundOut::new(&rb, stated.max_work);
+                        let mut again = RouteBoundOut::new(&rb, stated.max_work);
+                        again.cut_by_clock =
+                            stated.cut_by_clock && !rb.converged && rb.work < stated.max_work;
                         if !stated.agrees(&again) {
                             totals(format!(
                                 "states the route bound {stated:?}; derived again under its budget: {again:?}"

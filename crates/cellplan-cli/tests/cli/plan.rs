@@ -410,7 +410,10 @@ fn plan_states_the_route_bound_and_verify_derives_it_again() {
     assert!(verdict.to_string().contains("route-bound budget"), "{verdict}");
     let mut dropped = plan.clone();
     dropped.as_object_mut().unwrap().remove("route_bound");
-    for (what, doc) in [("raised", &raised), ("rounds", &rounds)] {
+    // A solved run said to be cut by the clock is caught too.
+    let mut clock = plan.clone();
+    clock["route_bound"]["cut_by_clock"] = Value::from(true);
+    for (what, doc) in [("raised", &raised), ("rounds", &rounds), ("clock", &clock)] {
         let verdict = verify(doc);
         assert_eq!(verdict["ok"], false, "{what}");
         let details: Vec<&str> = verdict["violations"]
@@ -427,6 +430,36 @@ fn plan_states_the_route_bound_and_verify_derives_it_again() {
     if bound > legs + 1e-6 {
         assert_eq!(verify(&dropped)["ok"], false, "the leg bound alone is smaller");
     }
+    // The run's time limit bounds the route bound too: cut before its first round, it is the
+    // leg bound, the plan says the clock cut it, and the verifier derives it again.
+    let cut_dir = dir.join("cut");
+    let cut = json_ok(
+        &[
+            "plan",
+            cell.to_str().unwrap(),
+            "-o",
+            cut_dir.to_str().unwrap(),
+            "--json",
+            "--route-bound",
+            "0.01",
+            "--time-limit",
+            "0.000001",
+        ],
+        &dir,
+    );
+    let crb = &cut["route_bound"];
+    assert_eq!(
+        (&crb["cut_by_clock"], &crb["rounds"]),
+        (&Value::from(true), &Value::from(0)),
+        "{crb}"
+    );
+    assert_eq!(crb["bound_s"], crb["legs_s"]);
+    assert_eq!(
+        (&cut["time_limit_hit"], &cut["verified"]),
+        (&Value::from(true), &Value::from(true))
+    );
+    let cut_plan: Value = serde_json::from_slice(&std::fs::read(cut_dir.join("plan.json")).unwrap()).unwrap();
+    assert_eq!(verify(&cut_plan)["ok"], true);
     // An absurd budget is refused before anything runs.
     let out = cellplan(&["plan", cell.to_str().unwrap(), "--route-bound", "5000"], &dir);
     assert_eq!(out.status.code(), Some(2));

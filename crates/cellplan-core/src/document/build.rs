@@ -47,12 +47,15 @@ pub fn build(
             .unwrap_or(outcome.allocated.lower_bound)
     };
     let began = std::time::Instant::now();
+    // The run's wall-clock limit bounds it too (none by default).
     let route_bound = settings.route_bound_work.and_then(|max_work| {
-        let rb =
-            crate::plan::allocate::route_bound(cell, table, &outcome.graphs, &left_out, max_work).ok()?;
+        let limits = (max_work, None, settings.deadline);
+        let rb = crate::plan::allocate::route_bound(cell, table, &outcome.graphs, &left_out, limits).ok()?;
         Some(RouteBoundOut::new(&rb, max_work))
     });
     let lb = route_bound.as_ref().map_or(lb, |r| lb.max(r.bound_s));
+    // The clock stopped the route bound: the plan says so.
+    let clock_cut = route_bound.as_ref().is_some_and(|r| r.cut_by_clock);
     let route_bound_s = if route_bound.is_some() {
         began.elapsed().as_secs_f64()
     } else {
@@ -73,7 +76,10 @@ pub fn build(
         coordination: coordination_out(cell, outcome, coordinated),
         robots,
         unmeasured: unmeasured(cell, table, &outcome.unreached),
-        stats: stats(table, outcome, coordinated),
+        stats: Stats {
+            time_limit_hit: outcome.time_limit_hit || clock_cut,
+            ..stats(table, outcome, coordinated)
+        },
         compute_s: compute_times(outcome, coordinated, load_s, candidates_s, route_bound_s),
     }
 }

@@ -87,6 +87,10 @@ pub struct RouteBoundOut {
     /// Whether the relaxation was solved (else the bound is that of the last round; see
     /// [`RouteBoundOut::ending`]).
     pub converged: bool,
+    /// Whether the run's wall-clock limit (`--time-limit`) stopped it before its budget: the
+    /// verifier then derives it again for the `rounds` stated (the same work and value).
+    #[serde(default)]
+    pub cut_by_clock: bool,
 }
 
 impl RouteBoundOut {
@@ -99,23 +103,37 @@ impl RouteBoundOut {
             work: rb.work,
             rounds: rb.rounds,
             converged: rb.converged,
+            cut_by_clock: rb.clock_cut,
         }
     }
 
     /// Whether `other` states the same run: the same budget, work, rounds and outcome, the
-    /// bounds within 10⁻⁶ (relative).
+    /// bounds within 10⁻⁶ (relative), and whether the clock cut it.
     pub fn agrees(&self, other: &RouteBoundOut) -> bool {
         let close = |a: f64, b: f64| (a - b).abs() <= 1e-6 * (1.0 + b.abs());
         close(self.bound_s, other.bound_s)
             && close(self.legs_s, other.legs_s)
-            && (self.max_work, self.work, self.rounds, self.converged)
-                == (other.max_work, other.work, other.rounds, other.converged)
+            && (
+                self.max_work,
+                self.work,
+                self.rounds,
+                self.converged,
+                self.cut_by_clock,
+            ) == (
+                other.max_work,
+                other.work,
+                other.rounds,
+                other.converged,
+                other.cut_by_clock,
+            )
     }
 
     /// How the run ended, in words.
     pub fn ending(&self) -> String {
         if self.converged {
             "the relaxation solved".to_string()
+        } else if self.cut_by_clock {
+            format!("cut by the time limit after {} rounds", self.rounds)
         } else if self.rounds == 0 {
             "not run: the problem passes its size limits (1,000 MPs, 60 M arcs), so the leg bound stands"
                 .to_string()

@@ -417,14 +417,16 @@ pub fn lower_bound(
 /// The route bound ([`minmax::route_bound`]) of the problem [`lower_bound`] bounds: column
 /// generation over whole routes, started from the routes of Algorithm 1 (seed 0, a
 /// construction: the verifier starts from the same ones) and stopped once its pricings have
-/// looked at `max_work` arcs. Every round's value is a proof, so a cut run still bounds every
-/// plan that measures these tasks; it is never below the leg bound.
+/// looked at `max_work` arcs, or after `rounds` rounds, or once `deadline` has passed, where
+/// given. Every round's value is a proof, so a cut run still bounds every plan that measures
+/// these tasks; it is never below the leg bound. A run the deadline stopped after `k` rounds
+/// is the run `rounds: Some(k)` makes without one.
 pub fn route_bound(
     cell: &Cell,
     table: &CandidateTable,
     graphs: &[RobotGraph],
     left_out: &[TaskId],
-    max_work: u64,
+    (max_work, rounds, deadline): (u64, Option<usize>, Option<std::time::Instant>),
 ) -> Result<minmax::RouteBound, PlanError> {
     let capable = capable_except(cell, table, left_out);
     let (p, _) = min_max_problem(cell, graphs, &capable)?;
@@ -435,9 +437,12 @@ pub fn route_bound(
         time_limit: Duration::from_secs(3600),
     };
     let start = minmax::solve(&p, &params).routes;
+    let defaults = minmax::RouteBoundSettings::default();
     let settings = minmax::RouteBoundSettings {
         max_work,
-        ..minmax::RouteBoundSettings::default()
+        max_rounds: rounds.unwrap_or(defaults.max_rounds),
+        deadline,
+        ..defaults
     };
     Ok(minmax::route_bound(&p, &start, &settings))
 }

@@ -62,6 +62,9 @@ pub struct RouteBoundSettings {
     /// Most arcs between the vehicles' task nodes, summed over the vehicles: beyond, only
     /// [`lower_bound`](super::lower_bound) is given (the pricing keeps its own copy of them).
     pub max_arcs: usize,
+    /// A wall clock: no round starts once it has passed (`None`: none; the result then
+    /// depends on the problem and the settings only, else on the machine's speed too).
+    pub deadline: Option<std::time::Instant>,
 }
 
 impl Default for RouteBoundSettings {
@@ -73,6 +76,7 @@ impl Default for RouteBoundSettings {
             max_work: 20_000_000_000,
             max_tasks: 1_000,
             max_arcs: 60_000_000,
+            deadline: None,
         }
     }
 }
@@ -97,6 +101,9 @@ pub struct RouteBound {
     /// Arcs looked at by all pricings (the work done: the completion bounds' and the
     /// labelling's).
     pub work: u64,
+    /// Whether the deadline stopped it (a round left to make, [`RouteBoundSettings::deadline`]
+    /// passed): the same settings with `max_rounds` set to `rounds` give the same result.
+    pub clock_cut: bool,
 }
 
 /// The route bound of `p`, starting from the routes of a solution (`start`, which must be a
@@ -112,6 +119,7 @@ pub fn route_bound(p: &MinMaxProblem, start: &Routes, settings: &RouteBoundSetti
         columns: 0,
         converged: false,
         work: 0,
+        clock_cut: false,
     };
     let arcs: usize = p
         .vehicles
@@ -146,6 +154,10 @@ pub fn route_bound(p: &MinMaxProblem, start: &Routes, settings: &RouteBoundSetti
     // routes goes back to quick ones.
     let mut quick = true;
     for round in 0..settings.max_rounds {
+        if settings.deadline.is_some_and(|d| std::time::Instant::now() >= d) {
+            out.clock_cut = true;
+            break;
+        }
         out.rounds = round + 1;
         let Some(duals) = solve_master(p, &columns) else {
             break;

@@ -435,6 +435,47 @@ fn no_round_starts_past_the_budget() {
 }
 
 #[test]
+fn a_run_the_clock_cut_is_the_run_of_its_rounds() {
+    for seed in 0..6 {
+        let p = random_asymmetric(3, 3 + seed as usize % 4, seed);
+        // Past already: no round, the leg bound.
+        let past = RouteBoundSettings {
+            deadline: Some(std::time::Instant::now()),
+            ..RouteBoundSettings::default()
+        };
+        let rb = route_bound_of(&p, &past);
+        assert!(
+            rb.clock_cut && rb.rounds == 0 && !rb.converged,
+            "seed {seed}: {rb:?}"
+        );
+        assert_eq!(rb.bound, lower_bound(&p));
+        // Cut wherever the clock cuts it: the same as the run of as many rounds, no clock.
+        for micros in [50, 500, 5_000] {
+            let soon = RouteBoundSettings {
+                deadline: Some(std::time::Instant::now() + std::time::Duration::from_micros(micros)),
+                ..RouteBoundSettings::default()
+            };
+            let cut = route_bound_of(&p, &soon);
+            let again = route_bound_of(
+                &p,
+                &RouteBoundSettings {
+                    max_rounds: cut.rounds,
+                    ..RouteBoundSettings::default()
+                },
+            );
+            assert!(!again.clock_cut);
+            assert_eq!(
+                (cut.bound.to_bits(), cut.work, cut.rounds, cut.converged),
+                (again.bound.to_bits(), again.work, again.rounds, again.converged),
+                "seed {seed}, {micros} µs"
+            );
+        }
+        // Without a clock, nothing says it cut the run.
+        assert!(!route_bound_of(&p, &RouteBoundSettings::default()).clock_cut);
+    }
+}
+
+#[test]
 fn route_bound_cut_by_its_budget_is_still_a_bound() {
     for seed in 0..10 {
         let p = random_asymmetric(3, 3 + seed as usize % 4, seed);
