@@ -58,10 +58,21 @@ impl CostMatrix {
     /// # Panics
     /// If a node is not below [`CostMatrix::n`].
     pub fn sub(&self, nodes: &[usize]) -> Self {
+        // Runs of consecutive nodes (a task's alternatives mostly are) are copied a slice at
+        // a time.
+        let mut runs: Vec<(usize, usize)> = Vec::new();
+        for &j in nodes {
+            match runs.last_mut() {
+                Some((from, to)) if *to == j => *to = j + 1,
+                _ => runs.push((j, j + 1)),
+            }
+        }
         let mut data = Vec::with_capacity(nodes.len() * nodes.len());
         for &i in nodes {
             let row = &self.data[i * self.n..(i + 1) * self.n];
-            data.extend(nodes.iter().map(|&j| row[j]));
+            for &(from, to) in &runs {
+                data.extend_from_slice(&row[from..to]);
+            }
         }
         CostMatrix { n: nodes.len(), data }
     }
@@ -392,6 +403,15 @@ mod tests {
             }
         }
         assert_eq!(m.sub(&[]).n(), 0);
+        // Runs of consecutive nodes (copied a slice at a time), repeats and turns back.
+        let big = CostMatrix::from_fn(12, |i, j| if i == j { 0.0 } else { (7 * i + 3 * j) as f64 });
+        let nodes = [0, 3, 4, 5, 5, 6, 11, 10, 1, 2, 3, 0];
+        let s = big.sub(&nodes);
+        for (i, &a) in nodes.iter().enumerate() {
+            for (j, &b) in nodes.iter().enumerate() {
+                assert_eq!(s.get(i, j), big.get(a, b), "({i}, {j})");
+            }
+        }
     }
 
     #[test]
