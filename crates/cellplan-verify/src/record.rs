@@ -109,8 +109,8 @@ fn lower_bound(cell: &Cell, table: &CandidateTable, plan: &Plan, totals: &mut dy
                 }
                 // A run the clock cut is derived again for the rounds it made: without a
                 // clock, that is where the same run stops. Its claim holds where the rounds
-                // neither solved the relaxation nor spent the budget (else the clock did not
-                // stop it).
+                // neither solved the relaxation nor spent the budget nor reached the round
+                // limit (else the clock did not stop it).
                 Some(stated) => match allocate::route_bound(
                     cell,
                     table,
@@ -124,8 +124,9 @@ fn lower_bound(cell: &Cell, table: &CandidateTable, plan: &Plan, totals: &mut dy
                 ) {
                     Ok(rb) => {
                         let mut again = RouteBoundOut::new(&rb, stated.max_work);
+                        let rounds_left = rb.rounds < allocate::route_bound_round_limit();
                         again.cut_by_clock =
-                            stated.cut_by_clock && !rb.converged && rb.work < stated.max_work;
+                            stated.cut_by_clock && !rb.converged && rb.work < stated.max_work && rounds_left;
                         if !stated.agrees(&again) {
                             totals(format!(
                                 "states the route bound {stated:?}; derived again under its budget: {again:?}"

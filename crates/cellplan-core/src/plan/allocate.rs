@@ -447,6 +447,11 @@ pub fn route_bound(
     Ok(minmax::route_bound(&p, &start, &settings))
 }
 
+/// The most rounds [`route_bound`] makes when not given fewer.
+pub fn route_bound_round_limit() -> usize {
+    minmax::RouteBoundSettings::default().max_rounds
+}
+
 /// Per task the robots able to do it, none for the tasks `left_out`.
 fn capable_except(cell: &Cell, table: &CandidateTable, left_out: &[TaskId]) -> Vec<Vec<usize>> {
     (0..cell.tasks.len())
