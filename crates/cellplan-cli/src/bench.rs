@@ -161,7 +161,8 @@ pub struct MinMaxBounds {
     /// Whether the route relaxation was solved (else the bound is that of the last round).
     route_bound_converged: bool,
     route_bound_rounds: usize,
-    /// Arcs its pricings looked at (its work; `RouteBoundSettings::max_work` at most).
+    /// Arcs its pricings looked at (its work; `RouteBoundSettings::max_work` at most, give or
+    /// take a round).
     route_bound_work: u64,
     /// Time of both bounds, in seconds.
     bounds_time_s: f64,

@@ -61,8 +61,7 @@ pub struct PlanArgs {
     blend_deviation: f64,
     /// Inspection cells: also prove a tighter lower bound from whole routes (column
     /// generation over the allocation problem), no round starting once its pricings have
-    /// looked at this many billion arcs (each robot's pricing stops at its share of what is
-    /// left, so the work never passes it; the README cell's
+    /// looked at this many billion arcs (a round may take it past; the README cell's
     /// converges within 1, the bench gives 20). The plan states the larger bound; `verify`
     /// derives it again, taking as long again. `--time-limit` bounds it too: no round starts
     /// past it (the output then says the clock cut it, and `verify` derives it for the rounds

@@ -125,11 +125,8 @@ fn lower_bound(cell: &Cell, table: &CandidateTable, plan: &Plan, totals: &mut dy
                     Ok(rb) => {
                         let mut again = RouteBoundOut::new(&rb, stated.max_work);
                         let rounds_left = rb.rounds < allocate::route_bound_round_limit();
-                        again.cut_by_clock = stated.cut_by_clock
-                            && !rb.converged
-                            && !rb.budget_cut
-                            && rb.work < stated.max_work
-                            && rounds_left;
+                        again.cut_by_clock =
+                            stated.cut_by_clock && !rb.converged && rb.work < stated.max_work && rounds_left;
                         if !stated.agrees(&again) {
                             totals(format!(
                                 "states the route bound {stated:?}; derived again under its budget: {again:?}"

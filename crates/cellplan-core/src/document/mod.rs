@@ -76,8 +76,8 @@ pub struct RouteBoundOut {
     pub bound_s: f64,
     /// The leg bound it started from (s).
     pub legs_s: f64,
-    /// The budget: the pricings look at no more arcs than this (no round starts once they
-    /// have, and each robot's pricing stops at its share of what is left).
+    /// The budget: no round starts once its pricings have looked at this many arcs (a round
+    /// may pass it).
     pub max_work: u64,
     /// Arcs its pricings looked at.
     pub work: u64,
@@ -91,10 +91,6 @@ pub struct RouteBoundOut {
     /// verifier then derives it again for the `rounds` stated (the same work and value).
     #[serde(default)]
     pub cut_by_clock: bool,
-    /// Whether a robot's pricing stopped at its share of the budget (the budget ended the
-    /// run, though `work` may stay a little below `max_work`).
-    #[serde(default)]
-    pub cut_by_budget: bool,
 }
 
 impl RouteBoundOut {
@@ -108,25 +104,28 @@ impl RouteBoundOut {
             rounds: rb.rounds,
             converged: rb.converged,
             cut_by_clock: rb.clock_cut,
-            cut_by_budget: rb.budget_cut,
         }
     }
 
     /// Whether `other` states the same run: the same budget, work, rounds and outcome, the
-    /// bounds within 10⁻⁶ (relative), and what cut it.
+    /// bounds within 10⁻⁶ (relative), and whether the clock cut it.
     pub fn agrees(&self, other: &RouteBoundOut) -> bool {
         let close = |a: f64, b: f64| (a - b).abs() <= 1e-6 * (1.0 + b.abs());
-        let run = |r: &RouteBoundOut| {
-            (
-                r.max_work,
-                r.work,
-                r.rounds,
-                r.converged,
-                r.cut_by_clock,
-                r.cut_by_budget,
+        close(self.bound_s, other.bound_s)
+            && close(self.legs_s, other.legs_s)
+            && (
+                self.max_work,
+                self.work,
+                self.rounds,
+                self.converged,
+                self.cut_by_clock,
+            ) == (
+                other.max_work,
+                other.work,
+                other.rounds,
+                other.converged,
+                other.cut_by_clock,
             )
-        };
-        close(self.bound_s, other.bound_s) && close(self.legs_s, other.legs_s) && run(self) == run(other)
     }
 
     /// How the run ended, in words.
@@ -138,7 +137,7 @@ impl RouteBoundOut {
         } else if self.rounds == 0 {
             "not run: the problem passes its size limits (1,000 MPs, 60 M arcs), so the leg bound stands"
                 .to_string()
-        } else if self.cut_by_budget || self.work >= self.max_work {
+        } else if self.work >= self.max_work {
             format!("cut by its budget of {:.2} G arcs", self.max_work as f64 * 1e-9)
         } else {
             "stopped before the relaxation was solved (its round limit or the linear solver)".to_string()

@@ -53,10 +53,8 @@ pub struct RouteBoundSettings {
     pub max_rounds: usize,
     /// Most labels one pricing may make (a pricing past it answers with its relaxation).
     pub max_labels: usize,
-    /// Most work of all pricings, in arcs looked at: no round starts beyond it, and each
-    /// vehicle's pricing stops at its share of what is left (answering with its relaxation, as
-    /// at `max_labels`), so the work stays within it (the budget of the whole; every round's
-    /// bound is a proof, so a cut run still gives one).
+    /// Most work of all pricings, in arcs looked at: no round starts beyond it (the budget
+    /// of the whole; every round's bound is a proof, so a cut run still gives one).
     pub max_work: u64,
     /// Most tasks: beyond, only [`lower_bound`](super::lower_bound) is given (the pricing's
     /// tables hold `tasks²` bytes per vehicle).
@@ -103,9 +101,6 @@ pub struct RouteBound {
     /// Arcs looked at by all pricings (the work done: the completion bounds' and the
     /// labelling's).
     pub work: u64,
-    /// Whether a pricing stopped at its share of the budget (see
-    /// [`RouteBoundSettings::max_work`]): the budget, not the relaxation, ended the run.
-    pub budget_cut: bool,
     /// Whether the deadline stopped it (a round left to make, [`RouteBoundSettings::deadline`]
     /// passed): the same settings with `max_rounds` set to `rounds` give the same result.
     pub clock_cut: bool,
@@ -125,7 +120,6 @@ pub fn route_bound(p: &MinMaxProblem, start: &Routes, settings: &RouteBoundSetti
         converged: false,
         work: 0,
         clock_cut: false,
-        budget_cut: false,
     };
     let arcs: usize = p
         .vehicles
@@ -172,18 +166,14 @@ pub fn route_bound(p: &MinMaxProblem, start: &Routes, settings: &RouteBoundSetti
         let mut value: f64 = duals.pi.iter().sum();
         let mut added = 0;
         let mut exact = true;
-        // The vehicles priced side by side, their answers taken in order, each within its
-        // share of the budget left.
-        let share = settings.max_work.saturating_sub(out.work) / graphs.len() as u64;
-        let limits = (settings.max_labels, share);
+        // The vehicles priced side by side, their answers taken in order.
         let priced: Vec<Priced> = graphs
             .par_iter()
             .enumerate()
-            .map(|(v, g)| g.price(duals.mu[v], &duals.pi, &p.service, limits, quick))
+            .map(|(v, g)| g.price(duals.mu[v], &duals.pi, &p.service, settings.max_labels, quick))
             .collect();
         for (v, (g, priced)) in graphs.iter().zip(priced).enumerate() {
             out.work += priced.work;
-            out.budget_cut |= priced.cut;
             exact &= priced.exact;
             value += priced.value.min(0.0);
             for nodes in priced.routes {
@@ -209,8 +199,7 @@ pub fn route_bound(p: &MinMaxProblem, start: &Routes, settings: &RouteBoundSetti
         // A quick round that found nothing is followed by an exact one, a round that found
         // routes by a quick one; past the budget, by none.
         quick = added > 0;
-        // A pricing stopped at its share: what is left is too little for another round.
-        if out.work >= settings.max_work || out.budget_cut {
+        if out.work >= settings.max_work {
             break;
         }
     }
@@ -345,8 +334,6 @@ struct Priced {
     exact: bool,
     /// Arcs looked at.
     work: u64,
-    /// Whether it stopped at its share of the budget.
-    cut: bool,
 }
 
 /// A partial route in the labelling: at `node`, having visited the tasks of `memory` (bits
@@ -450,17 +437,7 @@ impl Graph {
     /// The least `μ·time(route) − π(route)` over the vehicle's ng-routes of at most
     /// `longest` tasks (see the module's notes), or a lower bound of it.
     /// `quick`: [`Graph::price_quick`] instead, a heuristic.
-    /// `(max_labels, max_work)`: the labels and arcs it may make and look at; past either, it
-    /// stops (exact pricing answers with its relaxation, or with no bound when even the
-    /// completion bounds would pass `max_work`).
-    fn price(
-        &self,
-        mu: f64,
-        pi: &[f64],
-        service: &[f64],
-        (max_labels, max_work): (usize, u64),
-        quick: bool,
-    ) -> Priced {
+    fn price(&self, mu: f64, pi: &[f64], service: &[f64], max_labels: usize, quick: bool) -> Priced {
         let len = self.node.len();
         if len == 0 || self.longest == 0 {
             return Priced {
@@ -468,7 +445,6 @@ impl Graph {
                 routes: Vec::new(),
                 exact: true,
                 work: 0,
-                cut: false,
             };
         }
         if mu <= 0.0 {
@@ -487,21 +463,10 @@ impl Graph {
                 routes: if route.is_empty() { Vec::new() } else { vec![route] },
                 exact: true,
                 work: 0,
-                cut: false,
             };
         }
         if quick {
-            return self.price_quick(mu, pi, service, (max_labels, max_work));
-        }
-        let table = (self.longest * len * len) as u64;
-        if table > max_work {
-            return Priced {
-                value: f64::NEG_INFINITY,
-                routes: Vec::new(),
-                exact: false,
-                work: 0,
-                cut: true,
-            };
+            return self.price_quick(mu, pi, service, max_labels);
         }
         let w: Vec<f64> = (0..len)
             .map(|a| mu * service[self.task[a]] - pi[self.task[a]])
@@ -509,8 +474,7 @@ impl Graph {
         let arc = |a: usize, b: usize| mu * self.cost[a * len + b];
         // rest[k][a]: the least cost after `a` (its own paid) of at most `k` more nodes, then
         // home, without memory (q-routes): a bound of every completion.
-        let mut work = table;
-        let mut cut = false;
+        let mut work = (self.longest * len * len) as u64;
         let mut rest = vec![vec![0.0; len]; self.longest];
         for (r, back) in rest[0].iter_mut().zip(&self.back) {
             *r = mu * back;
@@ -583,10 +547,6 @@ impl Graph {
                 else {
                     continue;
                 };
-                if work + len as u64 > max_work {
-                    (exact, cut) = (false, true);
-                    break 'layers;
-                }
                 ahead.clear();
                 work += len as u64;
                 for c in 0..len {
@@ -605,10 +565,6 @@ impl Graph {
                 let hood = &self.near[t];
                 for k in 0..layer[a].len() {
                     let label = labels[layer[a][k] as usize];
-                    if work + ahead.len() as u64 > max_work {
-                        (exact, cut) = (false, true);
-                        break 'layers;
-                    }
                     work += ahead.len() as u64;
                     for &(x, c) in &ahead {
                         // (Values are finite or +inf, never NaN.)
@@ -657,7 +613,6 @@ impl Graph {
             routes,
             exact,
             work,
-            cut,
         }
     }
 
@@ -681,13 +636,7 @@ impl Graph {
     /// A quick pricing for `μ > 0`: one label per node (the cheapest), along the
     /// [`QUICK_SUCCESSORS`] cheapest arcs of each node, with the ng memory. A heuristic: it finds
     /// routes to add, and its value is no bound (minus infinity).
-    fn price_quick(
-        &self,
-        mu: f64,
-        pi: &[f64],
-        service: &[f64],
-        (max_labels, max_work): (usize, u64),
-    ) -> Priced {
+    fn price_quick(&self, mu: f64, pi: &[f64], service: &[f64], max_labels: usize) -> Priced {
         let len = self.node.len();
         let n = pi.len();
         let w: Vec<f64> = (0..len)
@@ -705,8 +654,7 @@ impl Graph {
         let mut best_at: Vec<u32> = vec![u32::MAX; len];
         let mut done: Vec<(f64, u32)> = Vec::new();
         let mut work = 0u64;
-        let mut cut = false;
-        'layers: for depth in 1..=self.longest {
+        for depth in 1..=self.longest {
             for &i in &layer {
                 let l = &labels[i as usize];
                 let x = l.value + mu * self.back[l.node as usize];
@@ -724,10 +672,6 @@ impl Graph {
                 let a = label.node as usize;
                 let t = self.task[a];
                 let hood = &self.near[t];
-                if work + self.successors[a].len() as u64 > max_work {
-                    cut = true;
-                    break 'layers;
-                }
                 work += self.successors[a].len() as u64;
                 for &c in &self.successors[a] {
                     let c = c as usize;
@@ -763,7 +707,6 @@ impl Graph {
             routes,
             exact: false,
             work,
-            cut,
         }
     }
 }
