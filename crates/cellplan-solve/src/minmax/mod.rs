@@ -25,7 +25,7 @@ mod tests;
 
 pub use bound::lower_bound;
 pub use generate::{TooLarge, generate, generate_within};
-pub use routes_bound::{RouteBound, RouteBoundSettings, route_bound};
+pub use routes_bound::{RouteBound, RouteBoundSettings, lagrangian_bound, route_bound};
 
 /// One vehicle (robot).
 #[derive(Clone, Debug, PartialEq)]

@@ -101,6 +101,10 @@ pub struct RouteBound {
     /// Arcs looked at by all pricings (the work done: the completion bounds' and the
     /// labelling's).
     pub work: u64,
+    /// The duals (per task `π`, per vehicle `μ`) of the round whose value is `bound`; `None`
+    /// when no round beat the leg bound. [`lagrangian_bound`] gives `bound` again from them,
+    /// with one exact pricing per vehicle: a certificate of the bound.
+    pub duals: Option<(Vec<f64>, Vec<f64>)>,
     /// Whether the deadline stopped it (a round left to make, [`RouteBoundSettings::deadline`]
     /// passed): the same settings with `max_rounds` set to `rounds` give the same result.
     pub clock_cut: bool,
@@ -120,6 +124,7 @@ pub fn route_bound(p: &MinMaxProblem, start: &Routes, settings: &RouteBoundSetti
         converged: false,
         work: 0,
         clock_cut: false,
+        duals: None,
     };
     let arcs: usize = p
         .vehicles
@@ -185,7 +190,10 @@ pub fn route_bound(p: &MinMaxProblem, start: &Routes, settings: &RouteBoundSetti
                 }
             }
         }
-        out.bound = out.bound.max(value);
+        if value > out.bound {
+            out.bound = value;
+            out.duals = Some((duals.pi.clone(), duals.mu.clone()));
+        }
         // The bound has reached the restricted problem's value, which is at least the
         // relaxation's: solved, however the routes were priced.
         if out.bound >= duals.value - 1e-9 * duals.value.max(1.0) {
@@ -205,6 +213,52 @@ pub fn route_bound(p: &MinMaxProblem, start: &Routes, settings: &RouteBoundSetti
     }
     out.columns = columns.len();
     out
+}
+
+/// The Lagrangian bound of `p` at duals `pi` (per task) and `mu` (per vehicle):
+/// `Σπ + Σ_v min(0, least μ_v·time(r) − π(r) over v's ng-routes r)`, each vehicle priced as the
+/// exact rounds of [`route_bound`] price it (`settings`' ng-neighbourhoods and label limit; past
+/// that limit the pricing's relaxation). Every `π, μ ≥ 0` with `Σμ ≤ 1` gives a lower bound of
+/// every solution's makespan, so this checks a stated bound from its duals alone. `None` when the
+/// duals are not such (wrong lengths, negative, not finite, `Σμ` above one by more than 10⁻¹²,
+/// the rounding of [`route_bound`]'s scaling) or `p` passes the size limits.
+pub fn lagrangian_bound(
+    p: &MinMaxProblem,
+    pi: &[f64],
+    mu: &[f64],
+    settings: &RouteBoundSettings,
+) -> Option<f64> {
+    let m = p.vehicles.len();
+    let finite = |x: &f64| x.is_finite() && *x >= 0.0;
+    if pi.len() != p.tasks || mu.len() != m || !pi.iter().all(finite) || !mu.iter().all(finite) {
+        return None;
+    }
+    // Scaled to sum one, the duals may sum a rounding above it: weaker by as little.
+    if mu.iter().sum::<f64>() > 1.0 + 1e-12 {
+        return None;
+    }
+    let arcs: usize = p
+        .vehicles
+        .iter()
+        .map(|v| v.alternatives.iter().map(Vec::len).sum::<usize>().pow(2))
+        .sum();
+    if p.tasks == 0 || p.tasks > settings.max_tasks || arcs > settings.max_arcs {
+        return None;
+    }
+    let ng = settings.ng.clamp(1, 32);
+    let priced: Vec<f64> = (0..m)
+        .into_par_iter()
+        .map(|v| {
+            Graph::new(p, v, ng)
+                .price(mu[v], pi, &p.service, settings.max_labels, false)
+                .value
+        })
+        .collect();
+    let mut value: f64 = pi.iter().sum();
+    for v in priced {
+        value += v.min(0.0);
+    }
+    Some(value)
 }
 
 /// One route of one vehicle, as the restricted problem sees it.

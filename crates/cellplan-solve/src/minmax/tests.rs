@@ -476,6 +476,41 @@ fn a_run_the_clock_cut_is_the_run_of_its_rounds() {
 }
 
 #[test]
+fn the_duals_of_the_bound_certify_it() {
+    let settings = RouteBoundSettings::default();
+    let mut certified = 0;
+    for seed in 0..20 {
+        let p = random_asymmetric(2 + seed as usize % 2, 3 + seed as usize % 4, seed);
+        let rb = route_bound_of(&p, &settings);
+        let opt = brute_force(&p);
+        let Some((pi, mu)) = &rb.duals else {
+            // No round beat the leg bound.
+            assert_eq!(rb.bound, rb.legs, "seed {seed}");
+            continue;
+        };
+        // One pricing per vehicle gives the bound again, bit for bit.
+        let again = lagrangian_bound(&p, pi, mu, &settings).expect("feasible duals");
+        assert_eq!(again.to_bits(), rb.bound.to_bits(), "seed {seed}");
+        certified += 1;
+        // Any other feasible duals bound the optimum too.
+        let half: Vec<f64> = mu.iter().map(|x| 0.5 * x).collect();
+        let more: Vec<f64> = pi.iter().map(|x| 1.1 * x).collect();
+        for (a, b) in [(pi, &half), (&more, mu)] {
+            let v = lagrangian_bound(&p, a, b, &settings).expect("feasible duals");
+            assert!(v <= opt + 1e-7, "seed {seed}: {v} against the optimum {opt}");
+        }
+        // Infeasible duals are refused.
+        let mut negative = pi.clone();
+        negative[0] = -1.0;
+        assert!(lagrangian_bound(&p, &negative, mu, &settings).is_none());
+        let heavy: Vec<f64> = mu.iter().map(|x| x + 1.0).collect();
+        assert!(lagrangian_bound(&p, pi, &heavy, &settings).is_none());
+        assert!(lagrangian_bound(&p, &pi[1..], mu, &settings).is_none());
+    }
+    assert!(certified >= 10, "{certified} of 20 certified");
+}
+
+#[test]
 fn route_bound_cut_by_its_budget_is_still_a_bound() {
     for seed in 0..10 {
         let p = random_asymmetric(3, 3 + seed as usize % 4, seed);
