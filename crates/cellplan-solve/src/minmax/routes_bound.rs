@@ -126,12 +126,7 @@ pub fn route_bound(p: &MinMaxProblem, start: &Routes, settings: &RouteBoundSetti
         clock_cut: false,
         duals: None,
     };
-    let arcs: usize = p
-        .vehicles
-        .iter()
-        .map(|v| v.alternatives.iter().map(Vec::len).sum::<usize>().pow(2))
-        .sum();
-    if p.tasks == 0 || p.tasks > settings.max_tasks || arcs > settings.max_arcs || start.tours.len() != m {
+    if !priceable(p, settings) || start.tours.len() != m {
         return out;
     }
     let ng = settings.ng.clamp(1, 32);
@@ -215,6 +210,17 @@ pub fn route_bound(p: &MinMaxProblem, start: &Routes, settings: &RouteBoundSetti
     out
 }
 
+/// Whether `p` has tasks and stays within `settings`' size limits (tasks, and arcs between
+/// the vehicles' nodes), so that its vehicles can be priced.
+fn priceable(p: &MinMaxProblem, settings: &RouteBoundSettings) -> bool {
+    let arcs: usize = p
+        .vehicles
+        .iter()
+        .map(|v| v.alternatives.iter().map(Vec::len).sum::<usize>().pow(2))
+        .sum();
+    p.tasks > 0 && p.tasks <= settings.max_tasks && arcs <= settings.max_arcs
+}
+
 /// The Lagrangian bound of `p` at duals `pi` (per task) and `mu` (per vehicle):
 /// `Σπ + Σ_v min(0, least μ_v·time(r) − π(r) over v's ng-routes r)`, each vehicle priced as the
 /// exact rounds of [`route_bound`] price it (`settings`' ng-neighbourhoods and label limit; past
@@ -237,12 +243,7 @@ pub fn lagrangian_bound(
     if mu.iter().sum::<f64>() > 1.0 + 1e-12 {
         return None;
     }
-    let arcs: usize = p
-        .vehicles
-        .iter()
-        .map(|v| v.alternatives.iter().map(Vec::len).sum::<usize>().pow(2))
-        .sum();
-    if p.tasks == 0 || p.tasks > settings.max_tasks || arcs > settings.max_arcs {
+    if !priceable(p, settings) {
         return None;
     }
     let ng = settings.ng.clamp(1, 32);
