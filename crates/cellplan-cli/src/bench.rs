@@ -379,7 +379,7 @@ fn run_minmax(args: &BenchArgs, limit: Duration) -> Result<Vec<Row>, BenchError>
             let settings = minmax::RouteBoundSettings::default();
             let routes = minmax::route_bound(p, &routes, &settings);
             MinMaxBounds {
-                ending: cellplan_core::document::RouteBoundOut::new(&routes, settings.max_work).ending(),
+                ending: cellplan_core::document::RouteBoundRun::new(&routes, settings.max_work).ending(),
                 lower_bound: routes.legs,
                 route_bound: routes.bound,
                 route_bound_converged: routes.converged,

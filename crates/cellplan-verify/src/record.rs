@@ -69,9 +69,6 @@ fn settings(cell: &Cell, plan: &Plan, totals: &mut dyn FnMut(String)) {
     }
 }
 
-/// The most arcs a stated route bound's budget may be (`plan --route-bound 1000`).
-const MAX_ROUTE_BOUND_WORK: u64 = 1_000_000_000_000;
-
 /// The lower bound, recomputed on the graphs the settings name, and its ratio.
 fn lower_bound(cell: &Cell, table: &CandidateTable, plan: &Plan, totals: &mut dyn FnMut(String)) {
     let s = &plan.settings;
@@ -95,50 +92,10 @@ fn lower_bound(cell: &Cell, table: &CandidateTable, plan: &Plan, totals: &mut dy
         .collect();
     match allocate::lower_bound(cell, table, &graphs, &left_out) {
         Ok(legs) => {
-            // The route bound, where stated, derived again under its budget: the same
-            // problem, start and work give the same rounds, work and value.
+            // The route bound, where stated, derived again from its certificate.
             let lb = match &plan.route_bound {
                 None => legs,
-                // `plan --route-bound` allows 1000 G arcs at most: a larger budget is not run.
-                Some(stated) if stated.max_work > MAX_ROUTE_BOUND_WORK => {
-                    totals(format!(
-                        "states a route-bound budget of {} arcs, more than the {MAX_ROUTE_BOUND_WORK} `plan --route-bound` allows: not derived again",
-                        stated.max_work
-                    ));
-                    legs
-                }
-                // A run the clock cut is derived again for the rounds it made: without a
-                // clock, that is where the same run stops. Its claim holds where the rounds
-                // neither solved the relaxation nor spent the budget nor reached the round
-                // limit (else the clock did not stop it).
-                Some(stated) => match allocate::route_bound(
-                    cell,
-                    table,
-                    &graphs,
-                    &left_out,
-                    (
-                        stated.max_work,
-                        stated.cut_by_clock.then_some(stated.rounds),
-                        None,
-                    ),
-                ) {
-                    Ok(rb) => {
-                        let mut again = RouteBoundOut::new(&rb, stated.max_work);
-                        let rounds_left = rb.rounds < allocate::route_bound_round_limit();
-                        again.cut_by_clock =
-                            stated.cut_by_clock && !rb.converged && rb.work < stated.max_work && rounds_left;
-                        if !stated.agrees(&again) {
-                            totals(format!(
-                                "states the route bound {stated:?}; derived again under its budget: {again:?}"
-                            ));
-                        }
-                        legs.max(rb.bound)
-                    }
-                    Err(e) => {
-                        totals(format!("the route bound cannot be derived again: {e}"));
-                        legs
-                    }
-                },
+                Some(stated) => legs.max(route_bound(cell, table, &graphs, &left_out, stated, legs, totals)),
             };
             if (plan.lower_bound_s - lb).abs() > 1e-6 * (1.0 + lb) {
                 totals(format!(
@@ -155,6 +112,92 @@ fn lower_bound(cell: &Cell, table: &CandidateTable, plan: &Plan, totals: &mut dy
             "states the ratio {:.6} to the lower bound; its cycle time and bound give {ratio:.6}",
             plan.ratio_to_lower_bound
         ));
+    }
+}
+
+/// The route bound `stated`, checked from its certificate: its leg bound is `legs`, and its
+/// duals, named by MP and robot, prove `bound_s` again with one pricing per robot. Returns the
+/// bound proved (`legs` when there is no certificate or it proves nothing).
+fn route_bound(
+    cell: &Cell,
+    table: &CandidateTable,
+    graphs: &[RobotGraph],
+    left_out: &[TaskId],
+    stated: &RouteBoundOut,
+    legs: f64,
+    totals: &mut dyn FnMut(String),
+) -> f64 {
+    let close = |a: f64, b: f64| (a - b).abs() <= 1e-6 * (1.0 + b.abs());
+    if !close(stated.legs_s, legs) {
+        totals(format!(
+            "states the route bound's leg bound {:.6} s; recomputed {legs:.6} s",
+            stated.legs_s
+        ));
+    }
+    let Some(duals) = &stated.duals else {
+        if !close(stated.bound_s, legs) {
+            totals(format!(
+                "states the route bound {:.6} s without its duals; without them it is the leg bound {legs:.6} s",
+                stated.bound_s
+            ));
+        }
+        return legs;
+    };
+    let mut pi = vec![0.0; cell.tasks.len()];
+    let mut mu = vec![0.0; cell.robots.len()];
+    let mut named = true;
+    for (name, &v) in &duals.mps {
+        match cell.tasks.iter().position(|t| &t.name == name) {
+            Some(t) if !left_out.contains(&TaskId(t)) => pi[t] = v,
+            Some(_) => {
+                totals(format!(
+                    "the route bound's duals price MP {name}, which the plan does not measure"
+                ));
+                named = false;
+            }
+            None => {
+                totals(format!(
+                    "the route bound's duals name MP {name}, which the cell does not have"
+                ));
+                named = false;
+            }
+        }
+    }
+    for (name, &v) in &duals.robots {
+        match cell.robots.iter().position(|r| &r.name == name) {
+            Some(r) => mu[r] = v,
+            None => {
+                totals(format!(
+                    "the route bound's duals name robot {name}, which the cell does not have"
+                ));
+                named = false;
+            }
+        }
+    }
+    if !named {
+        return legs;
+    }
+    match allocate::route_bound_at(cell, table, graphs, left_out, &pi, &mu) {
+        Ok(Some(proved)) => {
+            if !close(stated.bound_s, proved) {
+                totals(format!(
+                    "states the route bound {:.6} s; its duals prove {proved:.6} s",
+                    stated.bound_s
+                ));
+            }
+            proved
+        }
+        Ok(None) => {
+            totals(format!(
+                "states the route bound {:.6} s with duals that prove nothing (each must be at least 0 and the robots' sum at most 1, and the problem within the pricing's size limits)",
+                stated.bound_s
+            ));
+            legs
+        }
+        Err(e) => {
+            totals(format!("the route bound cannot be derived again: {e}"));
+            legs
+        }
     }
 }
 

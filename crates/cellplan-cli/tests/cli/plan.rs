@@ -26,7 +26,7 @@ fn plan_writes_a_plan_and_a_stable_summary() {
     assert!(cycle > 4.5);
     let plan: Value = serde_json::from_slice(&std::fs::read(out_dir.join("plan.json")).unwrap()).unwrap();
     assert_eq!(plan["format"], "cellplan-plan");
-    assert_eq!(plan["version"], 3);
+    assert_eq!(plan["version"], 4);
     assert_eq!(plan["robots"][0]["tasks"].as_array().unwrap().len(), 3);
     assert_eq!(plan["robots"][0]["legs"].as_array().unwrap().len(), 4);
     // The same seed gives the same plan, whatever the thread count.
@@ -342,7 +342,7 @@ fn plan_refuses_an_absurd_blend_deviation() {
 }
 
 #[test]
-fn plan_states_the_route_bound_and_verify_derives_it_again() {
+fn plan_states_the_route_bound_and_verify_checks_its_duals() {
     let dir = scratch("route-bound");
     small_cell(&dir);
     let cell = dir.join("cell.toml");
@@ -379,7 +379,16 @@ fn plan_states_the_route_bound_and_verify_derives_it_again() {
     );
     let plan_file = out_dir.join("plan.json");
     let plan: Value = serde_json::from_slice(&std::fs::read(&plan_file).unwrap()).unwrap();
-    assert_eq!(&plan["route_bound"], rb);
+    // The plan states the bound with its certificate; how the search went is in its stats.
+    let stated = &plan["route_bound"];
+    assert_eq!(
+        (&stated["bound_s"], &stated["legs_s"]),
+        (&rb["bound_s"], &rb["legs_s"])
+    );
+    let run = &plan["stats"]["route_bound"];
+    for key in ["max_work", "work", "rounds", "converged", "cut_by_clock"] {
+        assert_eq!(run[key], rb[key], "{key}");
+    }
     // The report says which bound it shows.
     let report = std::fs::read_to_string(out_dir.join("report.html")).unwrap();
     let from_routes = report.contains("lower bound from whole programs (legs alone:");
@@ -393,43 +402,69 @@ fn plan_states_the_route_bound_and_verify_derives_it_again() {
         );
         serde_json::from_slice::<Value>(&out.stdout).unwrap()
     };
+    let details = |verdict: &Value| -> Vec<String> {
+        verdict["violations"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|v| v["detail"].as_str().unwrap().to_string())
+            .collect()
+    };
     assert_eq!(verify(&plan)["ok"], true);
-    // A bound raised, with the lower bound and ratio made to agree with it, is caught; so is
-    // a round too many, and a route bound taken away with the lower bound left at its value.
+    // The search's record is not a claim: changed, the plan still verifies.
+    let mut search = plan.clone();
+    search["stats"]["route_bound"]["rounds"] = Value::from(run["rounds"].as_u64().unwrap() + 1);
+    assert_eq!(verify(&search)["ok"], true);
+    // Three MPs on one robot: the relaxation beats the leg bound, so the duals are there.
+    assert!(bound > legs + 1e-6, "{rb}");
+    let duals = &stated["duals"];
+    assert_eq!(duals["mps"].as_object().unwrap().len(), 3, "{duals}");
+    assert_eq!(duals["robots"].as_object().unwrap().len(), 1, "{duals}");
+    let (mp, robot) = (
+        duals["mps"].as_object().unwrap().keys().next().unwrap().clone(),
+        duals["robots"]
+            .as_object()
+            .unwrap()
+            .keys()
+            .next()
+            .unwrap()
+            .clone(),
+    );
+    // A bound raised, with the lower bound and ratio made to agree with it, is caught: its
+    // duals prove less.
     let cycle = plan["cycle_time_s"].as_f64().unwrap();
     let mut raised = plan.clone();
     raised["route_bound"]["bound_s"] = Value::from(bound + 0.5);
     raised["lower_bound_s"] = Value::from(bound + 0.5);
     raised["ratio_to_lower_bound"] = Value::from(cycle / (bound + 0.5));
-    let mut rounds = plan.clone();
-    rounds["route_bound"]["rounds"] = Value::from(rb["rounds"].as_u64().unwrap() + 1);
-    let mut huge = plan.clone();
-    huge["route_bound"]["max_work"] = Value::from(u64::MAX);
-    let verdict = verify(&huge);
-    assert_eq!(verdict["ok"], false);
-    assert!(verdict.to_string().contains("route-bound budget"), "{verdict}");
-    let mut dropped = plan.clone();
-    dropped.as_object_mut().unwrap().remove("route_bound");
-    // A solved run said to be cut by the clock is caught too.
-    let mut clock = plan.clone();
-    clock["route_bound"]["cut_by_clock"] = Value::from(true);
-    for (what, doc) in [("raised", &raised), ("rounds", &rounds), ("clock", &clock)] {
+    // Duals that prove nothing: the robots' μ above one in sum, a negative price.
+    let mut mu = plan.clone();
+    mu["route_bound"]["duals"]["robots"][&robot] = Value::from(1.5);
+    let mut negative = plan.clone();
+    negative["route_bound"]["duals"]["mps"][&mp] = Value::from(-1.0);
+    // Duals naming an MP the cell does not have.
+    let mut unknown = plan.clone();
+    unknown["route_bound"]["duals"]["mps"]["no-such-mp"] = Value::from(0.0);
+    // The duals taken away: the bound stated is then more than what is proved.
+    let mut bare = plan.clone();
+    bare["route_bound"]["duals"] = Value::Null;
+    for (what, doc, says) in [
+        ("raised", &raised, "its duals prove"),
+        ("mu", &mu, "prove nothing"),
+        ("negative", &negative, "prove nothing"),
+        ("unknown", &unknown, "no-such-mp"),
+        ("bare", &bare, "without its duals"),
+    ] {
         let verdict = verify(doc);
         assert_eq!(verdict["ok"], false, "{what}");
-        let details: Vec<&str> = verdict["violations"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .map(|v| v["detail"].as_str().unwrap())
-            .collect();
-        assert!(
-            details.iter().any(|d| d.contains("states the route bound")),
-            "{what}: {details:?}"
-        );
+        let details = details(&verdict);
+        assert!(details.iter().any(|d| d.contains(says)), "{what}: {details:?}");
     }
-    if bound > legs + 1e-6 {
-        assert_eq!(verify(&dropped)["ok"], false, "the leg bound alone is smaller");
-    }
+    // A route bound taken away with the lower bound left at its value: the leg bound alone is
+    // smaller.
+    let mut dropped = plan.clone();
+    dropped.as_object_mut().unwrap().remove("route_bound");
+    assert_eq!(verify(&dropped)["ok"], false);
     // The run's time limit bounds the route bound too: cut before its first round, it is the
     // leg bound, the plan says the clock cut it, and the verifier derives it again.
     let cut_dir = dir.join("cut");

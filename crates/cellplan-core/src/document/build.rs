@@ -2,8 +2,8 @@
 //! coordination record; the unmeasured tasks; the search's counts and times.
 use super::{
     ActivityOut, BlendOut, ComputeTimes, ConflictOut, CoordinationOut, FORMAT, LegOut, PROBE_TRACK_DT, Plan,
-    PoseOut, ProbeTrack, RobotPlan, RouteBoundOut, Sample, SettingsOut, Stats, UnmeasuredTask, VERSION,
-    Visit, WaitOut,
+    PoseOut, ProbeTrack, RobotPlan, RouteBoundOut, RouteBoundRun, Sample, SettingsOut, Stats, UnmeasuredTask,
+    VERSION, Visit, WaitOut,
 };
 use crate::candidates::CandidateTable;
 use crate::coord::{Activity, Conflict, Coordinated, Program, Timed};
@@ -49,13 +49,20 @@ pub fn build(
     let began = std::time::Instant::now();
     // The run's wall-clock limit bounds it too (none by default).
     let route_bound = settings.route_bound_work.and_then(|max_work| {
-        let limits = (max_work, None, settings.deadline);
-        let rb = crate::plan::allocate::route_bound(cell, table, &outcome.graphs, &left_out, limits).ok()?;
-        Some(RouteBoundOut::new(&rb, max_work))
+        let limits = (max_work, settings.deadline);
+        let (rb, tasks) =
+            crate::plan::allocate::route_bound(cell, table, &outcome.graphs, &left_out, limits).ok()?;
+        let tasks: Vec<&str> = tasks.iter().map(|&t| cell.tasks[t.0].name.as_str()).collect();
+        let robots: Vec<&str> = cell.robots.iter().map(|r| r.name.as_str()).collect();
+        Some((
+            RouteBoundOut::new(&rb, &tasks, &robots),
+            RouteBoundRun::new(&rb, max_work),
+        ))
     });
+    let (route_bound, route_run) = route_bound.unzip();
     let lb = route_bound.as_ref().map_or(lb, |r| lb.max(r.bound_s));
     // The clock stopped the route bound: the plan says so.
-    let clock_cut = route_bound.as_ref().is_some_and(|r| r.cut_by_clock);
+    let clock_cut = route_run.as_ref().is_some_and(|r| r.cut_by_clock);
     let route_bound_s = if route_bound.is_some() {
         began.elapsed().as_secs_f64()
     } else {
@@ -78,6 +85,7 @@ pub fn build(
         unmeasured: unmeasured(cell, table, &outcome.unreached),
         stats: Stats {
             time_limit_hit: outcome.time_limit_hit || clock_cut,
+            route_bound: route_run,
             ..stats(table, outcome, coordinated)
         },
         compute_s: compute_times(outcome, coordinated, load_s, candidates_s, route_bound_s),
@@ -280,6 +288,7 @@ fn stats(table: &CandidateTable, outcome: &Outcome, coordinated: &Coordinated) -
         conflicts_resolved: coordinated.resolved,
         passage_search: coordinated.search,
         time_limit_hit: outcome.time_limit_hit,
+        route_bound: None,
     }
 }
 

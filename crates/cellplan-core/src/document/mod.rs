@@ -21,7 +21,7 @@ use std::collections::BTreeMap;
 /// Value of the `format` key.
 pub const FORMAT: &str = "cellplan-plan";
 /// Value of the `version` key; raised when a key changes meaning or disappears.
-pub const VERSION: u32 = 3;
+pub const VERSION: u32 = 4;
 
 /// A plan for a cell.
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq, JsonSchema)]
@@ -67,8 +67,10 @@ pub struct Plan {
 }
 
 /// The route bound: column generation over whole routes of the allocation problem
-/// (`cellplan_solve::minmax::route_bound`), every number re-derived by the verifier under
-/// `max_work`.
+/// (`cellplan_solve::minmax::route_bound`), stated with its certificate: the duals of the round
+/// that set it, from which the verifier derives the bound again with one pricing per robot
+/// (`cellplan_solve::minmax::lagrangian_bound`). How the run went (budget, work, rounds,
+/// whether it was solved) is in `stats.route_bound`.
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct RouteBoundOut {
@@ -76,6 +78,47 @@ pub struct RouteBoundOut {
     pub bound_s: f64,
     /// The leg bound it started from (s).
     pub legs_s: f64,
+    /// The certificate: absent when no round beat the leg bound (`bound_s` is then `legs_s`).
+    pub duals: Option<RouteDuals>,
+}
+
+/// Duals of the route bound's linear relaxation: any `π, μ ≥ 0` with `Σμ ≤ 1` prove the bound
+/// `Σπ + Σ_robots min(0, least μ·time(r) − π(r) over the robot's programs r)`.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct RouteDuals {
+    /// `π` per MP the bound covers (an MP left out has `π = 0`), seconds.
+    pub mps: BTreeMap<String, f64>,
+    /// `μ` per robot (a robot left out has `μ = 0`), summing to at most one.
+    pub robots: BTreeMap<String, f64>,
+}
+
+impl RouteBoundOut {
+    /// The record of `rb`; `tasks` names its problem's tasks in order, `robots` its vehicles.
+    pub fn new(rb: &cellplan_solve::minmax::RouteBound, tasks: &[&str], robots: &[&str]) -> Self {
+        let named = |names: &[&str], values: &[f64]| -> BTreeMap<String, f64> {
+            names
+                .iter()
+                .zip(values)
+                .map(|(n, &v)| (n.to_string(), v))
+                .collect()
+        };
+        RouteBoundOut {
+            bound_s: rb.bound,
+            legs_s: rb.legs,
+            duals: rb.duals.as_ref().map(|(pi, mu)| RouteDuals {
+                mps: named(tasks, pi),
+                robots: named(robots, mu),
+            }),
+        }
+    }
+}
+
+/// How a route bound's column generation went: the search, not a claim about the plan (not
+/// checked; the bound is checked from its certificate).
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct RouteBoundRun {
     /// The budget: no round starts once its pricings have looked at this many arcs (a round
     /// may pass it).
     pub max_work: u64,
@@ -84,48 +127,23 @@ pub struct RouteBoundOut {
     /// Rounds of column generation (0: the problem passes the size limits, and the bound is
     /// the leg bound).
     pub rounds: usize,
-    /// Whether the relaxation was solved (else the bound is that of the last round; see
-    /// [`RouteBoundOut::ending`]).
+    /// Whether the relaxation was solved (else the bound is the best round's; see
+    /// [`RouteBoundRun::ending`]).
     pub converged: bool,
-    /// Whether the run's wall-clock limit (`--time-limit`) stopped it before its budget: the
-    /// verifier then derives it again for the `rounds` stated (the same work and value).
-    #[serde(default)]
+    /// Whether the run's wall-clock limit (`--time-limit`) stopped it before its budget.
     pub cut_by_clock: bool,
 }
 
-impl RouteBoundOut {
-    /// The record of `rb`, found under `max_work`.
+impl RouteBoundRun {
+    /// The run of `rb`, made under `max_work`.
     pub fn new(rb: &cellplan_solve::minmax::RouteBound, max_work: u64) -> Self {
-        RouteBoundOut {
-            bound_s: rb.bound,
-            legs_s: rb.legs,
+        RouteBoundRun {
             max_work,
             work: rb.work,
             rounds: rb.rounds,
             converged: rb.converged,
             cut_by_clock: rb.clock_cut,
         }
-    }
-
-    /// Whether `other` states the same run: the same budget, work, rounds and outcome, the
-    /// bounds within 10⁻⁶ (relative), and whether the clock cut it.
-    pub fn agrees(&self, other: &RouteBoundOut) -> bool {
-        let close = |a: f64, b: f64| (a - b).abs() <= 1e-6 * (1.0 + b.abs());
-        close(self.bound_s, other.bound_s)
-            && close(self.legs_s, other.legs_s)
-            && (
-                self.max_work,
-                self.work,
-                self.rounds,
-                self.converged,
-                self.cut_by_clock,
-            ) == (
-                other.max_work,
-                other.work,
-                other.rounds,
-                other.converged,
-                other.cut_by_clock,
-            )
     }
 
     /// How the run ended, in words.
@@ -485,6 +503,9 @@ pub struct Stats {
     /// then, and only then, the plan depends on the machine's speed.
     #[serde(default)]
     pub time_limit_hit: bool,
+    /// How the route bound's search went (`plan --route-bound`; absent without it).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub route_bound: Option<RouteBoundRun>,
 }
 
 /// `best`'s search over the orders in which robots pass their conflict boxes.

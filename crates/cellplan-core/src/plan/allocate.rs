@@ -416,20 +416,20 @@ pub fn lower_bound(
 
 /// The route bound ([`minmax::route_bound`]) of the problem [`lower_bound`] bounds: column
 /// generation over whole routes, started from the routes of Algorithm 1 (seed 0, a
-/// construction: the verifier starts from the same ones) and stopped once its pricings have
-/// looked at `max_work` arcs, or after `rounds` rounds, or once `deadline` has passed, where
-/// given. Every round's value is a proof, so a cut run still bounds every plan that measures
-/// these tasks; it is never below the leg bound. A run the deadline stopped after `k` rounds
-/// is the run `rounds: Some(k)` makes without one.
+/// construction) and stopped once its pricings have looked at `max_work` arcs, or once
+/// `deadline` has passed, where given. Every round's value is a proof, so a cut run still
+/// bounds every plan that measures these tasks; it is never below the leg bound, and the duals
+/// of the round that set it prove it again ([`route_bound_at`]). Returns it with the cell task
+/// of each of its problem's tasks, in the order of its duals.
 pub fn route_bound(
     cell: &Cell,
     table: &CandidateTable,
     graphs: &[RobotGraph],
     left_out: &[TaskId],
-    (max_work, rounds, deadline): (u64, Option<usize>, Option<std::time::Instant>),
-) -> Result<minmax::RouteBound, PlanError> {
+    (max_work, deadline): (u64, Option<std::time::Instant>),
+) -> Result<(minmax::RouteBound, Vec<TaskId>), PlanError> {
     let capable = capable_except(cell, table, left_out);
-    let (p, _) = min_max_problem(cell, graphs, &capable)?;
+    let (p, tasks) = min_max_problem(cell, graphs, &capable)?;
     let params = MinMaxParams {
         method: MinMaxMethod::Algorithm1,
         seed: 0,
@@ -440,16 +440,42 @@ pub fn route_bound(
     let defaults = minmax::RouteBoundSettings::default();
     let settings = minmax::RouteBoundSettings {
         max_work,
-        max_rounds: rounds.unwrap_or(defaults.max_rounds),
         deadline,
         ..defaults
     };
-    Ok(minmax::route_bound(&p, &start, &settings))
+    let rb = minmax::route_bound(&p, &start, &settings);
+    Ok((rb, tasks.into_iter().map(TaskId).collect()))
 }
 
-/// The most rounds [`route_bound`] makes when not given fewer.
-pub fn route_bound_round_limit() -> usize {
-    minmax::RouteBoundSettings::default().max_rounds
+/// The route bound's problem (the one [`route_bound`] solves) bounded from duals: `pi` per
+/// cell task, `mu` per robot, checked with one exact pricing per robot
+/// ([`minmax::lagrangian_bound`]). `Ok(None)` when the duals prove nothing: negative or not
+/// finite, `Σμ` above one, a task the problem leaves out given a `π`, or the problem past the
+/// pricing's size limits.
+pub fn route_bound_at(
+    cell: &Cell,
+    table: &CandidateTable,
+    graphs: &[RobotGraph],
+    left_out: &[TaskId],
+    pi: &[f64],
+    mu: &[f64],
+) -> Result<Option<f64>, PlanError> {
+    let capable = capable_except(cell, table, left_out);
+    let (p, tasks) = min_max_problem(cell, graphs, &capable)?;
+    if pi.len() != cell.tasks.len() {
+        return Ok(None);
+    }
+    let covered: Vec<bool> = (0..cell.tasks.len()).map(|t| !capable[t].is_empty()).collect();
+    if pi.iter().zip(&covered).any(|(&v, &c)| !c && v != 0.0) {
+        return Ok(None);
+    }
+    let pi: Vec<f64> = tasks.iter().map(|&t| pi[t]).collect();
+    Ok(minmax::lagrangian_bound(
+        &p,
+        &pi,
+        mu,
+        &minmax::RouteBoundSettings::default(),
+    ))
 }
 
 /// Per task the robots able to do it, none for the tasks `left_out`.
