@@ -146,8 +146,15 @@ fn route_bound(
     let mut pi = vec![0.0; cell.tasks.len()];
     let mut mu = vec![0.0; cell.robots.len()];
     let mut named = true;
+    // By name, once: a document may name as many MPs as it likes.
+    let tasks: std::collections::HashMap<&str, usize> = cell
+        .tasks
+        .iter()
+        .enumerate()
+        .map(|(t, task)| (task.name.as_str(), t))
+        .collect();
     for (name, &v) in &duals.mps {
-        match cell.tasks.iter().position(|t| &t.name == name) {
+        match tasks.get(name.as_str()).copied() {
             Some(t) if !left_out.contains(&TaskId(t)) => pi[t] = v,
             Some(_) => {
                 totals(format!(
