@@ -196,7 +196,7 @@ fn route_bound(
         }
         Ok(None) => {
             totals(format!(
-                "states the route bound {:.6} s with duals that prove nothing (each must be at least 0 and the robots' sum at most 1, and the problem within the pricing's size limits)",
+                "states the route bound {:.6} s with duals that prove nothing (each must be at least 0, the robots' sum at most 1 and the value finite, and the problem within the pricing's size limits)",
                 stated.bound_s
             ));
             legs

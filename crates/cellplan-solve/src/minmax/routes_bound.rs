@@ -227,7 +227,8 @@ fn priceable(p: &MinMaxProblem, settings: &RouteBoundSettings) -> bool {
 /// that limit the pricing's relaxation). Every `π, μ ≥ 0` with `Σμ ≤ 1` gives a lower bound of
 /// every solution's makespan, so this checks a stated bound from its duals alone. `None` when the
 /// duals are not such (wrong lengths, negative, not finite, `Σμ` above one by more than 10⁻¹²,
-/// the rounding of [`route_bound`]'s scaling) or `p` passes the size limits.
+/// the rounding of [`route_bound`]'s scaling), so large that the value is not finite, or `p`
+/// passes the size limits.
 pub fn lagrangian_bound(
     p: &MinMaxProblem,
     pi: &[f64],
@@ -259,7 +260,8 @@ pub fn lagrangian_bound(
     for v in priced {
         value += v.min(0.0);
     }
-    Some(value)
+    // Duals near the largest floats sum past them.
+    value.is_finite().then_some(value)
 }
 
 /// One route of one vehicle, as the restricted problem sees it.

@@ -506,6 +506,9 @@ fn the_duals_of_the_bound_certify_it() {
         let heavy: Vec<f64> = mu.iter().map(|x| x + 1.0).collect();
         assert!(lagrangian_bound(&p, pi, &heavy, &settings).is_none());
         assert!(lagrangian_bound(&p, &pi[1..], mu, &settings).is_none());
+        // So are duals whose value is not a number (prices near the largest floats).
+        let huge = vec![f64::MAX; pi.len()];
+        assert!(lagrangian_bound(&p, &huge, mu, &settings).is_none());
     }
     assert!(certified >= 10, "{certified} of 20 certified");
 }
