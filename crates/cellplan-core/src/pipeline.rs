@@ -141,6 +141,14 @@ pub fn is_ours(allocation: Allocation, strategy: Coordination) -> bool {
 /// allocation's second round.
 const BLOCKING_WEIGHT: f64 = 0.5;
 
+/// Where coordination lengthened the first plan by more than this share, the zones are tried
+/// a third time with the blocking weighed [`HEAVY_BLOCKING`] times more: robots that meet much
+/// gain from leaving each other the shared space, at the cost of balance.
+const CROWDED: f64 = 0.10;
+
+/// See [`CROWDED`].
+const HEAVY_BLOCKING: f64 = 8.0;
+
 /// Per task and robot, the seconds `coordinated` says the robot's measurement there blocked
 /// the others, weighted (0 for pairs it did not see).
 fn blocking_penalty(cell: &Cell, coordinated: &Coordinated) -> Vec<Vec<f64>> {
@@ -165,6 +173,8 @@ enum Try {
     /// The zones allocation again, each task × robot penalised by what the first plan's
     /// measurement there blocked the other robots (known once the first plan is coordinated).
     ZonesBlocking,
+    /// The same with the penalties weighed [`HEAVY_BLOCKING`] times more (see [`CROWDED`]).
+    ZonesBlockingHeavy,
 }
 
 /// One of ours' tries planned, `None` when it fails (it only loses its try). The balanced
@@ -478,6 +488,13 @@ pub fn coordinate(
                     task_penalty: blocking.clone(),
                     ..settings.clone()
                 }),
+                Some(Try::ZonesBlockingHeavy) => Some(PlanSettings {
+                    task_penalty: blocking
+                        .iter()
+                        .map(|row| row.iter().map(|p| p * HEAVY_BLOCKING).collect())
+                        .collect(),
+                    ..settings.clone()
+                }),
                 None => None,
             };
             if pending.is_none() && affordable() {
@@ -508,6 +525,12 @@ pub fn coordinate(
                     Some(Err(e)) if first => return Err(e),
                     Some(Ok(c)) if first => {
                         blocking = blocking_penalty(cell, &c);
+                        let lengthened = cycle_and_delta(&c.timed).0 / makespan(&o);
+                        if lengthened > 1.0 + CROWDED
+                            && let Some(at) = tries.iter().position(|t| matches!(t, Try::ZonesBlocking))
+                        {
+                            tries.insert(at + 1, Try::ZonesBlockingHeavy);
+                        }
                         best = Some((o, s, c));
                     }
                     Some(Ok(c)) => runners_up.offer(&mut best, (o, s, c)),
