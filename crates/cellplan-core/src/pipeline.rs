@@ -142,15 +142,15 @@ pub fn is_ours(allocation: Allocation, strategy: Coordination) -> bool {
 const BLOCKING_WEIGHT: f64 = 0.5;
 
 /// Where coordination lengthened the first plan by more than this share, the zones are tried
-/// a third time with the blocking weighed [`HEAVY_BLOCKING`] times more: robots that meet much
+/// a third time with the blocking weighed [`HEAVY_BLOCKING_WEIGHT`]: robots that meet much
 /// gain from leaving each other the shared space, at the cost of balance.
 const CROWDED: f64 = 0.10;
 
 /// See [`CROWDED`].
-const HEAVY_BLOCKING: f64 = 8.0;
+const HEAVY_BLOCKING_WEIGHT: f64 = 4.0;
 
 /// Per task and robot, the seconds `coordinated` says the robot's measurement there blocked
-/// the others, weighted (0 for pairs it did not see).
+/// the others (0 for pairs it did not see).
 fn blocking_penalty(cell: &Cell, coordinated: &Coordinated) -> Vec<Vec<f64>> {
     let mut pen = vec![vec![0.0; cell.robots.len()]; cell.tasks.len()];
     // The coordinated programs: their visits are those the blocking counts, in the order
@@ -160,7 +160,7 @@ fn blocking_penalty(cell: &Cell, coordinated: &Coordinated) -> Vec<Vec<f64>> {
             continue;
         };
         for (v, visit) in program.visits.iter().enumerate() {
-            pen[visit.task.0][r] = BLOCKING_WEIGHT * block.get(v).copied().unwrap_or(0.0);
+            pen[visit.task.0][r] = block.get(v).copied().unwrap_or(0.0);
         }
     }
     pen
@@ -171,10 +171,9 @@ enum Try {
     /// Planned with these settings.
     Plan(Box<PlanSettings>),
     /// The zones allocation again, each task × robot penalised by what the first plan's
-    /// measurement there blocked the other robots (known once the first plan is coordinated).
-    ZonesBlocking,
-    /// The same with the penalties weighed [`HEAVY_BLOCKING`] times more (see [`CROWDED`]).
-    ZonesBlockingHeavy,
+    /// measurement there blocked the other robots (known once the first plan is coordinated),
+    /// times this weight ([`BLOCKING_WEIGHT`]; [`HEAVY_BLOCKING_WEIGHT`] on crowded cells).
+    ZonesBlocking(f64),
 }
 
 /// One of ours' tries planned, `None` when it fails (it only loses its try). The balanced
@@ -384,7 +383,7 @@ pub fn coordinate(
     let mut tries: Vec<Try> = [
         sweep.map(|s| Try::Plan(Box::new(s))),
         Some(Try::Plan(Box::new(nearest))),
-        Some(Try::ZonesBlocking),
+        Some(Try::ZonesBlocking(BLOCKING_WEIGHT)),
         balanced.map(|s| Try::Plan(Box::new(s))),
     ]
     .into_iter()
@@ -426,7 +425,7 @@ pub fn coordinate(
     }
     // What the first plan's measurements blocked the other robots (set once it is coordinated,
     // before [`Try::ZonesBlocking`] comes up: the first try is planned while it is).
-    let mut blocking = Vec::new();
+    let mut blocking: Vec<Vec<f64>> = Vec::new();
     let mut next = 0;
     let mut cut = false;
     // Diagram work of the coordinations so far, and of the costliest.
@@ -484,14 +483,10 @@ pub fn coordinate(
             let more = match tries.get(next) {
                 _ if cut || !affordable() => None,
                 Some(Try::Plan(t)) => Some(PlanSettings::clone(t)),
-                Some(Try::ZonesBlocking) => Some(PlanSettings {
-                    task_penalty: blocking.clone(),
-                    ..settings.clone()
-                }),
-                Some(Try::ZonesBlockingHeavy) => Some(PlanSettings {
+                Some(&Try::ZonesBlocking(weight)) => Some(PlanSettings {
                     task_penalty: blocking
                         .iter()
-                        .map(|row| row.iter().map(|p| p * HEAVY_BLOCKING).collect())
+                        .map(|row| row.iter().map(|p| weight * p).collect())
                         .collect(),
                     ..settings.clone()
                 }),
@@ -527,9 +522,9 @@ pub fn coordinate(
                         blocking = blocking_penalty(cell, &c);
                         let lengthened = cycle_and_delta(&c.timed).0 / makespan(&o);
                         if lengthened > 1.0 + CROWDED
-                            && let Some(at) = tries.iter().position(|t| matches!(t, Try::ZonesBlocking))
+                            && let Some(at) = tries.iter().position(|t| matches!(t, Try::ZonesBlocking(_)))
                         {
-                            tries.insert(at + 1, Try::ZonesBlockingHeavy);
+                            tries.insert(at + 1, Try::ZonesBlocking(HEAVY_BLOCKING_WEIGHT));
                         }
                         best = Some((o, s, c));
                     }

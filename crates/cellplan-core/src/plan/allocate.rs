@@ -461,14 +461,15 @@ pub fn route_bound_at(
     mu: &[f64],
 ) -> Result<Option<f64>, PlanError> {
     let capable = capable_except(cell, table, left_out);
+    if pi.len() != cell.tasks.len()
+        || pi
+            .iter()
+            .zip(&capable)
+            .any(|(&v, who)| who.is_empty() && v != 0.0)
+    {
+        return Ok(None);
+    }
     let (p, tasks) = min_max_problem(cell, graphs, &capable)?;
-    if pi.len() != cell.tasks.len() {
-        return Ok(None);
-    }
-    let covered: Vec<bool> = (0..cell.tasks.len()).map(|t| !capable[t].is_empty()).collect();
-    if pi.iter().zip(&covered).any(|(&v, &c)| !c && v != 0.0) {
-        return Ok(None);
-    }
     let pi: Vec<f64> = tasks.iter().map(|&t| pi[t]).collect();
     Ok(minmax::lagrangian_bound(
         &p,
