@@ -227,7 +227,8 @@ pub const PLAN_FIRST_PAIRS: usize = 2_000;
 pub const OURS_COORDINATION_DISTANCES: usize = 16_000_000;
 
 /// The reliefs of [`plan::rebalance`] (a task of a robot the last one waits for handed to a
-/// third robot, tried once the hand-overs are spent) may go beyond the coordination budget by
+/// third robot, tried once the hand-overs are spent), and its group hand-overs after them, may
+/// go beyond the coordination budget by
 /// its share `1 / RELIEF_EXTRA_DISTANCES`: on the crowded cells the budget is spent by the time
 /// they come (crowded-6r seed 1: 1.637 with none beyond it, 1.534 with half of it). The bar on
 /// the costliest coordination (a quarter of the budget) is the same, so the cells whose
@@ -314,8 +315,9 @@ impl RunnersUp {
 /// end no sooner than the best cycle so far even uncoordinated is not coordinated. The shortest
 /// coordinated cycle (then Δt, then the earlier) wins; then [`plan::rebalance::rebalance`]
 /// hands tasks from the robot that ends last to others, one at a time, each hand-over kept
-/// when its plan, coordinated, ends sooner still, and then the reliefs (a task of a robot the
-/// last one waits for handed to a third), which may go beyond the work budget by the share
+/// when its plan, coordinated, ends sooner still, then the reliefs (a task of a robot the
+/// last one waits for handed to a third) and the groups (several tasks of the last robot to a
+/// robot it waits for), which may go beyond the work budget by the share
 /// [`RELIEF_EXTRA_DISTANCES`] sets. Plans are compared with every leg stopping at every
 /// waypoint; the winner and the [`RUNNERS_UP`] shortest plans that lost (within
 /// [`RUNNER_UP_REACH`] of it, on cells of at most `plan_first_pairs` MPs × robots) are then

@@ -382,10 +382,12 @@ fn a_hand_over_keeps_the_other_robots_programs() {
 
 /// Once the direct hand-overs are spent without help, a robot the last one waits for is
 /// relieved: one of its tasks goes to a third robot (never to the waiting one), within a budget
-/// of its own; without waits there is no relief (the test below).
+/// of its own; without waits there is no relief (the test below). Groups come after them.
 #[test]
 fn a_robot_the_last_one_waits_for_is_relieved_when_the_hand_overs_do_not_help() {
-    use plan::rebalance::{REBALANCE_JUDGED, RELIEF_JUDGED, RELIEF_PLANS, ends, makespan, rebalance};
+    use plan::rebalance::{
+        GROUP_JUDGED, REBALANCE_JUDGED, RELIEF_JUDGED, RELIEF_PLANS, ends, makespan, rebalance,
+    };
     let (cell, table, s, mut cache, base) = readme_nearest();
     let m = cell.robots.len();
     // As if coordination had made the robot that ends last wait 5 s for the busiest other one.
@@ -433,7 +435,23 @@ fn a_robot_the_last_one_waits_for_is_relieved_when_the_hand_overs_do_not_help() 
     };
     let kinds: Vec<(usize, usize)> = seen.iter().map(moved).collect();
     let direct = kinds.iter().take_while(|k| k.0 == stuck).count();
-    let relief = &kinds[direct..];
+    let reliefs = kinds[direct..].iter().take_while(|k| k.0 != stuck).count();
+    let relief = &kinds[direct..direct + reliefs];
+    // Then groups, if any (this robot takes none of the last one's tasks: see the next test).
+    let groups = &seen[direct + reliefs..];
+    assert!(
+        groups.len() <= GROUP_JUDGED,
+        "{} groups judged: {kinds:?}",
+        groups.len()
+    );
+    for o in groups {
+        assert_eq!(moved(o), (stuck, waited), "{kinds:?}");
+        let given = base.allocated.tasks[stuck]
+            .iter()
+            .filter(|t| !o.allocated.tasks[stuck].contains(t))
+            .count();
+        assert!(given >= 2, "a group of {given}");
+    }
     assert!(direct <= REBALANCE_JUDGED, "{direct} direct hand-overs judged");
     assert!(
         (1..=RELIEF_JUDGED.min(RELIEF_PLANS)).contains(&relief.len()),
@@ -451,8 +469,8 @@ fn a_robot_the_last_one_waits_for_is_relieved_when_the_hand_overs_do_not_help() 
         };
         build_checked(&cell, &table, o, &fixed);
     }
-    // The caller's work budget is asked before every plan, with `true` for a relief (which may
-    // go beyond it) and `false` for a hand-over: the hand-overs' asks first, then the reliefs'.
+    // The caller's work budget is asked before every plan, with `true` for a relief or a group
+    // (which may go beyond it) and `false` for a hand-over: the hand-overs' asks first.
     let asked = std::cell::RefCell::new(Vec::new());
     let mut judge =
         |_: &plan::Outcome, _: Option<(&plan::Outcome, &())>| -> Option<(f64, Vec<f64>, ())> { None };
@@ -477,6 +495,76 @@ fn a_robot_the_last_one_waits_for_is_relieved_when_the_hand_overs_do_not_help() 
         asked[hand_overs..].iter().all(|r| *r) && asked.len() - hand_overs >= relief.len(),
         "{asked:?}"
     );
+}
+
+/// When single tasks do not help, the robot that ends last hands groups of its tasks (two or
+/// more, those it adds least to first) to a robot it waits for that can take them, within a
+/// budget of their own; each group's plan re-checks clean.
+#[test]
+fn the_last_robot_hands_groups_of_tasks_to_the_robot_it_waits_for() {
+    use plan::rebalance::{GROUP_JUDGED, ends, makespan, rebalance};
+    let (cell, table, s, mut cache, base) = readme_nearest();
+    let m = cell.robots.len();
+    let mut end = ends(&base);
+    let stuck = (0..m)
+        .max_by(|&a, &b| end[a].total_cmp(&end[b]).then(b.cmp(&a)))
+        .unwrap();
+    // The robot that can take most of the last one's tasks (within its room under the cap)
+    // waited for 5 s.
+    let can = |r: usize| {
+        let able = base.allocated.tasks[stuck]
+            .iter()
+            .filter(|&&t| table.robots_for(t).iter().any(|x| x.0 == r))
+            .count();
+        able.min(
+            cell.planning
+                .task_cap
+                .saturating_sub(base.allocated.tasks[r].len()),
+        )
+    };
+    let waited = (0..m).filter(|&r| r != stuck).max_by_key(|&r| can(r)).unwrap();
+    assert!(can(waited) >= 2, "the README cell's nearest plan shares tasks");
+    end[stuck] += 5.0;
+    let mut waits = vec![vec![0.0; m]; m];
+    waits[stuck][waited] = 5.0;
+    let mut seen: Vec<plan::Outcome> = Vec::new();
+    let mut judge = |o: &plan::Outcome, _: Option<(&plan::Outcome, &())>| -> Option<(f64, Vec<f64>, ())> {
+        seen.push(o.clone());
+        None
+    };
+    rebalance(
+        &cell,
+        &table,
+        (&base, makespan(&base) + 5.0, &end, &waits),
+        &s,
+        &mut cache,
+        &|_| true,
+        (&mut judge, &|_| unreachable!("no plan is taken")),
+    )
+    .unwrap();
+    let given = |o: &plan::Outcome, r: usize| {
+        base.allocated.tasks[r]
+            .iter()
+            .filter(|t| !o.allocated.tasks[r].contains(t))
+            .count()
+    };
+    let groups: Vec<&plan::Outcome> = seen.iter().filter(|o| given(o, stuck) >= 2).collect();
+    assert!(
+        (1..=GROUP_JUDGED).contains(&groups.len()),
+        "{} groups judged of {}",
+        groups.len(),
+        seen.len()
+    );
+    for o in groups {
+        let moved = given(o, stuck);
+        let taken = o.allocated.tasks[waited].len() - base.allocated.tasks[waited].len();
+        assert_eq!(taken, moved, "the group goes to the robot waited for");
+        let fixed = PlanSettings {
+            tasks: Some(o.allocated.tasks.clone()),
+            ..s.clone()
+        };
+        build_checked(&cell, &table, o, &fixed);
+    }
 }
 
 /// A hand-over whose plan keeping the other robots' programs does not help is planned again
