@@ -380,6 +380,43 @@ fn a_hand_over_keeps_the_other_robots_programs() {
     build_checked(&cell, &table, &o, &fixed);
 }
 
+/// The plans `rebalance` judges from `base` when the robot `stuck` ends `wait` seconds later
+/// than planned, waiting that long for robot `waited`, and the judge takes none of them.
+fn judged_waiting(
+    (cell, table, s, cache, base): (
+        &Cell,
+        &CandidateTable,
+        &PlanSettings,
+        &mut plan::PlanCache,
+        &plan::Outcome,
+    ),
+    (stuck, waited, wait): (usize, usize, f64),
+) -> Vec<plan::Outcome> {
+    use plan::rebalance::{ends, makespan, rebalance};
+    let m = cell.robots.len();
+    let mut end = ends(base);
+    end[stuck] += wait;
+    let mut waits = vec![vec![0.0; m]; m];
+    waits[stuck][waited] = wait;
+    let mut seen: Vec<plan::Outcome> = Vec::new();
+    let mut judge = |o: &plan::Outcome, _: Option<(&plan::Outcome, &())>| -> Option<(f64, Vec<f64>, ())> {
+        seen.push(o.clone());
+        None
+    };
+    let (found, clock) = rebalance(
+        cell,
+        table,
+        (base, makespan(base) + wait, &end, &waits),
+        s,
+        cache,
+        &|_| true,
+        (&mut judge, &|_| unreachable!("no plan is taken")),
+    )
+    .unwrap();
+    assert!(found.is_none() && !clock);
+    seen
+}
+
 /// Once the direct hand-overs are spent without help, a robot the last one waits for is
 /// relieved: one of its tasks goes to a third robot (never to the waiting one), within a budget
 /// of its own; without waits there is no relief (the test below). Groups come after them.
@@ -399,26 +436,11 @@ fn a_robot_the_last_one_waits_for_is_relieved_when_the_hand_overs_do_not_help() 
         .filter(|&r| r != stuck)
         .max_by_key(|&r| base.allocated.tasks[r].len())
         .unwrap();
+    // A judge that no plan satisfies: every hand-over is tried, then every relief.
+    let seen = judged_waiting((&cell, &table, &s, &mut cache, &base), (stuck, waited, 5.0));
     end[stuck] += 5.0;
     let mut waits = vec![vec![0.0; m]; m];
     waits[stuck][waited] = 5.0;
-    // A judge that no plan satisfies: every hand-over is tried, then every relief.
-    let mut seen: Vec<plan::Outcome> = Vec::new();
-    let mut judge = |o: &plan::Outcome, _: Option<(&plan::Outcome, &())>| -> Option<(f64, Vec<f64>, ())> {
-        seen.push(o.clone());
-        None
-    };
-    let (found, clock) = rebalance(
-        &cell,
-        &table,
-        (&base, makespan(&base) + 5.0, &end, &waits),
-        &s,
-        &mut cache,
-        &|_| true,
-        (&mut judge, &|_| unreachable!("no plan is taken")),
-    )
-    .unwrap();
-    assert!(found.is_none() && !clock);
     // Which robot gave a task to which, in each plan judged.
     let moved = |o: &plan::Outcome| -> (usize, usize) {
         let (mut from, mut to) = (None, None);
@@ -502,10 +524,10 @@ fn a_robot_the_last_one_waits_for_is_relieved_when_the_hand_overs_do_not_help() 
 /// budget of their own; each group's plan re-checks clean.
 #[test]
 fn the_last_robot_hands_groups_of_tasks_to_the_robot_it_waits_for() {
-    use plan::rebalance::{GROUP_JUDGED, ends, makespan, rebalance};
+    use plan::rebalance::{GROUP_JUDGED, ends};
     let (cell, table, s, mut cache, base) = readme_nearest();
     let m = cell.robots.len();
-    let mut end = ends(&base);
+    let end = ends(&base);
     let stuck = (0..m)
         .max_by(|&a, &b| end[a].total_cmp(&end[b]).then(b.cmp(&a)))
         .unwrap();
@@ -524,24 +546,7 @@ fn the_last_robot_hands_groups_of_tasks_to_the_robot_it_waits_for() {
     };
     let waited = (0..m).filter(|&r| r != stuck).max_by_key(|&r| can(r)).unwrap();
     assert!(can(waited) >= 2, "the README cell's nearest plan shares tasks");
-    end[stuck] += 5.0;
-    let mut waits = vec![vec![0.0; m]; m];
-    waits[stuck][waited] = 5.0;
-    let mut seen: Vec<plan::Outcome> = Vec::new();
-    let mut judge = |o: &plan::Outcome, _: Option<(&plan::Outcome, &())>| -> Option<(f64, Vec<f64>, ())> {
-        seen.push(o.clone());
-        None
-    };
-    rebalance(
-        &cell,
-        &table,
-        (&base, makespan(&base) + 5.0, &end, &waits),
-        &s,
-        &mut cache,
-        &|_| true,
-        (&mut judge, &|_| unreachable!("no plan is taken")),
-    )
-    .unwrap();
+    let seen = judged_waiting((&cell, &table, &s, &mut cache, &base), (stuck, waited, 5.0));
     let given = |o: &plan::Outcome, r: usize| {
         base.allocated.tasks[r]
             .iter()

@@ -240,6 +240,13 @@ fn moves(cell: &Cell, o: &Outcome, end: &[f64]) -> Vec<Move> {
     ranked(out)
 }
 
+/// The robot that ends last by `end` and the seconds it waits for each robot (`waits[r][s]`:
+/// robot `r` for robot `s`, as judged).
+fn waiting<'a>(end: &[f64], waits: &'a [Vec<f64>]) -> Option<(usize, &'a [f64])> {
+    let stuck = last(end)?;
+    Some((stuck, waits.get(stuck)?))
+}
+
 /// The reliefs of `o` (Spensieri et al.'s loop one step further): where the robot that ends
 /// last by `end` waits, in all, at least [`RELIEF_MIN_WAIT`] for another (`waits[r][s]`: the
 /// seconds robot `r` waits for robot `s`, as judged), a task of the robot it waits for handed to
@@ -248,10 +255,7 @@ fn moves(cell: &Cell, o: &Outcome, end: &[f64]) -> Vec<Move> {
 /// waited for it, and the third robot to end (as judged) later by the task's addition. Ranked
 /// as [`moves`]; only reliefs expected to end sooner than the last robot ends now.
 fn reliefs(cell: &Cell, o: &Outcome, end: &[f64], waits: &[Vec<f64>]) -> Vec<Move> {
-    let Some(stuck) = last(end) else {
-        return Vec::new();
-    };
-    let Some(waited) = waits.get(stuck) else {
+    let Some((stuck, waited)) = waiting(end, waits) else {
         return Vec::new();
     };
     let tours = Tours::new(o);
@@ -282,14 +286,12 @@ fn reliefs(cell: &Cell, o: &Outcome, end: &[f64], waits: &[Vec<f64>]) -> Vec<Mov
 /// the receiver's tour, in the space the two share), handed over as the first 2, 3, …
 /// [`GROUP_MAX`] of them (within the receiver's room under the cap). Ranking them by what
 /// they add less what they save the giver, instead, picks the giver's cheap tasks wherever
-/// they are (door-opening-4r, seed 0: 41.88 s with those, 34.90 s with these). The last robot is expected to end sooner by what the tasks
-/// save it and by its wait, the receiver later (as judged) by what they add; ranked as
-/// [`moves`], only groups expected to end sooner than the last robot ends now.
+/// they are (door-opening-4r, seed 0: 41.88 s with those, 34.90 s with these). The last robot
+/// is expected to end sooner by what the tasks save it and by its wait, the receiver later (as
+/// judged) by what they add; ranked as [`moves`], only groups expected to end sooner than the
+/// last robot ends now.
 fn groups(cell: &Cell, o: &Outcome, end: &[f64], waits: &[Vec<f64>]) -> Vec<Move> {
-    let Some(stuck) = last(end) else {
-        return Vec::new();
-    };
-    let Some(waited) = waits.get(stuck) else {
+    let Some((stuck, waited)) = waiting(end, waits) else {
         return Vec::new();
     };
     let tours = Tours::new(o);
