@@ -437,7 +437,8 @@ pub fn coordinate(
         spent.set(spent.get() + c.diagram_distances);
         costliest.set(costliest.get().max(c.diagram_distances));
     };
-    // `extra`: work allowed beyond the budget (the reliefs', see [`RELIEF_EXTRA_DISTANCES`]).
+    // `extra`: work allowed beyond the budget (the reliefs' and the groups', see
+    // [`RELIEF_EXTRA_DISTANCES`]).
     let affordable_beyond = |extra: usize| {
         let (spent, costliest) = (spent.get(), costliest.get());
         spent + costliest <= coord.ours_distances.saturating_add(extra)
@@ -567,8 +568,9 @@ pub fn coordinate(
     if cut {
         best.0.time_limit_hit = true;
     }
-    // The best plan balanced on its real times (one task at a time from the robot that ends
-    // last, see [`plan::rebalance`]), each hand-over judged by its coordinated cycle.
+    // The best plan balanced on its real times (tasks handed from the robot that ends last, one
+    // at a time, then reliefs and groups: see [`plan::rebalance`]), each hand-over judged by its
+    // coordinated cycle.
     let ends = |c: &Coordinated| c.timed.iter().map(|t| t.end()).collect::<Vec<f64>>();
     let (score, base_ends) = (cycle_and_delta(&best.2.timed).0, ends(&best.2));
     // A hand-over's tours start their search over directions where the coordination of the

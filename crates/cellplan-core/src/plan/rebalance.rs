@@ -32,7 +32,8 @@ pub const RELIEF_PLANS: usize = 8;
 /// Of those, plans it hands its judge at most.
 pub const RELIEF_JUDGED: usize = 4;
 
-/// A robot the last one waits for at least this long (s) in all is one a relief may lighten.
+/// A robot the last one waits for at least this long (s) in all is one a relief may lighten,
+/// and one a group may go to.
 const RELIEF_MIN_WAIT: f64 = 0.5;
 
 /// Plans [`rebalance`] makes at most for group hand-overs (several tasks of the robot that
@@ -281,8 +282,8 @@ fn reliefs(cell: &Cell, o: &Outcome, end: &[f64], waits: &[Vec<f64>]) -> Vec<Mov
 /// The group hand-overs of `o` (where single tasks do not help, a robot that waits for a
 /// neighbour often needs a whole share of the space they both reach moved, not one MP of it):
 /// for each robot that the robot ending last by `end` waits for at least [`RELIEF_MIN_WAIT`]
-/// in all (`waits` as in [`reliefs`]), the last robot's tasks that robot can take, those it
-/// adds least to first (its dwell and cheapest insertion, as in [`moves`]: the tasks nearest
+/// in all (`waits` as in [`reliefs`]), the last robot's tasks that robot can take, those that
+/// add least to the receiver first (dwell and cheapest insertion, as in [`moves`]: the tasks nearest
 /// the receiver's tour, in the space the two share), handed over as the first 2, 3, …
 /// [`GROUP_MAX`] of them (within the receiver's room under the cap). Ranking them by what
 /// they add less what they save the giver, instead, picks the giver's cheap tasks wherever
@@ -376,7 +377,7 @@ pub fn rebalance<J>(
     let (mut score, mut judged_ends) = (base_score, base_ends.to_vec());
     let mut waits = base_waits.to_vec();
     let mut tried: Vec<Vec<Vec<TaskId>>> = vec![base.allocated.tasks.clone()];
-    // The direct hand-overs' budget, then the reliefs' (each its own).
+    // The direct hand-overs' budget, then the reliefs', then the groups' (each its own).
     let mut budgets = [
         Budget::new(REBALANCE_PLANS, REBALANCE_JUDGED),
         Budget::new(RELIEF_PLANS, RELIEF_JUDGED),
@@ -448,7 +449,8 @@ pub fn rebalance<J>(
                 }
             }
         }
-        // No hand-over of the robot ending last, and no relief of one it waits for, helped.
+        // No hand-over of the robot ending last, no relief of one it waits for, and no group
+        // to one, helped.
         break;
     }
     Ok((best, false))
