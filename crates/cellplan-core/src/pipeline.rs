@@ -307,7 +307,9 @@ impl RunnersUp {
 /// ([`PlanSettings::sweep`]; where the robots have a line), and the strips once more with each
 /// robot's estimates raised by how much slower than their lower bounds its legs were
 /// ([`PlanSettings::task_penalty`]); the nearest-robot allocation; the zones allocation
-/// again with what the first plan's measurements blocked the other robots; and, on cells of at
+/// again with what the first plan's measurements blocked the other robots (weighed
+/// [`BLOCKING_WEIGHT`], and where coordination lengthened the first plan by more than
+/// [`CROWDED`] a third time weighed [`HEAVY_BLOCKING_WEIGHT`]); and, on cells of at
 /// most [`BALANCED_MAX_PAIRS`] MPs × robots, the balanced allocation (which shares no planned
 /// legs with the others: it is planned and coordinated aside while they are, and judged at
 /// its turn, the last; on cells of more than `plan_first_pairs` it is a try like the others).
