@@ -7,7 +7,12 @@
 //! [`CoordSettings::blend_deviation`] of the corner in every joint. The blend's curve leaves the
 //! path the planner checked, so it is checked itself ([`curve_clear`]: distance-bounded
 //! stepping along the curve, as the planner steps along segments); a corner whose blend fails
-//! gets a quarter of the bound, then a sixteenth, then none. A robot's blended program is kept only if the exact
+//! gets a quarter of the bound, then a sixteenth, then none. Before it is blended, a leg that is
+//! not the direct segment loses its joints' needless detours (a wrist the sampler swung round
+//! and back): partial shortcuts of one joint at a time
+//! ([`cellplan_motion::plan::straighten_joints_timed`]), each changed segment checked against
+//! the cell. A robot's program straightened and blended is tried first where it ends sooner,
+//! then the program only blended. A robot's blended program is kept only if the exact
 //! search on the clock finds it clear of every other robot: first with its waits as long as
 //! they were (the robot runs ahead of its old timeline), else with each wait lengthened to end
 //! when it ended before (the timeline after every wait is the old one).
@@ -174,22 +179,64 @@ fn blend_leg(
     Ok(None)
 }
 
+/// Partial shortcuts of one joint at a time tried on each leg before it is blended
+/// ([`cellplan_motion::plan::straighten_joints_timed`]).
+const STRAIGHTEN_ATTEMPTS: usize = 40;
+
 /// `prog` with every leg that has no wait on the way blended where its blends check out;
-/// `None` when no leg changes. Returns the corners blended too.
-fn blended_program(ctx: &Ctx, prog: &Program, deviation: f64) -> Result<Option<(Program, usize)>, PlanError> {
+/// `None` when no leg changes. With `straighten`, each such leg that is not the direct segment
+/// first has its joints' needless detours removed (partial shortcuts of one joint at a time,
+/// every changed segment checked against the cell as the planner checks legs); the waypoints
+/// of a leg with a wait on the way stay where the wait is. Returns the corners blended and the
+/// legs straightened too.
+fn blended_program(
+    ctx: &Ctx,
+    prog: &Program,
+    deviation: f64,
+    straighten: bool,
+) -> Result<Option<(Program, usize, usize)>, PlanError> {
     let r = prog.robot;
     let mut out = prog.clone();
-    let mut corners = 0;
+    let (mut corners, mut straightened) = (0, 0);
+    let robot = &ctx.cell.robots[r];
+    let space = straighten.then(|| crate::motion::joint_space(ctx.cell, robot));
     for (k, leg) in prog.legs.iter().enumerate() {
         if leg.blend.is_some() || prog.waits.iter().any(|w| w.leg == k && w.waypoint > 0) {
             continue;
         }
-        if let Some(b) = blend_leg(&ctx.validity[r], &ctx.radii[r], &ctx.limits[r], leg, deviation)? {
-            corners += b.blend.as_ref().map_or(0, |x| x.corners.len());
-            out.legs[k] = b;
+        let mut leg = std::borrow::Cow::Borrowed(leg);
+        if let Some(space) = &space
+            && !leg.straight
+            && leg.waypoints.len() >= 3
+        {
+            let mut waypoints = leg.waypoints.clone();
+            let seed = ctx.settings.seed ^ ((r as u64) << 32) ^ k as u64;
+            cellplan_motion::plan::straighten_joints_timed(
+                space,
+                &ctx.validity[r],
+                &mut waypoints,
+                (seed, STRAIGHTEN_ATTEMPTS),
+                MIN_CLEARANCE,
+                &ctx.limits[r],
+            );
+            if waypoints != leg.waypoints {
+                straightened += 1;
+                leg = std::borrow::Cow::Owned(ProgramLeg::new(waypoints, false, &ctx.limits[r])?);
+            }
+        }
+        match blend_leg(&ctx.validity[r], &ctx.radii[r], &ctx.limits[r], &leg, deviation)? {
+            Some(b) => {
+                corners += b.blend.as_ref().map_or(0, |x| x.corners.len());
+                out.legs[k] = b;
+            }
+            None => {
+                if let std::borrow::Cow::Owned(l) = leg {
+                    out.legs[k] = l;
+                }
+            }
         }
     }
-    Ok((corners > 0).then_some((out, corners)))
+    Ok((corners + straightened > 0).then_some((out, corners, straightened)))
 }
 
 /// `blended` with each wait lengthened to end when it ended in `before` (the program as timed
@@ -226,17 +273,34 @@ pub(crate) fn blend_all(
     let all: Vec<usize> = (0..programs.len()).collect();
     let mut blended_corners = 0;
     for r in order {
-        let Some((blended, corners)) = blended_program(ctx, &programs[r], deviation)? else {
-            continue;
-        };
-        let keeping = if blended.waits.is_empty() {
-            vec![blended]
-        } else {
-            let kept = keep_wait_ends(ctx, blended.clone(), &timed[r])?;
-            vec![blended, kept]
-        };
-        for candidate in keeping {
-            let t = ctx.timed(&candidate)?;
+        // The legs straightened and blended, then blended only (when straightening changed
+        // a leg); each with its waits as long as they were, then ending when they ended.
+        let mut variants = Vec::new();
+        for straighten in [true, false] {
+            match blended_program(ctx, &programs[r], deviation, straighten)? {
+                Some((p, corners, straightened)) if !straighten || straightened > 0 => {
+                    variants.push((p, corners));
+                }
+                _ => {}
+            }
+        }
+        let mut keeping = Vec::new();
+        for (blended, corners) in variants {
+            if !blended.waits.is_empty() {
+                let kept = keep_wait_ends(ctx, blended.clone(), &timed[r])?;
+                keeping.push((blended, corners));
+                keeping.push((kept, corners));
+            } else {
+                keeping.push((blended, corners));
+            }
+        }
+        let mut keeping = keeping
+            .into_iter()
+            .map(|(p, c)| Ok((ctx.timed(&p)?, p, c)))
+            .collect::<Result<Vec<_>, PlanError>>()?;
+        // The soonest end first (a stable sort: of equal ends, the order above).
+        keeping.sort_by(|a, b| a.0.end().total_cmp(&b.0.end()));
+        for (t, candidate, corners) in keeping {
             if !check || ctx.clear(r, &t, &timed, &all, 0.0, f64::INFINITY, None) {
                 programs[r] = candidate;
                 timed[r] = t;

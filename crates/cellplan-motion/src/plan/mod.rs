@@ -73,7 +73,7 @@ pub use rrt_connect::RrtConnect;
 pub use rrt_star::RrtStar;
 pub use shared_roadmap::{RoadmapPath, SharedRoadmap, SharedRoadmapSettings};
 use simplify::shortcut_with;
-pub use simplify::{path_length, shortcut, shortcut_timed};
+pub use simplify::{path_length, shortcut, shortcut_timed, straighten_joints_timed};
 pub use space::JointSpace;
 pub use straight::Straight;
 use validity::segment_valid;

@@ -1,6 +1,6 @@
 //! Path post-processing: shortcuts and redundant waypoints.
 use super::{JointSpace, PlanSettings, StateValidity, check_segment};
-use crate::timing::{Limits, segment_time};
+use crate::timing::{Limits, segment_time, time_path_exact};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
@@ -63,6 +63,9 @@ pub fn shortcut_timed(
         Some(&cost),
     )
 }
+
+/// A whole path's cost (its time).
+type PathCost<'a> = &'a dyn Fn(&[Vec<f64>]) -> f64;
 
 /// A segment's cost: its time (rest to rest) when shortcutting for time.
 type SegmentCost<'a> = &'a dyn Fn(&[f64], &[f64]) -> f64;
@@ -171,6 +174,136 @@ fn shortcut_by(
         }
     }
     calls += remove_redundant(space, validity, waypoints, min_clearance, &seg);
+    calls
+}
+
+/// [`straighten_joints`] for a path timed stopping at every waypoint (each segment from rest
+/// to rest under `limits`, [`segment_time`]): up to `attempts` partial shortcuts of one joint,
+/// deterministic for `seed`. Never slows the path by that timing, keeps its waypoints' count and
+/// its ends, and keeps it valid (every changed segment passes [`check_segment`] at
+/// `min_clearance`). Returns the validity calls made.
+pub fn straighten_joints_timed(
+    space: &JointSpace,
+    validity: &dyn StateValidity,
+    waypoints: &mut [Vec<f64>],
+    (seed, attempts): (u64, usize),
+    min_clearance: f64,
+    limits: &Limits,
+) -> usize {
+    let seg = |a: &[f64], b: &[f64]| segment_time(a, b, limits);
+    let whole =
+        |p: &[Vec<f64>]| time_path_exact(p, limits).map_or(f64::INFINITY, |t| t.trajectory.duration());
+    let mut rng = ChaCha8Rng::seed_from_u64(seed ^ 0x4a4f_494e_5453_4855);
+    straighten_joints(
+        space,
+        validity,
+        waypoints,
+        (&mut rng, attempts),
+        min_clearance,
+        (&seg, &whole),
+    )
+}
+
+/// Partial shortcuts of one joint at a time (Geraerts and Overmars, "Creating high-quality
+/// paths for motion planning", 2007): up to `attempts` times (stopping after [`MAX_MISSES`]
+/// misses in a row), a joint drawn in proportion to how far it moves beyond what it must (the
+/// sum of its moves less its net move) and two waypoints `i < j` at least two apart; between
+/// them that joint moves straight from its value at `i` to its value at `j`, shared out over
+/// the segments in proportion to what each costs by `seg` without it (so that it rides on the
+/// other joints' motion), while the other joints keep their course. The waypoints stay where
+/// they are along the path, so no stop is added. Kept only when the path's cost by `whole`
+/// falls and
+/// every changed segment passes [`check_segment`]. Removes the detours of joints that the
+/// obstacles do not ask for (a wrist swung round and back by the sampler, which a shortcut of
+/// all joints at once cannot remove where the other joints' detour is needed). Returns the
+/// validity calls made.
+fn straighten_joints(
+    space: &JointSpace,
+    validity: &dyn StateValidity,
+    waypoints: &mut [Vec<f64>],
+    (rng, attempts): (&mut ChaCha8Rng, usize),
+    min_clearance: f64,
+    (seg, whole): (SegmentCost<'_>, PathCost<'_>),
+) -> usize {
+    let n = waypoints.len();
+    if n < 3 {
+        return 0;
+    }
+    let dof = waypoints[0].len();
+    let mut calls = 0;
+    let mut misses = 0;
+    let mut trial: Vec<Vec<f64>> = Vec::with_capacity(n);
+    let mut without = Vec::with_capacity(dof);
+    for _ in 0..attempts {
+        if misses >= MAX_MISSES {
+            break;
+        }
+        let excess: Vec<f64> = (0..dof)
+            .map(|d| {
+                let moved: f64 = waypoints.windows(2).map(|w| (w[1][d] - w[0][d]).abs()).sum();
+                (moved - (waypoints[n - 1][d] - waypoints[0][d]).abs()).max(0.0)
+            })
+            .collect();
+        let sum: f64 = excess.iter().sum();
+        if sum < 1e-9 {
+            break;
+        }
+        let mut pick = rng.random_range(0.0..sum);
+        let d = excess
+            .iter()
+            .position(|&e| {
+                pick -= e;
+                pick < 0.0
+            })
+            .unwrap_or(dof - 1);
+        let i = rng.random_range(0..n - 2);
+        let j = rng.random_range(i + 2..n);
+        // What each segment costs without joint d's move: d's share of the way.
+        let shares: Vec<f64> = waypoints[i..=j]
+            .windows(2)
+            .map(|w| {
+                without.clear();
+                without.extend_from_slice(&w[1]);
+                without[d] = w[0][d];
+                seg(&w[0], &without)
+            })
+            .collect();
+        let total: f64 = shares.iter().sum();
+        let (from, to) = (waypoints[i][d], waypoints[j][d]);
+        trial.clear();
+        trial.extend(waypoints.iter().cloned());
+        let mut along = 0.0;
+        for (k, share) in shares.iter().enumerate().take(j - i - 1) {
+            along += if total > 0.0 {
+                share / total
+            } else {
+                1.0 / (j - i) as f64
+            };
+            trial[i + k + 1][d] = from + (to - from) * along.min(1.0);
+        }
+        let (old, new) = (whole(waypoints), whole(&trial));
+        if new >= old - 1e-9 {
+            misses += 1;
+            continue;
+        }
+        let mut valid = true;
+        for w in trial[i..=j].windows(2) {
+            let check = check_segment(space, validity, &w[0], &w[1], min_clearance);
+            calls += check.calls;
+            if !check.valid {
+                valid = false;
+                break;
+            }
+        }
+        misses = if valid && old - new >= MIN_GAIN * old {
+            0
+        } else {
+            misses + 1
+        };
+        if valid {
+            waypoints.clone_from_slice(&trial);
+        }
+    }
     calls
 }
 

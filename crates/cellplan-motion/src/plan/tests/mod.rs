@@ -411,6 +411,85 @@ fn timed_shortcut_never_slows_the_path_and_stays_valid() {
     assert!(faster >= 15, "{faster} of 20 faster");
 }
 
+#[test]
+fn straightening_removes_a_joint_swing_the_obstacles_do_not_ask_for() {
+    use crate::timing::{Limits, time_path_exact};
+    // A third joint the wall (discs in the first two joints) does not see: a path around the
+    // wall's top along which it swings up and down needlessly, and sets the segments' times
+    // (at equal limits the joint that moves most does).
+    let space = square(3, 30.0);
+    let v = wall();
+    let limits = Limits::uniform(3, 1.0, 2.0).unwrap();
+    let time = |p: &[Vec<f64>]| time_path_exact(p, &limits).unwrap().trajectory.duration();
+    let swing = |p: &[Vec<f64>]| -> f64 {
+        p.windows(2).map(|w| (w[1][2] - w[0][2]).abs()).sum::<f64>() - (p[p.len() - 1][2] - p[0][2]).abs()
+    };
+    let path = vec![
+        vec![1.0, 1.0, 1.0],
+        vec![4.0, 9.0, 25.0],
+        vec![6.0, 9.0, 0.5],
+        vec![9.0, 1.0, 2.0],
+    ];
+    assert!(brute_force_valid(&v, &path, 1e-3));
+    let mut straight = path.clone();
+    let calls = straighten_joints_timed(&space, &v, &mut straight, (0, 40), 1e-4, &limits);
+    assert!(calls > 0);
+    assert_eq!(straight.len(), path.len());
+    assert_eq!(straight.first(), path.first());
+    assert_eq!(straight.last(), path.last());
+    assert!(brute_force_valid(&v, &straight, 1e-3));
+    // The first two joints keep their course (the wall needs it); the third no longer swings.
+    for (a, b) in straight.iter().zip(&path) {
+        assert_eq!(a[..2], b[..2]);
+    }
+    // 47 rad of needless swing: what is left no longer sets any segment's time.
+    assert!(
+        swing(&straight) < 2.0,
+        "swing left {}: {straight:?}",
+        swing(&straight)
+    );
+    assert!(
+        time(&straight) < 0.5 * time(&path),
+        "{} against {}",
+        time(&straight),
+        time(&path)
+    );
+}
+
+#[test]
+fn straightening_never_slows_a_path_and_keeps_it_valid() {
+    use crate::timing::{Limits, time_path_exact};
+    // Discs in all three joints: a joint's detour may be what keeps the path clear.
+    let space = square(3, 10.0);
+    let mut discs = Vec::new();
+    for y in 0..=8 {
+        for z in 0..=8 {
+            if (y, z) != (4, 4) {
+                discs.push((vec![5.0, 1.0 * y as f64 + 1.0, 1.0 * z as f64 + 1.0], 0.45));
+            }
+        }
+    }
+    let v = Discs::new(discs, 0.02);
+    let limits = Limits::new(vec![1.0, 0.7, 1.5], vec![2.0, 1.0, 3.0]).unwrap();
+    let time = |p: &[Vec<f64>]| time_path_exact(p, &limits).unwrap().trajectory.duration();
+    let mut faster = 0;
+    for seed in 0..20 {
+        let raw = RrtConnect::default()
+            .plan(&space, &v, &[1.0, 2.0, 8.0], &[9.0, 8.0, 2.0], &settings(seed))
+            .unwrap();
+        let mut path = raw.waypoints.clone();
+        straighten_joints_timed(&space, &v, &mut path, (seed, 40), 1e-4, &limits);
+        assert!(brute_force_valid(&v, &path, 1e-3), "seed {seed}");
+        assert_eq!(path.len(), raw.waypoints.len());
+        assert_eq!(path.first(), raw.waypoints.first());
+        assert_eq!(path.last(), raw.waypoints.last());
+        let (before, after) = (time(&raw.waypoints), time(&path));
+        assert!(after <= before + 1e-9, "seed {seed}: {after} > {before}");
+        faster += usize::from(after < before - 1e-9);
+    }
+    assert!(faster >= 10, "{faster} of 20 faster");
+}
+
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(300))]
 
