@@ -186,9 +186,9 @@ const STRAIGHTEN_ATTEMPTS: usize = 40;
 /// `prog` with every leg that has no wait on the way blended where its blends check out;
 /// `None` when no leg changes. With `straighten`, each such leg that is not the direct segment
 /// first has its joints' needless detours removed (partial shortcuts of one joint at a time,
-/// every changed segment checked against the cell as the planner checks legs); the waypoints
-/// of a leg with a wait on the way stay where the wait is. Returns the corners blended and the
-/// legs straightened too.
+/// every changed segment checked against the cell as the planner checks legs); a leg with a
+/// wait on the way is left as it is, its waypoints being where the wait is. Returns the
+/// corners blended and the legs straightened too.
 fn blended_program(
     ctx: &Ctx,
     prog: &Program,

@@ -177,9 +177,10 @@ fn shortcut_by(
     calls
 }
 
-/// [`straighten_joints`] for a path timed stopping at every waypoint (each segment from rest
-/// to rest under `limits`, [`segment_time`]): up to `attempts` partial shortcuts of one joint,
-/// deterministic for `seed`. Never slows the path by that timing, keeps its waypoints' count and
+/// [`straighten_joints`] for a path timed stopping at its corners under `limits` (the path's
+/// time as [`time_path_exact`] gives it; [`segment_time`] shares a joint's move out over the
+/// segments): up to `attempts` partial shortcuts of one joint, deterministic for `seed`. Never
+/// slows the path by that timing, keeps its waypoints' count and
 /// its ends, and keeps it valid (every changed segment passes [`check_segment`] at
 /// `min_clearance`). Returns the validity calls made.
 pub fn straighten_joints_timed(
@@ -212,8 +213,7 @@ pub fn straighten_joints_timed(
 /// the segments in proportion to what each costs by `seg` without it (so that it rides on the
 /// other joints' motion), while the other joints keep their course. The waypoints stay where
 /// they are along the path, so no stop is added. Kept only when the path's cost by `whole`
-/// falls and
-/// every changed segment passes [`check_segment`]. Removes the detours of joints that the
+/// falls and every changed segment passes [`check_segment`]. Removes the detours of joints that the
 /// obstacles do not ask for (a wrist swung round and back by the sampler, which a shortcut of
 /// all joints at once cannot remove where the other joints' detour is needed). Returns the
 /// validity calls made.
