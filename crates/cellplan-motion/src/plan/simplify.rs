@@ -177,7 +177,7 @@ fn shortcut_by(
     calls
 }
 
-/// [`straighten_joints`] for a path timed stopping at its corners under `limits` (the path's
+/// Partial shortcuts of one joint at a time (`straighten_joints`) for a path timed stopping at its corners under `limits` (the path's
 /// time as [`time_path_exact`] gives it; [`segment_time`] shares a joint's move out over the
 /// segments): up to `attempts` partial shortcuts of one joint, deterministic for `seed`. Never
 /// slows the path by that timing, keeps its waypoints' count and
