@@ -177,11 +177,11 @@ fn shortcut_by(
     calls
 }
 
-/// Partial shortcuts of one joint at a time (`straighten_joints`) for a path timed stopping at its corners under `limits` (the path's
-/// time as [`time_path_exact`] gives it; [`segment_time`] shares a joint's move out over the
-/// segments): up to `attempts` partial shortcuts of one joint, deterministic for `seed`. Never
-/// slows the path by that timing, keeps its waypoints' count and
-/// its ends, and keeps it valid (every changed segment passes [`check_segment`] at
+/// Partial shortcuts of one joint at a time (`straighten_joints`) for a path timed stopping at
+/// its corners under `limits` (the path's time as [`time_path_exact`] gives it;
+/// [`segment_time`] shares a joint's move out over the segments): up to `attempts` of them,
+/// deterministic for `seed`. Never slows the path by that timing, keeps its waypoints' count
+/// and its ends, and keeps it valid (every changed segment passes [`check_segment`] at
 /// `min_clearance`). Returns the validity calls made.
 pub fn straighten_joints_timed(
     space: &JointSpace,
