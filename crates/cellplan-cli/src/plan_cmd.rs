@@ -17,7 +17,7 @@ use std::time::{Duration, Instant};
 pub struct PlanArgs {
     /// The cell file (TOML).
     pub cell: PathBuf,
-    /// Output folder (default: out/<cell name>/); the plan goes to plan.json in it.
+    /// Output folder (default: out/CELL_NAME/); the plan goes to plan.json in it.
     #[arg(short, long, value_name = "DIR")]
     pub output: Option<PathBuf>,
     /// Allocation strategy.

@@ -308,8 +308,8 @@ impl RunnersUp {
 /// robot's estimates raised by how much slower than their lower bounds its legs were
 /// ([`PlanSettings::task_penalty`]); the nearest-robot allocation; the zones allocation
 /// again with what the first plan's measurements blocked the other robots (weighed
-/// [`BLOCKING_WEIGHT`], and where coordination lengthened the first plan by more than
-/// [`CROWDED`] a third time weighed [`HEAVY_BLOCKING_WEIGHT`]); and, on cells of at
+/// `BLOCKING_WEIGHT`, and where coordination lengthened the first plan by more than
+/// `CROWDED` a third time weighed `HEAVY_BLOCKING_WEIGHT`); and, on cells of at
 /// most [`BALANCED_MAX_PAIRS`] MPs × robots, the balanced allocation (which shares no planned
 /// legs with the others: it is planned and coordinated aside while they are, and judged at
 /// its turn, the last; on cells of more than `plan_first_pairs` it is a try like the others).
@@ -321,8 +321,8 @@ impl RunnersUp {
 /// last one waits for handed to a third) and the groups (several tasks of the last robot to a
 /// robot it waits for), which may go beyond the work budget by the share
 /// [`RELIEF_EXTRA_DISTANCES`] sets. Plans are compared with every leg stopping at every
-/// waypoint; the winner and the [`RUNNERS_UP`] shortest plans that lost (within
-/// [`RUNNER_UP_REACH`] of it, on cells of at most `plan_first_pairs` MPs × robots) are then
+/// waypoint; the winner and the `RUNNERS_UP` shortest plans that lost (within
+/// `RUNNER_UP_REACH` of it, on cells of at most `plan_first_pairs` MPs × robots) are then
 /// blended ([`crate::coord::blend`]) and the shortest blended cycle is the plan. The
 /// coordination compute of all is counted.
 /// Returns the winning run, its settings and its coordination. `cache` holds what earlier runs

@@ -9,7 +9,7 @@
 //! `d(a, b) = (sin a cos b, sin a sin b, −cos a)`, and the ball centre sits `L1 + L2` along it.
 //!
 //! [`CmmHead::inverse`] is the closed form from a ball-centre position and a probe direction;
-//! [`CmmHead::move_time`] is paper 003's motion model (assumption 1: the machine either moves or
+//! [`CmmSpeeds::move_time`] is paper 003's motion model (assumption 1: the machine either moves or
 //! rotates, never both; movement at one speed, rotation at another), with a trapezoidal option.
 use glam::DVec3;
 

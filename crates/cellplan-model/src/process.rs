@@ -6,7 +6,7 @@
 //! timing, the common clock, coordination, the plan document, motion verification, the report
 //! frame — is generic and lives once in the core, which never names a process. A process crate
 //! implements [`Process`] and offers a [`ProcessEntry`]; the binary puts the entries into a
-//! [`Registry`] and hands it to [`crate::load`].
+//! [`Registry`] and hands it to [`crate::load()`].
 use crate::InputError;
 use crate::robot::Robot;
 use crate::tasks::{Task, TaskId};

@@ -201,7 +201,7 @@ pub struct ArmValidity<'a> {
     /// default; off only to compare with the plain bound).
     pub own_radii: bool,
     /// Whether a segment step also bounds each part's motion at the sample itself (on by
-    /// default; off only to compare): see [`Self::posed_bound`].
+    /// default; off only to compare): see `posed_bound`.
     pub posed_radii: bool,
     /// Bodies checked against the scene (those moved by some joint), with their joints.
     moving: Vec<(usize, Range<usize>)>,
@@ -624,7 +624,7 @@ impl StateValidity for ArmValidity<'_> {
     /// As the default, with every part asked only as far as it matters (see `capped_step`):
     /// bodies from the tip inwards (the tool is the usual tightest part, and its step then caps
     /// the others' queries), then the self pairs; each queried part's motion bounded where the
-    /// arm stands ([`Self::posed_bound`]) when that is tighter.
+    /// arm stands (`posed_bound`) when that is tighter.
     fn segment_step(&self, q: &[f64], motion: &SegmentMotion, floor: f64, limit: f64) -> Option<f64> {
         if !self.arm.chain.within_limits(q, 1e-9) {
             return None;

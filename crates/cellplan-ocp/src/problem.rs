@@ -12,7 +12,7 @@
 //!   `q̇_0 = q̇_N = 0` as equal bounds).
 //!
 //! The Jacobian of `c` and the Hessian of the Lagrangian are exact and sparse (row block k
-//! touches `q_{k−1}, q_k, q_{k+1}`, `h` and two torques), computed step by step in [`exact`]
+//! touches `q_{k−1}, q_k, q_{k+1}`, `h` and two torques), computed step by step in `exact`
 //! by second-order forward differentiation over each midpoint ([`crate::taylor`]).
 use crate::dmoc::{del_residual, end_residual, start_residual};
 use cellplan_kin::dynamics::Dynamics;

@@ -199,7 +199,7 @@ fn along(m: &Move, path: &[Vec<f64>], profile: fn(f64) -> f64, slack: f64) -> Ve
 }
 
 /// The target of the trust regions' first iterate: the grid at rest-to-rest positions along
-/// the path ([`quintic`] in time, waypoints on the grid), so that a trajectory of the dynamics
+/// the path (`quintic` in time, waypoints on the grid), so that a trajectory of the dynamics
 /// lies near it; the step giving a mean speed of half the slowest joint's limit
 /// (the quintic peaks at 1.875× the mean); zero torques.
 pub fn rest_to_rest_guess(m: &Move, path: &[Vec<f64>]) -> Vec<f64> {

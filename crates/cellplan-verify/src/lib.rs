@@ -2,22 +2,22 @@
 //! geometry and kinematics primitives with the planner (forward kinematics, the collision
 //! world, the process's checks) and reads nothing but the plan document, and it re-derives
 //! every number the document states about the plan:
-//! - [`tasks`]: every task done exactly once by a robot that has it as a candidate, at a pose
+//! - `tasks`: every task done exactly once by a robot that has it as a candidate, at a pose
 //!   the process accepts, with the figures the process gives; the unmeasured list exactly the
 //!   tasks no robot can do, with their reasons;
-//! - [`paths`]: the legs chained home → tasks → home, re-sampled at the verifier's resolution
+//! - `paths`: the legs chained home → tasks → home, re-sampled at the verifier's resolution
 //!   against the static scene and the robot itself; the trajectory walked forward along them;
-//! - [`timing`]: the trajectory samples at the stated step, within joint position, velocity and
+//! - `timing`: the trajectory samples at the stated step, within joint position, velocity and
 //!   acceleration limits; the program's clock (legs, waits, visits) re-derived and every robot
 //!   total recomputed; each wait a standstill;
-//! - [`robots`]: robot–robot clearance over the common timeline;
-//! - [`record`]: the settings the cell fixes, the cycle time, Δt, the lower bound (recomputed
+//! - `robots`: robot–robot clearance over the common timeline;
+//! - `record`: the settings the cell fixes, the cycle time, Δt, the lower bound (recomputed
 //!   from the candidates), the coordination record and the candidate count.
 //!
 //! Apart from plans of cells, [`motion`] re-checks bare joint paths (the motion benchmark's)
 //! exactly, on the robot's collision meshes as given.
 //!
-//! Before any of that the document is [`validate`](cellplan_core::document::validate)d, and a plan too
+//! Before any of that the document is [`validate`]d, and a plan too
 //! large to check at the requested resolution is refused ([`workload`]).
 pub mod cmm;
 pub mod motion;

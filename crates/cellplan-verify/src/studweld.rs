@@ -7,7 +7,7 @@
 //!   (`cellplan_studweld::process::WELD_POSE_TOLERANCE`), the joints within their limits,
 //!   the pose collision-free at the cell's clearance, the gravity torques within the limits, the
 //!   pose held from `start_s` to `end_s` = weld time, and its node cost re-derived;
-//! - every move ([`legs`]): joins the welds (home at both ends), satisfies the discrete
+//! - every move (`legs`): joins the welds (home at both ends), satisfies the discrete
 //!   Euler–Lagrange equations of DMOC re-evaluated here with `cellplan_kin::dynamics` (the
 //!   planner's `cellplan-ocp` is not used), keeps joint, velocity and torque limits, and keeps
 //!   the clearance along the whole motion (each straight piece proven clear by the motion

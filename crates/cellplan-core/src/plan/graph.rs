@@ -149,7 +149,7 @@ pub fn per_task_within(per_task: usize, doable: usize) -> usize {
 
 impl RobotGraph {
     /// The robot's shared roadmap ([`crate::motion::robot_roadmap`]): the graph's
-    /// configurations (home and the candidates kept, at most [`MAX_ROADMAP_SEEDS`] of them)
+    /// configurations (home and the candidates kept, at most `MAX_ROADMAP_SEEDS` of them)
     /// and samples seeded by `seed` (half uniform, half near those configurations). Built the first time it is asked for; the same
     /// for every caller.
     pub fn roadmap(&self, cell: &Cell, robot: &Robot, seed: u64) -> &SharedRoadmap {

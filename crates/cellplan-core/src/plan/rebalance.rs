@@ -10,7 +10,7 @@
 //! down. Where those hand-overs do not help and the last robot waits for another, a task of the
 //! robot it waits for goes to a third one (a relief): the shared space is then held for less
 //! time. Where neither helps, a group of the last robot's tasks goes to the robot it waits for
-//! ([`groups`]): on a crowded cell one MP moved at a time changes the coordinated cycle
+//! (`groups`): on a crowded cell one MP moved at a time changes the coordinated cycle
 //! erratically, while a share of the space both reach, moved at once, can end the waiting.
 use super::{Outcome, PlanCache, PlanError, PlanSettings, dwell, plan_keeping};
 use crate::candidates::CandidateTable;
@@ -37,7 +37,7 @@ pub const RELIEF_JUDGED: usize = 4;
 const RELIEF_MIN_WAIT: f64 = 0.5;
 
 /// Plans [`rebalance`] makes at most for group hand-overs (several tasks of the robot that
-/// ends last to a robot it waits for, see [`groups`]), once the other two kinds are spent.
+/// ends last to a robot it waits for, see `groups`), once the other two kinds are spent.
 pub const GROUP_PLANS: usize = 4;
 
 /// Of those, plans it hands its judge at most.
@@ -352,7 +352,7 @@ fn groups(cell: &Cell, o: &Outcome, end: &[f64], waits: &[Vec<f64>]) -> Vec<Move
 /// tried the same way on a budget of their own ([`RELIEF_PLANS`], [`RELIEF_JUDGED`]): they need
 /// the judged waits, `base_waits` for `base` and `waits_of` for what the judge made of a plan
 /// (`w[r][s]`: seconds robot `r` waits for robot `s`; none given, no relief). After them the
-/// round's group hand-overs ([`groups`]), on a budget of their own too ([`GROUP_PLANS`],
+/// round's group hand-overs (`groups`), on a budget of their own too ([`GROUP_PLANS`],
 /// [`GROUP_JUDGED`]; `may_judge` asked with `true`, as for a relief). A relief or a group
 /// taken starts a new round, its hand-overs first while their budget lasts.
 /// Returns the best plan found with its settings and what the judge made of it, or `None` when
