@@ -493,6 +493,21 @@ fn render(doc: &output::Plan, working: &str) -> String {
         c.verification,
         c.total
     );
+    if let (Some(o), Some(t)) = (&doc.stats.ours, &c.ours) {
+        s += &format!(
+            "  (ours: {} plans coordinated in {:.2} s, then {} hand-overs judged in {:.2} s{}, the winner{} blended in {:.2} s)\n",
+            o.tries_coordinated,
+            t.tries,
+            o.handovers_judged,
+            t.handovers,
+            if o.handover_taken { ", one taken" } else { "" },
+            match o.blended {
+                0 | 1 => String::new(),
+                n => format!(" and {} runners-up", n - 1),
+            },
+            t.blend
+        );
+    }
     if c.route_bound > 0.0 {
         s += &format!(
             "  (of which the route bound {:.2} s; verification checks it from its duals)\n",

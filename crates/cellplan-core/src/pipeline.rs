@@ -435,7 +435,9 @@ pub fn coordinate(
     // Diagram work of the coordinations so far, and of the costliest.
     let spent = std::cell::Cell::new(0usize);
     let costliest = std::cell::Cell::new(0usize);
+    let coordinations = std::cell::Cell::new(0usize);
     let count = |c: &Coordinated| {
+        coordinations.set(coordinations.get() + 1);
         spent.set(spent.get() + c.diagram_distances);
         costliest.set(costliest.get().max(c.diagram_distances));
     };
@@ -570,6 +572,7 @@ pub fn coordinate(
     if cut {
         best.0.time_limit_hit = true;
     }
+    let (tries_s, tries_coordinated) = (lap.elapsed().as_secs_f64(), coordinations.get());
     // The best plan balanced on its real times (tasks handed from the robot that ends last, one
     // at a time, then reliefs and groups: see [`plan::rebalance`]), each hand-over judged by its
     // coordinated cycle.
@@ -588,6 +591,7 @@ pub fn coordinate(
     let base_waits = best.2.waits_for();
     let base = (&best.0, score, base_ends.as_slice(), base_waits.as_slice());
     let waits_of = |c: &Coordinated| c.waits_for();
+    let mut handover_taken = false;
     if let Ok((found, clock_cut)) = plan::rebalance::rebalance(
         cell,
         table,
@@ -604,11 +608,14 @@ pub fn coordinate(
         (&mut judge, &waits_of),
     ) {
         if let Some(found) = found {
+            handover_taken = true;
             runners_up.keep(Some(std::mem::replace(&mut best, found)));
         }
         // The clock stopped the hand-overs: the plan says so.
         best.0.time_limit_hit |= clock_cut;
     }
+    let handovers_s = lap.elapsed().as_secs_f64() - tries_s;
+    let handovers_judged = coordinations.get() - tries_coordinated;
     // The winner and the runners-up within reach of it, blended; the shortest blended cycle
     // (then Δt, then the winner first) is the plan.
     let blending = CoordSettings {
@@ -625,7 +632,9 @@ pub fn coordinate(
     );
     // One context for all of them: the robots' checkers are built once.
     let ctx = crate::coord::Ctx::new(cell, table, &blending, None);
+    let mut blended = 0;
     for (o, s, c) in candidates {
+        blended += 1;
         let c = crate::coord::blend::blend_with(&ctx, c)?;
         if chosen
             .as_ref()
@@ -636,11 +645,25 @@ pub fn coordinate(
     }
     let (o, s, c) = chosen.expect("the winner is a candidate");
     let spent = lap.elapsed().as_secs_f64();
+    let ours = (
+        crate::document::OursRun {
+            tries_coordinated,
+            handovers_judged,
+            handover_taken,
+            blended,
+        },
+        crate::document::OursTimes {
+            tries: tries_s,
+            handovers: handovers_s,
+            blend: spent - tries_s - handovers_s,
+        },
+    );
     Ok((
         o,
         s,
         Coordinated {
             compute_s: spent,
+            ours: Some(ours),
             ..c
         },
     ))

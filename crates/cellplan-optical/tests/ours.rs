@@ -77,6 +77,20 @@ fn ours_keeps_the_shortest_of_its_plans() {
     let report = verify(&f.cell, &doc, &VerifySettings::default());
     assert!(report.ok, "{:#?}", report.violations);
     assert!(doc.cycle_time_s <= coord::cycle_and_delta(&alone.timed).0 + 1e-9);
+    // The plan says how ours went: its first plan and others coordinated, the winner blended,
+    // the parts' seconds within the stage's; a plain coordination says nothing.
+    let ours = doc.stats.ours.expect("ours states its run");
+    assert!(ours.tries_coordinated >= 2, "{ours:?}");
+    assert!(ours.blended >= 1, "{ours:?}");
+    let t = doc.compute_s.ours.expect("and its parts' seconds");
+    let parts = [t.tries, t.handovers, t.blend];
+    assert!(parts.iter().all(|&s| s >= 0.0), "{t:?}");
+    assert!(
+        parts.iter().sum::<f64>() <= c.compute_s + 1e-9,
+        "{t:?} against {}",
+        c.compute_s
+    );
+    assert!(alone.ours.is_none());
 }
 
 /// Ours makes its balanced plan aside (on small cells like this one), planned and coordinated

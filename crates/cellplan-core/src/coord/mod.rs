@@ -134,6 +134,9 @@ pub struct Coordinated {
     pub blended_corners: usize,
     /// Wall seconds.
     pub compute_s: f64,
+    /// How ours went, and its parts' seconds, when this is ours' winner
+    /// ([`crate::pipeline::coordinate`]).
+    pub ours: Option<(crate::document::OursRun, crate::document::OursTimes)>,
 }
 
 impl Coordinated {
@@ -395,6 +398,7 @@ fn coordinate_with(
         blocking: res.blocking,
         reversed: res.reversed,
         compute_s: started.elapsed().as_secs_f64(),
+        ours: None,
     })
 }
 

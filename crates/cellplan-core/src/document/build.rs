@@ -289,6 +289,7 @@ fn stats(table: &CandidateTable, outcome: &Outcome, coordinated: &Coordinated) -
         passage_search: coordinated.search,
         time_limit_hit: outcome.time_limit_hit,
         route_bound: None,
+        ours: coordinated.ours.map(|o| o.0),
     }
 }
 
@@ -305,6 +306,7 @@ fn compute_times(
         candidates: candidates_s,
         coordination: coordinated.compute_s,
         route_bound: route_bound_s,
+        ours: coordinated.ours.map(|o| o.1),
         ..ComputeTimes::default()
     };
     for &(stage, s) in &outcome.compute {

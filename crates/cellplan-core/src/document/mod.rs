@@ -114,6 +114,36 @@ impl RouteBoundOut {
     }
 }
 
+/// How ours (`best` on the zones allocation) went through its coordination stage: the search,
+/// not a claim about the plan (not checked); its seconds are in [`ComputeTimes::ours`].
+#[derive(Clone, Copy, Debug, Serialize, Deserialize, PartialEq, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct OursRun {
+    /// Plans coordinated while choosing among ours' tries (the run's first plan, the strips,
+    /// the nearest robots, the zones again, the balanced allocation where it runs).
+    pub tries_coordinated: usize,
+    /// Hand-over plans (single hand-overs, reliefs, groups) coordinated and judged after them.
+    pub handovers_judged: usize,
+    /// Whether a hand-over beat the best try (the plan is then one).
+    pub handover_taken: bool,
+    /// Plans blended and compared at the end (the winner and the runners-up within reach).
+    pub blended: usize,
+}
+
+/// Wall seconds of ours' parts of its coordination stage, one after the other (they add up to
+/// about [`ComputeTimes::coordination`]).
+#[derive(Clone, Copy, Debug, Serialize, Deserialize, PartialEq, Default, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct OursTimes {
+    /// Until the best try was known: the first plan's coordination, every other try's
+    /// planning and coordination.
+    pub tries: f64,
+    /// The hand-overs: their planning and coordinations.
+    pub handovers: f64,
+    /// Blending the winner and the runners-up and choosing among them.
+    pub blend: f64,
+}
+
 /// How a route bound's column generation went: the search, not a claim about the plan (not
 /// checked; the bound is checked from its certificate).
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq, JsonSchema)]
@@ -506,6 +536,9 @@ pub struct Stats {
     /// How the route bound's search went (`plan --route-bound`; absent without it).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub route_bound: Option<RouteBoundRun>,
+    /// How ours spent its coordination stage (ours only: `best` on the zones allocation).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ours: Option<OursRun>,
 }
 
 /// `best`'s search over the orders in which robots pass their conflict boxes.
@@ -551,6 +584,9 @@ pub struct ComputeTimes {
     /// The route bound (`plan --route-bound`; 0 without it).
     #[serde(default)]
     pub route_bound: f64,
+    /// Ours' parts of `coordination` (ours only).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ours: Option<OursTimes>,
     /// Everything, including writing.
     pub total: f64,
 }
