@@ -503,6 +503,7 @@ fn render(doc: &output::Plan, working: &str) -> String {
             if o.handover_taken { ", one taken" } else { "" },
             match o.blended {
                 0 | 1 => String::new(),
+                2 => " and a runner-up".to_string(),
                 n => format!(" and {} runners-up", n - 1),
             },
             t.blend
