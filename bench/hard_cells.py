@@ -167,6 +167,10 @@ def bench_cell(name, out_root, timeout, threads1, seed=0):
     rc, so, se, wall, rss = run([str(BIN), "plan", str(cell), "-o", str(out), "--json", "--no-report"]
                                 + seeded, timeout)
     row.update(exit=rc, wall_s=wall, peak_rss_mb=rss)
+    # What the run printed besides its JSON (progress, a temporary build's traces), kept with
+    # the plan (with --out, where it outlives the run).
+    out.mkdir(parents=True, exist_ok=True)
+    (out / "plan.stderr").write_text(se or "")
     if rc not in (0, 3):
         row["ok"] = False
         row["problems"].append("plan timed out" if rc is None else f"plan exit {rc}: {last_error(se)}")
@@ -193,8 +197,12 @@ def bench_cell(name, out_root, timeout, threads1, seed=0):
                    route_bound_converged=rb["converged"], route_bound_rounds=rb["rounds"],
                    route_bound_work=rb["work"])
     try:
-        stats = json.loads((out / "plan.json").read_text())["stats"]
+        doc = json.loads((out / "plan.json").read_text())
+        stats = doc["stats"]
         row.update(legs_failed=stats["legs_failed"], legs_planned=stats["legs_planned"])
+        # How ours went (plans that state it): counts, and the seconds of its parts.
+        if stats.get("ours") and doc["compute_s"].get("ours"):
+            row.update(ours=stats["ours"], ours_s=doc["compute_s"]["ours"])
     except (OSError, ValueError, KeyError):
         pass
     vrc, vo, ve, vwall, _ = run([str(BIN), "verify", str(out / "plan.json"), str(cell), "--json"],
@@ -304,7 +312,7 @@ def main():
     ap.add_argument("--all", action="store_true", help="every cell, the long ones too")
     ap.add_argument("--quick", action="store_true", help="only " + ", ".join(QUICK))
     ap.add_argument("--json", action="store_true", help="print the rows as JSON")
-    ap.add_argument("--out", help="keep the plans in this folder (default: a temporary one)")
+    ap.add_argument("--out", help="keep the plans (and each run's stderr, plan.stderr) in this folder (default: a temporary one)")
     ap.add_argument("--timeout", type=float, default=3600, help="seconds per command (default 3600)")
     ap.add_argument("--no-threads1", action="store_true", help="skip the --threads 1 comparison")
     ap.add_argument("--seeds", default="0",
