@@ -187,13 +187,17 @@ const STRAIGHTEN_ATTEMPTS: usize = 40;
 /// `None` when no leg changes. With `straighten`, each such leg that is not the direct segment
 /// first has its joints' needless detours removed (partial shortcuts of one joint at a time,
 /// every changed segment checked against the cell as the planner checks legs); a leg with a
-/// wait on the way is left as it is, its waypoints being where the wait is. Returns the
-/// corners blended and the legs straightened too.
+/// wait on the way is left as it is, its waypoints being where the wait is. `plain`, when
+/// given, is `prog` blended without straightening (this function's answer, or `prog` itself
+/// when that was `None`): a leg straightening leaves as it was takes its blend from there
+/// instead of being blended again (the same leg, the same blend). Returns the corners blended
+/// and the legs straightened too.
 fn blended_program(
     ctx: &Ctx,
     prog: &Program,
     deviation: f64,
     straighten: bool,
+    plain: Option<&Program>,
 ) -> Result<Option<(Program, usize, usize)>, PlanError> {
     let r = prog.robot;
     let mut out = prog.clone();
@@ -223,6 +227,12 @@ fn blended_program(
                 straightened += 1;
                 leg = std::borrow::Cow::Owned(ProgramLeg::new(waypoints, false, &ctx.limits[r])?);
             }
+        }
+        if let (std::borrow::Cow::Borrowed(_), Some(plain)) = (&leg, plain) {
+            let blended = &plain.legs[k];
+            corners += blended.blend.as_ref().map_or(0, |x| x.corners.len());
+            out.legs[k] = blended.clone();
+            continue;
         }
         match blend_leg(&ctx.validity[r], &ctx.radii[r], &ctx.limits[r], &leg, deviation)? {
             Some(b) => {
@@ -275,14 +285,24 @@ pub(crate) fn blend_all(
     for r in order {
         // The legs straightened and blended, then blended only (when straightening changed
         // a leg); each with its waits as long as they were, then ending when they ended.
+        // (The plain blend first, so that the straightened program takes the legs
+        // straightening leaves alone from it.)
+        let plain = blended_program(ctx, &programs[r], deviation, false, None)?;
+        let straight = blended_program(
+            ctx,
+            &programs[r],
+            deviation,
+            true,
+            Some(plain.as_ref().map_or(&programs[r], |p| &p.0)),
+        )?;
         let mut variants = Vec::new();
-        for straighten in [true, false] {
-            match blended_program(ctx, &programs[r], deviation, straighten)? {
-                Some((p, corners, straightened)) if !straighten || straightened > 0 => {
-                    variants.push((p, corners));
-                }
-                _ => {}
-            }
+        if let Some((p, corners, straightened)) = straight
+            && straightened > 0
+        {
+            variants.push((p, corners));
+        }
+        if let Some((p, corners, _)) = plain {
+            variants.push((p, corners));
         }
         let mut keeping = Vec::new();
         for (blended, corners) in variants {
