@@ -184,26 +184,25 @@ fn blend_leg(
 const STRAIGHTEN_ATTEMPTS: usize = 40;
 
 /// `prog` with every leg that has no wait on the way blended where its blends check out;
-/// `None` when no leg changes. With `straighten`, each such leg that is not the direct segment
-/// first has its joints' needless detours removed (partial shortcuts of one joint at a time,
-/// every changed segment checked against the cell as the planner checks legs); a leg with a
-/// wait on the way is left as it is, its waypoints being where the wait is. `plain`, when
-/// given, is `prog` blended without straightening (this function's answer, or `prog` itself
-/// when that was `None`): a leg straightening leaves as it was takes its blend from there
-/// instead of being blended again (the same leg, the same blend). Returns the corners blended
+/// `None` when no leg changes. With `plain` — `prog` blended without straightening (this
+/// function's answer without `plain`, or `prog` itself when that was `None`) — each such leg
+/// that is not the direct segment first has its joints' needless detours removed (partial
+/// shortcuts of one joint at a time, every changed segment checked against the cell as the
+/// planner checks legs), and a leg that straightening leaves as it was takes its blend from
+/// `plain` instead of being blended again (the same leg, the same blend); a leg with a wait on
+/// the way is left as it is, its waypoints being where the wait is. Returns the corners blended
 /// and the legs straightened too.
 fn blended_program(
     ctx: &Ctx,
     prog: &Program,
     deviation: f64,
-    straighten: bool,
     plain: Option<&Program>,
 ) -> Result<Option<(Program, usize, usize)>, PlanError> {
     let r = prog.robot;
     let mut out = prog.clone();
     let (mut corners, mut straightened) = (0, 0);
     let robot = &ctx.cell.robots[r];
-    let space = straighten.then(|| crate::motion::joint_space(ctx.cell, robot));
+    let space = plain.map(|_| crate::motion::joint_space(ctx.cell, robot));
     for (k, leg) in prog.legs.iter().enumerate() {
         if leg.blend.is_some() || prog.waits.iter().any(|w| w.leg == k && w.waypoint > 0) {
             continue;
@@ -287,12 +286,11 @@ pub(crate) fn blend_all(
         // a leg); each with its waits as long as they were, then ending when they ended.
         // (The plain blend first, so that the straightened program takes the legs
         // straightening leaves alone from it.)
-        let plain = blended_program(ctx, &programs[r], deviation, false, None)?;
+        let plain = blended_program(ctx, &programs[r], deviation, None)?;
         let straight = blended_program(
             ctx,
             &programs[r],
             deviation,
-            true,
             Some(plain.as_ref().map_or(&programs[r], |p| &p.0)),
         )?;
         let mut variants = Vec::new();

@@ -234,16 +234,22 @@ fn straighten_joints(
     let mut misses = 0;
     let mut trial: Vec<Vec<f64>> = Vec::with_capacity(n);
     let mut without = Vec::with_capacity(dof);
-    for _ in 0..attempts {
-        if misses >= MAX_MISSES {
-            break;
-        }
-        let excess: Vec<f64> = (0..dof)
+    // Each joint's motion beyond its net move, and the path's cost: they change only when an
+    // attempt is kept.
+    let excess_of = |waypoints: &[Vec<f64>]| -> Vec<f64> {
+        (0..dof)
             .map(|d| {
                 let moved: f64 = waypoints.windows(2).map(|w| (w[1][d] - w[0][d]).abs()).sum();
                 (moved - (waypoints[n - 1][d] - waypoints[0][d]).abs()).max(0.0)
             })
-            .collect();
+            .collect()
+    };
+    let mut excess = excess_of(waypoints);
+    let mut old = whole(waypoints);
+    for _ in 0..attempts {
+        if misses >= MAX_MISSES {
+            break;
+        }
         let sum: f64 = excess.iter().sum();
         if sum < 1e-9 {
             break;
@@ -281,7 +287,7 @@ fn straighten_joints(
             };
             trial[i + k + 1][d] = from + (to - from) * along.min(1.0);
         }
-        let (old, new) = (whole(waypoints), whole(&trial));
+        let new = whole(&trial);
         if new >= old - 1e-9 {
             misses += 1;
             continue;
@@ -302,6 +308,8 @@ fn straighten_joints(
         };
         if valid {
             waypoints.clone_from_slice(&trial);
+            excess = excess_of(waypoints);
+            old = new;
         }
     }
     calls
