@@ -13,8 +13,8 @@ pub struct CellSpec {
     /// Units of every length and angle in this file and in the task list.
     #[serde(default)]
     pub units: UnitsSpec,
-    /// What the cell does; its parameters are read in a second pass (the process crate's own spec) so
-    /// that errors in them keep their line.
+    /// What the cell does; its parameters are read in a second pass (the process crate's own
+    /// spec) so that errors in them keep their line.
     pub process: Spanned<ProcessHeader>,
     /// Limits every process shares.
     #[serde(default)]

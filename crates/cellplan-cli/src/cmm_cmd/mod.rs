@@ -1,8 +1,8 @@
 //! `plan`, `reuse`, `verify`, `report`, `compare` and `check` on CMM-inspection cells (paper
 //! 003): argument checks, output files and printing only; the work is in `cellplan-cmm`, the
 //! check in `cellplan-verify::cmm`, the page in `cellplan-report::cmm`. Here: plan, verify,
-//! report, check; [`reuse`](mod@reuse) the `reuse` command, [`compare`](mod@compare) Tables 3 and 4, [`bench_local`](mod@bench_local)
-//! the local paths for the OMPL peer.
+//! report, check; [`reuse`](mod@reuse) the `reuse` command, [`compare`](mod@compare) Tables 3
+//! and 4, [`bench_local`](mod@bench_local) the local paths for the OMPL peer.
 
 mod bench_local;
 mod compare;

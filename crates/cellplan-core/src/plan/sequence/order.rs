@@ -13,8 +13,8 @@ const GTSP_STALL: usize = 100;
 
 /// The best order (GTSP over the tasks' candidates) under the current costs: planned legs at
 /// their real time, the others at their lower bound; with `sweep` keys per task (see
-/// [`crate::plan::PlanSettings::sweep`], [`crate::plan::sweep_keys`]), the order that sweeps the tasks in [`SWEEP_GROUPS`] groups of
-/// rising key wherever that is possible.
+/// [`crate::plan::PlanSettings::sweep`], [`crate::plan::sweep_keys`]), the order that sweeps
+/// the tasks in [`SWEEP_GROUPS`] groups of rising key wherever that is possible.
 pub fn best_order(
     graph: &RobotGraph,
     tasks: &[TaskId],
