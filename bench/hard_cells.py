@@ -64,6 +64,7 @@ CELLS = [
     ("dense-8r-120", True),
     ("dense-8r-250", True),
     ("side-4r-2000", True),
+    ("dense-8r-1000", True),
 ]
 QUICK = ["facing-4r-roof", "underbody-3r", "ur10-backdoor-2r"]
 
