@@ -4,9 +4,9 @@ use super::{Decision, Now, Rendezvous, dist};
 use crate::cell::PcbCell;
 
 /// The devices' state between two cycles of a one-robot cell: what
-/// [`simulate`](super::simulate) carries from one cycle to the next. `states[k]` is the state before cycle `k` (before its pick is
-/// chosen), so a decision that differs from another only from position `k` of the order on
-/// can be simulated from `states[k]` on.
+/// [`simulate`](super::simulate) carries from one cycle to the next. `states[k]` is the state
+/// before cycle `k` (before its pick is chosen), so a decision that differs from another only
+/// from position `k` of the order on can be simulated from `states[k]` on.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct State {
     robot: ([f64; 2], f64),
@@ -15,9 +15,9 @@ pub struct State {
 }
 
 /// [`simulate`](super::simulate)'s assembly time for a one-robot cell, from `states[from]` on
-/// (filling `states[from + 1..]`), stopping with `None` as soon as the time cannot end at or below
-/// `cutoff`: each component's cycle takes at least `least[c]` ([`least_cycles`]). `states`
-/// must hold `order.len() + 1` entries; with `from = 0` the first is set here.
+/// (filling `states[from + 1..]`), stopping with `None` as soon as the time cannot end at or
+/// below `cutoff`: each component's cycle takes at least `least[c]` ([`least_cycles`]).
+/// `states` must hold `order.len() + 1` entries; with `from = 0` the first is set here.
 #[allow(clippy::too_many_arguments)]
 pub fn one_robot_from(
     cell: &PcbCell,
