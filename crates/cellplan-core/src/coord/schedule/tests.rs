@@ -346,11 +346,11 @@ fn the_pairs_floor_bounds_and_ends_the_search_early() {
                 let (Found::Schedule(cut), _) = search(&tracks, &boxes, 12, 0.05, false) else {
                     continue;
                 };
-                if let (Found::Schedule(c), _) = search(&tracks, &boxes, 12, 0.05, true) {
-                    if c.proven {
-                        assert!((c.makespan - p.makespan).abs() < 1e-9);
-                        more_proven += usize::from(!cut.proven);
-                    }
+                if let (Found::Schedule(c), _) = search(&tracks, &boxes, 12, 0.05, true)
+                    && c.proven
+                {
+                    assert!((c.makespan - p.makespan).abs() < 1e-9);
+                    more_proven += usize::from(!cut.proven);
                 }
             }
             (Found::Infeasible, Found::Infeasible) => {}
