@@ -198,6 +198,26 @@ fn the_search_matches_brute_force() {
     assert!((s.makespan - best).abs() < 1e-9, "{} vs {best}", s.makespan);
 }
 
+/// `robots` random tracks, each with a number of rests in `rests` (home included after the
+/// first), 0.2–2 s apart, and 0.5–2 s of path after the last.
+fn random_tracks(
+    rng: &mut rand_chacha::ChaCha8Rng,
+    robots: usize,
+    rests: std::ops::Range<usize>,
+) -> Vec<Track> {
+    use rand::RngExt;
+    (0..robots)
+        .map(|r| {
+            let mut at = vec![0.0];
+            for _ in 0..rng.random_range(rests.clone()) {
+                let last = *at.last().unwrap();
+                at.push(last + rng.random_range(0.2..2.0));
+            }
+            track(r, at.last().unwrap() + rng.random_range(0.5..2.0), &at)
+        })
+        .collect()
+}
+
 /// The boxes still open after orders are chosen, found from the parent's open boxes and
 /// the raised nodes, are those a scan of every box finds (random tracks and boxes, random
 /// orders added one after another).
@@ -207,16 +227,7 @@ fn open_boxes_are_kept_up_without_a_scan() {
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(7);
     let mut checked = 0;
     for _ in 0..80 {
-        let tracks: Vec<Track> = (0..4)
-            .map(|r| {
-                let mut rests = vec![0.0];
-                for _ in 0..rng.random_range(2..9) {
-                    let last = *rests.last().unwrap();
-                    rests.push(last + rng.random_range(0.2..2.0));
-                }
-                track(r, rests.last().unwrap() + rng.random_range(0.5..2.0), &rests)
-            })
-            .collect();
+        let tracks = random_tracks(&mut rng, 4, 2..9);
         let span = |rng: &mut rand_chacha::ChaCha8Rng, len: f64| {
             let a = rng.random_range(0.0..len);
             (a, (a + rng.random_range(0.1..1.5)).min(len))
@@ -295,16 +306,7 @@ fn the_pairs_floor_bounds_and_ends_the_search_early() {
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
     let (mut compared, mut reached, mut more_proven) = (0, 0, 0);
     for _ in 0..80 {
-        let tracks: Vec<Track> = (0..4)
-            .map(|r| {
-                let mut rests = vec![0.0];
-                for _ in 0..rng.random_range(3..10) {
-                    let last = *rests.last().unwrap();
-                    rests.push(last + rng.random_range(0.2..2.0));
-                }
-                track(r, rests.last().unwrap() + rng.random_range(0.5..2.0), &rests)
-            })
-            .collect();
+        let tracks = random_tracks(&mut rng, 4, 3..10);
         let span = |rng: &mut rand_chacha::ChaCha8Rng, len: f64| {
             let a = rng.random_range(0.3..len - 0.3);
             (a, (a + rng.random_range(0.1..1.0)).min(len - 0.2))
