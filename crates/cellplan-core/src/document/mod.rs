@@ -549,10 +549,12 @@ pub struct PassageSearch {
     pub boxes: usize,
     /// Exact robot–robot distances the diagrams asked.
     pub distances: usize,
-    /// Nodes of the branch and bound, over every combination of tour directions tried.
+    /// Nodes of the branch and bound, over every combination of tour directions tried (the
+    /// searches of each robot pair alone, which bound it from below, included).
     pub nodes: usize,
-    /// Whether the search for the tour directions chosen ended within its node budget (the
-    /// schedule is then the shortest the boxes allow for them; else the best found).
+    /// Whether the search for the tour directions chosen ended within its node budget or
+    /// reached the bound of the robot pairs scheduled alone (the schedule is then the shortest
+    /// the boxes allow for them; else the best found).
     pub proven: bool,
     /// Robots whose tours the search runs the other way round (the direction of each tour
     /// is chosen with the passage orders).
