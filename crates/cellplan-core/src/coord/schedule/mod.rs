@@ -28,8 +28,10 @@
 //! Before it, every pair of robots that shares boxes is scheduled alone through its own boxes
 //! ([`floor`]): any schedule of all the robots is one of each pair, so the longest of the
 //! pairs' shortest schedules bounds every makespan from below, and a schedule that reaches it
-//! is the shortest. On a large diagram the search meets the bound long before its budget (the
-//! pairs are small and quick to prove): the same schedule, proven, in a fraction of the nodes.
+//! is the shortest. Where the bound is the shortest schedule (on dense-8r-120's 2,479 boxes),
+//! the search meets it long before its budget: the same schedule, proven, in under a third of
+//! the nodes. Where it is not (dense-8r-250, 8 robots × 1,000 MPs) the pairs cost about a sixth
+//! more nodes and under 1 % of the search's time.
 use super::diagram::ConflictBox;
 
 /// A robot's path as the scheduler sees it.
@@ -381,7 +383,7 @@ impl<'a> Search<'a> {
     /// One node of the search at times `x`: `open`, the boxes open at its parent's times, and
     /// `raised`, the nodes whose times rose since (at the root: every box open there, none).
     fn dive(&mut self, x: Vec<f64>, open: &[u32], raised: Vec<usize>, used: usize) {
-        if (self.stop_at_first || self.at_floor()) && self.best.is_some() {
+        if self.at_floor() || (self.stop_at_first && self.best.is_some()) {
             return;
         }
         self.nodes += 1;
