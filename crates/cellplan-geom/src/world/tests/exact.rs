@@ -463,8 +463,12 @@ proptest! {
         let mesh = SharedShape::trimesh(sheet.vertices, sheet.triangles).unwrap();
         let exact = query::distance(&pa, &*mesh, &(pb * local), &*shape).unwrap().distance.max(0.0);
         let capped = w.group_static_distance(g, &[pb], cap);
-        // Two GJK implementations on curved shapes (spheres) differ by a few 1e-6 (as before
-        // the cached axes).
-        prop_assert!((capped - exact.min(cap)).abs() < 1e-5, "{} vs min({}, {})", capped, exact, cap);
+        // Two GJK implementations on curved shapes (spheres, cylinders) differ by a few 1e-6,
+        // at times by more than 1e-5 (a cylinder of radius 0.114 m at 0.244 m: ours 1.1e-5
+        // below parry's; the case is kept in proptest-regressions). Ours may be that much more
+        // cautious, never more than 1e-5 less.
+        let want = exact.min(cap);
+        prop_assert!(capped < want + 1e-5, "{} above min({}, {})", capped, exact, cap);
+        prop_assert!(capped > want - 5e-5, "{} below min({}, {})", capped, exact, cap);
     }
 }
