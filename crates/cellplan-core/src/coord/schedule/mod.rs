@@ -31,7 +31,7 @@
 //! is the shortest. Where the bound is the shortest schedule (on dense-8r-120's 2,479 boxes),
 //! the search meets it long before its budget: the same schedule, proven, in under a third of
 //! the nodes. Where it is not (dense-8r-250, 8 robots × 1,000 MPs) the pairs cost about a sixth
-//! more nodes and under 1 % of the search's time.
+//! more nodes: 6 % of the search's time on dense-8r-250, 1.3 % on 8 × 1,000.
 use super::diagram::ConflictBox;
 
 /// A robot's path as the scheduler sees it.
