@@ -25,6 +25,16 @@
 //! nothing within the node budget; the best schedule found otherwise. Work is counted in
 //! nodes, so the result does not depend on the machine.
 //!
+//! A box both of whose orders close a positive cycle with the orders chosen above is a dead
+//! end. The search then jumps back to the deepest choice on those cycles (conflict-directed
+//! backjumping, Prosser 1993), not to the last choice made: on a large diagram the choice to
+//! blame is often hundreds of levels up, and backtracking one level at a time spent its whole
+//! allowance below it (8 of the 15 searches of the 8 robots × 1,000 MPs cell: 200,000 nodes
+//! and no schedule; with the jumps, every one finds one). Cycles through a lengthened wait
+//! are not traced, and their dead ends backtrack one level as before. The search keeps a
+//! schedule from a fixed priority of the robots too ([`Search::incumbent`]), so it has one
+//! even when its own dives find none.
+//!
 //! Before it, every pair of robots that shares boxes is scheduled alone through its own boxes
 //! ([`floor`]): any schedule of all the robots is one of each pair, so the longest of the
 //! pairs' shortest schedules bounds every makespan from below, and a schedule that reaches it
@@ -69,7 +79,12 @@ struct Edge {
     from: usize,
     to: usize,
     w: f64,
+    /// For an order the search chose, its place in [`Search::chosen`]; else [`NO_TAG`].
+    tag: u32,
 }
+
+/// The tag of an edge that is no choice of the search's.
+const NO_TAG: u32 = u32::MAX;
 
 /// The two ways of passing a box, as edges (`None`: that order is impossible).
 #[derive(Clone, Copy, Debug)]
@@ -83,6 +98,8 @@ struct Search<'a> {
     /// First node of each robot.
     offset: Vec<usize>,
     choices: Vec<Choice>,
+    /// Per box, its robots (track indices) and where each enters it.
+    entry: Vec<(usize, usize, f64, f64)>,
     /// Per node, the boxes one of whose orders starts there: times only rise, so a box one of
     /// whose orders holds can open again only where the time an order starts from rises.
     incident: Vec<Vec<u32>>,
@@ -92,6 +109,13 @@ struct Search<'a> {
     mark: u32,
     /// Nodes whose times the last [`Search::add`] or [`Search::lengthen`] raised.
     raised: Vec<usize>,
+    /// Per node, how the last propagation raised it: the node it came from, the tag of the
+    /// edge, and whether that edge is a lengthened wait (valid for the nodes it raised).
+    pred: Vec<(u32, u32, bool)>,
+    /// After a propagation that failed: the search's choices on the positive cycle it closed
+    /// (tags), or `None` when the cycle runs through a lengthened wait (whose cause is not
+    /// kept).
+    cycle: Option<Vec<u32>>,
     /// Cross edges by source node (chain edges are implicit).
     out: Vec<Vec<Edge>>,
     /// Per node, the least wait there (0, or the shortest wait allowed once a wait is needed).
@@ -100,14 +124,22 @@ struct Search<'a> {
     min_wait: f64,
     budget: usize,
     nodes: usize,
-    best: Option<(f64, Vec<f64>, Vec<Edge>)>,
+    /// The best schedule so far: makespan, times, the orders chosen, and how many boxes were
+    /// still open when their order was chosen.
+    best: Option<(f64, Vec<f64>, Vec<Edge>, usize)>,
     chosen: Vec<Edge>,
     /// Most discrepancies (second children taken) of a dive; `None`: depth first, all.
     discrepancies: Option<usize>,
     /// Whether a dive left a child out for the discrepancy limit.
     cut: bool,
-    /// Stop at the first schedule (the depth-first phase that precedes the discrepancy search).
+    /// Stop at the first schedule of the search's own (the depth-first phase that precedes the
+    /// discrepancy search).
     stop_at_first: bool,
+    /// Whether the search has found a schedule of its own (not only the incumbent).
+    found: bool,
+    /// Whether the search jumps back over choices not to blame (see [`Search::dive`]).
+    backjump: bool,
+
     /// A lower bound of every schedule's makespan (see [`floor`]): a schedule that reaches it
     /// is the shortest, and the search stops there.
     floor: f64,
@@ -158,6 +190,7 @@ impl<'a> Search<'a> {
                 from: offset[x] + i,
                 to: offset[y] + j,
                 w: (x2 - px.rests[i]) - (y1 - py.rests[j]),
+                tag: NO_TAG,
             })
         };
         let choices = boxes
@@ -179,14 +212,21 @@ impl<'a> Search<'a> {
             }
         }
         let seen = vec![0; choices.len()];
+        let entry = boxes
+            .iter()
+            .map(|b| (index[b.robots.0], index[b.robots.1], b.a.0, b.b.0))
+            .collect();
         Search {
             paths,
             offset,
             choices,
+            entry,
             incident,
             seen,
             mark: 0,
             raised: Vec::new(),
+            pred: vec![(0, NO_TAG, false); n],
+            cycle: None,
             out: vec![Vec::new(); n],
             hold: vec![0.0; n],
             min_wait,
@@ -197,6 +237,8 @@ impl<'a> Search<'a> {
             discrepancies: None,
             cut: false,
             stop_at_first: false,
+            found: false,
+            backjump: true,
             floor: f64::NEG_INFINITY,
         }
     }
@@ -204,6 +246,85 @@ impl<'a> Search<'a> {
     /// Whether the best schedule so far reaches the floor (no schedule is shorter).
     fn at_floor(&self) -> bool {
         self.best.as_ref().is_some_and(|b| b.0 <= self.floor + EPS)
+    }
+
+    /// A schedule from one complete selection of orders, chosen by `first_a(box)` (whether the
+    /// box's first robot passes first; the other order where that one is impossible), with
+    /// its times from the chain and every order, added box by box in the order robots reach
+    /// them, and short waits lengthened: `None` on a positive cycle (the orders cannot all
+    /// hold). Returns the makespan, the times, the
+    /// orders, and how many boxes were open before any order was chosen.
+    fn selection(&mut self, first_a: impl Fn(usize) -> bool) -> Option<(f64, Vec<f64>, Vec<Edge>, usize)> {
+        let mut x = self.initial();
+        let open = self.all_open(&x).len();
+        let mut order: Vec<usize> = (0..self.choices.len()).collect();
+        order.sort_by(|&i, &j| {
+            let (ei, ej) = (&self.entry[i], &self.entry[j]);
+            ei.2.min(ei.3).total_cmp(&ej.2.min(ej.3)).then(i.cmp(&j))
+        });
+        let mut chosen = Vec::with_capacity(order.len());
+        let mut ok = true;
+        for i in order {
+            let c = self.choices[i];
+            let (want, other) = if first_a(i) {
+                (c.first_a, c.first_b)
+            } else {
+                (c.first_b, c.first_a)
+            };
+            let Some(e) = want.or(other) else {
+                ok = false;
+                break;
+            };
+            chosen.push(e);
+            if !self.add(e, &mut x) {
+                ok = false;
+                break;
+            }
+        }
+        while ok && let Some(v) = self.short_wait(&x) {
+            ok = self.lengthen(v, &mut x);
+        }
+        for e in chosen.iter().rev() {
+            self.out[e.from].pop();
+        }
+        self.hold.fill(0.0);
+        ok.then(|| (self.makespan(&x), x, chosen, open))
+    }
+
+    /// The shortest of the schedules from a few complete selections (see [`Search::selection`]):
+    /// robots in a fixed priority (track order, reversed, and longest path first — the robot
+    /// that ends last does not wait). Orders by priority close no cycle but through a box that
+    /// only one order can pass, so one of them nearly always holds: a search that finds no
+    /// schedule of its own within its budget still has one. It is poor (on the 8 × 1,000 cell
+    /// about twice what the search finds); first come, first passed, by where each robot
+    /// enters the box, was tried and held on none of the benchmark diagrams.
+    fn incumbent(&mut self) -> Option<(f64, Vec<f64>, Vec<Edge>, usize)> {
+        let m = self.paths.len();
+        let mut longest: Vec<usize> = (0..m).collect();
+        longest.sort_by(|&a, &b| self.paths[b].len.total_cmp(&self.paths[a].len).then(a.cmp(&b)));
+        let mut ranks: Vec<Vec<usize>> = Vec::new();
+        for order in [(0..m).collect::<Vec<_>>(), (0..m).rev().collect(), longest] {
+            let mut rank = vec![0; m];
+            for (k, &r) in order.iter().enumerate() {
+                rank[r] = k;
+            }
+            if !ranks.contains(&rank) {
+                ranks.push(rank);
+            }
+        }
+        let entry = self.entry.clone();
+        let mut best: Option<(f64, Vec<f64>, Vec<Edge>, usize)> = None;
+        let mut keep = |found: Option<(f64, Vec<f64>, Vec<Edge>, usize)>| {
+            if let Some(f) = found
+                && best.as_ref().is_none_or(|b| f.0 < b.0 - EPS)
+            {
+                best = Some(f);
+            }
+        };
+        for rank in &ranks {
+            keep(self.selection(|i| rank[entry[i].0] < rank[entry[i].1]));
+        }
+        best
     }
 
     fn robot_of(&self, node: usize) -> usize {
@@ -275,7 +396,11 @@ impl<'a> Search<'a> {
         let need = self.arrival(r, v - self.offset[r], x) + self.min_wait;
         if x[v] < need - EPS {
             x[v] = need;
-            return self.propagate(v, x);
+            let ok = self.propagate(v, x);
+            if !ok {
+                self.cycle = None;
+            }
+            return ok;
         }
         true
     }
@@ -296,14 +421,18 @@ impl<'a> Search<'a> {
                     from: u,
                     to: next,
                     w: self.paths[r].rests[k] - self.paths[r].rests[k - 1] + self.hold[next],
+                    tag: NO_TAG,
                 }
             });
-            for f in chain.iter().chain(&self.out[u]) {
+            for (k, f) in chain.iter().chain(&self.out[u]).enumerate() {
                 if x[f.to] < x[u] + f.w - EPS {
+                    let held = k == 0 && chain.is_some() && self.hold[f.to] > 0.0;
                     if f.to == start {
+                        self.cycle = self.cycle_to(start, u, (f.tag, held));
                         return false;
                     }
                     x[f.to] = x[u] + f.w;
+                    self.pred[f.to] = (u as u32, f.tag, held);
                     raised.push(f.to);
                     stack.push(f.to);
                 }
@@ -311,6 +440,28 @@ impl<'a> Search<'a> {
         }
         self.raised = raised;
         true
+    }
+
+    /// The choices on the positive cycle that the edge `last` (its tag, whether it is a
+    /// lengthened wait) from `u` back to `start` closes, following how the propagation from
+    /// `start` reached `u`; `None` when a lengthened wait is on it.
+    fn cycle_to(&self, start: usize, u: usize, last: (u32, bool)) -> Option<Vec<u32>> {
+        let mut tags = Vec::new();
+        let (mut v, mut edge) = (u, last);
+        for _ in 0..=self.pred.len() {
+            if edge.1 {
+                return None;
+            }
+            if edge.0 != NO_TAG {
+                tags.push(edge.0);
+            }
+            if v == start {
+                return Some(tags);
+            }
+            let (p, tag, held) = self.pred[v];
+            (v, edge) = (p as usize, (tag, held));
+        }
+        None
     }
 
     fn holds(e: &Option<Edge>, x: &[f64]) -> bool {
@@ -382,14 +533,21 @@ impl<'a> Search<'a> {
 
     /// One node of the search at times `x`: `open`, the boxes open at its parent's times, and
     /// `raised`, the nodes whose times rose since (at the root: every box open there, none).
-    fn dive(&mut self, x: Vec<f64>, open: &[u32], raised: Vec<usize>, used: usize) {
-        if self.at_floor() || (self.stop_at_first && self.best.is_some()) {
-            return;
+    ///
+    /// Returns, when the subtree has no schedule at all because every order of some box closes
+    /// a positive cycle with orders chosen above, those choices (places in `chosen`): a conflict
+    /// set, as in conflict-directed backjumping (Prosser). A node whose own choice is not in a
+    /// child's set does not try its other order: that order would fail the same way, so the
+    /// search jumps back to the deepest choice that is to blame. `None` when the subtree found
+    /// a schedule, was cut (bound, budget, discrepancies) or failed through a lengthened wait.
+    fn dive(&mut self, x: Vec<f64>, open: &[u32], raised: Vec<usize>, used: usize) -> Option<Vec<u32>> {
+        if self.at_floor() || (self.stop_at_first && self.found) {
+            return None;
         }
         self.nodes += 1;
         let bound = self.makespan(&x);
         if self.best.as_ref().is_some_and(|b| bound >= b.0 - EPS) {
-            return;
+            return None;
         }
         let open = self.refresh(open, &raised, &x);
         debug_assert!({
@@ -402,23 +560,37 @@ impl<'a> Search<'a> {
             // the search goes on from there (it may open boxes again).
             if let Some(v) = self.short_wait(&x) {
                 let mut y = x;
+                let mut found = None;
                 if self.lengthen(v, &mut y) {
                     let raised = std::mem::take(&mut self.raised);
-                    self.dive(y, &open, raised, used);
+                    found = self.dive(y, &open, raised, used);
                 }
                 self.hold[v] = 0.0;
-                return;
+                return found;
             }
-            self.best = Some((bound, x, self.chosen.clone()));
-            return;
+            self.best = Some((bound, x, self.chosen.clone(), self.chosen.len()));
+            self.found = true;
+            return None;
         };
-        // Each order applied to a copy; the one finishing earlier explored first.
+        // Each order applied to a copy; the one finishing earlier explored first. An order
+        // that closes a cycle adds the choices on it to the conflict set.
+        let depth = self.chosen.len() as u32;
+        let mut conflict: Option<Vec<u32>> = Some(Vec::new());
+        let blame =
+            |conflict: &mut Option<Vec<u32>>, found: Option<Vec<u32>>| match (conflict.as_mut(), found) {
+                (Some(c), Some(f)) => c.extend(f.into_iter().filter(|&t| t != depth)),
+                _ => *conflict = None,
+            };
         let c = self.choices[i];
         let mut children = Vec::new();
-        for e in [c.first_a, c.first_b].into_iter().flatten() {
+        for mut e in [c.first_a, c.first_b].into_iter().flatten() {
+            e.tag = depth;
             let mut y = x.clone();
             if self.add(e, &mut y) {
                 children.push((self.makespan(&y), e, y, std::mem::take(&mut self.raised)));
+            } else {
+                let cycle = self.cycle.take();
+                blame(&mut conflict, cycle);
             }
             self.out[e.from].pop();
         }
@@ -427,24 +599,40 @@ impl<'a> Search<'a> {
             let used = used + k;
             if self.discrepancies.is_some_and(|d| used > d) {
                 self.cut = true;
-                return;
+                return None;
             }
             // Without a schedule yet the search may go on a while longer (the first dive
             // usually finds one; a search that does not is proving there is none).
-            let cap = if self.best.is_some() {
+            let cap = if self.found {
                 self.budget
             } else {
                 self.budget.saturating_mul(NO_SCHEDULE_FACTOR)
             };
             if self.nodes >= cap {
-                return;
+                return None;
             }
             self.out[e.from].push(e);
             self.chosen.push(e);
-            self.dive(y, &open, raised, used);
+            let found = self.dive(y, &open, raised, used);
             self.chosen.pop();
             self.out[e.from].pop();
+            if let Some(f) = &found
+                && !f.contains(&depth)
+                && self.backjump
+            {
+                // This choice is not to blame: the other order fails the same way.
+                return found;
+            }
+            blame(&mut conflict, found);
         }
+        if !self.backjump {
+            return None;
+        }
+        conflict.map(|mut c| {
+            c.sort_unstable();
+            c.dedup();
+            c
+        })
     }
 }
 
@@ -568,7 +756,20 @@ fn search(
     min_wait: f64,
     floored: bool,
 ) -> (Found, usize) {
+    search_with(paths, boxes, budget, min_wait, floored, true)
+}
+
+/// [`search`], with or without backjumping.
+fn search_with(
+    paths: &[Track],
+    boxes: &[ConflictBox],
+    budget: usize,
+    min_wait: f64,
+    floored: bool,
+    backjump: bool,
+) -> (Found, usize) {
     let mut s = Search::new(paths, boxes, budget.max(1), min_wait.max(0.0));
+    s.backjump = backjump;
     if s.choices
         .iter()
         .any(|c| c.first_a.is_none() && c.first_b.is_none())
@@ -586,8 +787,10 @@ fn search(
             None => return (Found::Infeasible, spent),
         }
     }
-    // Depth first until the first schedule (the first dive is the greedy one; a search that
-    // finds none goes on to prove there is none, as before).
+    // A schedule from a complete selection of orders to start from, when one holds; then
+    // depth first until the first schedule of the search's own (the first dive is the greedy
+    // one; a search that finds none goes on to prove there is none).
+    s.best = s.incumbent();
     let x = s.initial();
     let open = s.all_open(&x);
     s.stop_at_first = true;
@@ -614,7 +817,7 @@ fn search(
         }
     }
     let nodes = s.nodes + spent;
-    let Some((makespan, x, chosen)) = s.best.take() else {
+    let Some((makespan, x, chosen, decisions)) = s.best.take() else {
         let found = if s.nodes >= s.budget.saturating_mul(NO_SCHEDULE_FACTOR) {
             Found::Unknown
         } else {
@@ -646,7 +849,7 @@ fn search(
         waits,
         makespan,
         nodes,
-        decisions: chosen.len(),
+        decisions,
         proven,
     });
     (found, nodes)

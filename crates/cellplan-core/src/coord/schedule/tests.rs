@@ -298,7 +298,7 @@ fn short_waits_are_lengthened_and_the_budget_binds() {
 
 /// The pairs' floor is a lower bound (never above the proven shortest schedule of all the
 /// robots), often the shortest itself; the search with it ends with the same makespan as
-/// without it, and on a small budget it proves schedules shortest that the search alone cannot
+/// without it, and on a small budget (6 nodes) it proves schedules shortest that the search alone cannot
 /// (random diagrams of four robots).
 #[test]
 fn the_pairs_floor_bounds_and_ends_the_search_early() {
@@ -345,10 +345,10 @@ fn the_pairs_floor_bounds_and_ends_the_search_early() {
                 compared += 1;
                 reached += usize::from(lb >= p.makespan - 1e-9);
                 // On a small budget: proven with the floor only when it is the shortest.
-                let (Found::Schedule(cut), _) = search(&tracks, &boxes, 12, 0.05, false) else {
+                let (Found::Schedule(cut), _) = search(&tracks, &boxes, 6, 0.05, false) else {
                     continue;
                 };
-                if let (Found::Schedule(c), _) = search(&tracks, &boxes, 12, 0.05, true)
+                if let (Found::Schedule(c), _) = search(&tracks, &boxes, 6, 0.05, true)
                     && c.proven
                 {
                     assert!((c.makespan - p.makespan).abs() < 1e-9);
@@ -362,4 +362,122 @@ fn the_pairs_floor_bounds_and_ends_the_search_early() {
     assert!(compared > 40, "{compared}");
     assert!(reached > compared / 3, "{reached} of {compared}");
     assert!(more_proven > 0, "{more_proven} of {compared}");
+}
+
+/// A complete selection of orders (fixed priorities, first come first passed) gives a schedule
+/// that passes every box whenever it holds, so a search of one node already has one; the
+/// search never ends above it, and a full search proves it the shortest on some diagrams
+/// (random diagrams of five robots).
+#[test]
+fn complete_selections_give_the_search_a_schedule_at_once() {
+    use rand::{RngExt, SeedableRng};
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(11);
+    let (mut held, mut shortest, mut tried) = (0, 0, 0);
+    for _ in 0..60 {
+        let tracks = random_tracks(&mut rng, 5, 3..12);
+        let span = |rng: &mut rand_chacha::ChaCha8Rng, len: f64| {
+            let a = rng.random_range(0.3..len - 0.3);
+            (a, (a + rng.random_range(0.1..1.0)).min(len - 0.2))
+        };
+        let boxes: Vec<ConflictBox> = (0..rng.random_range(5..40))
+            .map(|_| {
+                let (a, b) = (rng.random_range(0..5), rng.random_range(0..4));
+                let b = if b >= a { b + 1 } else { b };
+                let (a, b) = (a.min(b), a.max(b));
+                boxed(
+                    (a, b),
+                    span(&mut rng, tracks[a].len),
+                    span(&mut rng, tracks[b].len),
+                )
+            })
+            .collect();
+        tried += 1;
+        let Some((at_once, ..)) = Search::new(&tracks, &boxes, 1, 0.05).incumbent() else {
+            continue;
+        };
+        held += 1;
+        let (Found::Schedule(one), nodes) = search(&tracks, &boxes, 1, 0.05, false) else {
+            panic!("a selection holds, so a search of one node has a schedule");
+        };
+        assert!(nodes <= NO_SCHEDULE_FACTOR + 1, "{nodes}");
+        assert!(one.makespan <= at_once + 1e-9, "{} above {at_once}", one.makespan);
+        assert_clear(&tracks, &boxes, &one);
+        let (Found::Schedule(full), _) = search(&tracks, &boxes, 200_000, 0.05, true) else {
+            panic!("a selection holds, so the full search has a schedule");
+        };
+        assert!(full.proven && full.makespan <= at_once + 1e-9);
+        assert_clear(&tracks, &boxes, &full);
+        shortest += usize::from(full.makespan >= at_once - 1e-9);
+    }
+    assert!(held > tried / 2, "{held} of {tried}");
+    assert!(shortest > 0 && shortest < held, "{shortest} of {held}");
+}
+
+/// Backjumping leaves the search exact: on random diagrams of five robots with few rests
+/// (where orders chosen early close cycles late), it ends with the same shortest makespan, or
+/// the same proof that there is none, as chronological backtracking, in no more nodes, and in
+/// fewer on some.
+#[test]
+fn backjumping_keeps_the_search_exact_in_fewer_nodes() {
+    use rand::{RngExt, SeedableRng};
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(13);
+    let (mut fewer, mut infeasible, mut same) = (0, 0, 0);
+    let (mut with, mut without) = (0, 0);
+    for _ in 0..120 {
+        let tracks = random_tracks(&mut rng, 5, 1..4);
+        // Now and then a box from home or to the end (a robot at home in another's way).
+        let span = |rng: &mut rand_chacha::ChaCha8Rng, len: f64| {
+            let a = if rng.random_bool(0.03) {
+                0.0
+            } else {
+                rng.random_range(0.1..len - 0.1)
+            };
+            let b = if rng.random_bool(0.03) {
+                len
+            } else {
+                (a + rng.random_range(0.2..1.5)).min(len - 0.05)
+            };
+            (a, b)
+        };
+        let boxes: Vec<ConflictBox> = (0..rng.random_range(20..80))
+            .map(|_| {
+                let (a, b) = (rng.random_range(0..5), rng.random_range(0..4));
+                let b = if b >= a { b + 1 } else { b };
+                let (a, b) = (a.min(b), a.max(b));
+                boxed(
+                    (a, b),
+                    span(&mut rng, tracks[a].len),
+                    span(&mut rng, tracks[b].len),
+                )
+            })
+            .collect();
+        let (jumped, n_jump) = search_with(&tracks, &boxes, 200_000, 0.05, false, true);
+        let (plain, n_plain) = search_with(&tracks, &boxes, 200_000, 0.05, false, false);
+        assert!(n_jump <= n_plain, "{n_jump} > {n_plain}");
+        (with, without) = (with + n_jump, without + n_plain);
+        fewer += usize::from(n_jump < n_plain);
+        match (jumped, plain) {
+            (Found::Schedule(j), Found::Schedule(p)) => {
+                assert!(j.proven && p.proven);
+                assert!(
+                    (j.makespan - p.makespan).abs() < 1e-9,
+                    "{} vs {}",
+                    j.makespan,
+                    p.makespan
+                );
+                assert_clear(&tracks, &boxes, &j);
+                same += 1;
+            }
+            (Found::Infeasible, Found::Infeasible) => infeasible += 1,
+            (j, p) => panic!("{j:?} against {p:?}"),
+        }
+    }
+    assert!(
+        same > 20 && infeasible > 5,
+        "{same} schedules, {infeasible} infeasible"
+    );
+    assert!(
+        fewer > 5 && with < without,
+        "{fewer}: {with} against {without} nodes"
+    );
 }
