@@ -44,6 +44,12 @@
 //! more nodes: 6 % of the search's time on dense-8r-250, 1.3 % on 8 × 1,000.
 use super::diagram::ConflictBox;
 
+mod incumbent;
+mod parts;
+
+use parts::floor;
+pub(crate) use parts::infeasible_core;
+
 /// A robot's path as the scheduler sees it.
 #[derive(Clone, Debug)]
 pub(crate) struct Track {
@@ -86,6 +92,10 @@ struct Edge {
 /// The tag of an edge that is no choice of the search's.
 const NO_TAG: u32 = u32::MAX;
 
+/// A schedule the search holds: makespan, times, the orders chosen, and how many boxes were
+/// still open when their order was chosen.
+type Best = (f64, Vec<f64>, Vec<Edge>, usize);
+
 /// The two ways of passing a box, as edges (`None`: that order is impossible).
 #[derive(Clone, Copy, Debug)]
 struct Choice {
@@ -98,8 +108,8 @@ struct Search<'a> {
     /// First node of each robot.
     offset: Vec<usize>,
     choices: Vec<Choice>,
-    /// Per box, its robots (track indices) and where each enters it.
-    entry: Vec<(usize, usize, f64, f64)>,
+    /// Per box, its robots (track indices) and where the first of them enters it.
+    entry: Vec<(usize, usize, f64)>,
     /// Per node, the boxes one of whose orders starts there: times only rise, so a box one of
     /// whose orders holds can open again only where the time an order starts from rises.
     incident: Vec<Vec<u32>>,
@@ -124,9 +134,8 @@ struct Search<'a> {
     min_wait: f64,
     budget: usize,
     nodes: usize,
-    /// The best schedule so far: makespan, times, the orders chosen, and how many boxes were
-    /// still open when their order was chosen.
-    best: Option<(f64, Vec<f64>, Vec<Edge>, usize)>,
+    /// The best schedule so far.
+    best: Option<Best>,
     chosen: Vec<Edge>,
     /// Most discrepancies (second children taken) of a dive; `None`: depth first, all.
     discrepancies: Option<usize>,
@@ -214,7 +223,7 @@ impl<'a> Search<'a> {
         let seen = vec![0; choices.len()];
         let entry = boxes
             .iter()
-            .map(|b| (index[b.robots.0], index[b.robots.1], b.a.0, b.b.0))
+            .map(|b| (index[b.robots.0], index[b.robots.1], b.a.0.min(b.b.0)))
             .collect();
         Search {
             paths,
@@ -246,85 +255,6 @@ impl<'a> Search<'a> {
     /// Whether the best schedule so far reaches the floor (no schedule is shorter).
     fn at_floor(&self) -> bool {
         self.best.as_ref().is_some_and(|b| b.0 <= self.floor + EPS)
-    }
-
-    /// A schedule from one complete selection of orders, chosen by `first_a(box)` (whether the
-    /// box's first robot passes first; the other order where that one is impossible), with
-    /// its times from the chain and every order, added box by box in the order robots reach
-    /// them, and short waits lengthened: `None` on a positive cycle (the orders cannot all
-    /// hold). Returns the makespan, the times, the
-    /// orders, and how many boxes were open before any order was chosen.
-    fn selection(&mut self, first_a: impl Fn(usize) -> bool) -> Option<(f64, Vec<f64>, Vec<Edge>, usize)> {
-        let mut x = self.initial();
-        let open = self.all_open(&x).len();
-        let mut order: Vec<usize> = (0..self.choices.len()).collect();
-        order.sort_by(|&i, &j| {
-            let (ei, ej) = (&self.entry[i], &self.entry[j]);
-            ei.2.min(ei.3).total_cmp(&ej.2.min(ej.3)).then(i.cmp(&j))
-        });
-        let mut chosen = Vec::with_capacity(order.len());
-        let mut ok = true;
-        for i in order {
-            let c = self.choices[i];
-            let (want, other) = if first_a(i) {
-                (c.first_a, c.first_b)
-            } else {
-                (c.first_b, c.first_a)
-            };
-            let Some(e) = want.or(other) else {
-                ok = false;
-                break;
-            };
-            chosen.push(e);
-            if !self.add(e, &mut x) {
-                ok = false;
-                break;
-            }
-        }
-        while ok && let Some(v) = self.short_wait(&x) {
-            ok = self.lengthen(v, &mut x);
-        }
-        for e in chosen.iter().rev() {
-            self.out[e.from].pop();
-        }
-        self.hold.fill(0.0);
-        ok.then(|| (self.makespan(&x), x, chosen, open))
-    }
-
-    /// The shortest of the schedules from a few complete selections (see [`Search::selection`]):
-    /// robots in a fixed priority (track order, reversed, and longest path first — the robot
-    /// that ends last does not wait). Orders by priority close no cycle but through a box that
-    /// only one order can pass, so one of them nearly always holds: a search that finds no
-    /// schedule of its own within its budget still has one. It is poor (on the 8 × 1,000 cell
-    /// about twice what the search finds); first come, first passed, by where each robot
-    /// enters the box, was tried and held on none of the benchmark diagrams.
-    fn incumbent(&mut self) -> Option<(f64, Vec<f64>, Vec<Edge>, usize)> {
-        let m = self.paths.len();
-        let mut longest: Vec<usize> = (0..m).collect();
-        longest.sort_by(|&a, &b| self.paths[b].len.total_cmp(&self.paths[a].len).then(a.cmp(&b)));
-        let mut ranks: Vec<Vec<usize>> = Vec::new();
-        for order in [(0..m).collect::<Vec<_>>(), (0..m).rev().collect(), longest] {
-            let mut rank = vec![0; m];
-            for (k, &r) in order.iter().enumerate() {
-                rank[r] = k;
-            }
-            if !ranks.contains(&rank) {
-                ranks.push(rank);
-            }
-        }
-        let entry = self.entry.clone();
-        let mut best: Option<(f64, Vec<f64>, Vec<Edge>, usize)> = None;
-        let mut keep = |found: Option<(f64, Vec<f64>, Vec<Edge>, usize)>| {
-            if let Some(f) = found
-                && best.as_ref().is_none_or(|b| f.0 < b.0 - EPS)
-            {
-                best = Some(f);
-            }
-        };
-        for rank in &ranks {
-            keep(self.selection(|i| rank[entry[i].0] < rank[entry[i].1]));
-        }
-        best
     }
 
     fn robot_of(&self, node: usize) -> usize {
@@ -639,9 +569,6 @@ impl<'a> Search<'a> {
 /// How many times its budget the search may spend while it has no schedule at all.
 const NO_SCHEDULE_FACTOR: usize = 10;
 
-/// The infeasible core's search stops after this many searches' budgets of nodes.
-const CORE_SEARCHES: usize = 40;
-
 /// What the search found.
 #[derive(Clone, Debug)]
 pub(crate) enum Found {
@@ -665,85 +592,6 @@ pub(crate) fn schedule(
     match search(paths, boxes, budget, min_wait, true).0 {
         Found::Schedule(s) => Some(s),
         Found::Infeasible | Found::Unknown => None,
-    }
-}
-
-/// A lower bound of the makespan of every schedule of `paths` through `boxes`: the longest
-/// path, and for each pair of robots that share boxes, the shortest schedule of the two alone
-/// through their boxes (any schedule of all the robots is one of the pair too, its makespan at
-/// least the pair's), where the pair's search proves it within its share of `budget`. `None`
-/// when a pair's search proves that the two alone have no order of passing (then neither have
-/// all). Returns the nodes the pairs' searches took too.
-fn floor(paths: &[Track], boxes: &[ConflictBox], budget: usize, min_wait: f64) -> (Option<f64>, usize) {
-    let mut floor = paths.iter().map(|p| p.len).fold(0.0, f64::max);
-    let mut by_pair: std::collections::BTreeMap<(usize, usize), Vec<ConflictBox>> = Default::default();
-    for b in boxes {
-        by_pair.entry(b.robots).or_default().push(b.clone());
-    }
-    if by_pair.len() < 2 {
-        return (Some(floor), 0);
-    }
-    let share = (budget / by_pair.len()).max(1);
-    let mut spent = 0;
-    for ((a, b), boxes) in by_pair {
-        let two: Vec<Track> = paths
-            .iter()
-            .filter(|p| p.robot == a || p.robot == b)
-            .cloned()
-            .collect();
-        let (found, nodes) = search(&two, &boxes, share, min_wait, false);
-        spent += nodes;
-        match found {
-            Found::Schedule(s) if s.proven => floor = f64::max(floor, s.makespan),
-            Found::Infeasible => return (None, spent),
-            Found::Schedule(_) | Found::Unknown => {}
-        }
-    }
-    (Some(floor), spent)
-}
-
-/// A small set of boxes that no order can pass (indices into `boxes`), when `boxes` are
-/// infeasible: a deletion filter in halving chunks (a set whose feasibility the search cannot
-/// decide within `budget` counts as feasible, so the core is infeasible for certain). Each
-/// test is one search; after [`CORE_SEARCHES`] searches' worth of nodes the filter stops and
-/// the boxes left (infeasible, not always minimal) are the core.
-pub(crate) fn infeasible_core(
-    paths: &[Track],
-    boxes: &[ConflictBox],
-    budget: usize,
-    min_wait: f64,
-) -> Vec<usize> {
-    let spent = std::cell::Cell::new(0usize);
-    let limit = budget.max(1).saturating_mul(CORE_SEARCHES);
-    let infeasible = |keep: &[usize]| -> bool {
-        let b: Vec<ConflictBox> = keep.iter().map(|&i| boxes[i].clone()).collect();
-        let (found, nodes) = search(paths, &b, budget, min_wait, false);
-        spent.set(spent.get() + nodes);
-        matches!(found, Found::Infeasible)
-    };
-    let mut keep: Vec<usize> = (0..boxes.len()).collect();
-    if !infeasible(&keep) {
-        return Vec::new();
-    }
-    let mut chunk = keep.len().div_ceil(2).max(1);
-    loop {
-        let mut i = 0;
-        while i < keep.len() {
-            if spent.get() >= limit {
-                return keep;
-            }
-            let end = (i + chunk).min(keep.len());
-            let trial: Vec<usize> = keep[..i].iter().chain(&keep[end..]).copied().collect();
-            if infeasible(&trial) {
-                keep = trial;
-            } else {
-                i = end;
-            }
-        }
-        if chunk == 1 {
-            return keep;
-        }
-        chunk = chunk.div_ceil(2);
     }
 }
 

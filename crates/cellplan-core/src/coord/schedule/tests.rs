@@ -218,6 +218,33 @@ fn random_tracks(
         .collect()
 }
 
+/// Random boxes between the robots of `tracks` (as many as `count` draws), each robot's
+/// interval drawn by `span` from its path's length.
+fn random_boxes(
+    rng: &mut rand_chacha::ChaCha8Rng,
+    tracks: &[Track],
+    count: std::ops::Range<usize>,
+    span: impl Fn(&mut rand_chacha::ChaCha8Rng, f64) -> (f64, f64),
+) -> Vec<ConflictBox> {
+    use rand::RngExt;
+    let m = tracks.len();
+    (0..rng.random_range(count))
+        .map(|_| {
+            let (a, b) = (rng.random_range(0..m), rng.random_range(0..m - 1));
+            let b = if b >= a { b + 1 } else { b };
+            let (a, b) = (a.min(b), a.max(b));
+            boxed((a, b), span(rng, tracks[a].len), span(rng, tracks[b].len))
+        })
+        .collect()
+}
+
+/// An interval inside a path, clear of both ends.
+fn inner_span(rng: &mut rand_chacha::ChaCha8Rng, len: f64) -> (f64, f64) {
+    use rand::RngExt;
+    let a = rng.random_range(0.3..len - 0.3);
+    (a, (a + rng.random_range(0.1..1.0)).min(len - 0.2))
+}
+
 /// The boxes still open after orders are chosen, found from the parent's open boxes and
 /// the raised nodes, are those a scan of every box finds (random tracks and boxes, random
 /// orders added one after another).
@@ -302,27 +329,12 @@ fn short_waits_are_lengthened_and_the_budget_binds() {
 /// (random diagrams of four robots).
 #[test]
 fn the_pairs_floor_bounds_and_ends_the_search_early() {
-    use rand::{RngExt, SeedableRng};
+    use rand::SeedableRng;
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
     let (mut compared, mut reached, mut more_proven) = (0, 0, 0);
     for _ in 0..80 {
         let tracks = random_tracks(&mut rng, 4, 3..10);
-        let span = |rng: &mut rand_chacha::ChaCha8Rng, len: f64| {
-            let a = rng.random_range(0.3..len - 0.3);
-            (a, (a + rng.random_range(0.1..1.0)).min(len - 0.2))
-        };
-        let boxes: Vec<ConflictBox> = (0..rng.random_range(4..24))
-            .map(|_| {
-                let (a, b) = (rng.random_range(0..4), rng.random_range(0..3));
-                let b = if b >= a { b + 1 } else { b };
-                let (a, b) = (a.min(b), a.max(b));
-                boxed(
-                    (a, b),
-                    span(&mut rng, tracks[a].len),
-                    span(&mut rng, tracks[b].len),
-                )
-            })
-            .collect();
+        let boxes = random_boxes(&mut rng, &tracks, 4..24, inner_span);
         let (plain, _) = search(&tracks, &boxes, 200_000, 0.05, false);
         let (floored, _) = search(&tracks, &boxes, 200_000, 0.05, true);
         let (lb, _) = floor(&tracks, &boxes, 200_000, 0.05);
@@ -364,33 +376,18 @@ fn the_pairs_floor_bounds_and_ends_the_search_early() {
     assert!(more_proven > 0, "{more_proven} of {compared}");
 }
 
-/// A complete selection of orders (fixed priorities, first come first passed) gives a schedule
+/// A complete selection of orders by a fixed priority of the robots gives a schedule
 /// that passes every box whenever it holds, so a search of one node already has one; the
 /// search never ends above it, and a full search proves it the shortest on some diagrams
 /// (random diagrams of five robots).
 #[test]
 fn complete_selections_give_the_search_a_schedule_at_once() {
-    use rand::{RngExt, SeedableRng};
+    use rand::SeedableRng;
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(11);
     let (mut held, mut shortest, mut tried) = (0, 0, 0);
     for _ in 0..60 {
         let tracks = random_tracks(&mut rng, 5, 3..12);
-        let span = |rng: &mut rand_chacha::ChaCha8Rng, len: f64| {
-            let a = rng.random_range(0.3..len - 0.3);
-            (a, (a + rng.random_range(0.1..1.0)).min(len - 0.2))
-        };
-        let boxes: Vec<ConflictBox> = (0..rng.random_range(5..40))
-            .map(|_| {
-                let (a, b) = (rng.random_range(0..5), rng.random_range(0..4));
-                let b = if b >= a { b + 1 } else { b };
-                let (a, b) = (a.min(b), a.max(b));
-                boxed(
-                    (a, b),
-                    span(&mut rng, tracks[a].len),
-                    span(&mut rng, tracks[b].len),
-                )
-            })
-            .collect();
+        let boxes = random_boxes(&mut rng, &tracks, 5..40, inner_span);
         tried += 1;
         let Some((at_once, ..)) = Search::new(&tracks, &boxes, 1, 0.05).incumbent() else {
             continue;
@@ -439,18 +436,7 @@ fn backjumping_keeps_the_search_exact_in_fewer_nodes() {
             };
             (a, b)
         };
-        let boxes: Vec<ConflictBox> = (0..rng.random_range(20..80))
-            .map(|_| {
-                let (a, b) = (rng.random_range(0..5), rng.random_range(0..4));
-                let b = if b >= a { b + 1 } else { b };
-                let (a, b) = (a.min(b), a.max(b));
-                boxed(
-                    (a, b),
-                    span(&mut rng, tracks[a].len),
-                    span(&mut rng, tracks[b].len),
-                )
-            })
-            .collect();
+        let boxes = random_boxes(&mut rng, &tracks, 20..80, span);
         let (jumped, n_jump) = search_with(&tracks, &boxes, 200_000, 0.05, false, true);
         let (plain, n_plain) = search_with(&tracks, &boxes, 200_000, 0.05, false, false);
         assert!(n_jump <= n_plain, "{n_jump} > {n_plain}");
