@@ -320,7 +320,11 @@ impl RunnersUp {
 /// when its plan, coordinated, ends sooner still, then the reliefs (a task of a robot the
 /// last one waits for handed to a third) and the groups (several tasks of the last robot to a
 /// robot it waits for), which may go beyond the work budget by the share
-/// [`RELIEF_EXTRA_DISTANCES`] sets. Plans are compared with every leg stopping at every
+/// [`RELIEF_EXTRA_DISTANCES`] sets. When no hand-over from the winner helps, they start again
+/// from the shortest plan that lost (a runner-up, see below), within as much work again as the
+/// first start took, and the shorter of the two stands. The winner is then polished
+/// ([`CoordSettings::polish`]) and kept so where that ends sooner. Plans are compared with
+/// every leg stopping at every
 /// waypoint; the winner and the `RUNNERS_UP` shortest plans that lost (within
 /// `RUNNER_UP_REACH` of it, on cells of at most `plan_first_pairs` MPs × robots) are then
 /// blended ([`crate::coord::blend`]) and the shortest blended cycle is the plan. The
@@ -577,45 +581,105 @@ pub fn coordinate(
     // at a time, then reliefs and groups: see [`plan::rebalance`]), each hand-over judged by its
     // coordinated cycle.
     let ends = |c: &Coordinated| c.timed.iter().map(|t| t.end()).collect::<Vec<f64>>();
-    let (score, base_ends) = (cycle_and_delta(&best.2.timed).0, ends(&best.2));
-    // A hand-over's tours start their search over directions where the coordination of the
-    // plan it was made from ended.
-    let base_turns = crate::coord::canonical_turns(&best.0, &best.2);
-    let mut judge = |o: &Outcome, from: Option<(&Outcome, &Coordinated)>| {
-        let turns = from.map(|(f, c)| crate::coord::canonical_turns(f, c));
-        let turns = turns.as_deref().unwrap_or(&base_turns);
-        let c = crate::coord::coordinate_outcome_turned(cell, table, o, coord, &diagrams, turns).ok()?;
-        count(&c);
-        Some((cycle_and_delta(&c.timed).0, ends(&c), c))
+    let diagrams = &diagrams;
+    // The hand-overs from one start: each hand-over's tours start their search over directions
+    // where the coordination of the plan it was made from ended (the start's, for the first).
+    let handovers = |start: &Tried,
+                     cache: &mut plan::PlanCache,
+                     may_judge: &dyn Fn(bool) -> bool|
+     -> Result<(Option<Tried>, bool), PlanError> {
+        let (score, base_ends) = (cycle_and_delta(&start.2.timed).0, ends(&start.2));
+        let base_turns = crate::coord::canonical_turns(&start.0, &start.2);
+        let mut judge = |o: &Outcome, from: Option<(&Outcome, &Coordinated)>| {
+            let turns = from.map(|(f, c)| crate::coord::canonical_turns(f, c));
+            let turns = turns.as_deref().unwrap_or(&base_turns);
+            let c = crate::coord::coordinate_outcome_turned(cell, table, o, coord, diagrams, turns).ok()?;
+            count(&c);
+            Some((cycle_and_delta(&c.timed).0, ends(&c), c))
+        };
+        let base_waits = start.2.waits_for();
+        let base = (&start.0, score, base_ends.as_slice(), base_waits.as_slice());
+        let waits_of = |c: &Coordinated| c.waits_for();
+        plan::rebalance::rebalance(
+            cell,
+            table,
+            base,
+            &start.1,
+            cache,
+            may_judge,
+            (&mut judge, &waits_of),
+        )
     };
-    let base_waits = best.2.waits_for();
-    let base = (&best.0, score, base_ends.as_slice(), base_waits.as_slice());
-    let waits_of = |c: &Coordinated| c.waits_for();
     let mut handover_taken = false;
-    if let Ok((found, clock_cut)) = plan::rebalance::rebalance(
-        cell,
-        table,
-        base,
-        &best.1,
-        cache,
-        &|relief: bool| {
-            affordable_beyond(if relief {
-                coord.ours_distances / RELIEF_EXTRA_DISTANCES
-            } else {
-                0
-            })
-        },
-        (&mut judge, &waits_of),
-    ) {
-        if let Some(found) = found {
-            handover_taken = true;
-            runners_up.keep(Some(std::mem::replace(&mut best, found)));
+    let before_handovers = spent.get();
+    let first = handovers(&best, cache, &|relief: bool| {
+        affordable_beyond(if relief {
+            coord.ours_distances / RELIEF_EXTRA_DISTANCES
+        } else {
+            0
+        })
+    });
+    let mut second_start = false;
+    if let Ok((found, clock_cut)) = first {
+        match found {
+            Some(found) => {
+                handover_taken = true;
+                runners_up.keep(Some(std::mem::replace(&mut best, found)));
+            }
+            // No hand-over from the best try helped: the best try is not always the best
+            // start (a plan whose coordination happened to go well may have no hand-over
+            // left that pays), so the hand-overs start again from the shortest try that lost,
+            // within as much work again as the first start's took.
+            None if !clock_cut => second_start = true,
+            None => {}
         }
         // The clock stopped the hand-overs: the plan says so.
         best.0.time_limit_hit |= clock_cut;
     }
+    if second_start && let Some(start) = runners_up.kept.first() {
+        let allowed = spent.get() - before_handovers;
+        let from = spent.get();
+        let may_judge = |_: bool| {
+            let costliest = costliest.get();
+            spent.get() - from + costliest <= allowed && costliest.saturating_mul(4) <= coord.ours_distances
+        };
+        if let Ok((found, clock_cut)) = handovers(start, cache, &may_judge) {
+            if let Some(found) = found {
+                if cycle_and_delta(&found.2.timed) < cycle_and_delta(&best.2.timed) {
+                    handover_taken = true;
+                    runners_up.keep(Some(std::mem::replace(&mut best, found)));
+                } else {
+                    runners_up.keep(Some(found));
+                }
+            }
+            best.0.time_limit_hit |= clock_cut;
+        }
+    }
     let handovers_s = lap.elapsed().as_secs_f64() - tries_s;
     let handovers_judged = coordinations.get() - tries_coordinated;
+    // The winner polished: coordinated again in the tour directions it runs in, and where the
+    // search over passage orders ends unproven, each robot put back through the others (see
+    // `coord::schedule`); kept when it ends sooner. Only the winner: done to every try and
+    // hand-over, a better coordination changes which plan wins and where the hand-overs lead,
+    // and on the hard cells that did not pay on average (`bench/cells/README.md`).
+    let mut polished = false;
+    if settings.deadline.is_some_and(|d| Instant::now() >= d) {
+        best.0.time_limit_hit = true;
+    } else {
+        let polish = CoordSettings {
+            polish: true,
+            ..coord.clone()
+        };
+        let turns = crate::coord::canonical_turns(&best.0, &best.2);
+        if let Ok(c) =
+            crate::coord::coordinate_outcome_turned(cell, table, &best.0, &polish, diagrams, &turns)
+            && cycle_and_delta(&c.timed) < cycle_and_delta(&best.2.timed)
+        {
+            best.2 = c;
+            polished = true;
+        }
+    }
+    let polish_s = lap.elapsed().as_secs_f64() - tries_s - handovers_s;
     // The winner and the runners-up within reach of it, blended; the shortest blended cycle
     // (then Δt, then the winner first) is the plan.
     let blending = CoordSettings {
@@ -650,12 +714,14 @@ pub fn coordinate(
             tries_coordinated,
             handovers_judged,
             handover_taken,
+            polished,
             blended,
         },
         crate::document::OursTimes {
             tries: tries_s,
             handovers: handovers_s,
-            blend: spent - tries_s - handovers_s,
+            polish: polish_s,
+            blend: spent - tries_s - handovers_s - polish_s,
         },
     );
     Ok((

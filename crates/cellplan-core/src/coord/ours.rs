@@ -183,7 +183,7 @@ pub(super) fn scheduled(
             searched += spent;
             (found, back)
         } else {
-            let s = schedule::schedule(&tracks, &boxes, nodes, min_wait);
+            let s = schedule::schedule_with(&tracks, &boxes, nodes, min_wait, ctx.settings.polish);
             searched += s.as_ref().map_or(nodes, |s| s.nodes);
             let found = s.map(|s| vec![(vec![false; m], s, boxes.clone())]);
             (found.unwrap_or_default(), Vec::new())
@@ -377,7 +377,7 @@ fn directions(
                 _ => paths[i].track(),
             })
             .collect();
-        let s = schedule::schedule(&tracks, &mirrored, nodes, min_wait);
+        let s = schedule::schedule_with(&tracks, &mirrored, nodes, min_wait, ctx.settings.polish);
         spent += s.as_ref().map_or(nodes, |s| s.nodes);
         Ok(s.map(|s| (flip, s, mirrored)))
     };
@@ -388,7 +388,12 @@ fn directions(
         found.insert(at, d);
         found.truncate(DIRECTIONS_FINISHED);
     };
-    if m <= ALL_DIRECTIONS_UP_TO {
+    if let Some(t) = turned.filter(|t| ctx.settings.polish && t.len() == m) {
+        // Polishing a plan: only the directions it ran in.
+        if let Some(d) = try_turn(t)? {
+            keep(d, &mut found);
+        }
+    } else if m <= ALL_DIRECTIONS_UP_TO {
         // By number of turns, then mask.
         let mut masks: Vec<usize> = (0..1usize << m.saturating_sub(1)).collect();
         masks.sort_by_key(|&k| (k.count_ones(), k));

@@ -126,6 +126,10 @@ pub struct OursRun {
     pub handovers_judged: usize,
     /// Whether a hand-over beat the best try (the plan is then one).
     pub handover_taken: bool,
+    /// Whether the winner's coordination, polished (searched again in its own tour directions,
+    /// each robot then put back through the others), ended sooner and was kept.
+    #[serde(default)]
+    pub polished: bool,
     /// Plans blended and compared at the end (the winner and the runners-up within reach).
     pub blended: usize,
 }
@@ -140,6 +144,9 @@ pub struct OursTimes {
     pub tries: f64,
     /// The hand-overs: their planning and coordinations.
     pub handovers: f64,
+    /// Polishing the winner's coordination.
+    #[serde(default)]
+    pub polish: f64,
     /// Blending the winner and the runners-up and choosing among them.
     pub blend: f64,
 }

@@ -437,8 +437,8 @@ fn backjumping_keeps_the_search_exact_in_fewer_nodes() {
             (a, b)
         };
         let boxes = random_boxes(&mut rng, &tracks, 20..80, span);
-        let (jumped, n_jump) = search_with(&tracks, &boxes, 200_000, 0.05, false, true);
-        let (plain, n_plain) = search_with(&tracks, &boxes, 200_000, 0.05, false, false);
+        let (jumped, n_jump) = search_with(&tracks, &boxes, 200_000, 0.05, false, true, false);
+        let (plain, n_plain) = search_with(&tracks, &boxes, 200_000, 0.05, false, false, false);
         assert!(n_jump <= n_plain, "{n_jump} > {n_plain}");
         (with, without) = (with + n_jump, without + n_plain);
         fewer += usize::from(n_jump < n_plain);
@@ -466,4 +466,48 @@ fn backjumping_keeps_the_search_exact_in_fewer_nodes() {
         fewer > 5 && with < without,
         "{fewer}: {with} against {without} nodes"
     );
+}
+
+/// The neighbourhood search after an unproven search ([`Search::improve`]) keeps every
+/// schedule clear of the boxes, never ends above the search without it nor below the proven
+/// shortest, and shortens some: on random diagrams of six robots searched with a budget far
+/// too small to prove anything (21 of 60 shorter when written).
+#[test]
+fn putting_each_robot_back_through_the_others_shortens_unproven_schedules() {
+    use rand::SeedableRng;
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(21);
+    let (mut compared, mut shorter) = (0, 0);
+    for _ in 0..60 {
+        let tracks = random_tracks(&mut rng, 6, 1..4);
+        let boxes = random_boxes(&mut rng, &tracks, 40..120, inner_span);
+        let (Found::Schedule(plain), _) = search_with(&tracks, &boxes, 30, 0.05, false, true, false) else {
+            continue;
+        };
+        if plain.proven {
+            continue;
+        }
+        let (Found::Schedule(lns), _) = search_with(&tracks, &boxes, 30, 0.05, false, true, true) else {
+            panic!("the neighbourhood search starts from a schedule and keeps one");
+        };
+        assert_clear(&tracks, &boxes, &lns);
+        assert!(
+            lns.makespan <= plain.makespan + 1e-9,
+            "{} above {}",
+            lns.makespan,
+            plain.makespan
+        );
+        if let (Found::Schedule(full), _) = search(&tracks, &boxes, 400_000, 0.05, true)
+            && full.proven
+        {
+            assert!(
+                lns.makespan >= full.makespan - 1e-9,
+                "{} below {}",
+                lns.makespan,
+                full.makespan
+            );
+        }
+        compared += 1;
+        shorter += usize::from(lns.makespan < plain.makespan - 1e-9);
+    }
+    assert!(compared >= 40 && shorter >= 10, "{shorter} shorter of {compared}");
 }
