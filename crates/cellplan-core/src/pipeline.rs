@@ -657,9 +657,9 @@ pub fn coordinate(
     }
     let handovers_s = lap.elapsed().as_secs_f64() - tries_s;
     let handovers_judged = coordinations.get() - tries_coordinated;
-    // The winner polished: coordinated again in the tour directions it runs in, and where the
-    // search over passage orders ends unproven, each robot put back through the others (see
-    // `coord::schedule`); kept when it ends sooner. Only the winner: done to every try and
+    // The winner polished: coordinated again (its tour directions searched from those it runs
+    // in), and where a search over passage orders ends unproven, each robot put back through
+    // the others (see `coord::schedule`); kept when it ends sooner. Only the winner: done to every try and
     // hand-over, a better coordination changes which plan wins and where the hand-overs lead,
     // and on the hard cells that did not pay on average (`bench/cells/README.md`).
     let mut polished = false;

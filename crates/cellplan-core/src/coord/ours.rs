@@ -388,12 +388,7 @@ fn directions(
         found.insert(at, d);
         found.truncate(DIRECTIONS_FINISHED);
     };
-    if let Some(t) = turned.filter(|t| ctx.settings.polish && t.len() == m) {
-        // Polishing a plan: only the directions it ran in.
-        if let Some(d) = try_turn(t)? {
-            keep(d, &mut found);
-        }
-    } else if m <= ALL_DIRECTIONS_UP_TO {
+    if m <= ALL_DIRECTIONS_UP_TO {
         // By number of turns, then mask.
         let mut masks: Vec<usize> = (0..1usize << m.saturating_sub(1)).collect();
         masks.sort_by_key(|&k| (k.count_ones(), k));

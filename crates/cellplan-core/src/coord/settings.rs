@@ -39,10 +39,9 @@ pub struct CoordSettings {
     /// without stopping, each corner's blend within this much (rad, per joint) of the corner
     /// and checked against the scene (see [`super::blend`]); 0: every leg stops at every waypoint.
     pub blend_deviation: f64,
-    /// Polishing a coordinated plan: `best` searches only the tour directions it is given, and
-    /// its search over passage orders, where it ends unproven, spends one more budget putting
-    /// each robot back through the others (what ours does to its winner before blending, see
-    /// [`crate::pipeline::coordinate`]).
+    /// Polishing a coordinated plan: `best`'s searches over passage orders, where they end
+    /// unproven, spend one more budget putting each robot back through the others (what ours
+    /// does to its winner before blending, see [`crate::pipeline::coordinate`]).
     pub polish: bool,
 }
 

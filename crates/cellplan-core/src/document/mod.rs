@@ -126,8 +126,9 @@ pub struct OursRun {
     pub handovers_judged: usize,
     /// Whether a hand-over beat the best try (the plan is then one).
     pub handover_taken: bool,
-    /// Whether the winner's coordination, polished (searched again in its own tour directions,
-    /// each robot then put back through the others), ended sooner and was kept.
+    /// Whether the winner's coordination, polished (searched again, each robot then put back
+    /// through the others where a search over passage orders ended unproven), ended sooner and
+    /// was kept.
     #[serde(default)]
     pub polished: bool,
     /// Plans blended and compared at the end (the winner and the runners-up within reach).
