@@ -659,9 +659,11 @@ pub fn coordinate(
     let handovers_judged = coordinations.get() - tries_coordinated;
     // The winner polished: coordinated again (its tour directions searched from those it runs
     // in), and where a search over passage orders ends unproven, each robot put back through
-    // the others (see `coord::schedule`); kept when it ends sooner. Only the winner: done to every try and
-    // hand-over, a better coordination changes which plan wins and where the hand-overs lead,
-    // and on the hard cells that did not pay on average (`bench/cells/README.md`).
+    // the others (see `coord::schedule`); kept when it ends sooner. Only the winner: done to
+    // every try and hand-over, a better coordination changes which plan wins and where the
+    // hand-overs lead, and on the hard cells that did not pay on average
+    // (`bench/cells/README.md`). On cells beyond `plan_first_pairs` no runner-up is kept, so
+    // there is no second start either.
     let mut polished = false;
     if settings.deadline.is_some_and(|d| Instant::now() >= d) {
         best.0.time_limit_hit = true;
