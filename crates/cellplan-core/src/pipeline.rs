@@ -629,7 +629,8 @@ pub fn coordinate(
             // No hand-over from the best try helped: the best try is not always the best
             // start (a plan whose coordination happened to go well may have no hand-over
             // left that pays), so the hand-overs start again from the shortest try that lost,
-            // within as much work again as the first start's took.
+            // within as much work again as the first start's took (none on cells beyond
+            // `plan_first_pairs`: no runner-up is kept there).
             None if !clock_cut => second_start = true,
             None => {}
         }
@@ -662,8 +663,7 @@ pub fn coordinate(
     // the others (see `coord::schedule`); kept when it ends sooner. Only the winner: done to
     // every try and hand-over, a better coordination changes which plan wins and where the
     // hand-overs lead, and on the hard cells that did not pay on average
-    // (`bench/cells/README.md`). On cells beyond `plan_first_pairs` no runner-up is kept, so
-    // there is no second start either.
+    // (`bench/cells/README.md`).
     let mut polished = false;
     if settings.deadline.is_some_and(|d| Instant::now() >= d) {
         best.0.time_limit_hit = true;
