@@ -290,14 +290,23 @@ impl RunnersUp {
     /// A coordinated plan that is not the first: it becomes `best` if its cycle (then Δt) is
     /// shorter, and the plan it replaces is kept as a runner-up; else it is kept as one.
     fn offer(&mut self, best: &mut Option<Tried>, run: Tried) {
-        if best
-            .as_ref()
-            .is_some_and(|b| cycle_and_delta(&run.2.timed) < cycle_and_delta(&b.2.timed))
-        {
-            self.keep(best.replace(run));
+        match best {
+            Some(b) => {
+                self.offer_to(b, run);
+            }
+            None => self.keep(Some(run)),
+        }
+    }
+
+    /// [`RunnersUp::offer`] against a best plan there is: whether `run` replaced it.
+    fn offer_to(&mut self, best: &mut Tried, run: Tried) -> bool {
+        let shorter = cycle_and_delta(&run.2.timed) < cycle_and_delta(&best.2.timed);
+        if shorter {
+            self.keep(Some(std::mem::replace(best, run)));
         } else {
             self.keep(Some(run));
         }
+        shorter
     }
 }
 
@@ -646,12 +655,7 @@ pub fn coordinate(
         };
         if let Ok((found, clock_cut)) = handovers(start, cache, &may_judge) {
             if let Some(found) = found {
-                if cycle_and_delta(&found.2.timed) < cycle_and_delta(&best.2.timed) {
-                    handover_taken = true;
-                    runners_up.keep(Some(std::mem::replace(&mut best, found)));
-                } else {
-                    runners_up.keep(Some(found));
-                }
+                handover_taken |= runners_up.offer_to(&mut best, found);
             }
             best.0.time_limit_hit |= clock_cut;
         }
