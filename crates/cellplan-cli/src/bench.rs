@@ -454,7 +454,9 @@ pub fn generate(args: &BenchArgs) -> Result<String, BenchError> {
     for v in &mut p.vehicles {
         let k = v.costs.n();
         let data = v.costs.data().iter().map(|&c| round(c)).collect();
-        v.costs = cellplan_solve::CostMatrix::new(k, data).map_err(|e| BenchError::Failed(e.to_string()))?;
+        v.costs = cellplan_solve::CostMatrix::new(k, data)
+            .map_err(|e| BenchError::Failed(e.to_string()))?
+            .into();
     }
     p.service.iter_mut().for_each(|s| *s = round(*s));
     p.validate().map_err(|e| BenchError::Failed(e.to_string()))?;

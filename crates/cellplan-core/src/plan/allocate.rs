@@ -26,6 +26,7 @@ use cellplan_solve::setcover::{self, ExactLimits, PenaltyParams};
 use cellplan_solve::{CostMatrix, Gtsp, GtspParams, SetCover};
 use glam::DVec3;
 use std::collections::BTreeMap;
+use std::sync::OnceLock;
 use std::time::Duration;
 
 mod strips;
@@ -84,12 +85,26 @@ pub fn allocate(
     settings: &PlanSettings,
     costs: Option<&[CostMatrix]>,
 ) -> Result<Allocated, PlanError> {
+    allocate_bounded(cell, table, graphs, settings, costs, &OnceLock::new())
+}
+
+/// [`allocate`], with the lower bound of `graphs` taken from `bound` where an earlier call
+/// with the same graphs (of the same cell and candidate table) has set it, and set there
+/// otherwise: it does not depend on the allocation, and costs a search of its own.
+pub fn allocate_bounded(
+    cell: &Cell,
+    table: &CandidateTable,
+    graphs: &[RobotGraph],
+    settings: &PlanSettings,
+    costs: Option<&[CostMatrix]>,
+    bound: &OnceLock<f64>,
+) -> Result<Allocated, PlanError> {
     let m = cell.robots.len();
     let capable: Vec<Vec<usize>> = (0..cell.tasks.len())
         .map(|t| table.robots_for(TaskId(t)).into_iter().map(|r| r.0).collect())
         .collect();
     let problem = min_max_problem(cell, graphs, &capable)?;
-    let lower_bound = minmax::lower_bound(&problem.0);
+    let lower_bound = *bound.get_or_init(|| minmax::lower_bound(&problem.0));
     if let Some(fixed) = &settings.tasks {
         return Ok(Allocated {
             tasks: fixed.clone(),
@@ -136,7 +151,7 @@ pub fn allocate(
                 Some(c) => {
                     let mut p = problem.0.clone();
                     for (v, m) in p.vehicles.iter_mut().zip(c) {
-                        v.costs = m.clone();
+                        v.costs = std::sync::Arc::new(m.clone());
                     }
                     (p, problem.1)
                 }

@@ -33,7 +33,7 @@ pub struct RobotGraph {
     /// Time spent at each node's task (s; 0 at home).
     pub dwell: Vec<f64>,
     /// Lower-bound move times between nodes (s).
-    pub costs: CostMatrix,
+    pub costs: Arc<CostMatrix>,
     /// The joint limits used for timing.
     pub limits: Limits,
     /// The robot's roadmap in the cell (see [`RobotGraph::roadmap`]), built on first need and
@@ -214,7 +214,7 @@ impl RobotGraph {
             dwell,
             node_task,
             alternatives,
-            costs,
+            costs: Arc::new(costs),
             limits,
             roadmap: Arc::default(),
             legs: Arc::default(),

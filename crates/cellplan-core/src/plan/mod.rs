@@ -24,7 +24,7 @@ use cellplan_motion::plan::PlanSettings as MotionSettings;
 use cellplan_solve::CostMatrix;
 use graph::RobotGraph;
 use rayon::prelude::*;
-use std::sync::Arc;
+use std::sync::{Arc, OnceLock};
 use std::time::{Duration, Instant};
 
 /// Knobs of a planning run.
@@ -364,10 +364,11 @@ pub fn plan(
 /// lazy sequencing knows (their real times replace the bounds), so a run's plan depends on
 /// the legs the cache holds: runs that share one give the plans of one after the other only
 /// in that order (a run made ahead, to be dropped if not needed, takes a copy). The graphs'
-/// memo of legs ([`PlanCache::graphs_only`]) changes no plan.
+/// memo of legs ([`PlanCache::graphs_only`]) changes no plan; nor does the lower bound of the
+/// graphs' min-max problem, found once for all ([`allocate::allocate_bounded`]).
 #[derive(Clone, Debug, Default)]
 pub struct PlanCache {
-    graphs: Option<(MoveModel, usize, u64, Arc<Vec<RobotGraph>>)>,
+    graphs: Option<CachedGraphs>,
     planned: Vec<sequence::Planned>,
 }
 
@@ -387,9 +388,13 @@ impl PlanCache {
     pub fn legs_served(&self) -> usize {
         self.graphs
             .as_ref()
-            .map_or(0, |(.., g)| g.iter().map(|g| g.legs.served()).sum())
+            .map_or(0, |(.., g, _)| g.iter().map(|g| g.legs.served()).sum())
     }
 }
+
+/// The robot graphs of [`PlanCache`] with what they were made for (move model, `alternatives`,
+/// `roomy`) and the lower bound of their min-max problem once found.
+type CachedGraphs = (MoveModel, usize, u64, Arc<Vec<RobotGraph>>, Arc<OnceLock<f64>>);
 
 /// The min-max problem the allocations of `cell` work on with `settings` (its move model,
 /// alternatives and room): per robot its graph's lower-bound move times between home and its
@@ -468,19 +473,20 @@ pub fn plan_keeping(
         settings.alternatives,
         settings.roomy.to_bits(),
     );
-    let graphs: Arc<Vec<RobotGraph>> = match &cache.graphs {
-        Some((m, a, r, g)) if (*m, *a, *r) == key => Arc::clone(g),
+    let (graphs, bound): (Arc<Vec<RobotGraph>>, Arc<OnceLock<f64>>) = match &cache.graphs {
+        Some((m, a, r, g, b)) if (*m, *a, *r) == key => (Arc::clone(g), Arc::clone(b)),
         _ => {
             let g = Arc::new(robot_graphs(cell, table, settings));
-            cache.graphs = Some((key.0, key.1, key.2, Arc::clone(&g)));
+            let b = Arc::new(OnceLock::new());
+            cache.graphs = Some((key.0, key.1, key.2, Arc::clone(&g), Arc::clone(&b)));
             cache.planned = vec![Default::default(); cell.robots.len()];
-            g
+            (g, b)
         }
     };
     tick(Stage::Costs, &mut compute);
 
     progress(Stage::Allocation);
-    let mut allocated = allocate::allocate(cell, table, &graphs, settings, None)?;
+    let mut allocated = allocate::allocate_bounded(cell, table, &graphs, settings, None, &bound)?;
     // The allocation searches stop at their iteration counts; past the deadline, the clock
     // stopped them.
     let mut clock_cut = Instant::now() >= deadline;
@@ -514,7 +520,7 @@ pub fn plan_keeping(
         };
         // The nearest-robot allocation is tried too, so that ours is never worse than the
         // baseline on the real times.
-        let proximity = allocate::allocate(
+        let proximity = allocate::allocate_bounded(
             cell,
             table,
             &graphs,
@@ -523,6 +529,7 @@ pub fn plan_keeping(
                 ..settings.clone()
             },
             None,
+            &bound,
         )?;
         let mut tried = vec![allocated.tasks.clone()];
         for round in 0..=settings.reallocation_rounds {
@@ -538,7 +545,7 @@ pub fn plan_keeping(
                     .zip(&planned)
                     .map(|(g, p)| mixed_costs(g, p))
                     .collect();
-                allocate::allocate(cell, table, &graphs, settings, Some(&mixed))?.tasks
+                allocate::allocate_bounded(cell, table, &graphs, settings, Some(&mixed), &bound)?.tasks
             };
             if tried.contains(&next) {
                 continue;

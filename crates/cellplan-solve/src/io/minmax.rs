@@ -451,7 +451,7 @@ fn parse_vehicle(
         alternatives.push(alts);
     }
     Ok(Vehicle {
-        costs,
+        costs: costs.into(),
         depot,
         cap,
         alternatives,

@@ -114,7 +114,7 @@ pub fn generate_within(
             ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt() / speed
         });
         vs.push(Vehicle {
-            costs,
+            costs: costs.into(),
             depot: 0,
             cap: 0,
             alternatives: alts,

@@ -8,6 +8,7 @@
 //! Service times are **per task** (the same whichever vehicle or node does it); the depot has
 //! none. Methods ([`MinMaxMethod`]): the proximity baseline, paper 000's Algorithm 1 generalised
 //! to m vehicles, and an iterated local search between routes on top of the GTSP solver.
+use std::sync::Arc;
 use std::time::Duration;
 
 use crate::problem::CostMatrix;
@@ -30,8 +31,9 @@ pub use routes_bound::{RouteBound, RouteBoundSettings, lagrangian_bound, route_b
 /// One vehicle (robot).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Vehicle {
-    /// Travel times between the vehicle's own nodes (depot included).
-    pub costs: CostMatrix,
+    /// Travel times between the vehicle's own nodes (depot included); shared, so that a
+    /// problem made again from the same matrices (or cloned) does not copy them.
+    pub costs: Arc<CostMatrix>,
     /// The home node: every route starts and ends here. In no task's alternatives.
     pub depot: usize,
     /// Most tasks the vehicle may take (φ).
@@ -45,13 +47,13 @@ impl Vehicle {
     /// A vehicle, validated on its own: depot and nodes in range, the depot in no alternative
     /// list, no node serving two tasks (or listed twice).
     pub fn new(
-        costs: CostMatrix,
+        costs: impl Into<Arc<CostMatrix>>,
         depot: usize,
         cap: usize,
         alternatives: Vec<Vec<usize>>,
     ) -> Result<Self, VehicleError> {
         let v = Vehicle {
-            costs,
+            costs: costs.into(),
             depot,
             cap,
             alternatives,
