@@ -495,14 +495,26 @@ fn render(doc: &output::Plan, working: &str) -> String {
     );
     if let (Some(o), Some(t)) = (&doc.stats.ours, &c.ours) {
         s += &format!(
-            "  (ours: {} plans coordinated in {:.2} s, then {} hand-overs judged in {:.2} s{}, the winner polished in {:.2} s{}, the winner{} blended in {:.2} s)\n",
+            "  (ours: {} plans coordinated{} in {:.2} s, then {} hand-overs judged in {:.2} s{}{}, the winner{} blended in {:.2} s)\n",
             o.tries_coordinated,
+            if o.polished_throughout {
+                " and polished"
+            } else {
+                ""
+            },
             t.tries,
             o.handovers_judged,
             t.handovers,
             if o.handover_taken { ", one taken" } else { "" },
-            t.polish,
-            if o.polished { " (kept)" } else { "" },
+            if o.polished_throughout {
+                String::new()
+            } else {
+                format!(
+                    ", the winner polished in {:.2} s{}",
+                    t.polish,
+                    if o.polished { " (kept)" } else { "" }
+                )
+            },
             match o.blended {
                 0 | 1 => String::new(),
                 2 => " and a runner-up".to_string(),

@@ -332,7 +332,8 @@ impl RunnersUp {
 /// [`RELIEF_EXTRA_DISTANCES`] sets. When no hand-over from the winner helps, they start again
 /// from the shortest plan that lost (a runner-up, see below), within as much work again as the
 /// first start took, and the shorter of the two stands. The winner is then polished
-/// ([`CoordSettings::polish`]) and kept so where that ends sooner. Plans are compared with
+/// ([`CoordSettings::polish`]) and kept so where that ends sooner; on cells beyond
+/// `plan_first_pairs` every coordination is polished as it is made instead. Plans are compared with
 /// every leg stopping at every
 /// waypoint; the winner and the `RUNNERS_UP` shortest plans that lost (within
 /// `RUNNER_UP_REACH` of it, on cells of at most `plan_first_pairs` MPs × robots) are then
@@ -387,6 +388,15 @@ pub fn coordinate(
         ..settings.clone()
     });
     let plan_first = cell.tasks.len() * cell.robots.len() > coord.plan_first_pairs;
+    // Where the plans are planned first, the work budget affords few coordinations (one on
+    // 8 robots × 1,000 MPs), and no runner-up is kept: each is polished as it is made. On the
+    // smaller cells a better coordination changes which plan wins and where the hand-overs
+    // lead, and there it did not pay on average (see the polish below).
+    let polishing = CoordSettings {
+        polish: true,
+        ..coord.clone()
+    };
+    let coord = if plan_first { &polishing } else { coord };
     // The balanced plan shares with the others only the robot graphs (and their memo of legs)
     // and the diagrams, neither of which changes an answer: where the plans are coordinated as
     // they come, it is planned and coordinated beside them, on what would be an idle core, and
@@ -669,7 +679,9 @@ pub fn coordinate(
     // hand-overs lead, and on the hard cells that did not pay on average
     // (`bench/cells/README.md`).
     let mut polished = false;
-    if settings.deadline.is_some_and(|d| Instant::now() >= d) {
+    if plan_first {
+        // Polished as it was coordinated (see `polishing` above).
+    } else if settings.deadline.is_some_and(|d| Instant::now() >= d) {
         best.0.time_limit_hit = true;
     } else {
         let polish = CoordSettings {
@@ -721,6 +733,7 @@ pub fn coordinate(
             handovers_judged,
             handover_taken,
             polished,
+            polished_throughout: plan_first,
             blended,
         },
         crate::document::OursTimes {

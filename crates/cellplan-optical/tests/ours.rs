@@ -173,7 +173,8 @@ fn ours_past_its_work_budget_keeps_its_first_plan() {
 
 /// Ours planning every try first (as on large cells) within a budget that allows one
 /// coordination: the plan coordinated is the most promising of its plans — here another than the
-/// zones plan it starts from, whose robots end sooner uncoordinated; the plan verifies.
+/// zones plan it starts from, whose robots end sooner uncoordinated; every coordination is
+/// polished as it is made, so the winner is not polished again; the plan verifies.
 #[test]
 fn ours_planning_first_coordinates_its_most_promising_plan() {
     use cellplan_core::plan::rebalance::makespan;
@@ -195,6 +196,8 @@ fn ours_planning_first_coordinates_its_most_promising_plan() {
         o.allocated.tasks != zones_tasks && makespan(&o) < start - 1e-9,
         "the zones plan ({start} s) was coordinated, not the most promising"
     );
+    let (run, _) = c.ours.expect("ours states its run");
+    assert!(run.polished_throughout && !run.polished, "{run:?}");
     let doc = cellplan_core::document::build(&f.cell, &f.table, &o, &c, &s, 0.0, 0.0);
     let report = verify(&f.cell, &doc, &VerifySettings::default());
     assert!(report.ok, "{:#?}", report.violations);

@@ -131,6 +131,11 @@ pub struct OursRun {
     /// was kept.
     #[serde(default)]
     pub polished: bool,
+    /// Whether every coordination was polished as it was made (on cells beyond
+    /// [`crate::coord::CoordSettings::plan_first_pairs`], where the work budget affords few);
+    /// the winner is then not polished again.
+    #[serde(default)]
+    pub polished_throughout: bool,
     /// Plans blended and compared at the end (the winner and the runners-up within reach).
     pub blended: usize,
 }
