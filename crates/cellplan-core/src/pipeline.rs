@@ -362,8 +362,14 @@ pub fn coordinate(
     };
     let coord = &unblended;
     let lap = Instant::now();
-    // Pair diagrams shared by the coordinations below (many robots keep their paths).
-    let diagrams = DiagramCache::default();
+    let plan_first = cell.tasks.len() * cell.robots.len() > coord.plan_first_pairs;
+    // Pair diagrams shared by the coordinations below (many robots keep their paths), and
+    // where many coordinations are affordable, the pairs of pieces (most legs recur).
+    let diagrams = if plan_first {
+        DiagramCache::default()
+    } else {
+        DiagramCache::with_pieces()
+    };
     // The nearest-robot allocation the zones start from, planned and coordinated as it is:
     // where neighbours share much space, uneven but separate work can end sooner than
     // balanced work that meets.
@@ -387,7 +393,6 @@ pub fn coordinate(
         task_penalty: Vec::new(),
         ..settings.clone()
     });
-    let plan_first = cell.tasks.len() * cell.robots.len() > coord.plan_first_pairs;
     // Where the plans are planned first, the work budget affords few coordinations (one on
     // 8 robots × 1,000 MPs), and no runner-up is kept: each is polished as it is made. On the
     // smaller cells a better coordination changes which plan wins and where the hand-overs

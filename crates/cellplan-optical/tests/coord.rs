@@ -230,6 +230,61 @@ fn coordination_from_kept_diagrams_is_the_same() {
     }
 }
 
+/// Keeping pairs of pieces changes no answer: the crossing plan coordinated with a cache that
+/// keeps them is the plan coordinated alone, counts and search included. A hand-over plan (one
+/// MP of the second robot given to the first, the plan made keeping what it can) coordinated
+/// after it with the same cache is what it is with a fresh one, and works out fewer pairs of
+/// pieces: most of its legs' pieces were met before.
+#[test]
+fn coordination_keeping_pairs_of_pieces_is_the_same() {
+    use cellplan_core::plan::{self, PlanCache, PlanSettings};
+    let f = fixture();
+    let settings = coord::CoordSettings::default();
+    let same = |a: &coord::Coordinated, b: &coord::Coordinated| {
+        assert_eq!(a.programs, b.programs);
+        assert_eq!(a.search, b.search);
+        assert_eq!(a.diagram_distances, b.diagram_distances);
+        assert_eq!(
+            (a.resolved, a.waits, a.reversed.clone()),
+            (b.resolved, b.waits, b.reversed.clone())
+        );
+    };
+    let alone = coord::coordinate_outcome(&f.cell, &f.table, &f.outcome, &settings).unwrap();
+    let kept = coord::DiagramCache::with_pieces();
+    let first = coord::coordinate_outcome_cached(&f.cell, &f.table, &f.outcome, &settings, &kept).unwrap();
+    same(&first, &alone);
+    let met = kept.piece_pairs();
+    assert!(met >= 1, "the robots' pieces meet");
+    // One MP handed from the second robot to the first.
+    let mut tasks = f.outcome.allocated.tasks.clone();
+    let handed = tasks[1].remove(0);
+    tasks[0].push(handed);
+    let handover = PlanSettings {
+        tasks: Some(tasks),
+        ..f.settings.clone()
+    };
+    let o = plan::plan_keeping(
+        &f.cell,
+        &f.table,
+        &handover,
+        &|_| {},
+        &mut PlanCache::default(),
+        Some(&f.outcome),
+    )
+    .unwrap();
+    let fresh = coord::DiagramCache::with_pieces();
+    let alone = coord::coordinate_outcome_cached(&f.cell, &f.table, &o, &settings, &fresh).unwrap();
+    assert!(!alone.before.is_empty(), "the hand-over plan's robots meet");
+    let again = coord::coordinate_outcome_cached(&f.cell, &f.table, &o, &settings, &kept).unwrap();
+    same(&again, &alone);
+    let new = kept.piece_pairs() - met;
+    assert!(
+        new < fresh.piece_pairs(),
+        "{new} pairs of pieces worked out after the first plan, {} alone",
+        fresh.piece_pairs()
+    );
+}
+
 /// The directions a coordination chose, as `canonical_turns` states them (against each tour's
 /// canonical direction, the first robot's taken as canonical), and a coordination started from
 /// given directions: up to five robots every combination is searched, so where the search

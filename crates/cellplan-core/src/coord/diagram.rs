@@ -14,12 +14,16 @@
 //! Rectangles that cannot be proven free are halved (along the robot that moves more) down to [`MIN_CELL`]; those
 //! left are in conflict. Each pair of pieces (one of each path) keeps the bounding box of its
 //! conflicts: a box per pair of pieces follows the shape of a long conflict as a staircase,
-//! where one bounding box of the whole would serialise the robots.
+//! where one bounding box of the whole would serialise the robots. A pair of pieces is worked
+//! out in the pieces' own positions, from each piece's own motion, so its answer depends on
+//! what the two pieces are and not on where they lie on their paths ([`DiagramCache::with_pieces`]
+//! keeps it by that).
 use super::Ctx;
 use super::program::{Activity, Program, Timed};
 use crate::plan::PlanError;
 use cellplan_geom::DVec3;
 use cellplan_model::robot::Scratch;
+use cellplan_motion::timing::Trajectory;
 use rayon::prelude::*;
 use std::collections::HashMap;
 use std::hash::{BuildHasherDefault, Hasher};
@@ -77,6 +81,48 @@ struct Piece {
     from: f64,
     to: f64,
     moving: bool,
+    /// Its motion from its own start: the diagram of two pieces is worked out in the pieces'
+    /// own positions, `[0, len]`, so that it depends on what the pieces are, never on where
+    /// they lie on their paths (see [`PieceCache`]).
+    motion: Motion,
+    /// Its length in its own positions.
+    len: f64,
+    /// Its entry in the context's [`PieceCache`] (`None`: not kept there).
+    id: Option<u32>,
+}
+
+/// A piece's motion from its own start.
+#[derive(Clone, Debug)]
+enum Motion {
+    /// Along one segment from rest to rest (the segment timed on its own).
+    Segment(Trajectory),
+    /// Standing at a configuration.
+    Stand(Vec<f64>),
+    /// A segment of a blended leg: the leg's trajectory from this time on.
+    Blended(std::sync::Arc<Trajectory>, f64),
+}
+
+impl Piece {
+    /// The configuration at position `s` of the piece's own (clamped to `[0, len]`).
+    fn at(&self, s: f64) -> Vec<f64> {
+        let s = s.clamp(0.0, self.len);
+        match &self.motion {
+            Motion::Segment(t) => t.position(s),
+            Motion::Stand(q) => q.clone(),
+            Motion::Blended(t, start) => t.position(start + s),
+        }
+    }
+
+    /// A position of the piece's own on its path: its ends exactly at the piece's ends.
+    fn on_path(&self, s: f64) -> f64 {
+        if s <= 0.0 {
+            self.from
+        } else if s >= self.len {
+            self.to
+        } else {
+            (self.from + s).min(self.to)
+        }
+    }
 }
 
 /// A robot's path as positions: its program without waits on the clock.
@@ -127,15 +173,54 @@ impl RobotPath {
                 },
             );
         }
-        let pieces = timed
-            .spans
-            .iter()
-            .map(|s| Piece {
+        let limits = &ctx.limits[program.robot];
+        let mut keys = Vec::with_capacity(timed.spans.len());
+        let mut pieces = Vec::with_capacity(timed.spans.len());
+        for s in &timed.spans {
+            let (motion, len, key) = match s.what {
+                Activity::Move { leg, segment } => {
+                    let leg = &bare.legs[leg];
+                    match &leg.blend {
+                        Some(b) => {
+                            let times = &b.waypoint_times;
+                            let t = std::sync::Arc::new(b.trajectory.clone());
+                            let len = times[segment + 1] - times[segment];
+                            (Motion::Blended(t, times[segment]), len, None)
+                        }
+                        None => {
+                            let (a, b) = (&leg.waypoints[segment], &leg.waypoints[segment + 1]);
+                            let t = super::program::segment_trajectory(a, b, limits)?;
+                            let len = t.duration();
+                            let mut key = vec![0, program.robot as u64];
+                            key.extend(a.iter().chain(b).map(|x| x.to_bits()));
+                            (Motion::Segment(t), len, Some(key))
+                        }
+                    }
+                }
+                Activity::Measure { visit } => {
+                    let v = &bare.visits[visit];
+                    let mut key = vec![1, program.robot as u64, v.dwell.to_bits()];
+                    key.extend(v.q.iter().map(|x| x.to_bits()));
+                    (Motion::Stand(v.q.clone()), v.dwell, Some(key))
+                }
+                // Without waits, only a program without legs has one: at home, for no time.
+                Activity::Wait { .. } => (Motion::Stand(bare.home.clone()), s.end - s.start, None),
+            };
+            keys.push(key);
+            pieces.push(Piece {
                 from: s.start,
                 to: s.end,
                 moving: matches!(s.what, Activity::Move { .. }),
-            })
-            .collect();
+                motion,
+                len,
+                id: None,
+            });
+        }
+        if let Some(cache) = ctx.diagrams.and_then(|d| d.pieces.as_ref()) {
+            for (piece, id) in pieces.iter_mut().zip(cache.ids(keys)) {
+                piece.id = id;
+            }
+        }
         let mut signature = vec![program.robot as u64];
         signature.extend(bare.home.iter().map(|x| x.to_bits()));
         for leg in &bare.legs {
@@ -169,10 +254,6 @@ impl RobotPath {
             len: self.len,
             rests: self.rests.iter().map(|r| r.at).collect(),
         }
-    }
-
-    fn at(&self, s: f64) -> Vec<f64> {
-        self.timed.trajectory.position(s.clamp(0.0, self.len))
     }
 }
 
@@ -239,8 +320,11 @@ struct PairDiagram<'a> {
     cb: Covers,
     scratch: Scratch,
     work: DiagramWork,
+    /// The pieces worked on (one of each path); rectangles are in their own positions.
+    x: &'a Piece,
+    y: &'a Piece,
     /// The bounding box of the conflicts found so far in the current pair of pieces.
-    found: Option<ConflictBox>,
+    found: Option<LocalBox>,
     /// Placements in the current pair of pieces, by robot (first or not) and position.
     placed: ByPosition<Rc<Placed>>,
     /// Room for the close body pairs of a smallest rectangle.
@@ -254,23 +338,38 @@ struct PairDiagram<'a> {
     pool: Vec<Placed>,
 }
 
-impl PairDiagram<'_> {
-    /// Robot `path` placed at position `s`, remembered for the current pair of pieces (halving
-    /// along one robot keeps the other where it was).
-    fn place(&mut self, path: &RobotPath, first: bool, s: f64) -> Rc<Placed> {
+/// The conflicts of one pair of pieces in the pieces' own positions: `a` of the first piece,
+/// `b` of the second, and which ends are open (as [`ConflictBox::open`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct LocalBox {
+    a: (f64, f64),
+    b: (f64, f64),
+    open: [bool; 4],
+}
+
+impl<'a> PairDiagram<'a> {
+    /// The piece worked on of the first robot or of the second.
+    fn piece(&self, first: bool) -> &'a Piece {
+        if first { self.x } else { self.y }
+    }
+
+    /// Robot `first` (or the second) placed at position `s` of its piece, remembered for the
+    /// current pair of pieces (halving along one robot keeps the other where it was).
+    fn place(&mut self, first: bool, s: f64) -> Rc<Placed> {
         let key = (first, s.to_bits());
         if let Some(p) = self.placed.get(&key) {
             return Rc::clone(p);
         }
-        let p = Rc::new(self.place_new(path, first, s));
+        let p = Rc::new(self.place_new(first, s));
         self.placed.insert(key, Rc::clone(&p));
         p
     }
 
-    fn place_new(&mut self, path: &RobotPath, first: bool, s: f64) -> Placed {
+    fn place_new(&mut self, first: bool, s: f64) -> Placed {
+        let path = if first { self.pa } else { self.pb };
         let robot = &self.ctx.cell.robots[path.robot];
         let mut out = self.pool.pop().unwrap_or_default();
-        out.q = path.at(s);
+        out.q = self.piece(first).at(s);
         robot.body_poses(&out.q, &mut self.scratch);
         let bodies_at = &self.scratch.bodies;
         let local = if first { &self.sa } else { &self.sb };
@@ -304,11 +403,17 @@ impl PairDiagram<'_> {
         self.positions.clear();
     }
 
-    /// The swept spheres of one piece of `path` (see [`Swept`]).
-    fn swept(&mut self, path: &RobotPath, first: bool, piece: &Piece) -> Swept {
-        let mid = 0.5 * (piece.from + piece.to);
-        let placed = self.place(path, first, mid);
-        let reach = self.reach(first, &placed.q, path, piece.from, piece.to, piece.moving);
+    /// The swept spheres of piece `piece` of the first path (or of the second) (see
+    /// [`Swept`]).
+    fn swept(&mut self, first: bool, piece: &'a Piece) -> Swept {
+        if first {
+            self.x = piece;
+        } else {
+            self.y = piece;
+        }
+        let placed = self.place(first, 0.5 * piece.len);
+        let reach = self.reach(first, &placed.q, 0.0, piece.len, piece.moving);
+        self.forget();
         let bodies: Vec<(DVec3, f64)> = placed.spheres.iter().map(|&(c, r)| (c, r + reach)).collect();
         let centre = if bodies.is_empty() {
             DVec3::ZERO
@@ -358,13 +463,14 @@ impl PairDiagram<'_> {
     }
 
     /// How far any point of the robot can be from where it is at `mid` while at positions in
-    /// `[from, to]` (inside one piece).
-    fn reach(&mut self, first: bool, mid: &[f64], path: &RobotPath, from: f64, to: f64, moving: bool) -> f64 {
+    /// `[from, to]` of its piece.
+    fn reach(&mut self, first: bool, mid: &[f64], from: f64, to: f64, moving: bool) -> f64 {
         if !moving || to <= from {
             return 0.0;
         }
-        let ctx = self.ctx;
-        let radii = &ctx.radii[path.robot];
+        let path = if first { self.pa } else { self.pb };
+        let piece = self.piece(first);
+        let radii = &self.ctx.radii[path.robot];
         [from, to]
             .iter()
             .map(|&s| {
@@ -372,7 +478,7 @@ impl PairDiagram<'_> {
                 let q = self
                     .positions
                     .entry((first, s.to_bits()))
-                    .or_insert_with(|| path.at(s));
+                    .or_insert_with(|| piece.at(s));
                 q.iter()
                     .zip(mid)
                     .zip(radii)
@@ -382,17 +488,16 @@ impl PairDiagram<'_> {
             .fold(0.0, f64::max)
     }
 
-    /// What rectangle `[a0, a1] × [b0, b1]` (inside pieces of the two paths) is: free (the
+    /// What rectangle `[a0, a1] × [b0, b1]` (of the two pieces' positions) is: free (the
     /// sphere covers, or the exact distance, exceed the clearance plus both robots' reach over
     /// it), to be halved (along the robot that moves more), or — once nothing is left to halve
     /// — in conflict.
     fn judge(&mut self, a: (f64, f64, bool), b: (f64, f64, bool)) -> Rect {
         self.work.cells += 1;
-        let (pa, pb) = (self.pa, self.pb);
-        let xa = self.place(pa, true, 0.5 * (a.0 + a.1));
-        let xb = self.place(pb, false, 0.5 * (b.0 + b.1));
-        let ra = self.reach(true, &xa.q, pa, a.0, a.1, a.2);
-        let rb = self.reach(false, &xb.q, pb, b.0, b.1, b.2);
+        let xa = self.place(true, 0.5 * (a.0 + a.1));
+        let xb = self.place(false, 0.5 * (b.0 + b.1));
+        let ra = self.reach(true, &xa.q, a.0, a.1, a.2);
+        let rb = self.reach(false, &xb.q, b.0, b.1, b.2);
         let need = self.ctx.margin + ra + rb;
         let split_a = a.2 && a.1 - a.0 > MIN_CELL;
         let split_b = b.2 && b.1 - b.0 > MIN_CELL;
@@ -418,7 +523,7 @@ impl PairDiagram<'_> {
         }
     }
 
-    /// Rectangle `[a0, a1] × [b0, b1]` inside pieces of the two paths: free, or halved, or
+    /// Rectangle `[a0, a1] × [b0, b1]` of the two pieces' positions: free, or halved, or
     /// recorded as in conflict.
     fn cell(&mut self, a: (f64, f64, bool), b: (f64, f64, bool)) {
         // Inside what is already in conflict: nothing to learn.
@@ -432,9 +537,7 @@ impl PairDiagram<'_> {
         match self.judge(a, b) {
             Rect::Free => {}
             Rect::Conflict => {
-                let robots = (self.pa.robot, self.pb.robot);
-                let f = self.found.get_or_insert(ConflictBox {
-                    robots,
+                let f = self.found.get_or_insert(LocalBox {
                     a: (a.0, a.1),
                     b: (b.0, b.1),
                     open: [false; 4],
@@ -464,32 +567,31 @@ impl PairDiagram<'_> {
         }
     }
 
-    /// Marks the ends of `f` (found in pieces `x` of the first robot and `y` of the second)
-    /// at which a robot standing still is clear of the other's whole interval. Only ends at
-    /// the ends of moving pieces are looked at: those are where rests are.
+    /// Marks the ends of `f` (found in the current pieces) at which a robot standing still is
+    /// clear of the other's whole interval. Only ends at the ends of moving pieces are looked
+    /// at: those are where rests are.
     ///
     /// Home is clear by construction: every leg and every measurement pose was planned with
     /// the other robots parked at home, keeping the cell's clearance (see
     /// [`crate::motion::robot_validity`]); the rectangles, by contrast, are conservative by
     /// the robots' reach over a smallest rectangle and by [`super::REPLAY_SLACK`], and would
     /// otherwise let a robot's home seem to block a path that was planned past it.
-    fn open_ends(&mut self, f: &mut ConflictBox, x: &Piece, y: &Piece) {
-        const AT: f64 = 1e-9;
-        let (la, lb) = (self.pa.len, self.pb.len);
+    fn open_ends(&mut self, f: &mut LocalBox, ends: PieceEnds) {
+        let (x, y) = (self.x, self.y);
         if x.moving {
-            if f.a.0 <= x.from + AT {
-                f.open[0] = x.from <= AT || self.certify((x.from, x.from, false), (f.b.0, f.b.1, y.moving));
+            if f.a.0 <= 0.0 {
+                f.open[0] = ends.0[0] || self.certify((0.0, 0.0, false), (f.b.0, f.b.1, y.moving));
             }
-            if f.a.1 >= x.to - AT {
-                f.open[1] = x.to >= la - AT || self.certify((x.to, x.to, false), (f.b.0, f.b.1, y.moving));
+            if f.a.1 >= x.len {
+                f.open[1] = ends.0[1] || self.certify((x.len, x.len, false), (f.b.0, f.b.1, y.moving));
             }
         }
         if y.moving {
-            if f.b.0 <= y.from + AT {
-                f.open[2] = y.from <= AT || self.certify((f.a.0, f.a.1, x.moving), (y.from, y.from, false));
+            if f.b.0 <= 0.0 {
+                f.open[2] = ends.1[0] || self.certify((f.a.0, f.a.1, x.moving), (0.0, 0.0, false));
             }
-            if f.b.1 >= y.to - AT {
-                f.open[3] = y.to >= lb - AT || self.certify((f.a.0, f.a.1, x.moving), (y.to, y.to, false));
+            if f.b.1 >= y.len {
+                f.open[3] = ends.1[1] || self.certify((f.a.0, f.a.1, x.moving), (y.len, y.len, false));
             }
         }
     }
@@ -505,11 +607,36 @@ impl PairDiagram<'_> {
         self.cell(a, (b.0, m, b.2));
         self.cell(a, (m, b.1, b.2));
     }
+
+    /// The conflicts of pieces `x` and `y` in their own positions, and the work they took
+    /// (`ends`: whether each piece starts and ends its path, where the robot is at home).
+    fn pieces(&mut self, x: &'a Piece, y: &'a Piece, ends: PieceEnds) -> (Option<LocalBox>, DiagramWork) {
+        let before = self.work;
+        (self.x, self.y) = (x, y);
+        self.cell((0.0, x.len, x.moving), (0.0, y.len, y.moving));
+        let found = self.found.take().map(|mut f| {
+            self.open_ends(&mut f, ends);
+            f
+        });
+        self.forget();
+        let work = DiagramWork {
+            cells: self.work.cells - before.cells,
+            distances: self.work.distances - before.distances,
+        };
+        (found, work)
+    }
 }
+
+/// Whether a piece starts its path and whether it ends it (home, where a robot is clear of
+/// the others by construction; see [`PairDiagram::open_ends`]), for the two pieces of a pair.
+type PieceEnds = ([bool; 2], [bool; 2]);
 
 /// The conflict boxes of robots `pa` and `pb`, and the work done.
 fn pair_boxes(ctx: &Ctx, pa: &RobotPath, pb: &RobotPath) -> (Vec<ConflictBox>, DiagramWork) {
     let cell = ctx.cell;
+    let (Some(x0), Some(y0)) = (pa.pieces.first(), pb.pieces.first()) else {
+        return (Vec::new(), DiagramWork::default());
+    };
     let mut d = PairDiagram {
         ctx,
         pa,
@@ -520,6 +647,8 @@ fn pair_boxes(ctx: &Ctx, pa: &RobotPath, pb: &RobotPath) -> (Vec<ConflictBox>, D
         cb: Covers::of(ctx, &cell.robots[pb.robot]),
         scratch: Scratch::default(),
         work: DiagramWork::default(),
+        x: x0,
+        y: y0,
         found: None,
         placed: ByPosition::default(),
         close: Vec::new(),
@@ -530,25 +659,47 @@ fn pair_boxes(ctx: &Ctx, pa: &RobotPath, pb: &RobotPath) -> (Vec<ConflictBox>, D
     // Each piece's swept body spheres (placed at its middle, grown by its reach) and one
     // sphere around them: most pairs of pieces are far apart, and a sphere test says so
     // without placing the robots again.
-    let swept_a: Vec<Swept> = pa.pieces.iter().map(|x| d.swept(pa, true, x)).collect();
-    let swept_b: Vec<Swept> = pb.pieces.iter().map(|y| d.swept(pb, false, y)).collect();
-    d.forget();
+    let swept_a: Vec<Swept> = pa.pieces.iter().map(|x| d.swept(true, x)).collect();
+    let swept_b: Vec<Swept> = pb.pieces.iter().map(|y| d.swept(false, y)).collect();
+    const AT: f64 = 1e-9;
+    let ends = |p: &Piece, path: &RobotPath| [p.from <= AT, p.to >= path.len - AT];
+    let kept = ctx.diagrams.and_then(|c| c.pieces.as_ref());
     let margin = ctx.margin;
     let mut boxes = Vec::new();
+    let mut work = DiagramWork::default();
     for (x, sx) in pa.pieces.iter().zip(&swept_a) {
         for (y, sy) in pb.pieces.iter().zip(&swept_b) {
             if !sx.may_meet(sy, margin) {
                 continue;
             }
-            d.cell((x.from, x.to, x.moving), (y.from, y.to, y.moving));
-            if let Some(mut f) = d.found.take() {
-                d.open_ends(&mut f, x, y);
-                boxes.push(f);
+            let pair_ends = (ends(x, pa), ends(y, pb));
+            let key = kept
+                .zip(x.id.zip(y.id))
+                .map(|(k, (i, j))| (k, PieceKey::new(i, j, pair_ends)));
+            let held = key.as_ref().and_then(|(k, key)| k.get(key));
+            let (found, w) = match held {
+                Some(h) => h,
+                None => {
+                    let made = d.pieces(x, y, pair_ends);
+                    if let Some((k, key)) = &key {
+                        k.put(*key, made);
+                    }
+                    made
+                }
+            };
+            work.cells += w.cells;
+            work.distances += w.distances;
+            if let Some(f) = found {
+                boxes.push(ConflictBox {
+                    robots: (pa.robot, pb.robot),
+                    a: (x.on_path(f.a.0), x.on_path(f.a.1)),
+                    b: (y.on_path(f.b.0), y.on_path(f.b.1)),
+                    open: f.open,
+                });
             }
-            d.forget();
         }
     }
-    (boxes, d.work)
+    (boxes, work)
 }
 
 /// Where a robot can be while on one piece of its path: its body spheres at the piece's
@@ -596,9 +747,85 @@ pub(crate) type PairBoxes = Option<Built>;
 pub struct DiagramCache {
     /// By the first path's signature, then the second's.
     pairs: std::sync::Mutex<HashMap<Vec<u64>, BySecond>>,
+    /// The pairs of pieces worked out, where kept ([`DiagramCache::with_pieces`]).
+    pieces: Option<PieceCache>,
+}
+
+/// Pairs of pieces [`PieceCache`] holds at most (about 100 bytes each); beyond, pairs are
+/// worked out without being kept.
+const PIECE_PAIRS_KEPT: usize = 2_000_000;
+
+/// The conflicts of pairs of pieces already worked out, by what the pieces are: a hand-over
+/// changes a few legs of two robots, and the pieces of every other leg recur in the new paths
+/// (at other positions: a pair is worked out in the pieces' own positions, so its answer is
+/// the same wherever they lie). Each piece (a segment, or a configuration held for a time, of
+/// one robot) is known by a number; answers do not depend on which coordination asked first.
+#[derive(Default)]
+struct PieceCache {
+    ids: std::sync::Mutex<HashMap<Vec<u64>, u32>>,
+    pairs: std::sync::Mutex<HashMap<PieceKey, PieceAnswer>>,
+}
+
+/// What a pair of pieces gave: its conflicts (in the pieces' own positions) and its work.
+type PieceAnswer = (Option<LocalBox>, DiagramWork);
+
+/// A pair of pieces, with whether each starts and ends its path (see [`PieceEnds`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+struct PieceKey {
+    a: u32,
+    b: u32,
+    ends: u8,
+}
+
+impl PieceKey {
+    fn new(a: u32, b: u32, (ea, eb): PieceEnds) -> PieceKey {
+        let ends = [ea[0], ea[1], eb[0], eb[1]]
+            .iter()
+            .enumerate()
+            .fold(0u8, |m, (k, &e)| m | (u8::from(e) << k));
+        PieceKey { a, b, ends }
+    }
+}
+
+impl PieceCache {
+    /// The numbers of pieces known by `keys` (`None` stays `None`), new pieces numbered.
+    fn ids(&self, keys: Vec<Option<Vec<u64>>>) -> Vec<Option<u32>> {
+        let mut ids = self.ids.lock().unwrap_or_else(|e| e.into_inner());
+        keys.into_iter()
+            .map(|k| {
+                let k = k?;
+                let next = u32::try_from(ids.len()).ok()?;
+                Some(*ids.entry(k).or_insert(next))
+            })
+            .collect()
+    }
+
+    fn get(&self, key: &PieceKey) -> Option<PieceAnswer> {
+        let pairs = self.pairs.lock().unwrap_or_else(|e| e.into_inner());
+        pairs.get(key).copied()
+    }
+
+    fn put(&self, key: PieceKey, answer: PieceAnswer) {
+        let mut pairs = self.pairs.lock().unwrap_or_else(|e| e.into_inner());
+        if pairs.len() < PIECE_PAIRS_KEPT {
+            pairs.insert(key, answer);
+        }
+    }
 }
 
 impl DiagramCache {
+    /// A cache that also keeps the pairs of pieces it works out, by what the pieces are (a
+    /// segment, or a configuration held for a time, of one robot; a pair is worked out in the
+    /// pieces' own positions, so its answer is the same wherever they lie): for the many
+    /// coordinations of one cell's plans that share most legs (a hand-over changes a few legs
+    /// of two robots). The answers and the work counted are those without it.
+    pub fn with_pieces() -> DiagramCache {
+        DiagramCache {
+            pieces: Some(PieceCache::default()),
+            ..DiagramCache::default()
+        }
+    }
+
     /// Robot pairs' diagrams held.
     pub fn len(&self) -> usize {
         let pairs = self.pairs.lock().unwrap_or_else(|e| e.into_inner());
@@ -608,6 +835,14 @@ impl DiagramCache {
     /// Whether none is held.
     pub fn is_empty(&self) -> bool {
         self.len() == 0
+    }
+
+    /// Pairs of pieces held (none unless made [`DiagramCache::with_pieces`]).
+    pub fn piece_pairs(&self) -> usize {
+        self.pieces.as_ref().map_or(0, |p| {
+            let pairs = p.pairs.lock().unwrap_or_else(|e| e.into_inner());
+            pairs.len()
+        })
     }
 
     fn get(&self, a: &RobotPath, b: &RobotPath) -> PairBoxes {
