@@ -24,12 +24,15 @@ use crate::plan::PlanError;
 use cellplan_geom::DVec3;
 use cellplan_model::robot::Scratch;
 use cellplan_motion::timing::Trajectory;
-use rayon::prelude::*;
 use std::collections::HashMap;
 use std::hash::{BuildHasherDefault, Hasher};
 use std::rc::Rc;
 
+mod cache;
 mod spheres;
+pub use cache::DiagramCache;
+use cache::PieceKey;
+pub(crate) use cache::diagrams_reusing;
 use spheres::{Covers, Placed, body_spheres, close_pairs};
 
 /// A hasher for the diagram's keys by position (a robot flag and the bits of an `f64`): one
@@ -727,177 +730,4 @@ impl Swept {
 pub(crate) fn diagrams(ctx: &Ctx, paths: &[RobotPath]) -> (Vec<ConflictBox>, DiagramWork) {
     let mut parts = Vec::new();
     diagrams_reusing(ctx, paths, &mut parts)
-}
-
-/// Boxes of one robot pair, and what they cost.
-type Built = (Vec<ConflictBox>, DiagramWork);
-
-/// Built pairs by the second path's signature.
-type BySecond = HashMap<Vec<u64>, Built>;
-
-/// Boxes of one robot pair, and what they cost (see [`diagrams_reusing`]).
-pub(crate) type PairBoxes = Option<Built>;
-
-/// The boxes of robot pairs already built on a cell, by the two paths' signatures: the
-/// plans ours makes of one cell share many robots' paths (a hand-over changes two robots),
-/// and a pair's diagram depends on nothing else (the cell, its clearance and the robots'
-/// paths). A pair found here is not built again; its work is counted as when it was built, so
-/// counts and results are those of a run without the cache.
-#[derive(Default)]
-pub struct DiagramCache {
-    /// By the first path's signature, then the second's.
-    pairs: std::sync::Mutex<HashMap<Vec<u64>, BySecond>>,
-    /// The pairs of pieces worked out, where kept ([`DiagramCache::with_pieces`]).
-    pieces: Option<PieceCache>,
-}
-
-/// Pairs of pieces [`PieceCache`] holds at most (about 100 bytes each); beyond, pairs are
-/// worked out without being kept.
-const PIECE_PAIRS_KEPT: usize = 2_000_000;
-
-/// The conflicts of pairs of pieces already worked out, by what the pieces are: a hand-over
-/// changes a few legs of two robots, and the pieces of every other leg recur in the new paths
-/// (at other positions: a pair is worked out in the pieces' own positions, so its answer is
-/// the same wherever they lie). Each piece (a segment, or a configuration held for a time, of
-/// one robot) is known by a number; answers do not depend on which coordination asked first.
-#[derive(Default)]
-struct PieceCache {
-    ids: std::sync::Mutex<HashMap<Vec<u64>, u32>>,
-    pairs: std::sync::Mutex<HashMap<PieceKey, PieceAnswer>>,
-}
-
-/// What a pair of pieces gave: its conflicts (in the pieces' own positions) and its work.
-type PieceAnswer = (Option<LocalBox>, DiagramWork);
-
-/// A pair of pieces, with whether each starts and ends its path (see [`PieceEnds`]).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-struct PieceKey {
-    a: u32,
-    b: u32,
-    ends: u8,
-}
-
-impl PieceKey {
-    fn new(a: u32, b: u32, (ea, eb): PieceEnds) -> PieceKey {
-        let ends = [ea[0], ea[1], eb[0], eb[1]]
-            .iter()
-            .enumerate()
-            .fold(0u8, |m, (k, &e)| m | (u8::from(e) << k));
-        PieceKey { a, b, ends }
-    }
-}
-
-impl PieceCache {
-    /// The numbers of pieces known by `keys` (`None` stays `None`), new pieces numbered.
-    fn ids(&self, keys: Vec<Option<Vec<u64>>>) -> Vec<Option<u32>> {
-        let mut ids = self.ids.lock().unwrap_or_else(|e| e.into_inner());
-        keys.into_iter()
-            .map(|k| {
-                let k = k?;
-                let next = u32::try_from(ids.len()).ok()?;
-                Some(*ids.entry(k).or_insert(next))
-            })
-            .collect()
-    }
-
-    fn get(&self, key: &PieceKey) -> Option<PieceAnswer> {
-        let pairs = self.pairs.lock().unwrap_or_else(|e| e.into_inner());
-        pairs.get(key).copied()
-    }
-
-    fn put(&self, key: PieceKey, answer: PieceAnswer) {
-        let mut pairs = self.pairs.lock().unwrap_or_else(|e| e.into_inner());
-        if pairs.len() < PIECE_PAIRS_KEPT {
-            pairs.insert(key, answer);
-        }
-    }
-}
-
-impl DiagramCache {
-    /// A cache that also keeps the pairs of pieces it works out, by what the pieces are (a
-    /// segment, or a configuration held for a time, of one robot; a pair is worked out in the
-    /// pieces' own positions, so its answer is the same wherever they lie): for the many
-    /// coordinations of one cell's plans that share most legs (a hand-over changes a few legs
-    /// of two robots). The answers and the work counted are those without it.
-    pub fn with_pieces() -> DiagramCache {
-        DiagramCache {
-            pieces: Some(PieceCache::default()),
-            ..DiagramCache::default()
-        }
-    }
-
-    /// Robot pairs' diagrams held.
-    pub fn len(&self) -> usize {
-        let pairs = self.pairs.lock().unwrap_or_else(|e| e.into_inner());
-        pairs.values().map(HashMap::len).sum()
-    }
-
-    /// Whether none is held.
-    pub fn is_empty(&self) -> bool {
-        self.len() == 0
-    }
-
-    /// Pairs of pieces held (none unless made [`DiagramCache::with_pieces`]).
-    pub fn piece_pairs(&self) -> usize {
-        self.pieces.as_ref().map_or(0, |p| {
-            let pairs = p.pairs.lock().unwrap_or_else(|e| e.into_inner());
-            pairs.len()
-        })
-    }
-
-    fn get(&self, a: &RobotPath, b: &RobotPath) -> PairBoxes {
-        let pairs = self.pairs.lock().unwrap_or_else(|e| e.into_inner());
-        pairs
-            .get(a.signature.as_slice())?
-            .get(b.signature.as_slice())
-            .cloned()
-    }
-
-    fn put(&self, a: &RobotPath, b: &RobotPath, part: &Built) {
-        let mut pairs = self.pairs.lock().unwrap_or_else(|e| e.into_inner());
-        pairs
-            .entry(a.signature.clone())
-            .or_default()
-            .insert(b.signature.clone(), part.clone());
-    }
-}
-
-/// As [`diagrams`], keeping each pair's boxes in `parts` (pairs `(a, b)`, `a < b`, in order);
-/// a pair whose entry is already there is not built again (clear the entries of pairs whose
-/// paths changed), nor one the context's [`DiagramCache`] holds. The work counts the pairs
-/// whose entries were empty (built now, or as built before when the cache had them).
-pub(crate) fn diagrams_reusing(
-    ctx: &Ctx,
-    paths: &[RobotPath],
-    parts: &mut Vec<PairBoxes>,
-) -> (Vec<ConflictBox>, DiagramWork) {
-    let pairs: Vec<(usize, usize)> = (0..paths.len())
-        .flat_map(|a| (a + 1..paths.len()).map(move |b| (a, b)))
-        .collect();
-    parts.resize(pairs.len(), None);
-    // What this call provides (built, or found in the cache): its work is counted.
-    let fresh: Vec<usize> = (0..pairs.len()).filter(|&i| parts[i].is_none()).collect();
-    if let Some(cache) = ctx.diagrams {
-        for &i in &fresh {
-            parts[i] = cache.get(&paths[pairs[i].0], &paths[pairs[i].1]);
-        }
-    }
-    let todo: Vec<usize> = (0..pairs.len()).filter(|&i| parts[i].is_none()).collect();
-    let built: Vec<(Vec<ConflictBox>, DiagramWork)> = todo
-        .par_iter()
-        .map(|&i| pair_boxes(ctx, &paths[pairs[i].0], &paths[pairs[i].1]))
-        .collect();
-    let mut work = DiagramWork::default();
-    for (i, part) in todo.into_iter().zip(built) {
-        if let Some(cache) = ctx.diagrams {
-            cache.put(&paths[pairs[i].0], &paths[pairs[i].1], &part);
-        }
-        parts[i] = Some(part);
-    }
-    for part in fresh.iter().filter_map(|&i| parts[i].as_ref()) {
-        work.cells += part.1.cells;
-        work.distances += part.1.distances;
-    }
-    let boxes = parts.iter().flatten().flat_map(|p| p.0.iter().cloned()).collect();
-    (boxes, work)
 }
