@@ -481,11 +481,7 @@ pub fn coordinate(
     // plans whose cycles are close, so the winner and these are blended and compared at the end.
     let mut runners_up = RunnersUp {
         kept: Vec::new(),
-        room: if cell.tasks.len() * cell.robots.len() <= coord.plan_first_pairs {
-            RUNNERS_UP
-        } else {
-            0
-        },
+        room: if plan_first { 0 } else { RUNNERS_UP },
     };
     let cycle_of = |b: &Option<Tried>| {
         b.as_ref()

@@ -177,34 +177,48 @@ impl RobotPath {
             );
         }
         let limits = &ctx.limits[program.robot];
+        let kept = ctx.diagrams.and_then(|d| d.pieces.as_ref());
+        // A piece's key (only where pieces are kept): its robot and bits.
+        let key = |tag: u64, head: &[u64], values: &[&[f64]]| {
+            kept.map(|_| {
+                let mut key = vec![tag, program.robot as u64];
+                key.extend_from_slice(head);
+                key.extend(values.iter().flat_map(|v| v.iter()).map(|x| x.to_bits()));
+                key
+            })
+        };
+        // Each blended leg's trajectory, shared by its segments.
+        let mut blended: Vec<Option<std::sync::Arc<Trajectory>>> = vec![None; bare.legs.len()];
         let mut keys = Vec::with_capacity(timed.spans.len());
         let mut pieces = Vec::with_capacity(timed.spans.len());
         for s in &timed.spans {
             let (motion, len, key) = match s.what {
-                Activity::Move { leg, segment } => {
-                    let leg = &bare.legs[leg];
+                Activity::Move { leg: k, segment } => {
+                    let leg = &bare.legs[k];
                     match &leg.blend {
                         Some(b) => {
                             let times = &b.waypoint_times;
-                            let t = std::sync::Arc::new(b.trajectory.clone());
+                            let t =
+                                blended[k].get_or_insert_with(|| std::sync::Arc::new(b.trajectory.clone()));
                             let len = times[segment + 1] - times[segment];
-                            (Motion::Blended(t, times[segment]), len, None)
+                            (
+                                Motion::Blended(std::sync::Arc::clone(t), times[segment]),
+                                len,
+                                None,
+                            )
                         }
                         None => {
                             let (a, b) = (&leg.waypoints[segment], &leg.waypoints[segment + 1]);
                             let t = super::program::segment_trajectory(a, b, limits)?;
                             let len = t.duration();
-                            let mut key = vec![0, program.robot as u64];
-                            key.extend(a.iter().chain(b).map(|x| x.to_bits()));
-                            (Motion::Segment(t), len, Some(key))
+                            (Motion::Segment(t), len, key(0, &[], &[a, b]))
                         }
                     }
                 }
                 Activity::Measure { visit } => {
                     let v = &bare.visits[visit];
-                    let mut key = vec![1, program.robot as u64, v.dwell.to_bits()];
-                    key.extend(v.q.iter().map(|x| x.to_bits()));
-                    (Motion::Stand(v.q.clone()), v.dwell, Some(key))
+                    let key = key(1, &[v.dwell.to_bits()], &[&v.q]);
+                    (Motion::Stand(v.q.clone()), v.dwell, key)
                 }
                 // Without waits, only a program without legs has one: at home, for no time.
                 Activity::Wait { .. } => (Motion::Stand(bare.home.clone()), s.end - s.start, None),
@@ -219,7 +233,7 @@ impl RobotPath {
                 id: None,
             });
         }
-        if let Some(cache) = ctx.diagrams.and_then(|d| d.pieces.as_ref()) {
+        if let Some(cache) = kept {
             for (piece, id) in pieces.iter_mut().zip(cache.ids(keys)) {
                 piece.id = id;
             }
