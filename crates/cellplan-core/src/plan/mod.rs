@@ -7,12 +7,14 @@
 //! 4. timing: every leg timed under the joint limits, a dwell for each measurement;
 //! 5. [`crate::document`]: the Plan document.
 pub mod allocate;
+mod cache;
 pub mod graph;
 pub mod rebalance;
 mod rows;
 pub mod sequence;
 
 pub use allocate::{Allocation, CoverMethod};
+pub use cache::PlanCache;
 pub use graph::MoveModel;
 pub use rows::{robot_rows, sweep_keys};
 
@@ -24,7 +26,7 @@ use cellplan_motion::plan::PlanSettings as MotionSettings;
 use cellplan_solve::CostMatrix;
 use graph::RobotGraph;
 use rayon::prelude::*;
-use std::sync::{Arc, OnceLock};
+use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 /// Knobs of a planning run.
@@ -357,45 +359,6 @@ pub fn plan(
     plan_cached(cell, table, settings, progress, &mut PlanCache::default())
 }
 
-/// What runs of [`plan_cached`] on one cell share: the robot graphs (they depend on the cell,
-/// the move model, `alternatives` and `roomy` only) and every leg planned so far. Each leg is
-/// a function of its robot, its two nodes and the settings, so a later run with the same
-/// settings plans only the legs no run planned before. The planned legs are also what the
-/// lazy sequencing knows (their real times replace the bounds), so a run's plan depends on
-/// the legs the cache holds: runs that share one give the plans of one after the other only
-/// in that order (a run made ahead, to be dropped if not needed, takes a copy). The graphs'
-/// memo of legs ([`PlanCache::graphs_only`]) changes no plan; nor does the lower bound of the
-/// graphs' min-max problem, found once for all ([`allocate::allocate_bounded`]).
-#[derive(Clone, Debug, Default)]
-pub struct PlanCache {
-    graphs: Option<CachedGraphs>,
-    planned: Vec<sequence::Planned>,
-}
-
-impl PlanCache {
-    /// A cache with this one's robot graphs (and the legs their memos hold) but no planned
-    /// legs: a plan made with it is the plan made afresh, without planning again the legs
-    /// the motion planner already gave.
-    pub fn graphs_only(&self) -> PlanCache {
-        PlanCache {
-            graphs: self.graphs.clone(),
-            planned: Vec::new(),
-        }
-    }
-
-    /// Legs the motion planner did not plan again because its graphs' memos held them
-    /// (see [`sequence::LegMemo`]).
-    pub fn legs_served(&self) -> usize {
-        self.graphs
-            .as_ref()
-            .map_or(0, |(.., g, _)| g.iter().map(|g| g.legs.served()).sum())
-    }
-}
-
-/// The robot graphs of [`PlanCache`] with what they were made for (move model, `alternatives`,
-/// `roomy`) and the lower bound of their min-max problem once found.
-type CachedGraphs = (MoveModel, usize, u64, Arc<Vec<RobotGraph>>, Arc<OnceLock<f64>>);
-
 /// The min-max problem the allocations of `cell` work on with `settings` (its move model,
 /// alternatives and room): per robot its graph's lower-bound move times between home and its
 /// candidates, per measurable task the robots' candidates for it and its measuring time, the
@@ -473,16 +436,7 @@ pub fn plan_keeping(
         settings.alternatives,
         settings.roomy.to_bits(),
     );
-    let (graphs, bound): (Arc<Vec<RobotGraph>>, Arc<OnceLock<f64>>) = match &cache.graphs {
-        Some((m, a, r, g, b)) if (*m, *a, *r) == key => (Arc::clone(g), Arc::clone(b)),
-        _ => {
-            let g = Arc::new(robot_graphs(cell, table, settings));
-            let b = Arc::new(OnceLock::new());
-            cache.graphs = Some((key.0, key.1, key.2, Arc::clone(&g), Arc::clone(&b)));
-            cache.planned = vec![Default::default(); cell.robots.len()];
-            (g, b)
-        }
-    };
+    let (graphs, bound) = cache.graphs_for(key, cell.robots.len(), || robot_graphs(cell, table, settings));
     tick(Stage::Costs, &mut compute);
 
     progress(Stage::Allocation);
