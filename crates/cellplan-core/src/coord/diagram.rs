@@ -336,6 +336,7 @@ struct PairDiagram<'a> {
     ca: Covers,
     cb: Covers,
     scratch: Scratch,
+    /// The work of the current pair of pieces.
     work: DiagramWork,
     /// The pieces worked on (one of each path); rectangles are in their own positions.
     x: &'a Piece,
@@ -628,7 +629,7 @@ impl<'a> PairDiagram<'a> {
     /// The conflicts of pieces `x` and `y` in their own positions, and the work they took
     /// (`ends`: whether each piece starts and ends its path, where the robot is at home).
     fn pieces(&mut self, x: &'a Piece, y: &'a Piece, ends: PieceEnds) -> (Option<LocalBox>, DiagramWork) {
-        let before = self.work;
+        self.work = DiagramWork::default();
         (self.x, self.y) = (x, y);
         self.cell((0.0, x.len, x.moving), (0.0, y.len, y.moving));
         let found = self.found.take().map(|mut f| {
@@ -636,11 +637,7 @@ impl<'a> PairDiagram<'a> {
             f
         });
         self.forget();
-        let work = DiagramWork {
-            cells: self.work.cells - before.cells,
-            distances: self.work.distances - before.distances,
-        };
-        (found, work)
+        (found, self.work)
     }
 }
 
@@ -690,19 +687,9 @@ fn pair_boxes(ctx: &Ctx, pa: &RobotPath, pb: &RobotPath) -> (Vec<ConflictBox>, D
                 continue;
             }
             let pair_ends = (ends(x, pa), ends(y, pb));
-            let key = kept
-                .zip(x.id.zip(y.id))
-                .map(|(k, (i, j))| (k, PieceKey::new(i, j, pair_ends)));
-            let held = key.as_ref().and_then(|(k, key)| k.get(key));
-            let (found, w) = match held {
-                Some(h) => h,
-                None => {
-                    let made = d.pieces(x, y, pair_ends);
-                    if let Some((k, key)) = &key {
-                        k.put(*key, made);
-                    }
-                    made
-                }
+            let (found, w) = match kept.zip(x.id.zip(y.id)) {
+                Some((k, (i, j))) => k.answer(PieceKey::new(i, j, pair_ends), || d.pieces(x, y, pair_ends)),
+                None => d.pieces(x, y, pair_ends),
             };
             work.cells += w.cells;
             work.distances += w.distances;

@@ -31,6 +31,10 @@ pub struct DiagramCache {
 /// room when full); beyond, pairs are worked out without being kept.
 const PIECE_PAIRS_KEPT: usize = 2_000_000;
 
+/// Pieces [`PieceCache`] numbers at most (a key of 15 words or so each: about 200 MB when
+/// full).
+const PIECES_NUMBERED: usize = 1_000_000;
+
 /// The conflicts of pairs of pieces already worked out, by what the pieces are: a hand-over
 /// changes a few legs of two robots, and the pieces of every other leg recur in the new paths
 /// (at other positions: a pair is worked out in the pieces' own positions, so its answer is
@@ -64,28 +68,43 @@ impl PieceKey {
 }
 
 impl PieceCache {
-    /// The numbers of pieces known by `keys` (`None` stays `None`), new pieces numbered.
+    /// The numbers of pieces known by `keys` (`None` stays `None`), new pieces numbered while
+    /// fewer than [`PIECES_NUMBERED`] are (beyond, a new piece has none: it is not kept).
     pub(super) fn ids(&self, keys: Vec<Option<Vec<u64>>>) -> Vec<Option<u32>> {
         let mut ids = self.ids.lock().unwrap_or_else(|e| e.into_inner());
         keys.into_iter()
             .map(|k| {
                 let k = k?;
-                let next = u32::try_from(ids.len()).ok()?;
-                Some(*ids.entry(k).or_insert(next))
+                if let Some(&id) = ids.get(&k) {
+                    return Some(id);
+                }
+                let next = u32::try_from(ids.len())
+                    .ok()
+                    .filter(|&n| (n as usize) < PIECES_NUMBERED)?;
+                ids.insert(k, next);
+                Some(next)
             })
             .collect()
     }
 
-    pub(super) fn get(&self, key: &PieceKey) -> Option<PieceAnswer> {
-        let pairs = self.pairs.lock().unwrap_or_else(|e| e.into_inner());
-        pairs.get(key).copied()
-    }
-
-    pub(super) fn put(&self, key: PieceKey, answer: PieceAnswer) {
+    /// The answer held for `key`, or `make`'s, then held (the lock is not held while `make`
+    /// works: two threads may work out one pair, and give the same answer).
+    pub(super) fn answer(&self, key: PieceKey, make: impl FnOnce() -> PieceAnswer) -> PieceAnswer {
+        let held = self
+            .pairs
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .get(&key)
+            .copied();
+        if let Some(answer) = held {
+            return answer;
+        }
+        let answer = make();
         let mut pairs = self.pairs.lock().unwrap_or_else(|e| e.into_inner());
         if pairs.len() < PIECE_PAIRS_KEPT {
             pairs.insert(key, answer);
         }
+        answer
     }
 }
 
