@@ -29,11 +29,11 @@ impl PlanCache {
         make: impl FnOnce() -> Vec<RobotGraph>,
     ) -> (Arc<Vec<RobotGraph>>, Arc<OnceLock<f64>>) {
         match &self.graphs {
-            Some((m, a, r, g, b)) if (*m, *a, *r) == key => (Arc::clone(g), Arc::clone(b)),
+            Some((k, g, b)) if *k == key => (Arc::clone(g), Arc::clone(b)),
             _ => {
                 let g = Arc::new(make());
                 let b = Arc::new(OnceLock::new());
-                self.graphs = Some((key.0, key.1, key.2, Arc::clone(&g), Arc::clone(&b)));
+                self.graphs = Some((key, Arc::clone(&g), Arc::clone(&b)));
                 self.planned = vec![Default::default(); robots];
                 (g, b)
             }
@@ -55,10 +55,10 @@ impl PlanCache {
     pub fn legs_served(&self) -> usize {
         self.graphs
             .as_ref()
-            .map_or(0, |(.., g, _)| g.iter().map(|g| g.legs.served()).sum())
+            .map_or(0, |(_, g, _)| g.iter().map(|g| g.legs.served()).sum())
     }
 }
 
 /// The robot graphs of [`PlanCache`] with what they were made for (move model, `alternatives`,
 /// `roomy`) and the lower bound of their min-max problem once found.
-type CachedGraphs = (MoveModel, usize, u64, Arc<Vec<RobotGraph>>, Arc<OnceLock<f64>>);
+type CachedGraphs = ((MoveModel, usize, u64), Arc<Vec<RobotGraph>>, Arc<OnceLock<f64>>);

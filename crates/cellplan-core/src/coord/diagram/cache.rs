@@ -78,9 +78,10 @@ impl PieceCache {
                 if let Some(&id) = ids.get(&k) {
                     return Some(id);
                 }
-                let next = u32::try_from(ids.len())
-                    .ok()
-                    .filter(|&n| (n as usize) < PIECES_NUMBERED)?;
+                if ids.len() >= PIECES_NUMBERED {
+                    return None;
+                }
+                let next = ids.len() as u32;
                 ids.insert(k, next);
                 Some(next)
             })
