@@ -322,11 +322,15 @@ type Directed = (Vec<bool>, schedule::Schedule, Vec<ConflictBox>);
 /// canonical directions, see [`against_canonical`].) Combinations are tried all (up
 /// to [`ALL_DIRECTIONS_UP_TO`] robots) or one flip at a time (a flip kept when it shortens the
 /// schedule, [`FLIP_ROUNDS`] rounds, from `turned` when given — per robot, whether its tour
-/// starts turned); ties go to fewer flips, then to the earlier combination.
+/// starts turned); ties go to fewer flips, then to the earlier combination. Each combination's
+/// search depends on the combination alone, so they run in parallel (all at once; or two
+/// neighbouring flips side by side, the second kept only if the first was not) and are taken
+/// in the order above: the result is that of one search after the other.
 ///
 /// Returns the [`DIRECTIONS_FINISHED`] best combinations by makespan (flips relative to
 /// `programs`; empty when no combination has a schedule), per robot its reversed program and
-/// path (made for every robot some combination reversed), and the nodes searched.
+/// path (made for every robot but the first, and for the first when `turned` turns it), and
+/// the nodes searched (of the searches taken).
 #[allow(clippy::type_complexity)]
 fn directions(
     ctx: &Ctx,
@@ -337,7 +341,6 @@ fn directions(
 ) -> Result<(Vec<Directed>, Vec<Option<(Program, diagram::RobotPath)>>, usize), PlanError> {
     let m = programs.len();
     let (nodes, min_wait) = (ctx.settings.schedule_nodes, ctx.settings.min_wait);
-    let mut back: Vec<Option<(Program, diagram::RobotPath)>> = (0..m).map(|_| None).collect();
     let index: Vec<usize> = {
         let mut v = vec![usize::MAX; paths.iter().map(|p| p.robot + 1).max().unwrap_or(0)];
         for (i, p) in paths.iter().enumerate() {
@@ -345,16 +348,26 @@ fn directions(
         }
         v
     };
-    let mut spent = 0;
-    let mut try_turn = |flip: &[bool]| -> Result<Option<Directed>, PlanError> {
-        let flip = flip.to_vec();
-        for (i, &f) in flip.iter().enumerate() {
-            if f && back[i].is_none() {
-                let p = programs[i].reversed(&ctx.limits[programs[i].robot])?;
-                let path = diagram::RobotPath::new(ctx, &p)?;
-                back[i] = Some((p, path));
+    let start = match turned {
+        Some(t) if t.len() == m => t.to_vec(),
+        _ => vec![false; m],
+    };
+    // Every robot but the first is flipped by some combination below (the first only where
+    // `turned` says so): each reversed program and its path made once, in parallel.
+    let back: Vec<Option<(Program, diagram::RobotPath)>> = (0..m)
+        .into_par_iter()
+        .map(|i| -> Result<_, PlanError> {
+            if i == 0 && !start[0] {
+                return Ok(None);
             }
-        }
+            let p = programs[i].reversed(&ctx.limits[programs[i].robot])?;
+            let path = diagram::RobotPath::new(ctx, &p)?;
+            Ok(Some((p, path)))
+        })
+        .collect::<Result<_, _>>()?;
+    // One combination's search (a function of the combination alone), and the nodes it took.
+    let try_turn = |flip: &[bool]| -> (Option<Directed>, usize) {
+        let flip = flip.to_vec();
         let mirrored: Vec<ConflictBox> = boxes
             .iter()
             .map(|b| {
@@ -378,9 +391,10 @@ fn directions(
             })
             .collect();
         let s = schedule::schedule_with(&tracks, &mirrored, nodes, min_wait, ctx.settings.polish);
-        spent += s.as_ref().map_or(nodes, |s| s.nodes);
-        Ok(s.map(|s| (flip, s, mirrored)))
+        let spent = s.as_ref().map_or(nodes, |s| s.nodes);
+        (s.map(|s| (flip, s, mirrored)), spent)
     };
+    let mut spent = 0;
     let mut found: Vec<Directed> = Vec::new();
     // Kept sorted by makespan (stable: ties stay in the order tried).
     let keep = |d: Directed, found: &mut Vec<Directed>| {
@@ -389,50 +403,97 @@ fn directions(
         found.truncate(DIRECTIONS_FINISHED);
     };
     if m <= ALL_DIRECTIONS_UP_TO {
-        // By number of turns, then mask.
+        // By number of turns, then mask; searched in parallel, taken in that order.
         let mut masks: Vec<usize> = (0..1usize << m.saturating_sub(1)).collect();
         masks.sort_by_key(|&k| (k.count_ones(), k));
-        for k in masks {
-            let turn: Vec<bool> = (0..m).map(|i| i > 0 && (k >> (i - 1)) & 1 == 1).collect();
-            if let Some(d) = try_turn(&turn)? {
+        let searched: Vec<(Option<Directed>, usize)> = masks
+            .par_iter()
+            .map(|&k| {
+                let turn: Vec<bool> = (0..m).map(|i| i > 0 && (k >> (i - 1)) & 1 == 1).collect();
+                try_turn(&turn)
+            })
+            .collect();
+        for (d, n) in searched {
+            spent += n;
+            if let Some(d) = d {
                 keep(d, &mut found);
             }
         }
     } else {
         // From the directions given (those of the plan this one was made from), else from
         // every tour in its canonical direction.
-        let mut turn = match turned {
-            Some(t) if t.len() == m => t.to_vec(),
-            _ => vec![false; m],
-        };
-        let mut now = try_turn(&turn)?.map(|d| {
-            let span = d.1.makespan;
+        let (taken, n) = flip_one_at_a_time(start, FLIP_ROUNDS, &try_turn, &|d: &Directed| d.1.makespan);
+        spent += n;
+        for d in taken {
             keep(d, &mut found);
-            span
-        });
-        for _ in 0..FLIP_ROUNDS {
-            let mut changed = false;
-            for i in 1..m {
-                turn[i] = !turn[i];
-                match try_turn(&turn)? {
-                    Some(d) if now.is_none_or(|n| d.1.makespan < n - 1e-3) => {
-                        now = Some(d.1.makespan);
-                        keep(d, &mut found);
-                        changed = true;
-                    }
-                    Some(d) => {
-                        keep(d, &mut found);
-                        turn[i] = !turn[i];
-                    }
-                    None => turn[i] = !turn[i],
-                }
-            }
-            if !changed {
-                break;
-            }
         }
     }
     Ok((found, back, spent))
+}
+
+/// One search of [`flip_one_at_a_time`]: per robot whether its tour is turned, to what the
+/// search found for those directions (if anything) and the nodes it took.
+type DirectionSearch<'a, T> = dyn Fn(&[bool]) -> (Option<T>, usize) + Sync + 'a;
+
+/// The search over tour directions one flip at a time: from `start`, each robot but the first
+/// in turn gets its direction flipped, and the flip is kept when `search` finds a schedule
+/// whose `span` is shorter (by 1 ms) than the shortest so far; up to `rounds` rounds, stopping
+/// after a round that kept none. Returns every schedule found, in the order searched (the
+/// start's first), and the nodes of those searches.
+///
+/// The flips of robots `i` and `i + 1` are searched side by side, both from the directions as
+/// they stand: the second is taken only when the first is not kept (else it is dropped,
+/// uncounted, and searched again from the new directions), so what is returned is what
+/// searching one flip after the other returns.
+fn flip_one_at_a_time<T: Send>(
+    start: Vec<bool>,
+    rounds: usize,
+    search: &DirectionSearch<'_, T>,
+    span: &dyn Fn(&T) -> f64,
+) -> (Vec<T>, usize) {
+    let m = start.len();
+    let mut turn = start;
+    let (first, mut spent) = search(&turn);
+    let mut now = first.as_ref().map(span);
+    let mut taken: Vec<T> = first.into_iter().collect();
+    let flipped = |turn: &[bool], i: usize| {
+        let mut t = turn.to_vec();
+        t[i] = !t[i];
+        t
+    };
+    for _ in 0..rounds {
+        let mut changed = false;
+        let mut i = 1;
+        while i < m {
+            let (first, mut second) = rayon::join(
+                || search(&flipped(&turn, i)),
+                || (i + 1 < m).then(|| search(&flipped(&turn, i + 1))),
+            );
+            let mut next = Some(first);
+            let mut at = i;
+            while let Some((d, n)) = next.take() {
+                spent += n;
+                let shorter = d.as_ref().is_some_and(|d| now.is_none_or(|n| span(d) < n - 1e-3));
+                if shorter {
+                    now = d.as_ref().map(span);
+                    turn[at] = !turn[at];
+                    changed = true;
+                }
+                taken.extend(d);
+                if shorter || at > i {
+                    break;
+                }
+                // The first flip not kept: the second was searched from these directions.
+                next = second.take();
+                at = i + 1;
+            }
+            i = at + 1;
+        }
+        if !changed {
+            break;
+        }
+    }
+    (taken, spent)
 }
 
 /// Per program, whether it runs against its tour's canonical direction (the first MP after
@@ -641,5 +702,79 @@ fn permutations(v: &mut Vec<usize>, k: usize, out: &mut Vec<Vec<usize>>) {
         v.swap(k, i);
         permutations(v, k + 1, out);
         v.swap(k, i);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::flip_one_at_a_time;
+
+    /// One flip after the other, without searching ahead: what [`flip_one_at_a_time`] must
+    /// return.
+    fn one_after_the_other(
+        start: Vec<bool>,
+        rounds: usize,
+        search: &super::DirectionSearch<'_, (Vec<bool>, f64)>,
+    ) -> (Vec<(Vec<bool>, f64)>, usize) {
+        let m = start.len();
+        let mut turn = start;
+        let (d, mut spent) = search(&turn);
+        let mut now = d.as_ref().map(|d| d.1);
+        let mut taken: Vec<_> = d.into_iter().collect();
+        for _ in 0..rounds {
+            let mut changed = false;
+            for i in 1..m {
+                turn[i] = !turn[i];
+                let (d, n) = search(&turn);
+                spent += n;
+                match d {
+                    Some(d) if now.is_none_or(|x| d.1 < x - 1e-3) => {
+                        now = Some(d.1);
+                        taken.push(d);
+                        changed = true;
+                    }
+                    Some(d) => {
+                        taken.push(d);
+                        turn[i] = !turn[i];
+                    }
+                    None => turn[i] = !turn[i],
+                }
+            }
+            if !changed {
+                break;
+            }
+        }
+        (taken, spent)
+    }
+
+    /// Flips searched two at a time give what flipping one robot after the other gives — the
+    /// schedules in the same order and the same nodes — on made-up searches whose spans and
+    /// failures depend on the directions alone (kept and dropped flips both happen).
+    #[test]
+    fn flips_searched_side_by_side_are_the_flips_one_after_the_other() {
+        let mut kept_some = 0;
+        for seed in 0..200u64 {
+            let search = |flip: &[bool]| {
+                let mut h = seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ 0xD1B5_4A32_D192_ED03;
+                for &f in flip {
+                    h = (h ^ u64::from(f)).wrapping_mul(0x100_0000_01B3).rotate_left(17);
+                }
+                let span = (h % 10_000) as f64 / 100.0;
+                let found = (h % 7 != 0).then(|| (flip.to_vec(), span));
+                (found, (h % 97) as usize)
+            };
+            let m = 2 + (seed % 8) as usize;
+            let start: Vec<bool> = (0..m).map(|i| i > 0 && (seed >> i) & 1 == 1).collect();
+            let want = one_after_the_other(start.clone(), 2, &search);
+            let got = flip_one_at_a_time(start.clone(), 2, &search, &|d: &(Vec<bool>, f64)| d.1);
+            assert_eq!(got, want, "seed {seed}, {m} robots");
+            // A schedule shorter than the start's was kept (its flip with it).
+            let first = want.0.first().map_or(f64::INFINITY, |d| d.1);
+            kept_some += usize::from(want.0.iter().any(|d| d.1 < first - 1e-3));
+        }
+        assert!(
+            (20..200).contains(&kept_some),
+            "flips were kept in {kept_some} of 200 searches"
+        );
     }
 }
