@@ -329,8 +329,8 @@ type Directed = (Vec<bool>, schedule::Schedule, Vec<ConflictBox>);
 ///
 /// Returns the [`DIRECTIONS_FINISHED`] best combinations by makespan (flips relative to
 /// `programs`; empty when no combination has a schedule), per robot its reversed program and
-/// path (made for every robot but the first, and for the first when `turned` turns it), and
-/// the nodes searched (of the searches taken).
+/// path (made for every robot but the first, and for the first when the flips start from
+/// `turned` turning it), and the nodes searched (of the searches taken).
 #[allow(clippy::type_complexity)]
 fn directions(
     ctx: &Ctx,
@@ -352,12 +352,14 @@ fn directions(
         Some(t) if t.len() == m => t.to_vec(),
         _ => vec![false; m],
     };
-    // Every robot but the first is flipped by some combination below (the first only where
-    // `turned` says so): each reversed program and its path made once, in parallel.
+    let all = m <= ALL_DIRECTIONS_UP_TO;
+    // Every robot but the first is flipped by some combination below (the first only by the
+    // flips, where `turned` turns it): each reversed program and its path made once, in
+    // parallel.
     let back: Vec<Option<(Program, diagram::RobotPath)>> = (0..m)
         .into_par_iter()
         .map(|i| -> Result<_, PlanError> {
-            if i == 0 && !start[0] {
+            if i == 0 && (all || !start[0]) {
                 return Ok(None);
             }
             let p = programs[i].reversed(&ctx.limits[programs[i].robot])?;
@@ -402,7 +404,7 @@ fn directions(
         found.insert(at, d);
         found.truncate(DIRECTIONS_FINISHED);
     };
-    if m <= ALL_DIRECTIONS_UP_TO {
+    if all {
         // By number of turns, then mask; searched in parallel, taken in that order.
         let mut masks: Vec<usize> = (0..1usize << m.saturating_sub(1)).collect();
         masks.sort_by_key(|&k| (k.count_ones(), k));
@@ -465,13 +467,12 @@ fn flip_one_at_a_time<T: Send>(
         let mut changed = false;
         let mut i = 1;
         while i < m {
-            let (first, mut second) = rayon::join(
+            let (first, second) = rayon::join(
                 || search(&flipped(&turn, i)),
                 || (i + 1 < m).then(|| search(&flipped(&turn, i + 1))),
             );
-            let mut next = Some(first);
-            let mut at = i;
-            while let Some((d, n)) = next.take() {
+            // One search taken for the flip of robot `at`: whether the flip is kept.
+            let mut take = |(d, n): (Option<T>, usize), at: usize| {
                 spent += n;
                 let shorter = d.as_ref().is_some_and(|d| now.is_none_or(|n| span(d) < n - 1e-3));
                 if shorter {
@@ -480,14 +481,18 @@ fn flip_one_at_a_time<T: Send>(
                     changed = true;
                 }
                 taken.extend(d);
-                if shorter || at > i {
-                    break;
+                shorter
+            };
+            // The second was searched from the directions the first leaves when not kept;
+            // else it is dropped, and searched again from the new directions.
+            let kept = take(first, i);
+            i += match second {
+                Some(second) if !kept => {
+                    take(second, i + 1);
+                    2
                 }
-                // The first flip not kept: the second was searched from these directions.
-                next = second.take();
-                at = i + 1;
-            }
-            i = at + 1;
+                _ => 1,
+            };
         }
         if !changed {
             break;
@@ -752,7 +757,7 @@ mod tests {
     /// failures depend on the directions alone (kept and dropped flips both happen).
     #[test]
     fn flips_searched_side_by_side_are_the_flips_one_after_the_other() {
-        let mut kept_some = 0;
+        let (mut kept_some, mut dropped_some) = (0, 0);
         for seed in 0..200u64 {
             let search = |flip: &[bool]| {
                 let mut h = seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ 0xD1B5_4A32_D192_ED03;
@@ -771,7 +776,13 @@ mod tests {
             // A schedule shorter than the start's was kept (its flip with it).
             let first = want.0.first().map_or(f64::INFINITY, |d| d.1);
             kept_some += usize::from(want.0.iter().any(|d| d.1 < first - 1e-3));
+            // A schedule found no shorter than the start's: its flip was dropped.
+            dropped_some += usize::from(want.0.iter().skip(1).any(|d| d.1 >= first - 1e-3));
         }
+        assert!(
+            (20..200).contains(&dropped_some),
+            "flips were dropped in {dropped_some} of 200 searches"
+        );
         assert!(
             (20..200).contains(&kept_some),
             "flips were kept in {kept_some} of 200 searches"
