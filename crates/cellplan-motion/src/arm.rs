@@ -141,8 +141,9 @@ thread_local! {
     static AXES: RefCell<PosedAxes> = RefCell::new(PosedAxes::default());
 }
 
-/// The arm's joint space: the chain's limits, [`joint_radii`], and metric weights `1/v` from
-/// `max_velocity` (1 where a velocity is missing, zero or not finite).
+/// The arm's joint space: the chain's limits, [`joint_radii`], metric weights `1/v` from
+/// `max_velocity` (1 where a velocity is missing, zero or not finite), and its rotational
+/// joints marked as turning ([`JointSpace::turns`]).
 pub fn joint_space(arm: &Arm, max_velocity: &[f64]) -> JointSpace {
     let chain = arm.chain;
     let lower = chain.joints.iter().map(|j| j.lower).collect();
@@ -153,7 +154,10 @@ pub fn joint_space(arm: &Arm, max_velocity: &[f64]) -> JointSpace {
             _ => 1.0,
         })
         .collect();
-    JointSpace::new(lower, upper, joint_radii(arm)).with_weights(weights)
+    let turns = chain.joints.iter().map(|j| j.is_rotational()).collect();
+    JointSpace::new(lower, upper, joint_radii(arm))
+        .with_weights(weights)
+        .with_turns(turns)
 }
 
 /// A part index shared by the threads that use one checker (relaxed: a hint, never a result).

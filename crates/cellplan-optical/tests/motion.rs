@@ -413,3 +413,66 @@ fn capped_segment_step_agrees_with_the_default() {
     assert!(shorter * 4 < checked, "{shorter} of {checked} shorter");
     assert!(fast_sum >= 0.8 * slow_sum, "steps {fast_sum} against {slow_sum}");
 }
+
+/// A leg whose middle waypoints stand a full turn of the wrist's last joint from where the
+/// ends have it (as a path through samples drawn over the joint's ±2π range can): straightening
+/// unwinds it on the R-2000iC in the car-body cell — the middle waypoints are posed as they
+/// were, the joint moves a turn less each way, the leg takes less time, and the dense re-check
+/// finds it clear.
+#[test]
+fn straightening_unwinds_a_wrist_turned_round_on_the_real_robot() {
+    use cellplan_core::plan::graph::limits_of;
+    use cellplan_motion::plan::{check_segment, straighten_joints_timed};
+    use cellplan_motion::timing::time_path_exact;
+    let f = fixture();
+    let cell = &f.cell;
+    let tau = std::f64::consts::TAU;
+    let robot = &cell.robots[0];
+    let space = joint_space(cell, robot);
+    let v = robot_validity(cell, robot, margin(cell));
+    let limits = limits_of(robot);
+    let last = robot.dof() - 1;
+    assert!(space.winds(last), "joint 6 of the R-2000iC turns over ±2π");
+    let home = robot.home.clone();
+    let mut tried = 0;
+    for goal in &f.candidates[0] {
+        // Two middle waypoints, a third and two thirds of the way, turned a full turn.
+        let mut path = vec![home.clone()];
+        for t in [1.0 / 3.0, 2.0 / 3.0] {
+            let mut q = Vec::new();
+            space.interpolate(&home, goal, t, &mut q);
+            q[last] += if q[last] > 0.0 { -tau } else { tau };
+            path.push(q);
+        }
+        path.push(goal.clone());
+        if !path.iter().all(|q| space.contains(q))
+            || !path
+                .windows(2)
+                .all(|w| check_segment(&space, &v, &w[0], &w[1], 1e-4).valid)
+        {
+            continue;
+        }
+        tried += 1;
+        let time = |p: &[Vec<f64>]| time_path_exact(p, &limits).unwrap().trajectory.duration();
+        let turned = |p: &[Vec<f64>]| p.windows(2).map(|w| (w[1][last] - w[0][last]).abs()).sum::<f64>();
+        let mut straight = path.clone();
+        straighten_joints_timed(&space, &v, &mut straight, (3, 40), 1e-4, &limits);
+        assert_eq!(straight.first(), path.first());
+        assert_eq!(straight.last(), path.last());
+        assert!(
+            turned(&straight) < turned(&path) - tau,
+            "joint 6 turned {} rad before, {} after",
+            turned(&path),
+            turned(&straight)
+        );
+        assert!(time(&straight) < time(&path));
+        dense_contact_free(cell, robot, &straight).unwrap();
+        if tried == 3 {
+            break;
+        }
+    }
+    assert_eq!(
+        tried, 3,
+        "three legs home → candidate clear with the wrist turned round"
+    );
+}

@@ -177,12 +177,15 @@ fn shortcut_by(
     calls
 }
 
-/// Partial shortcuts of one joint at a time (`straighten_joints`) for a path timed stopping at
-/// its corners under `limits` (the path's time as [`time_path_exact`] gives it;
-/// [`segment_time`] shares a joint's move out over the segments): up to `attempts` of them,
-/// deterministic for `seed`. Never slows the path by that timing, keeps its waypoints' count
-/// and its ends, and keeps it valid (every changed segment passes [`check_segment`] at
-/// `min_clearance`). Returns the validity calls made.
+/// A path's needless joint motion removed, for a path timed stopping at its corners under
+/// `limits` (the path's time as [`time_path_exact`] gives it): partial shortcuts of one joint
+/// at a time (`straighten_joints`; [`segment_time`] shares a joint's move out over the
+/// segments), up to `attempts` of them, deterministic for `seed`; where the turns its turning
+/// joints need not make can be taken back (`unwind`), the same shortcuts are also made on the
+/// unwound path, which is kept if it ends faster (each can trap the other's shortcuts in a
+/// worse local optimum). Never slows the path by that timing, keeps its
+/// waypoints' count and its ends, and keeps it valid (every changed segment passes
+/// [`check_segment`] at `min_clearance`). Returns the validity calls made.
 pub fn straighten_joints_timed(
     space: &JointSpace,
     validity: &dyn StateValidity,
@@ -194,15 +197,29 @@ pub fn straighten_joints_timed(
     let seg = |a: &[f64], b: &[f64]| segment_time(a, b, limits);
     let whole =
         |p: &[Vec<f64>]| time_path_exact(p, limits).map_or(f64::INFINITY, |t| t.trajectory.duration());
-    let mut rng = ChaCha8Rng::seed_from_u64(seed ^ 0x4a4f_494e_5453_4855);
-    straighten_joints(
-        space,
-        validity,
-        waypoints,
-        (&mut rng, attempts),
-        min_clearance,
-        (&seg, &whole),
-    )
+    let straighten = |waypoints: &mut [Vec<f64>]| {
+        let mut rng = ChaCha8Rng::seed_from_u64(seed ^ 0x4a4f_494e_5453_4855);
+        straighten_joints(
+            space,
+            validity,
+            waypoints,
+            (&mut rng, attempts),
+            min_clearance,
+            (&seg, &whole),
+        )
+    };
+    // Unwound first: a path that does not change needs no second straightening.
+    let mut unwound = waypoints.to_vec();
+    let mut calls = unwind(space, validity, &mut unwound, min_clearance, &whole);
+    let changed = unwound != waypoints;
+    calls += straighten(waypoints);
+    if changed {
+        calls += straighten(&mut unwound);
+        if whole(&unwound) < whole(waypoints) {
+            waypoints.clone_from_slice(&unwound);
+        }
+    }
+    calls
 }
 
 /// Partial shortcuts of one joint at a time (Geraerts and Overmars, "Creating high-quality
@@ -313,6 +330,108 @@ fn straighten_joints(
         }
     }
     calls
+}
+
+/// Unwinds a path's turning joints ([`JointSpace::winds`]): each interior waypoint may take
+/// such a joint a whole number of turns from its value (within the limits), which poses every
+/// body the same, so the waypoint stays as valid as it was. Per joint, the values that move the
+/// joint least along the whole path are chosen (a shortest path over the waypoints' choices,
+/// the waypoint's own value first on ties); every segment that changes must pass
+/// [`check_segment`], and a waypoint at the end of a segment that does not is held at its own
+/// values and the choice made again (at most once per waypoint). The unwound path is kept only
+/// when its cost by `total` falls. The sampler draws a joint over its whole range, so a path
+/// through samples can swing a wrist joint round by turns it need not make (a leg of
+/// dense-8r-120 turned joint 6 by 16.1 rad for a net 2.0 rad), and a shortcut between
+/// two such waypoints cannot remove that: it moves the other joints too. Returns the validity
+/// calls made.
+pub(super) fn unwind(
+    space: &JointSpace,
+    validity: &dyn StateValidity,
+    waypoints: &mut [Vec<f64>],
+    min_clearance: f64,
+    total: PathCost<'_>,
+) -> usize {
+    let n = waypoints.len();
+    let winding: Vec<usize> = (0..space.dim()).filter(|&j| space.winds(j)).collect();
+    if n < 3 || winding.is_empty() || waypoints.iter().any(|w| w.len() != space.dim()) {
+        return 0;
+    }
+    let tau = std::f64::consts::TAU;
+    // Waypoints held at their own values: the ends always.
+    let mut held = vec![false; n];
+    held[0] = true;
+    held[n - 1] = true;
+    let mut calls = 0;
+    loop {
+        let mut trial = waypoints.to_vec();
+        for &j in &winding {
+            let (lo, hi) = (space.lower[j] - 1e-9, space.upper[j] + 1e-9);
+            // Each waypoint's choices: its own value first, then the others a whole number of
+            // turns away within the limits (at most a few: the limits are finite).
+            let choices: Vec<Vec<f64>> = waypoints
+                .iter()
+                .zip(&held)
+                .map(|(w, &held)| {
+                    let v = w[j];
+                    let mut c = vec![v];
+                    if !held && v.is_finite() && hi - lo < 64.0 * tau {
+                        let (k_lo, k_hi) = (((lo - v) / tau).ceil() as i64, ((hi - v) / tau).floor() as i64);
+                        c.extend((k_lo..=k_hi).filter(|&k| k != 0).map(|k| v + k as f64 * tau));
+                    }
+                    c
+                })
+                .collect();
+            // The least travel to each choice of each waypoint, and where it came from.
+            let mut cost = vec![0.0];
+            let mut from: Vec<Vec<usize>> = Vec::with_capacity(n);
+            for k in 1..n {
+                let (prev, next) = (&choices[k - 1], &choices[k]);
+                let mut c = Vec::with_capacity(next.len());
+                let mut f = Vec::with_capacity(next.len());
+                for &v in next {
+                    let (mut best, mut at) = (f64::INFINITY, 0);
+                    for (a, &u) in prev.iter().enumerate() {
+                        let x = cost[a] + (v - u).abs();
+                        if x < best {
+                            (best, at) = (x, a);
+                        }
+                    }
+                    c.push(best);
+                    f.push(at);
+                }
+                cost = c;
+                from.push(f);
+            }
+            let mut at = 0;
+            for k in (1..n).rev() {
+                trial[k][j] = choices[k][at];
+                at = from[k - 1][at];
+            }
+        }
+        if trial == waypoints || total(&trial) >= total(waypoints) {
+            return calls;
+        }
+        let mut blocked = false;
+        for k in 0..n - 1 {
+            if trial[k] == waypoints[k] && trial[k + 1] == waypoints[k + 1] {
+                continue;
+            }
+            let check = check_segment(space, validity, &trial[k], &trial[k + 1], min_clearance);
+            calls += check.calls;
+            if !check.valid {
+                blocked = true;
+                for end in [k, k + 1] {
+                    if trial[end] != waypoints[end] {
+                        held[end] = true;
+                    }
+                }
+            }
+        }
+        if !blocked {
+            waypoints.clone_from_slice(&trial);
+            return calls;
+        }
+    }
 }
 
 /// Drops redundant waypoints: from each kept waypoint in turn, the farthest later waypoint it

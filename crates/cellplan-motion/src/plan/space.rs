@@ -17,6 +17,11 @@ pub struct JointSpace {
     /// Metric weights for nearest neighbours, steering and path length: the distance is
     /// `sqrt(Σ_j (weights[j]·(a_j − b_j))²)`. `1/v_max` makes it time-like.
     pub weights: Vec<f64>,
+    /// Per joint, whether values a full turn (2π) apart pose every body the same (a revolute
+    /// joint): a path's interior waypoints may then take such a joint a whole number of turns
+    /// from where they have it without changing what stands there (see
+    /// [`super::straighten_joints_timed`]). False for joints not listed.
+    pub turns: Vec<bool>,
 }
 
 impl JointSpace {
@@ -28,7 +33,22 @@ impl JointSpace {
             upper,
             radii,
             weights,
+            turns: Vec::new(),
         }
+    }
+
+    /// The same space with the joints whose values a full turn apart pose every body the same
+    /// marked (see [`JointSpace::turns`]).
+    pub fn with_turns(mut self, turns: Vec<bool>) -> Self {
+        self.turns = turns;
+        self
+    }
+
+    /// Whether joint `j` turns ([`JointSpace::turns`]) over a range wider than a full turn:
+    /// only there can a value move by whole turns and stay within the limits.
+    pub fn winds(&self, j: usize) -> bool {
+        self.turns.get(j).copied().unwrap_or(false)
+            && matches!((self.lower.get(j), self.upper.get(j)), (Some(lo), Some(hi)) if hi - lo > std::f64::consts::TAU)
     }
 
     /// The same space with other metric weights (one per joint).
