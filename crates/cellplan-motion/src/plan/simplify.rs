@@ -365,7 +365,9 @@ pub(super) fn unwind(
     loop {
         let mut trial = waypoints.to_vec();
         for &j in &winding {
-            let (lo, hi) = (space.lower[j] - 1e-9, space.upper[j] + 1e-9);
+            // A value moved by turns lands within the limits exactly (no tolerance: the
+            // verifier and the timing read the limits as they are).
+            let (lo, hi) = (space.lower[j], space.upper[j]);
             // Each waypoint's choices: its own value first, then the others a whole number of
             // turns away within the limits (at most a few: the limits are finite).
             let choices: Vec<Vec<f64>> = waypoints
@@ -376,7 +378,12 @@ pub(super) fn unwind(
                     let mut c = vec![v];
                     if !held && v.is_finite() && hi - lo < 64.0 * tau {
                         let (k_lo, k_hi) = (((lo - v) / tau).ceil() as i64, ((hi - v) / tau).floor() as i64);
-                        c.extend((k_lo..=k_hi).filter(|&k| k != 0).map(|k| v + k as f64 * tau));
+                        c.extend(
+                            (k_lo..=k_hi)
+                                .filter(|&k| k != 0)
+                                .map(|k| v + k as f64 * tau)
+                                .filter(|x| (lo..=hi).contains(x)),
+                        );
                     }
                     c
                 })
