@@ -362,6 +362,8 @@ pub(super) fn unwind(
     held[0] = true;
     held[n - 1] = true;
     let mut calls = 0;
+    // Segments found clear in an earlier round: a round after a hold asks most of them again.
+    let mut clear: Vec<(Vec<f64>, Vec<f64>)> = Vec::new();
     loop {
         let mut trial = waypoints.to_vec();
         for &j in &winding {
@@ -420,12 +422,15 @@ pub(super) fn unwind(
         }
         let mut blocked = false;
         for k in 0..n - 1 {
-            if trial[k] == waypoints[k] && trial[k + 1] == waypoints[k + 1] {
+            let (a, b) = (&trial[k], &trial[k + 1]);
+            if (*a == waypoints[k] && *b == waypoints[k + 1]) || clear.iter().any(|(x, y)| x == a && y == b) {
                 continue;
             }
-            let check = check_segment(space, validity, &trial[k], &trial[k + 1], min_clearance);
+            let check = check_segment(space, validity, a, b, min_clearance);
             calls += check.calls;
-            if !check.valid {
+            if check.valid {
+                clear.push((a.clone(), b.clone()));
+            } else {
                 blocked = true;
                 for end in [k, k + 1] {
                     if trial[end] != waypoints[end] {
