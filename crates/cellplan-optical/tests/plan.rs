@@ -287,6 +287,36 @@ fn readme_nearest() -> (Cell, CandidateTable, PlanSettings, plan::PlanCache, pla
     (cell, table, s, cache, base)
 }
 
+/// A hand-over whose plan, the other robots' programs kept, coordinates to a cycle far longer
+/// than the one to beat ([`plan::rebalance::FAR_WORSE`]) is not planned again with every robot
+/// sequenced anew: each allocation is judged once. One that coordinates a little longer is.
+#[test]
+fn a_hand_over_coordinated_far_worse_is_not_sequenced_again() {
+    use plan::rebalance::{FAR_WORSE, ends, makespan};
+    let (cell, table, s, _, base) = readme_nearest();
+    let score = makespan(&base);
+    let run = |factor: f64| -> Vec<Vec<Vec<TaskId>>> {
+        let mut seen = Vec::new();
+        let mut judge =
+            |o: &plan::Outcome, _: Option<(&plan::Outcome, &())>| -> Option<(f64, Vec<f64>, ())> {
+                seen.push(o.allocated.tasks.clone());
+                Some((score * factor, ends(o), ()))
+            };
+        let mut cache = plan::PlanCache::default();
+        let (found, clock) = rebalanced(&cell, &table, &base, &s, &mut cache, &mut judge);
+        assert!(found.is_none() && !clock);
+        seen
+    };
+    let far = run(1.0 + 2.0 * FAR_WORSE);
+    assert!(far.len() >= 2, "{} plans judged", far.len());
+    assert!(far.windows(2).all(|w| w[0] != w[1]), "an allocation judged twice");
+    let near = run(1.0 + FAR_WORSE / 2.0);
+    assert!(
+        near.windows(2).any(|w| w[0] == w[1]),
+        "no hand-over judged again with every robot sequenced anew"
+    );
+}
+
 #[test]
 fn rebalancing_hands_tasks_from_the_robot_ending_last_until_the_robots_end_sooner() {
     use plan::rebalance::{REBALANCE_PLANS, ends, makespan};

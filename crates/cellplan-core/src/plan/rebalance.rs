@@ -22,6 +22,16 @@ use std::time::Instant;
 /// machine).
 pub const REBALANCE_PLANS: usize = 10;
 
+/// A hand-over whose plan, the other robots' programs kept, coordinates to a cycle longer
+/// than the one to beat by more than this share is not planned again with every robot
+/// sequenced anew: the judge and the plan go to the next hand-over instead. Where coordination
+/// adds that much, other paths of the same allocation did not win in the traces (hulls-6r:
+/// 103.3 then 97.9 s against 71.5; door-opening-4r: 62.3 then 63.6 s against 43.3), and each
+/// judge on the crowded cells costs seconds. Ten cells × seeds 0–2: mean ratio 1.395 → 1.392
+/// (5 shorter, 4 longer, 21 the same); dense-8r-250 seed 0 106.9 → 100.2 s wall side by side
+/// (`bench/cells/README.md`, forty-fifth session).
+pub const FAR_WORSE: f64 = 0.05;
+
 /// Plans [`rebalance`] hands its judge at most (a coordination each: the costly part).
 pub const REBALANCE_JUDGED: usize = 5;
 
@@ -438,12 +448,20 @@ pub fn rebalance<J>(
                     }
                     o.unreached.clone_from(&base.unreached);
                     budget.judged += 1;
-                    if let Some((sc, e, j)) = judge(&o, best.as_ref().map(|b| (&b.0, &b.2)))
+                    let judged = judge(&o, best.as_ref().map(|b| (&b.0, &b.2)));
+                    let far_worse = judged
+                        .as_ref()
+                        .is_some_and(|(sc, _, _)| *sc > score * (1.0 + FAR_WORSE));
+                    if let Some((sc, e, j)) = judged
                         && sc < score - 1e-6
                     {
                         (score, judged_ends, waits) = (sc, e, waits_of(&j));
                         best = Some((o, next, j));
                         continue 'rounds;
+                    }
+                    // Far worse with the programs kept: not sequenced anew (see FAR_WORSE).
+                    if keep && far_worse {
+                        break;
                     }
                     kept = Some(o);
                 }
