@@ -449,9 +449,11 @@ pub fn rebalance<J>(
                     o.unreached.clone_from(&base.unreached);
                     budget.judged += 1;
                     let judged = judge(&o, best.as_ref().map(|b| (&b.0, &b.2)));
-                    let far_worse = judged
-                        .as_ref()
-                        .is_some_and(|(sc, _, _)| *sc > score * (1.0 + FAR_WORSE));
+                    // Far worse with the programs kept: not sequenced anew (see FAR_WORSE).
+                    let far_worse = keep
+                        && judged
+                            .as_ref()
+                            .is_some_and(|(sc, _, _)| *sc > score * (1.0 + FAR_WORSE));
                     if let Some((sc, e, j)) = judged
                         && sc < score - 1e-6
                     {
@@ -459,8 +461,7 @@ pub fn rebalance<J>(
                         best = Some((o, next, j));
                         continue 'rounds;
                     }
-                    // Far worse with the programs kept: not sequenced anew (see FAR_WORSE).
-                    if keep && far_worse {
+                    if far_worse {
                         break;
                     }
                     kept = Some(o);

@@ -18,8 +18,8 @@ pub struct JointSpace {
     /// `sqrt(Σ_j (weights[j]·(a_j − b_j))²)`. `1/v_max` makes it time-like.
     pub weights: Vec<f64>,
     /// Per joint, whether values a full turn (2π) apart pose every body the same (a revolute
-    /// or continuous joint): a path's interior waypoints may then take such a joint a whole number of turns
-    /// from where they have it without changing what stands there (see
+    /// or continuous joint): a path's interior waypoints may then take such a joint a whole
+    /// number of turns from where they have it without changing what stands there (see
     /// [`super::straighten_joints_timed`]). False for joints not listed.
     pub turns: Vec<bool>,
 }
