@@ -96,6 +96,10 @@ pub fn limit_variants(q: &[f64], chain: &Chain, out: &mut Vec<Vec<f64>>) {
 pub struct OpwIk {
     chain: Chain,
     params: OpwParameters,
+    /// The OPW base in the chain's root frame (the identity but for derived parameters, see
+    /// [`OpwIk::derive`]), and its inverse.
+    base: Pose,
+    root_to_base: Pose,
     /// `C`: chain tip in the OPW flange frame (`chain.fk_tip(q) = params.forward(q) * C`).
     flange_to_tip: Pose,
     tip_to_flange: Pose,
@@ -114,15 +118,56 @@ impl OpwIk {
     /// pseudo-random configurations within the limits.
     pub fn new(chain: &Chain, params: OpwParameters) -> Result<Self, KinError> {
         let source = PathBuf::from(format!("URDF chain {}→{}", chain.root_name(), chain.tip_name()));
-        Self::build(chain, params, source)
+        Self::build(chain, params, Pose::IDENTITY, source)
+    }
+
+    /// The solver for a chain given without OPW parameters, when it is an ortho-parallel arm
+    /// with a spherical wrist: the parameters are read off the chain's geometry
+    /// ([`OpwParameters::candidates_for`]), and the first set kept is one that reproduces the
+    /// chain at [`OPW_CHECKS`] configurations (as [`OpwIk::new`] checks) and whose inverse
+    /// finds each of those configurations again. `None` for any other chain (use the numeric
+    /// solver).
+    pub fn derive(chain: &Chain) -> Option<Self> {
+        let source = PathBuf::from(format!("URDF chain {}→{}", chain.root_name(), chain.tip_name()));
+        OpwParameters::candidates_for(chain)
+            .into_iter()
+            .filter_map(|(p, base)| Self::build(chain, p, base, source.clone()).ok())
+            .find(|ik| ik.finds_again())
+    }
+
+    /// Whether the inverse finds [`OPW_CHECKS`] deterministic pseudo-random configurations
+    /// within the limits again (up to whole turns) from their tips.
+    fn finds_again(&self) -> bool {
+        let mut rng = ChaCha8Rng::seed_from_u64(0x0_0f1d_a9a1);
+        let mut q = [0.0; 6];
+        let mut raw = [[0.0; 6]; 8];
+        (0..OPW_CHECKS).all(|_| {
+            for (v, joint) in q.iter_mut().zip(&self.chain.joints) {
+                let lo = joint.lower.max(-PI);
+                let hi = joint.upper.min(PI);
+                *v = if lo < hi {
+                    rng.random_range(lo..hi)
+                } else {
+                    joint.mid()
+                };
+            }
+            let flange = self.root_to_base * self.chain.fk_tip(&q) * self.tip_to_flange;
+            let n = self.params.inverse_into(&flange, &mut raw);
+            raw[..n].iter().any(|s| {
+                s.iter()
+                    .zip(&q)
+                    .all(|(a, b)| crate::wrap_angle(a - b).abs() <= OPW_MATCH_TOLERANCE)
+            })
+        })
     }
 
     /// As [`OpwIk::new`] on the chain of `model`; errors name the URDF file.
     pub fn for_robot(model: &RobotModel, params: OpwParameters) -> Result<Self, KinError> {
-        Self::build(&model.chain, params, model.path.clone())
+        Self::build(&model.chain, params, Pose::IDENTITY, model.path.clone())
     }
 
-    fn build(chain: &Chain, params: OpwParameters, source: PathBuf) -> Result<Self, KinError> {
+    /// The solver with the OPW base at `base` in the chain's root frame.
+    fn build(chain: &Chain, params: OpwParameters, base: Pose, source: PathBuf) -> Result<Self, KinError> {
         let fail = |message: String| KinError::Opw {
             path: source.clone(),
             line: None,
@@ -152,7 +197,8 @@ impl OpwIk {
             )));
         }
         let zero = [0.0; 6];
-        let flange_to_tip = params.forward(&zero).inverse() * chain.fk_tip(&zero);
+        let root_to_base = base.inverse();
+        let flange_to_tip = params.forward(&zero).inverse() * root_to_base * chain.fk_tip(&zero);
         let mut rng = ChaCha8Rng::seed_from_u64(0x0_0b5e_55ed);
         let mut q = [0.0; 6];
         for _ in 0..OPW_CHECKS {
@@ -165,7 +211,7 @@ impl OpwIk {
                     joint.mid()
                 };
             }
-            let (dp, da) = pose_error(&chain.fk_tip(&q), &(params.forward(&q) * flange_to_tip));
+            let (dp, da) = pose_error(&chain.fk_tip(&q), &(base * params.forward(&q) * flange_to_tip));
             if !(dp <= OPW_MATCH_TOLERANCE && da <= OPW_MATCH_TOLERANCE) {
                 let deg: Vec<String> = q.iter().map(|v| format!("{:.1}", v.to_degrees())).collect();
                 return Err(fail(format!(
@@ -182,6 +228,8 @@ impl OpwIk {
         Ok(Self {
             chain: chain.clone(),
             params,
+            base,
+            root_to_base,
             flange_to_tip,
             tip_to_flange: flange_to_tip.inverse(),
         })
@@ -195,6 +243,10 @@ impl OpwIk {
     pub fn params(&self) -> &OpwParameters {
         &self.params
     }
+    /// The OPW base in the chain's root frame (the identity but for derived parameters).
+    pub fn base(&self) -> Pose {
+        self.base
+    }
     /// The chain.
     pub fn chain(&self) -> &Chain {
         &self.chain
@@ -203,7 +255,7 @@ impl OpwIk {
 
 impl IkSolver for OpwIk {
     fn solve(&self, target: &Pose, out: &mut Vec<Vec<f64>>) -> usize {
-        let flange = *target * self.tip_to_flange;
+        let flange = self.root_to_base * *target * self.tip_to_flange;
         let mut branches = [[0.0; 6]; 8];
         let n = self.params.inverse_into(&flange, &mut branches);
         for q in &branches[..n] {

@@ -3,6 +3,7 @@
 use cellplan_geom::{DMat3, DQuat, DVec3, Pose};
 use std::f64::consts::{PI, TAU};
 
+mod derive;
 mod yaml;
 
 /// OPW geometric parameters (metres), joint offsets (rad) and sign corrections (±1).
@@ -38,6 +39,15 @@ impl OpwParameters {
     /// values. Other top-level keys (`dof`, `constraints`, ...) are ignored.
     pub fn from_ros_yaml(text: &str) -> Result<Self, (Option<usize>, String)> {
         yaml::parse(text)
+    }
+
+    /// The parameter sets a six-joint chain's geometry at zero allows (see `opw/derive.rs`),
+    /// each with the OPW base in the chain's root frame (a level shift of the root onto joint
+    /// 1's axis), the usual choice of axis directions first; empty when the chain is not an
+    /// ortho-parallel arm with a spherical wrist and a vertical joint 1. Each must still be
+    /// checked against the chain: [`crate::OpwIk::derive`] keeps the first that reproduces it.
+    pub fn candidates_for(chain: &crate::Chain) -> Vec<(Self, Pose)> {
+        derive::candidates(chain)
     }
 
     /// The ROS-Industrial convention maps a model (URDF) joint value `q` to the angle of the

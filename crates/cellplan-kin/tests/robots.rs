@@ -1,4 +1,5 @@
-//! The real robot files in data/robots: the FANUC R-2000iC/125L (OPW) and the UR5 (DLS).
+//! The real robot files in data/robots: the FANUC R-2000iC/125L (OPW), the UR5 (DLS), and the
+//! OPW parameters read off the FANUC, ABB and KUKA URDFs.
 use cellplan_geom::ShapeSpec;
 use cellplan_kin::{
     DlsIk, DlsParams, IkSolver, JointKind, KinError, OpwIk, OpwParameters, load_urdf, pose_error,
@@ -247,4 +248,153 @@ fn ur5_dls_reaches_random_targets() {
         multi * 4 >= n * 3,
         "most targets have several distinct solutions: {multi}/{n}"
     );
+}
+
+fn abb_irb2400() -> cellplan_kin::RobotModel {
+    let packages = BTreeMap::from([(
+        "abb_irb2400_support".to_string(),
+        data().join("robots/abb_irb2400/abb_irb2400_support"),
+    )]);
+    load_urdf(
+        &data().join("robots/abb_irb2400/urdf/irb2400.urdf"),
+        &packages,
+        None,
+    )
+    .unwrap()
+}
+
+fn kr210() -> cellplan_kin::RobotModel {
+    let packages = BTreeMap::from([(
+        "kuka_kr210_support".to_string(),
+        data().join("robots/kuka_kr210/kuka_kr210_support"),
+    )]);
+    load_urdf(
+        &data().join("robots/kuka_kr210/urdf/kr210l150.urdf"),
+        &packages,
+        None,
+    )
+    .unwrap()
+}
+
+/// The seven lengths of two parameter sets, side by side.
+fn lengths(p: &OpwParameters) -> [f64; 7] {
+    [p.a1, p.a2, p.b, p.c1, p.c2, p.c3, p.c4]
+}
+
+/// Whether `ik` finds every configuration of `n` random ones within the limits again from its
+/// tip, and every solution it gives reaches the tip.
+fn finds_every_configuration_again(ik: &dyn IkSolver, chain: &cellplan_kin::Chain, n: usize, seed: u64) {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let mut out = Vec::new();
+    for _ in 0..n {
+        let q = random_q(chain, &mut rng);
+        let target = chain.fk_tip(&q);
+        out.clear();
+        ik.solve(&target, &mut out);
+        assert!(
+            out.iter()
+                .any(|s| s.iter().zip(&q).all(|(a, b)| (a - b).abs() < 1e-9)),
+            "{q:?} not among {out:?}"
+        );
+        for s in &out {
+            let (dp, da) = pose_error(&chain.fk_tip(s), &target);
+            assert!(dp < 1e-9 && da < 1e-9, "{s:?}: {dp} m, {da} rad");
+        }
+    }
+}
+
+#[test]
+fn opw_parameters_read_off_the_fanuc_urdf_are_its_parameter_file() {
+    let model = load_urdf(&fanuc_urdf(), &fanuc_packages(), None).unwrap();
+    let ik = OpwIk::derive(&model.chain).expect("the R-2000iC is an OPW arm");
+    let (got, file) = (ik.params(), fanuc_opw());
+    for (a, b) in lengths(got).iter().zip(lengths(&file)) {
+        assert!((a - b).abs() < 1e-12, "{got:?} against {file:?}");
+    }
+    // The same solutions as the solver built on the parameter file, for random targets.
+    let from_file = OpwIk::for_robot(&model, file).unwrap();
+    let mut rng = ChaCha8Rng::seed_from_u64(5);
+    let (mut a, mut b) = (Vec::new(), Vec::new());
+    for _ in 0..200 {
+        let target = model.chain.fk_tip(&random_q(&model.chain, &mut rng));
+        a.clear();
+        b.clear();
+        ik.solve(&target, &mut a);
+        from_file.solve(&target, &mut b);
+        let key = |v: &mut Vec<Vec<f64>>| {
+            v.sort_by(|x, y| x.partial_cmp(y).unwrap());
+        };
+        key(&mut a);
+        key(&mut b);
+        assert_eq!(a.len(), b.len(), "{a:?} against {b:?}");
+        for (x, y) in a.iter().zip(&b) {
+            assert!(
+                x.iter().zip(y).all(|(u, v)| (u - v).abs() < 1e-9),
+                "{x:?} against {y:?}"
+            );
+        }
+    }
+    finds_every_configuration_again(&ik, &model.chain, 200, 6);
+}
+
+#[test]
+fn opw_parameters_read_off_the_abb_irb2400_urdf_are_the_published_set() {
+    let model = abb_irb2400();
+    let ik = OpwIk::derive(&model.chain).expect("the IRB 2400 is an OPW arm");
+    // opw_kinematics' IRB 2400-10 set (the URDF's arm).
+    let published = [0.100, -0.135, 0.0, 0.615, 0.705, 0.755, 0.085];
+    for (a, b) in lengths(ik.params()).iter().zip(published) {
+        assert!((a - b).abs() < 1e-9, "{:?}", ik.params());
+    }
+    finds_every_configuration_again(&ik, &model.chain, 200, 7);
+}
+
+#[test]
+fn opw_parameters_are_read_off_the_kuka_kr210_urdf() {
+    let model = kr210();
+    let ik = OpwIk::derive(&model.chain).expect("the KR 210 is an OPW arm");
+    // Its URDF, made from CAD, puts joint 1 2.8 mm off the root's origin: the OPW base is moved
+    // onto it.
+    let base = ik.base().translation;
+    assert!(
+        base.length() > 1e-3 && base.length() < 5e-3 && base.z == 0.0,
+        "{base:?}"
+    );
+    finds_every_configuration_again(&ik, &model.chain, 200, 8);
+}
+
+#[test]
+fn opw_parameters_are_read_off_the_abb_irb6640_urdf() {
+    // Its balancing cylinder and piston hang on fixed joints off the chain.
+    let packages = BTreeMap::from([(
+        "abb_irb6600_support".to_string(),
+        data().join("robots/abb_irb6640/abb_irb6600_support"),
+    )]);
+    let model = load_urdf(
+        &data().join("robots/abb_irb6640/urdf/irb6640.urdf"),
+        &packages,
+        None,
+    )
+    .unwrap();
+    let ik = OpwIk::derive(&model.chain).expect("the IRB 6640 is an OPW arm");
+    assert!(ik.params().c2 > 1.0 && ik.params().c3 > 1.0, "{:?}", ik.params());
+    finds_every_configuration_again(&ik, &model.chain, 200, 9);
+}
+
+#[test]
+fn arms_that_are_not_opw_get_no_parameters() {
+    // The UR5's wrist has no centre: its three wrist axes do not meet.
+    let ur5 = load_urdf(&ur5_urdf(), &ur_packages(), None).unwrap();
+    assert!(OpwParameters::candidates_for(&ur5.chain).is_empty());
+    assert!(OpwIk::derive(&ur5.chain).is_none());
+    // The R-2000iC with its wrist moved 5 mm sideways, or its forearm turned by 0.01 rad out of the arm's plane.
+    let model = load_urdf(&fanuc_urdf(), &fanuc_packages(), None).unwrap();
+    let wrist = model.chain.joint_link(4).unwrap();
+    let mut moved = model.chain.clone();
+    moved.links[wrist].origin.translation.y += 0.005;
+    assert!(OpwIk::derive(&moved).is_none());
+    let elbow = model.chain.joint_link(3).unwrap();
+    let mut tilted = model.chain.clone();
+    tilted.links[elbow].origin.rotation = cellplan_geom::DQuat::from_rotation_z(0.01);
+    assert!(OpwIk::derive(&tilted).is_none());
 }

@@ -25,6 +25,8 @@ pub struct Tool {
 pub enum IkKind {
     /// Closed form for ortho-parallel arms, all branches.
     Opw,
+    /// The same, its parameters read off the URDF (no `opw` given).
+    OpwDerived,
     /// Damped least squares from several starts.
     Numeric,
 }

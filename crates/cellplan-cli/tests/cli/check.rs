@@ -24,6 +24,31 @@ fn small_cell_checks_and_classifies() {
     assert_eq!(v["shared"].as_array().unwrap().len(), 0);
 }
 
+/// A FANUC given without its OPW parameter file gets the parameters read off its URDF: the same
+/// candidates as with the file (the numeric solver, which the loader used before, finds fewer
+/// branches near the joint limits and takes far longer).
+#[test]
+fn an_arm_without_its_opw_file_checks_as_with_it() {
+    let dir = scratch("opw-derived");
+    let (cell, _) = small_cell(&dir);
+    let counts = |v: &Value| -> Vec<u64> {
+        v["candidates"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|t| t["robots"]["R1"].as_u64().unwrap())
+            .collect()
+    };
+    let path = dir.join("cell.toml");
+    let with = json_ok(&["check", path.to_str().unwrap(), "--json"], &dir);
+    let opw_line = cell.lines().find(|l| l.starts_with("opw =")).unwrap();
+    std::fs::write(&path, cell.replace(opw_line, "")).unwrap();
+    let without = json_ok(&["check", path.to_str().unwrap(), "--json"], &dir);
+    assert!(counts(&with).iter().all(|&n| n > 0), "{with}");
+    assert_eq!(counts(&with), counts(&without));
+    assert_eq!(with["total_candidates"], without["total_candidates"]);
+}
+
 #[test]
 fn malformed_toml_names_the_line() {
     let dir = scratch("toml");

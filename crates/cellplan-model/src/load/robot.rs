@@ -153,8 +153,10 @@ fn joint_scale(ctx: &Ctx, chain: &Chain, j: usize) -> f64 {
     }
 }
 
-/// The robot's inverse kinematics: analytic OPW when `opw` is given (a 6-joint arm only), else
-/// the numeric solver.
+/// The robot's inverse kinematics: analytic OPW with the parameters `opw` gives (a 6-joint arm
+/// only); without them, OPW with the parameters read off the URDF where the chain is an
+/// ortho-parallel arm with a spherical wrist (checked against the chain, see
+/// [`OpwIk::derive`]), else the numeric solver.
 fn ik_solver(
     ctx: &Ctx,
     entry: &Spanned<RobotSpec>,
@@ -163,6 +165,9 @@ fn ik_solver(
     let r = entry.get_ref();
     let dof = model.chain.dof();
     let Some(opw) = &r.opw else {
+        if let Some(derived) = OpwIk::derive(&model.chain) {
+            return Ok((Arc::new(derived), IkKind::OpwDerived));
+        }
         return Ok((
             Arc::new(DlsIk::new(&model.chain, DlsParams::default())),
             IkKind::Numeric,
