@@ -124,7 +124,7 @@ impl OpwIk {
     /// The solver for a chain given without OPW parameters, when it is an ortho-parallel arm
     /// with a spherical wrist: the parameters are read off the chain's geometry
     /// ([`OpwParameters::candidates_for`]), and the first set kept is one that reproduces the
-    /// chain at [`OPW_CHECKS`] configurations (as [`OpwIk::new`] checks) and whose inverse
+    /// chain at 20 configurations (as [`OpwIk::new`] checks) and whose inverse
     /// finds each of those configurations again. `None` for any other chain (use the numeric
     /// solver).
     pub fn derive(chain: &Chain) -> Option<Self> {
