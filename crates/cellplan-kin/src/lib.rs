@@ -6,6 +6,8 @@
 //! - [`srdf`]: the `disable_collisions` rules of an SRDF.
 //! - [`chain`]: the serial [`Chain`], its [`Joint`]s and forward kinematics.
 //! - [`opw`]: [`OpwParameters`] and the closed-form solution with all eight branches.
+//! - [`parallel`]: [`ParallelIk`], the closed form of arms with three parallel axes and an
+//!   offset wrist (Universal Robots), read off the chain.
 //! - [`cmm`]: a five-axis CMM head and probe (paper 003): closed-form inverse from ball centre and
 //!   probe direction, the move-or-rotate motion model.
 //! - [`ik`]: the [`IkSolver`] trait, [`OpwIk`] (OPW on a URDF chain), [`DlsIk`] (numeric),
@@ -14,12 +16,14 @@
 //! Units: metres and radians. Poses are `cellplan_geom::Pose`.
 #![warn(missing_docs)]
 
+mod axes;
 pub mod chain;
 pub mod cmm;
 pub mod dynamics;
 pub mod error;
 pub mod ik;
 pub mod opw;
+pub mod parallel;
 pub mod srdf;
 pub mod urdf;
 
@@ -27,4 +31,5 @@ pub use chain::{Chain, ChainLink, Joint, JointKind, pose_error};
 pub use error::KinError;
 pub use ik::{DlsIk, DlsParams, IkSolver, LIMIT_TOLERANCE, OpwIk, limit_variants};
 pub use opw::{OpwParameters, wrap_angle};
+pub use parallel::ParallelIk;
 pub use urdf::{RobotModel, load_urdf, load_urdf_str};

@@ -27,6 +27,9 @@ pub enum IkKind {
     Opw,
     /// The same, its parameters read off the URDF (no `opw` given).
     OpwDerived,
+    /// Closed form for arms with three parallel axes and an offset wrist (Universal Robots),
+    /// read off the URDF, all branches.
+    Parallel,
     /// Damped least squares from several starts.
     Numeric,
 }

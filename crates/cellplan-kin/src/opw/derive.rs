@@ -13,64 +13,8 @@
 //! reproduces the chain (see [`crate::OpwIk::derive`]): nothing here is trusted unchecked.
 use super::OpwParameters;
 use crate::Chain;
+use crate::axes::{EPS, closest, level_base, lines};
 use cellplan_geom::{DMat3, DVec3, Pose};
-
-/// Tolerance of the geometric tests (unit vectors, and metres over a robot's size).
-const EPS: f64 = 1e-7;
-
-/// A joint's line at the chain's zero, in the root frame: a point on it and its unit direction.
-#[derive(Clone, Copy, Debug)]
-struct Line {
-    point: DVec3,
-    dir: DVec3,
-}
-
-impl Line {
-    /// Distance from `p` to the line.
-    fn distance(&self, p: DVec3) -> f64 {
-        (p - self.point).cross(self.dir).length()
-    }
-}
-
-/// The closest points of two lines that are not parallel: the point on `a` and the point on
-/// `b`.
-fn closest(a: &Line, b: &Line) -> Option<(DVec3, DVec3)> {
-    let w = a.point - b.point;
-    let (p, q) = (a.dir.dot(b.dir), a.dir.dot(w));
-    let r = b.dir.dot(w);
-    let den = 1.0 - p * p;
-    if den < EPS {
-        return None;
-    }
-    let s = (p * r - q) / den;
-    let t = (r - p * q) / den;
-    Some((a.point + s * a.dir, b.point + t * b.dir))
-}
-
-/// The six joints' lines at zero, when the chain has six rotational joints.
-fn lines(chain: &Chain) -> Option<[Line; 6]> {
-    if chain.dof() != 6 || !chain.joints.iter().all(|j| j.is_rotational()) {
-        return None;
-    }
-    let mut poses = vec![Pose::IDENTITY; chain.links.len()];
-    chain.fk_all(&[0.0; 6], &mut poses);
-    let mut out = [Line {
-        point: DVec3::ZERO,
-        dir: DVec3::Z,
-    }; 6];
-    for (j, line) in out.iter_mut().enumerate() {
-        let pose = poses[chain.joint_link(j)?];
-        let dir = (pose.rotation * chain.joints[j].axis).normalize();
-        if !dir.is_finite() || !pose.translation.is_finite() {
-            return None;
-        }
-        *line = Line {
-            point: pose.translation,
-            dir,
-        };
-    }
-    Some(out)
-}
 
 /// Every set of OPW parameters that the chain's geometry at zero allows, each with the OPW
 /// base in the chain's root frame (the root moved level onto joint 1's axis), the usual choice
@@ -85,14 +29,10 @@ pub(crate) fn candidates(chain: &Chain) -> Vec<(OpwParameters, Pose)> {
     };
     let z = DVec3::Z;
     // Joint 1: parallel to the root's z axis (either way); the OPW base is the root moved level
-    // onto it (URDFs made from CAD put it a few millimetres off).
-    if l[0].dir.cross(z).length() > EPS {
+    // onto it.
+    let Some(base) = level_base(&mut l) else {
         return Vec::new();
-    }
-    let base = DVec3::new(l[0].point.x, l[0].point.y, 0.0);
-    for line in &mut l {
-        line.point -= base;
-    }
+    };
     let sign1 = l[0].dir.z.signum();
     // Joints 2 and 3: parallel, square to joint 1.
     if l[1].dir.dot(z).abs() > EPS || l[2].dir.cross(l[1].dir).length() > EPS {

@@ -7,7 +7,8 @@ use crate::spec::{OpwSpec, RobotSpec};
 use crate::{InputError, error::line_of};
 use cellplan_geom::Pose;
 use cellplan_kin::{
-    Chain, DlsIk, DlsParams, IkSolver, JointKind, KinError, OpwIk, OpwParameters, RobotModel, load_urdf,
+    Chain, DlsIk, DlsParams, IkSolver, JointKind, KinError, OpwIk, OpwParameters, ParallelIk, RobotModel,
+    load_urdf,
 };
 use std::collections::{BTreeMap, HashMap};
 use std::ops::Range;
@@ -156,7 +157,8 @@ fn joint_scale(ctx: &Ctx, chain: &Chain, j: usize) -> f64 {
 /// The robot's inverse kinematics: analytic OPW with the parameters `opw` gives (a 6-joint arm
 /// only); without them, OPW with the parameters read off the URDF where the chain is an
 /// ortho-parallel arm with a spherical wrist (checked against the chain, see
-/// [`OpwIk::derive`]), else the numeric solver.
+/// [`OpwIk::derive`]), the closed form of three parallel axes where it is a Universal Robots
+/// kind of arm ([`ParallelIk::derive`]), else the numeric solver.
 fn ik_solver(
     ctx: &Ctx,
     entry: &Spanned<RobotSpec>,
@@ -167,6 +169,9 @@ fn ik_solver(
     let Some(opw) = &r.opw else {
         if let Some(derived) = OpwIk::derive(&model.chain) {
             return Ok((Arc::new(derived), IkKind::OpwDerived));
+        }
+        if let Some(parallel) = ParallelIk::derive(&model.chain) {
+            return Ok((Arc::new(parallel), IkKind::Parallel));
         }
         return Ok((
             Arc::new(DlsIk::new(&model.chain, DlsParams::default())),
