@@ -70,7 +70,7 @@ enum Command {
 struct CheckArgs {
     /// The cell file (TOML).
     cell: PathBuf,
-    /// Print the report as JSON (stable keys: tasks, robots, candidates, unmeasurable, shared).
+    /// Print the report as JSON (stable keys: tasks, robots, ik, candidates, unmeasurable, shared).
     #[arg(long)]
     json: bool,
     /// Also draw the cell from above and from the side into this SVG file.

@@ -2,6 +2,7 @@
 //! task no robot can do with the reason. Its JSON keys are stable: scripts read `tasks`,
 //! `robots`, `candidates`, `unmeasurable` and `shared`.
 use crate::candidates::{CandidateTable, Classes, classes};
+use cellplan_model::robot::IkKind;
 use cellplan_model::{Cell, InputError, Rejection, RobotId, TaskId};
 use serde::Serialize;
 use serde_json::{Map, Value};
@@ -73,6 +74,9 @@ pub struct CheckReport {
     pub tasks: usize,
     /// Robot names, in file order.
     pub robots: Vec<String>,
+    /// Each robot's inverse kinematics, in file order: `opw` (the parameters given), `opw-derived`
+    /// and `parallel` (closed forms read off the URDF), `numeric`.
+    pub ik: Vec<IkKind>,
     /// Candidates per task and robot.
     pub candidates: Vec<TaskCandidates>,
     /// Total number of candidates.
@@ -93,6 +97,7 @@ fn names(cell: &Cell, tasks: &[TaskId]) -> Vec<String> {
 pub fn report(cell: &Cell, table: &CandidateTable) -> CheckReport {
     let cls: Classes = classes(table, cell.robots.len());
     let robots: Vec<String> = cell.robots.iter().map(|r| r.name.clone()).collect();
+    let ik = cell.robots.iter().map(|r| r.ik_kind).collect();
     let candidates = cell
         .tasks
         .iter()
@@ -148,6 +153,7 @@ pub fn report(cell: &Cell, table: &CandidateTable) -> CheckReport {
         cell: cell.name.clone(),
         tasks: cell.tasks.len(),
         robots,
+        ik,
         candidates,
         total_candidates: table.total(),
         classes: ClassReport {
@@ -280,6 +286,24 @@ pub fn render_text(cell: &Cell, table: &CandidateTable, r: &CheckReport) -> Stri
         r.tasks,
         r.total_candidates
     );
+    // Which inverse kinematics each robot got, grouped (a closed form read off the URDF is worth
+    // knowing: the numeric solver is slower and may miss branches).
+    let mut kinds: Vec<(IkKind, Vec<&str>)> = Vec::new();
+    for (name, &kind) in r.robots.iter().zip(&r.ik) {
+        match kinds.iter_mut().find(|(k, _)| *k == kind) {
+            Some((_, names)) => names.push(name),
+            None => kinds.push((kind, vec![name])),
+        }
+    }
+    for (kind, names) in kinds {
+        let what = match kind {
+            IkKind::Opw => "closed form (OPW, the parameters given)",
+            IkKind::OpwDerived => "closed form (OPW, read off the URDF)",
+            IkKind::Parallel => "closed form (three parallel axes, read off the URDF)",
+            IkKind::Numeric => "numeric (damped least squares from several starts)",
+        };
+        let _ = writeln!(s, "inverse kinematics {what}: {}", names.join(", "));
+    }
     let width = cell.tasks.iter().map(|t| t.name.len()).max().unwrap_or(4).max(4);
     let cols: Vec<usize> = r.robots.iter().map(|n| n.len().max(5)).collect();
     let _ = write!(s, "\n{:<width$}", "task");

@@ -47,6 +47,15 @@ fn an_arm_without_its_opw_file_checks_as_with_it() {
     assert!(counts(&with).iter().all(|&n| n > 0), "{with}");
     assert_eq!(counts(&with), counts(&without));
     assert_eq!(with["total_candidates"], without["total_candidates"]);
+    assert_eq!(with["ik"], serde_json::json!(["opw"]));
+    assert_eq!(without["ik"], serde_json::json!(["opw-derived"]));
+    // The text says which solver each robot got.
+    let out = run_ok(&["check", path.to_str().unwrap()], &dir);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        text.contains("inverse kinematics closed form (OPW, read off the URDF): R1"),
+        "{text}"
+    );
 }
 
 #[test]
