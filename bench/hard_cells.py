@@ -60,6 +60,7 @@ CELLS = [
     ("crowded-6r", False),
     ("side-4r-260", False),
     ("abb6640-6r", False),
+    ("track-2r", False),
     ("hulls-6r", True),
     ("door-opening-4r", True),
     ("dense-8r-120", True),
