@@ -75,7 +75,8 @@ pub struct CheckReport {
     /// Robot names, in file order.
     pub robots: Vec<String>,
     /// Each robot's inverse kinematics, in file order: `opw` (the parameters given), `opw-derived`
-    /// and `parallel` (closed forms read off the URDF), `numeric`.
+    /// and `parallel` (closed forms read off the URDF), `track` (an OPW arm on a track),
+    /// `numeric`.
     pub ik: Vec<IkKind>,
     /// Candidates per task and robot.
     pub candidates: Vec<TaskCandidates>,
@@ -300,6 +301,7 @@ pub fn render_text(cell: &Cell, table: &CandidateTable, r: &CheckReport) -> Stri
             IkKind::Opw => "closed form (OPW, the parameters given)",
             IkKind::OpwDerived => "closed form (OPW, read off the URDF)",
             IkKind::Parallel => "closed form (three parallel axes, read off the URDF)",
+            IkKind::Track => "track positions sampled, the arm's closed form (OPW, read off the URDF)",
             IkKind::Numeric => "numeric (damped least squares from several starts)",
         };
         let _ = writeln!(s, "inverse kinematics {what}: {}", names.join(", "));

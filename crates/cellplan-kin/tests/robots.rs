@@ -2,7 +2,8 @@
 //! OPW parameters read off the FANUC, ABB and KUKA URDFs.
 use cellplan_geom::ShapeSpec;
 use cellplan_kin::{
-    DlsIk, DlsParams, IkSolver, JointKind, KinError, OpwIk, OpwParameters, ParallelIk, load_urdf, pose_error,
+    DlsIk, DlsParams, IkSolver, JointKind, KinError, OpwIk, OpwParameters, ParallelIk, TrackIk, load_urdf,
+    pose_error,
 };
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -433,6 +434,53 @@ fn the_universal_robots_get_the_closed_form_of_three_parallel_axes() {
     let fanuc = load_urdf(&fanuc_urdf(), &fanuc_packages(), None).unwrap();
     assert!(ParallelIk::derive(&fanuc.chain).is_none());
     assert!(ParallelIk::derive(&kr210().chain).is_none());
+}
+
+#[test]
+fn an_opw_arm_on_a_track_gets_sampled_track_positions_and_the_arms_closed_form() {
+    let model = load_urdf(
+        &data().join("robots/fanuc_r2000ic/urdf/r2000ic125l_on_track.urdf"),
+        &fanuc_packages(),
+        None,
+    )
+    .unwrap();
+    assert_eq!(model.chain.dof(), 7);
+    let ik = TrackIk::derive(&model.chain).expect("an R-2000iC on a track");
+    let dls = DlsIk::new(&model.chain, DlsParams::default());
+    let mut rng = ChaCha8Rng::seed_from_u64(12);
+    let (mut out, mut numeric) = (Vec::new(), Vec::new());
+    let (mut solved, mut centred) = (0, 0);
+    for _ in 0..100 {
+        let q = random_q(&model.chain, &mut rng);
+        let target = model.chain.fk_tip(&q);
+        out.clear();
+        ik.solve(&target, &mut out);
+        for s in &out {
+            let (dp, da) = pose_error(&model.chain.fk_tip(s), &target);
+            assert!(dp < 1e-8 && da < 1e-8, "{s:?}: {dp} m, {da} rad");
+            assert!(model.chain.within_limits(s, 0.0), "{s:?}");
+        }
+        // Five track positions at most, 0.4 m apart, within the track's ±2 m.
+        let samples = ik.samples(&target);
+        assert!(!samples.is_empty() && samples.len() <= 5, "{samples:?}");
+        assert!(samples.iter().all(|s| s.abs() <= 2.0));
+        let mut sorted = samples.clone();
+        sorted.sort_by(f64::total_cmp);
+        assert!(sorted.windows(2).all(|w| w[1] - w[0] > 0.4 - 1e-9), "{samples:?}");
+        // Where the numeric solver reaches a target with the track in the sampled stretch, so
+        // does the closed form.
+        numeric.clear();
+        dls.solve(&target, &mut numeric);
+        let (lo, hi) = (sorted[0], sorted[sorted.len() - 1]);
+        if numeric.iter().any(|n| n[0] >= lo && n[0] <= hi) {
+            centred += 1;
+            solved += usize::from(!out.is_empty());
+        }
+    }
+    assert!(centred >= 20 && solved == centred, "{solved} of {centred}");
+    // A six-joint arm is no track robot.
+    let fanuc = load_urdf(&fanuc_urdf(), &fanuc_packages(), None).unwrap();
+    assert!(TrackIk::derive(&fanuc.chain).is_none());
 }
 
 #[test]

@@ -30,6 +30,9 @@ pub enum IkKind {
     /// Closed form for arms with three parallel axes and an offset wrist (Universal Robots),
     /// read off the URDF, all branches.
     Parallel,
+    /// An OPW arm on a linear track: track positions sampled around each target, the arm's
+    /// closed form (read off the URDF) at each.
+    Track,
     /// Damped least squares from several starts.
     Numeric,
 }

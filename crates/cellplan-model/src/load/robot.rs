@@ -8,7 +8,7 @@ use crate::{InputError, error::line_of};
 use cellplan_geom::Pose;
 use cellplan_kin::{
     Chain, DlsIk, DlsParams, IkSolver, JointKind, KinError, OpwIk, OpwParameters, ParallelIk, RobotModel,
-    load_urdf,
+    TrackIk, load_urdf,
 };
 use std::collections::{BTreeMap, HashMap};
 use std::ops::Range;
@@ -158,7 +158,8 @@ fn joint_scale(ctx: &Ctx, chain: &Chain, j: usize) -> f64 {
 /// only); without them, OPW with the parameters read off the URDF where the chain is an
 /// ortho-parallel arm with a spherical wrist (checked against the chain, see
 /// [`OpwIk::derive`]), the closed form of three parallel axes where it is a Universal Robots
-/// kind of arm ([`ParallelIk::derive`]), else the numeric solver.
+/// kind of arm ([`ParallelIk::derive`]), sampled track positions with the arm's closed form
+/// where it is such an arm on a linear track ([`TrackIk::derive`]), else the numeric solver.
 fn ik_solver(
     ctx: &Ctx,
     entry: &Spanned<RobotSpec>,
@@ -172,6 +173,9 @@ fn ik_solver(
         }
         if let Some(parallel) = ParallelIk::derive(&model.chain) {
             return Ok((Arc::new(parallel), IkKind::Parallel));
+        }
+        if let Some(track) = TrackIk::derive(&model.chain) {
+            return Ok((Arc::new(track), IkKind::Track));
         }
         return Ok((
             Arc::new(DlsIk::new(&model.chain, DlsParams::default())),
