@@ -58,6 +58,29 @@ fn an_arm_without_its_opw_file_checks_as_with_it() {
     );
 }
 
+/// The same arm on a floor track (a prismatic first joint) gets sampled track positions and
+/// the arm's closed form, and reaches the small cell's tasks.
+#[test]
+fn an_arm_on_a_track_gets_the_track_solver() {
+    let dir = scratch("track");
+    let (cell, _) = small_cell(&dir);
+    let urdf_line = cell.lines().find(|l| l.starts_with("urdf =")).unwrap();
+    let home_line = cell.lines().find(|l| l.starts_with("home =")).unwrap();
+    let opw_line = cell.lines().find(|l| l.starts_with("opw =")).unwrap();
+    let track = root().join(FANUC).join("urdf/r2000ic125l_on_track.urdf");
+    let text = cell
+        .replace(urdf_line, &format!("urdf = \"{}\"", track.display()))
+        .replace(home_line, "home = [0, 0, -30, 0, 0, -60, 0]")
+        .replace(opw_line, "");
+    let path = dir.join("cell.toml");
+    std::fs::write(&path, text).unwrap();
+    let v = json_ok(&["check", path.to_str().unwrap(), "--json"], &dir);
+    assert_eq!(v["ik"], serde_json::json!(["track"]));
+    for t in v["candidates"].as_array().unwrap() {
+        assert!(t["robots"]["R1"].as_u64().unwrap() > 0, "{t}");
+    }
+}
+
 #[test]
 fn malformed_toml_names_the_line() {
     let dir = scratch("toml");
