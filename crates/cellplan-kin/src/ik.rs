@@ -90,6 +90,21 @@ pub fn limit_variants(q: &[f64], chain: &Chain, out: &mut Vec<Vec<f64>>) {
     }
 }
 
+/// Writes into `q` a pseudo-random configuration of `chain`: each joint uniform over its range
+/// cut to (−π, π) (its middle where that is empty), for the checks the closed-form solvers make
+/// of themselves when built.
+pub(crate) fn random_within_a_turn(chain: &Chain, rng: &mut ChaCha8Rng, q: &mut [f64]) {
+    for (v, joint) in q.iter_mut().zip(&chain.joints) {
+        let lo = joint.lower.max(-PI);
+        let hi = joint.upper.min(PI);
+        *v = if lo < hi {
+            rng.random_range(lo..hi)
+        } else {
+            joint.mid()
+        };
+    }
+}
+
 /// OPW closed form applied to a 6-joint URDF chain: the constant transform between the OPW
 /// flange frame and the chain tip is found and checked when built.
 #[derive(Clone, Debug)]
@@ -142,15 +157,7 @@ impl OpwIk {
         let mut q = [0.0; 6];
         let mut raw = [[0.0; 6]; 8];
         (0..OPW_CHECKS).all(|_| {
-            for (v, joint) in q.iter_mut().zip(&self.chain.joints) {
-                let lo = joint.lower.max(-PI);
-                let hi = joint.upper.min(PI);
-                *v = if lo < hi {
-                    rng.random_range(lo..hi)
-                } else {
-                    joint.mid()
-                };
-            }
+            random_within_a_turn(&self.chain, &mut rng, &mut q);
             let flange = self.root_to_base * self.chain.fk_tip(&q) * self.tip_to_flange;
             let n = self.params.inverse_into(&flange, &mut raw);
             raw[..n].iter().any(|s| {
@@ -202,15 +209,7 @@ impl OpwIk {
         let mut rng = ChaCha8Rng::seed_from_u64(0x0_0b5e_55ed);
         let mut q = [0.0; 6];
         for _ in 0..OPW_CHECKS {
-            for (v, joint) in q.iter_mut().zip(&chain.joints) {
-                let lo = joint.lower.max(-PI);
-                let hi = joint.upper.min(PI);
-                *v = if lo < hi {
-                    rng.random_range(lo..hi)
-                } else {
-                    joint.mid()
-                };
-            }
+            random_within_a_turn(chain, &mut rng, &mut q);
             let (dp, da) = pose_error(&chain.fk_tip(&q), &(base * params.forward(&q) * flange_to_tip));
             if !(dp <= OPW_MATCH_TOLERANCE && da <= OPW_MATCH_TOLERANCE) {
                 let deg: Vec<String> = q.iter().map(|v| format!("{:.1}", v.to_degrees())).collect();

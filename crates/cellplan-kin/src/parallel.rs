@@ -18,11 +18,11 @@
 //!   `P56`, and the planar part reaches it like a two-link arm (two branches), joint 4 turning
 //!   the last link onto joint 5's axis.
 use crate::axes::{EPS, angle_about, closest, level_base, lines};
+use crate::ik::random_within_a_turn;
 use crate::{Chain, IkSolver, limit_variants, pose_error, wrap_angle};
 use cellplan_geom::{DMat3, DVec3, Pose};
-use rand::{RngExt, SeedableRng};
+use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
-use std::f64::consts::PI;
 
 /// Configurations [`ParallelIk::derive`] checks its solver at.
 const CHECKS: usize = 20;
@@ -148,19 +148,8 @@ impl ParallelIk {
         let mut rng = ChaCha8Rng::seed_from_u64(0x0_9a2a_11e1);
         let mut out = Vec::new();
         (0..CHECKS).all(|_| {
-            let q: Vec<f64> = self
-                .chain
-                .joints
-                .iter()
-                .map(|j| {
-                    let (lo, hi) = (j.lower.max(-PI), j.upper.min(PI));
-                    if lo < hi {
-                        rng.random_range(lo..hi)
-                    } else {
-                        j.mid()
-                    }
-                })
-                .collect();
+            let mut q = vec![0.0; self.chain.dof()];
+            random_within_a_turn(&self.chain, &mut rng, &mut q);
             out.clear();
             self.branches(&self.chain.fk_tip(&q), &mut out);
             out.iter()

@@ -5,9 +5,10 @@
 //! samples are the track position that puts joint 1's axis level with the target's wrist
 //! centre (the arm reaching straight out to the side) and positions [`STEP`] apart around it,
 //! [`SAMPLES`] in all, within the track's limits ([`TrackIk::samples`]).
+use crate::ik::random_within_a_turn;
 use crate::{Chain, ChainLink, IkSolver, JointKind, OpwIk, pose_error};
 use cellplan_geom::{DVec3, Pose};
-use rand::{RngExt, SeedableRng};
+use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 
 /// Track positions tried per target (odd: the centre and as many either side).
@@ -92,22 +93,8 @@ impl TrackIk {
         let mut out = Vec::new();
         let mut found = 0;
         for _ in 0..CHECKS {
-            let q: Vec<f64> = self
-                .chain
-                .joints
-                .iter()
-                .map(|j| {
-                    let (lo, hi) = (
-                        j.lower.max(-std::f64::consts::PI),
-                        j.upper.min(std::f64::consts::PI),
-                    );
-                    if lo < hi {
-                        rng.random_range(lo..hi)
-                    } else {
-                        j.mid()
-                    }
-                })
-                .collect();
+            let mut q = vec![0.0; self.chain.dof()];
+            random_within_a_turn(&self.chain, &mut rng, &mut q);
             let target = self.chain.fk_tip(&q);
             out.clear();
             self.solve(&target, &mut out);
