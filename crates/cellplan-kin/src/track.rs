@@ -11,7 +11,8 @@ use cellplan_geom::{DVec3, Pose};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 
-/// Track positions tried per target (odd: the centre and as many either side).
+/// Track positions tried per target, at most (the nearest to the arm-beside-the-target position,
+/// [`STEP`] apart, within the track's limits).
 pub const SAMPLES: usize = 5;
 /// Distance between two track positions tried (m).
 pub const STEP: f64 = 0.4;
