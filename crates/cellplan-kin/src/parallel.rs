@@ -43,8 +43,7 @@ const SINGULAR: f64 = 1e-9;
 #[derive(Clone, Debug)]
 pub struct ParallelIk {
     chain: Chain,
-    /// The base (the root moved level onto joint 1's axis) in the root frame, and its inverse.
-    base: Pose,
+    /// The root frame to the base (the root moved level onto joint 1's axis).
     root_to_base: Pose,
     /// Joint 1's axis is `sign1 · z`.
     sign1: f64,
@@ -120,7 +119,6 @@ impl ParallelIk {
         let v6 = tip.rotation * v6_tip;
         let ik = ParallelIk {
             chain: chain.clone(),
-            base,
             root_to_base: base.inverse(),
             sign1: l[0].dir.z.signum(),
             n,
@@ -155,16 +153,6 @@ impl ParallelIk {
             out.iter()
                 .any(|s| s.iter().zip(&q).all(|(a, b)| wrap_angle(a - b).abs() <= FOUND))
         })
-    }
-
-    /// The base in the chain's root frame (the root moved level onto joint 1's axis).
-    pub fn base(&self) -> Pose {
-        self.base
-    }
-
-    /// The chain.
-    pub fn chain(&self) -> &Chain {
-        &self.chain
     }
 
     /// Every branch (up to 8) that puts the tip at `target` (root frame), joint values in
