@@ -105,6 +105,33 @@ pub(crate) fn random_within_a_turn(chain: &Chain, rng: &mut ChaCha8Rng, q: &mut 
     }
 }
 
+/// Whether a six-joint solver finds `checks` configurations of `chain` again from their tips
+/// (drawn by [`random_within_a_turn`] from `seed`): `branches(tip, out)` appends the solver's
+/// branches for a tip (root frame), and one of them must match the configuration to
+/// `tolerance` rad per joint, up to whole turns. The closed-form solvers' check of themselves
+/// when they read their parameters off a chain.
+pub(crate) fn finds_again(
+    chain: &Chain,
+    seed: u64,
+    checks: usize,
+    tolerance: f64,
+    mut branches: impl FnMut(&Pose, &mut Vec<[f64; 6]>),
+) -> bool {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let mut q = [0.0; 6];
+    let mut out = Vec::new();
+    (0..checks).all(|_| {
+        random_within_a_turn(chain, &mut rng, &mut q);
+        out.clear();
+        branches(&chain.fk_tip(&q), &mut out);
+        out.iter().any(|s| {
+            s.iter()
+                .zip(&q)
+                .all(|(a, b)| crate::wrap_angle(a - b).abs() <= tolerance)
+        })
+    })
+}
+
 /// OPW closed form applied to a 6-joint URDF chain: the constant transform between the OPW
 /// flange frame and the chain tip is found and checked when built.
 #[derive(Clone, Debug)]
@@ -153,19 +180,18 @@ impl OpwIk {
     /// Whether the inverse finds [`OPW_CHECKS`] deterministic pseudo-random configurations
     /// within the limits again (up to whole turns) from their tips.
     fn finds_again(&self) -> bool {
-        let mut rng = ChaCha8Rng::seed_from_u64(0x0_0f1d_a9a1);
-        let mut q = [0.0; 6];
         let mut raw = [[0.0; 6]; 8];
-        (0..OPW_CHECKS).all(|_| {
-            random_within_a_turn(&self.chain, &mut rng, &mut q);
-            let flange = self.root_to_base * self.chain.fk_tip(&q) * self.tip_to_flange;
-            let n = self.params.inverse_into(&flange, &mut raw);
-            raw[..n].iter().any(|s| {
-                s.iter()
-                    .zip(&q)
-                    .all(|(a, b)| crate::wrap_angle(a - b).abs() <= OPW_MATCH_TOLERANCE)
-            })
-        })
+        finds_again(
+            &self.chain,
+            0x0_0f1d_a9a1,
+            OPW_CHECKS,
+            OPW_MATCH_TOLERANCE,
+            |tip, out| {
+                let flange = self.root_to_base * *tip * self.tip_to_flange;
+                let n = self.params.inverse_into(&flange, &mut raw);
+                out.extend_from_slice(&raw[..n]);
+            },
+        )
     }
 
     /// As [`OpwIk::new`] on the chain of `model`; errors name the URDF file.

@@ -18,11 +18,9 @@
 //!   `P56`, and the planar part reaches it like a two-link arm (two branches), joint 4 turning
 //!   the last link onto joint 5's axis.
 use crate::axes::{EPS, angle_about, closest, level_base, lines};
-use crate::ik::random_within_a_turn;
+use crate::ik::finds_again;
 use crate::{Chain, IkSolver, limit_variants, pose_error, wrap_angle};
 use cellplan_geom::{DMat3, DVec3, Pose};
-use rand::SeedableRng;
-use rand_chacha::ChaCha8Rng;
 
 /// Configurations [`ParallelIk::derive`] checks its solver at.
 const CHECKS: usize = 20;
@@ -47,16 +45,15 @@ pub struct ParallelIk {
     root_to_base: Pose,
     /// Joint 1's axis is `sign1 · z`.
     sign1: f64,
-    /// At zero, in the base frame: the parallel axes' direction and joints 2–6's directions.
-    n: DVec3,
+    /// At zero, in the base frame: the joints' directions (`u[1]`, `u[2]` and `u[3]` are
+    /// parallel: `u[1]` is the parallel axes' direction `n`).
     u: [DVec3; 6],
     /// At zero: a point of joint 2's axis.
     a2: DVec3,
     /// `P56 − P45` along joint 5's axis (signed), and `P56 · n`.
     e: f64,
     lateral: f64,
-    /// The planar links' lengths: joint 2's axis to joint 3's, joint 3's to joint 4's.
-    l2: f64,
+    /// The planar link from joint 3's axis to joint 4's: its length.
     l3: f64,
     /// In the tip frame: `P56`, joint 6's axis and a direction square to it.
     p56_tip: DVec3,
@@ -105,8 +102,8 @@ impl ParallelIk {
         let (a2, a3) = (l[1].point, l[2].point);
         let e2 = flat(a3 - a2, n);
         let e3 = flat(p45 - a3, n);
-        let (l2, l3) = (e2.length(), e3.length());
-        if l2 < EPS || l3 < EPS {
+        let l3 = e3.length();
+        if e2.length() < EPS || l3 < EPS {
             return None;
         }
         let u: [DVec3; 6] = std::array::from_fn(|j| l[j].dir);
@@ -121,12 +118,10 @@ impl ParallelIk {
             chain: chain.clone(),
             root_to_base: base.inverse(),
             sign1: l[0].dir.z.signum(),
-            n,
             u,
             a2,
             e: (p56 - p45).dot(u[4]),
             lateral: p56.dot(n),
-            l2,
             l3,
             p56_tip: to_tip.transform_point(p56),
             u6_tip,
@@ -143,15 +138,8 @@ impl ParallelIk {
     /// Whether the inverse finds [`CHECKS`] deterministic pseudo-random configurations within
     /// the limits again (up to whole turns) from their tips.
     fn finds_again(&self) -> bool {
-        let mut rng = ChaCha8Rng::seed_from_u64(0x0_9a2a_11e1);
-        let mut out = Vec::new();
-        (0..CHECKS).all(|_| {
-            let mut q = vec![0.0; self.chain.dof()];
-            random_within_a_turn(&self.chain, &mut rng, &mut q);
-            out.clear();
-            self.branches(&self.chain.fk_tip(&q), &mut out);
-            out.iter()
-                .any(|s| s.iter().zip(&q).all(|(a, b)| wrap_angle(a - b).abs() <= FOUND))
+        finds_again(&self.chain, 0x0_9a2a_11e1, CHECKS, FOUND, |tip, out| {
+            self.branches(tip, out)
         })
     }
 
@@ -163,8 +151,9 @@ impl ParallelIk {
         let u6 = (t.rotation * self.u6_tip).normalize();
         let v6 = t.rotation * self.v6_tip;
         // Joint 1: P56 · n(φ) = lateral, with n(φ) = cos φ · n + sin φ · (z × n).
-        let side = DVec3::Z.cross(self.n);
-        let (a, b) = (p56.dot(self.n), p56.dot(side));
+        let (n0, l2) = (self.u[1], self.e2.length());
+        let side = DVec3::Z.cross(n0);
+        let (a, b) = (p56.dot(n0), p56.dot(side));
         let r = a.hypot(b);
         if r < EPS || self.lateral.abs() > r {
             return;
@@ -172,7 +161,7 @@ impl ParallelIk {
         let spread = (self.lateral / r).clamp(-1.0, 1.0).acos();
         for phi in [b.atan2(a) + spread, b.atan2(a) - spread] {
             let turn = DMat3::from_rotation_z(phi);
-            let n = turn * self.n;
+            let n = turn * n0;
             let u: [DVec3; 6] = std::array::from_fn(|j| turn * self.u[j]);
             let q1 = self.sign1 * phi;
             // Joint 5: the angle from n to joint 6's axis about joint 5's.
@@ -193,14 +182,14 @@ impl ParallelIk {
                 if d < EPS {
                     continue;
                 }
-                let cos_in = (self.l2 * self.l2 + d * d - self.l3 * self.l3) / (2.0 * self.l2 * d);
+                let cos_in = (l2 * l2 + d * d - self.l3 * self.l3) / (2.0 * l2 * d);
                 if !(-1.0 - 1e-12..=1.0 + 1e-12).contains(&cos_in) {
                     continue;
                 }
                 let alpha = cos_in.clamp(-1.0, 1.0).acos();
                 let wh = w / d;
                 for al in [alpha, -alpha] {
-                    let e2 = self.l2 * (al.cos() * wh + al.sin() * n.cross(wh));
+                    let e2 = l2 * (al.cos() * wh + al.sin() * n.cross(wh));
                     let e3 = w - e2;
                     let q2 = angle_about(turn * self.e2, e2, u[1]);
                     let q3 = angle_about(e2, e3, u[2]) - self.ref3;

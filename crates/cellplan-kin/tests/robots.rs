@@ -251,30 +251,20 @@ fn ur5_dls_reaches_random_targets() {
     );
 }
 
+/// The URDF `data/robots/{folder}/urdf/{file}`, its one package `package` in the folder of that
+/// name beside it.
+fn data_robot(folder: &str, file: &str, package: &str) -> cellplan_kin::RobotModel {
+    let robot = data().join("robots").join(folder);
+    let packages = BTreeMap::from([(package.to_string(), robot.join(package))]);
+    load_urdf(&robot.join("urdf").join(file), &packages, None).unwrap()
+}
+
 fn abb_irb2400() -> cellplan_kin::RobotModel {
-    let packages = BTreeMap::from([(
-        "abb_irb2400_support".to_string(),
-        data().join("robots/abb_irb2400/abb_irb2400_support"),
-    )]);
-    load_urdf(
-        &data().join("robots/abb_irb2400/urdf/irb2400.urdf"),
-        &packages,
-        None,
-    )
-    .unwrap()
+    data_robot("abb_irb2400", "irb2400.urdf", "abb_irb2400_support")
 }
 
 fn kr210() -> cellplan_kin::RobotModel {
-    let packages = BTreeMap::from([(
-        "kuka_kr210_support".to_string(),
-        data().join("robots/kuka_kr210/kuka_kr210_support"),
-    )]);
-    load_urdf(
-        &data().join("robots/kuka_kr210/urdf/kr210l150.urdf"),
-        &packages,
-        None,
-    )
-    .unwrap()
+    data_robot("kuka_kr210", "kr210l150.urdf", "kuka_kr210_support")
 }
 
 /// The seven lengths of two parameter sets, side by side.
@@ -373,27 +363,14 @@ fn opw_parameters_are_read_off_the_kuka_kr210_urdf() {
 #[test]
 fn opw_parameters_are_read_off_the_abb_irb6640_urdf() {
     // Its balancing cylinder and piston hang on fixed joints off the chain.
-    let packages = BTreeMap::from([(
-        "abb_irb6600_support".to_string(),
-        data().join("robots/abb_irb6640/abb_irb6600_support"),
-    )]);
-    let model = load_urdf(
-        &data().join("robots/abb_irb6640/urdf/irb6640.urdf"),
-        &packages,
-        None,
-    )
-    .unwrap();
+    let model = data_robot("abb_irb6640", "irb6640.urdf", "abb_irb6600_support");
     let ik = OpwIk::derive(&model.chain).expect("the IRB 6640 is an OPW arm");
     assert!(ik.params().c2 > 1.0 && ik.params().c3 > 1.0, "{:?}", ik.params());
     finds_every_configuration_again(&ik, &model.chain, 200, 9, 1e-9);
 }
 
 fn ur10() -> cellplan_kin::RobotModel {
-    let packages = BTreeMap::from([(
-        "ur_description".to_string(),
-        data().join("robots/ur10/ur_description"),
-    )]);
-    load_urdf(&data().join("robots/ur10/urdf/ur10.urdf"), &packages, None).unwrap()
+    data_robot("ur10", "ur10.urdf", "ur_description")
 }
 
 #[test]
