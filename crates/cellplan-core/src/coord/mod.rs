@@ -276,6 +276,8 @@ fn coordinate_with(
     let uncoordinated_cycle = cycle_and_delta(&timed).0;
     let cell_order: Vec<usize> = (0..programs.len()).collect();
     let mut distances = 0;
+    // The programs as given (the tracks before coordination are theirs).
+    let given = programs.clone();
     // With `best`, the kept programs blended as its choice scored them (not done again below).
     let (programs, res, priority, pre_blended) = match settings.strategy {
         Coordination::None => (programs, Resolution::default(), Vec::new(), None),
@@ -299,7 +301,6 @@ fn coordinate_with(
             // Tours in their canonical directions; `reversed` then says which run against the
             // planned ones.
             let against = against_canonical(&programs);
-            let as_planned = programs.clone();
             let programs: Vec<Program> = programs
                 .iter()
                 .zip(&against)
@@ -325,7 +326,7 @@ fn coordinate_with(
                 first,
                 &cell_order,
                 cover.as_ref(),
-                (&as_planned, &against),
+                (&given, &against),
             )?;
             res.reversed = (0..programs.len())
                 .map(|i| against[i] != res.reversed.get(i).copied().unwrap_or(false))
@@ -336,13 +337,19 @@ fn coordinate_with(
             (progs, res, priority, blended)
         }
     };
-    // Tours `best` runs the other way round: what they meet uncoordinated.
+    // Tours `best` runs the other way round: what they meet uncoordinated — the programs as
+    // they were given (before any measuring pose was changed), each turned as `reversed` says,
+    // as the plan's tracks before coordination are made (`document::build`).
     let before = if res.reversed.iter().any(|&r| r) {
-        let bare: Vec<Timed> = programs
+        let bare: Vec<Timed> = given
             .iter()
-            .map(|p| {
-                let mut p = p.clone();
-                p.waits.clear();
+            .zip(&res.reversed)
+            .map(|(p, &turned)| {
+                let p = if turned {
+                    p.reversed(&ctx.limits[p.robot])?
+                } else {
+                    p.clone()
+                };
                 ctx.timed(&p)
             })
             .collect::<Result<_, _>>()?;
