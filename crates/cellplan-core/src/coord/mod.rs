@@ -276,7 +276,6 @@ fn coordinate_with(
     let uncoordinated_cycle = cycle_and_delta(&timed).0;
     let cell_order: Vec<usize> = (0..programs.len()).collect();
     let mut distances = 0;
-    // The programs as given (the tracks before coordination are theirs).
     let given = programs.clone();
     // With `best`, the kept programs blended as its choice scored them (not done again below).
     let (programs, res, priority, pre_blended) = match settings.strategy {
@@ -337,9 +336,8 @@ fn coordinate_with(
             (progs, res, priority, blended)
         }
     };
-    // Tours `best` runs the other way round: what they meet uncoordinated — the programs as
-    // they were given (before any measuring pose was changed), each turned as `reversed` says,
-    // as the plan's tracks before coordination are made (`document::build`).
+    // Tours `best` runs the other way round: what the programs as given (no pose changed) meet
+    // uncoordinated, each turned as run — as the plan's tracks before coordination are made.
     let before = if res.reversed.iter().any(|&r| r) {
         let bare: Vec<Timed> = given
             .iter()
