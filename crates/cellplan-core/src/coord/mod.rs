@@ -341,14 +341,11 @@ fn coordinate_with(
     let before = if res.reversed.iter().any(|&r| r) {
         let bare: Vec<Timed> = given
             .iter()
+            .zip(&timed)
             .zip(&res.reversed)
-            .map(|(p, &turned)| {
-                let p = if turned {
-                    p.reversed(&ctx.limits[p.robot])?
-                } else {
-                    p.clone()
-                };
-                ctx.timed(&p)
+            .map(|((p, t), &turned)| match turned {
+                true => ctx.timed(&p.reversed(&ctx.limits[p.robot])?),
+                false => Ok(t.clone()),
             })
             .collect::<Result<_, _>>()?;
         ctx.timeline(&bare).conflicts()
