@@ -29,36 +29,47 @@ pub fn on_threads<T: Send>(threads: usize, f: impl FnOnce() -> T + Send) -> T {
         .install(f)
 }
 
-/// A fresh temporary folder `cellplan-{name}-XXXXXX`, created and kept (fixtures live as long
-/// as the test process).
-pub fn scratch_dir(name: &str) -> PathBuf {
-    tempfile::Builder::new()
-        .prefix(&format!("cellplan-{name}-"))
-        .tempdir()
-        .unwrap()
-        .keep()
-}
-
 /// The bundled two-robot example with only its first `tasks` MPs, named `name` and its
-/// `cell.toml` text edited by `edit`, written to [`scratch_dir`]`(folder)`; returns the path
-/// of its `cell.toml`.
+/// `cell.toml` text edited by `edit`, written to a folder of the system's temporary folder;
+/// returns the path of its `cell.toml`. The folder is named by `folder` and a hash of what it
+/// holds, and its files are written whole (each to a temporary file, then renamed): test
+/// processes that want the same copy share one folder, running or not, and no run leaves
+/// another folder behind.
 pub fn example_copy(folder: &str, name: &str, tasks: usize, edit: impl FnOnce(String) -> String) -> PathBuf {
     let root = repo_root();
     let example = root.join("examples/autobody-2r");
-    let dir = scratch_dir(folder);
     let text = std::fs::read_to_string(example.join("cell.toml"))
         .unwrap()
         .replace("../../data", &root.join("data").display().to_string())
         .replace("name = \"autobody-2r\"", &format!("name = \"{name}\""));
-    std::fs::write(dir.join("cell.toml"), edit(text)).unwrap();
+    let text = edit(text);
     let csv = std::fs::read_to_string(example.join("tasks.csv")).unwrap();
     let keep: Vec<&str> = csv
         .lines()
         .filter(|l| !l.starts_with('#'))
         .take(tasks + 1)
         .collect();
-    std::fs::write(dir.join("tasks.csv"), keep.join("\n") + "\n").unwrap();
+    let csv = keep.join("\n") + "\n";
+    let dir = std::env::temp_dir().join(format!("cellplan-{folder}-{:016x}", fnv1a(&[&text, &csv])));
+    std::fs::create_dir_all(&dir).unwrap();
+    for (file, contents) in [("cell.toml", &text), ("tasks.csv", &csv)] {
+        let mut part = tempfile::NamedTempFile::new_in(&dir).unwrap();
+        std::io::Write::write_all(&mut part, contents.as_bytes()).unwrap();
+        part.persist(dir.join(file)).unwrap();
+    }
     dir.join("cell.toml")
+}
+
+/// The 64-bit FNV-1a hash of `parts` (each followed by a zero byte): stable across runs and
+/// builds, unlike the standard library's hasher.
+fn fnv1a(parts: &[&str]) -> u64 {
+    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+    for part in parts {
+        for b in part.bytes().chain([0]) {
+            h = (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3);
+        }
+    }
+    h
 }
 
 /// Writes the crossing cell to a temporary folder of this process and returns the path of its

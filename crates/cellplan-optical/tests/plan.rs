@@ -7,7 +7,7 @@ use cellplan_core::document as output;
 use cellplan_core::plan::{self, Allocation, PlanSettings};
 use cellplan_model::{Cell, LoadOptions, TaskId};
 use cellplan_optical::load;
-use cellplan_optical::testing::{on_threads, repo_root, scratch_dir};
+use cellplan_optical::testing::{on_threads, repo_root};
 use common::*;
 use std::path::Path;
 
@@ -63,7 +63,11 @@ fn the_plan_does_not_depend_on_the_thread_count() {
 #[test]
 fn allocation_strategies_give_the_known_answers_on_a_hand_made_cell() {
     let fanuc = repo_root().join("data/robots/fanuc_r2000ic");
-    let dir = scratch_dir("plan-known");
+    let scratch = tempfile::Builder::new()
+        .prefix("cellplan-plan-known-")
+        .tempdir()
+        .unwrap();
+    let dir = scratch.path();
     let robot = |name: &str, y: i32| {
         format!(
             r#"

@@ -47,13 +47,32 @@ pub(crate) fn json_ok(args: &[&str], cache: &Path) -> Value {
     serde_json::from_slice(&run_ok(args, cache).stdout).expect("stdout is JSON")
 }
 
-/// A fresh scratch folder per test (kept after the run, for a look at what a test wrote).
-pub(crate) fn scratch(name: &str) -> PathBuf {
-    tempfile::Builder::new()
+/// A fresh scratch folder per test, removed when the test ends (kept, for a look at what a
+/// test wrote, with `CELLPLAN_KEEP_SCRATCH` set).
+pub(crate) fn scratch(name: &str) -> Scratch {
+    let dir = tempfile::Builder::new()
         .prefix(&format!("cellplan-cli-{name}-"))
+        .disable_cleanup(std::env::var_os("CELLPLAN_KEEP_SCRATCH").is_some())
         .tempdir()
-        .unwrap()
-        .keep()
+        .unwrap();
+    Scratch(dir)
+}
+
+/// A test's scratch folder (see [`scratch`]), read as its path.
+pub(crate) struct Scratch(tempfile::TempDir);
+
+impl std::ops::Deref for Scratch {
+    type Target = Path;
+
+    fn deref(&self) -> &Path {
+        self.0.path()
+    }
+}
+
+impl AsRef<Path> for Scratch {
+    fn as_ref(&self) -> &Path {
+        self.0.path()
+    }
 }
 
 pub(crate) const FANUC: &str = "data/robots/fanuc_r2000ic";
@@ -144,7 +163,7 @@ pub(crate) fn refused(
 
 /// Plans the small cell in a fresh scratch folder `name` with `--json`: the folder, the cell
 /// file, the output folder and the printed summary.
-pub(crate) fn plan_small_cell(name: &str) -> (PathBuf, PathBuf, PathBuf, Value) {
+pub(crate) fn plan_small_cell(name: &str) -> (Scratch, PathBuf, PathBuf, Value) {
     let dir = scratch(name);
     small_cell(&dir);
     let cell = dir.join("cell.toml");
