@@ -262,6 +262,14 @@ pub fn segment_trajectory(a: &[f64], b: &[f64], limits: &Limits) -> Result<Traje
 }
 
 impl Program {
+    /// The same program without its waits.
+    pub fn without_waits(&self) -> Program {
+        Program {
+            waits: Vec::new(),
+            ..self.clone()
+        }
+    }
+
     /// A robot's program from its final sequence, without waits: the sequence's candidates
     /// as visits, every leg timed segment by segment.
     pub fn from_sequence(
