@@ -11,6 +11,7 @@
 pub mod cell;
 pub mod document;
 pub mod error;
+pub mod hash;
 pub mod io;
 pub mod load;
 pub mod names;

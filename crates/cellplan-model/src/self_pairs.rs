@@ -3,6 +3,7 @@
 //! in many random configurations are left out. (MoveIt also drops pairs touching in the default
 //! pose; here the loader refuses a home where any non-adjacent pair touches instead.) The result
 //! depends only on the robot's geometry, so it is cached on disk keyed by a hash of that geometry.
+use crate::hash::Fnv;
 use crate::robot::{BodyFrame, Robot, Scratch};
 use cellplan_geom::{CollisionWorld, Pose, ShapeSpec};
 use rand::{RngExt, SeedableRng};
@@ -138,21 +139,6 @@ pub fn sample_self_pairs(robot: &Robot, world: &CollisionWorld, samples: usize, 
     SelfPairs { pairs }
 }
 
-/// FNV-1a, stable across runs and platforms (std's hasher makes no such promise).
-struct Fnv(u64);
-
-impl Hasher for Fnv {
-    fn finish(&self) -> u64 {
-        self.0
-    }
-    fn write(&mut self, bytes: &[u8]) {
-        for b in bytes {
-            self.0 ^= u64::from(*b);
-            self.0 = self.0.wrapping_mul(0x100_0000_01b3);
-        }
-    }
-}
-
 fn hash_pose(h: &mut Fnv, p: &Pose) {
     for v in p.translation.to_array().into_iter().chain(p.rotation.to_array()) {
         h.write_u64(v.to_bits());
@@ -192,7 +178,7 @@ fn hash_shape(h: &mut Fnv, s: &ShapeSpec) {
 /// A key for everything the sampling result depends on: the chain, its geometry, the tool,
 /// the home configuration, the sample count and seed.
 pub fn geometry_key(robot: &Robot, samples: usize, seed: u64) -> u64 {
-    let mut h = Fnv(0xcbf2_9ce4_8422_2325);
+    let mut h = Fnv::default();
     h.write_u64(RULE_VERSION);
     h.write_u64(samples as u64);
     h.write_u64(seed);

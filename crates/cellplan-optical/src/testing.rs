@@ -50,7 +50,13 @@ pub fn example_copy(folder: &str, name: &str, tasks: usize, edit: impl FnOnce(St
         .take(tasks + 1)
         .collect();
     let csv = keep.join("\n") + "\n";
-    let dir = std::env::temp_dir().join(format!("cellplan-{folder}-{:016x}", fnv1a(&[&text, &csv])));
+    let mut hash = cellplan_model::hash::Fnv::default();
+    for part in [&text, &csv] {
+        std::hash::Hasher::write(&mut hash, part.as_bytes());
+        std::hash::Hasher::write_u8(&mut hash, 0);
+    }
+    let hash = std::hash::Hasher::finish(&hash);
+    let dir = std::env::temp_dir().join(format!("cellplan-{folder}-{hash:016x}"));
     std::fs::create_dir_all(&dir).unwrap();
     for (file, contents) in [("cell.toml", &text), ("tasks.csv", &csv)] {
         let mut part = tempfile::NamedTempFile::new_in(&dir).unwrap();
@@ -58,18 +64,6 @@ pub fn example_copy(folder: &str, name: &str, tasks: usize, edit: impl FnOnce(St
         part.persist(dir.join(file)).unwrap();
     }
     dir.join("cell.toml")
-}
-
-/// The 64-bit FNV-1a hash of `parts` (each followed by a zero byte): stable across runs and
-/// builds, unlike the standard library's hasher.
-fn fnv1a(parts: &[&str]) -> u64 {
-    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
-    for part in parts {
-        for b in part.bytes().chain([0]) {
-            h = (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3);
-        }
-    }
-    h
 }
 
 /// Writes the crossing cell to a temporary folder of this process and returns the path of its

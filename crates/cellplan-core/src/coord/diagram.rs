@@ -150,8 +150,7 @@ pub(crate) struct RobotPath {
 impl RobotPath {
     /// The path of `program` (its waits are ignored).
     pub fn new(ctx: &Ctx, program: &Program) -> Result<RobotPath, PlanError> {
-        let mut bare = program.clone();
-        bare.waits.clear();
+        let bare = program.without_waits();
         let timed = ctx.timed(&bare)?;
         let mut rests = Vec::new();
         for (k, at) in timed.arrivals.iter().enumerate() {

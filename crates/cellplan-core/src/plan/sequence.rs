@@ -558,14 +558,11 @@ impl LegMemo {
 
 /// A seed per leg, so that a leg's path does not depend on which thread plans it or when.
 fn leg_seed(seed: u64, robot: usize, a: usize, b: usize) -> u64 {
-    let mut h = 0xcbf2_9ce4_8422_2325u64;
+    let mut h = cellplan_model::hash::Fnv::default();
     for x in [seed, robot as u64, a as u64, b as u64] {
-        for byte in x.to_le_bytes() {
-            h ^= u64::from(byte);
-            h = h.wrapping_mul(0x0100_0000_01b3);
-        }
+        std::hash::Hasher::write(&mut h, &x.to_le_bytes());
     }
-    h
+    std::hash::Hasher::finish(&h)
 }
 
 #[cfg(test)]
