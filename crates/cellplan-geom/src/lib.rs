@@ -31,5 +31,5 @@ pub use shape::ShapeSpec;
 pub use spheres::Sphere;
 pub use world::{
     BodyContact, BroadPhase, CollisionWorld, GroupBody, GroupId, PlacedCovers, RayHit, StaticId,
-    convex_distance,
+    convex_distance, convex_overlap,
 };

@@ -540,7 +540,7 @@ mod narrow;
 mod rays;
 
 pub use broad::{BroadPhase, PlacedCovers};
-pub use distance::convex_distance;
+pub use distance::{convex_distance, convex_overlap};
 
 use narrow::{convex_within, static_within};
 

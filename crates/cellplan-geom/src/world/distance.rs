@@ -436,6 +436,20 @@ pub fn convex_distance(pa: &Pose, a: &dyn SupportMap, pb: &Pose, b: &dyn Support
     hinted_distance(&pa.inv_mul(pb), a, b, sanitize_margin(cap), DVec3::ZERO)
 }
 
+/// Whether two convex support maps at poses `pa` and `pb` (world) overlap, as GJK finds the
+/// origin inside their difference. GJK declares an overlap within its tolerance of a touch
+/// (far below a micrometre at these scales): a caller that needs a proof of contact asks it of
+/// one shape shrunk by more than that.
+pub fn convex_overlap(pa: &Pose, a: &dyn SupportMap, pb: &Pose, b: &dyn SupportMap) -> bool {
+    if !(pa.is_finite() && pb.is_finite()) {
+        return false;
+    }
+    matches!(
+        super::narrow::convex_gjk(&pa.inv_mul(pb), a, b, 1e-9, false, None),
+        parry3d_f64::query::gjk::GJKResult::Intersection
+    )
+}
+
 #[cfg(test)]
 mod tests {
     use super::{Sphere, covers_within};
@@ -490,5 +504,18 @@ mod tests {
             }
         }
         assert!(yes > 500 && no > 500, "{yes} within, {no} apart");
+    }
+
+    /// Two boxes overlap by GJK's account exactly when they do: 1 mm apart, 1 mm into each
+    /// other, and at non-finite poses (no answer, so no overlap).
+    #[test]
+    fn convex_overlap_tells_overlap_from_a_gap() {
+        use crate::Pose;
+        use parry3d_f64::shape::Cuboid;
+        let b = Cuboid::new(DVec3::splat(0.1));
+        let at = |x: f64| Pose::from_parts(DVec3::new(x, 0.0, 0.0), Default::default());
+        assert!(super::convex_overlap(&at(0.0), &b, &at(0.199), &b));
+        assert!(!super::convex_overlap(&at(0.0), &b, &at(0.201), &b));
+        assert!(!super::convex_overlap(&at(0.0), &b, &at(f64::NAN), &b));
     }
 }

@@ -577,3 +577,59 @@ fn posed_bounds_bound_the_motion() {
     }
     assert!(posed_sum < 0.85 * static_sum, "{posed_sum} against {static_sum}");
 }
+
+/// A pair table's proof of contact holds: wherever it says a pair touches, the pair's exact
+/// distance is zero (random configurations, and configurations whose table joint is moved to
+/// within a hair of its sample spacing's edges); and it proves most of the base and upper arm's
+/// contacts, the contacts most random configurations of the UR5 have.
+#[test]
+fn pair_tables_prove_only_real_contacts() {
+    let setup = ur5();
+    let arm = setup.arm();
+    let tables = crate::arm::PairTables::build(&arm);
+    let mut rng = ChaCha8Rng::seed_from_u64(21);
+    let (mut links, mut poses) = (Vec::new(), Vec::<Pose>::new());
+    let (mut base_contacts, mut base_proven, mut proofs) = (0, 0, 0);
+    for _ in 0..3000 {
+        let mut q = random_q(&arm, &mut rng);
+        for &(i, j) in arm.self_pairs {
+            let Some(t) = tables.get(i, j) else { continue };
+            let k = t.joint();
+            // Half the time, the joint a hair off the nearest sample's cell edge.
+            if rng.random_bool(0.5) {
+                let (lo, step) = (t.lo, t.step);
+                let g = ((q[k] - lo) / step).round();
+                let edge = lo + step * (g + 0.5 - 1e-9);
+                if edge <= arm.chain.joints[k].upper {
+                    q[k] = edge;
+                }
+            }
+            arm.body_poses(&q, &mut links, &mut poses);
+            let exact = arm.world.pair_distance(arm.group, i, j, &poses, 1.0);
+            let proven = t.touches(q[k]);
+            assert!(
+                !proven || exact <= 0.0,
+                "pair ({i}, {j}) proven in contact {exact} m apart at {q:?}"
+            );
+            proofs += usize::from(proven);
+            if (i, j) == (0, 2) && exact <= 0.0 {
+                base_contacts += 1;
+                base_proven += usize::from(proven);
+            }
+            assert_eq!(
+                tables.prove_contact(&q),
+                arm.self_pairs
+                    .iter()
+                    .any(|&(a, b)| tables.get(a, b).is_some_and(|t| t.touches(q[t.joint()])))
+            );
+        }
+    }
+    assert!(proofs > 500, "only {proofs} proofs");
+    assert!(
+        2 * base_proven > base_contacts,
+        "{base_proven} of {base_contacts} contacts of the base and the upper arm proven"
+    );
+    // Out of range and non-finite values prove nothing.
+    let t = tables.get(0, 2).expect("a table for the base and the upper arm");
+    assert!(!t.touches(f64::NAN) && !t.touches(f64::INFINITY));
+}

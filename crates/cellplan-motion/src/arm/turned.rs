@@ -26,7 +26,8 @@
 //! [`PROBES`] configurations spread over the limits (a fixed sequence: the tables, and so the
 //! work of every check, depend on the arm alone).
 use super::{Arm, DISTANCE_SLACK, moved_by};
-use cellplan_geom::revolved::Revolved;
+use cellplan_geom::convex_overlap;
+use cellplan_geom::revolved::{Cylinder, Revolved, inner_cylinders};
 use cellplan_geom::{BroadPhase, PlacedCovers};
 use cellplan_geom::{DVec3, Pose, convex_distance};
 use parry3d_f64::shape::SupportMap;
@@ -50,27 +51,68 @@ const MIN_SAMPLES: usize = 16;
 /// Distances are asked up to this (m); beyond, the sample says this much.
 const TABLE_CAP: f64 = 0.1;
 
+/// What a proof of contact shrinks a cylinder by beyond the motion it covers (m): far more than
+/// GJK's tolerance for an overlap ([`convex_overlap`]).
+const CONTACT_SLACK: f64 = 1e-4;
+
+/// A turned end's cylinders for proofs of contact are the largest and the widest at least twice
+/// this long (m; see [`inner_cylinders`]): a robot's base is a disc whose widest part is thin.
+const CYLINDER_HALF_HEIGHT: f64 = 0.003;
+
 /// A lower bound on one self pair's distance as a function of one joint's value.
 #[derive(Clone, Debug, PartialEq)]
 pub struct PairTable {
     /// The joint.
     joint: usize,
     /// Its value at the first sample.
-    lo: f64,
+    pub(super) lo: f64,
     /// The spacing of the samples.
-    step: f64,
+    pub(super) step: f64,
     /// A whole turn when the joint's range spans one: values are taken modulo it.
     period: Option<f64>,
     /// How fast the distance can fall per unit of the joint (m/rad).
     lipschitz: f64,
     /// The distance at each sample, certified from below, less the slack.
     values: Vec<f64>,
+    /// At each sample, whether the pair is proven in contact for every value of the joint
+    /// within half a spacing of it, whatever the other joints (see [`PairTable::touches`]);
+    /// empty when the ends have no cylinder to prove it with.
+    contact: Vec<bool>,
 }
 
 impl PairTable {
     /// The joint the table runs over.
     pub fn joint(&self) -> usize {
         self.joint
+    }
+
+    /// Whether the pair is in contact, proven, wherever the joint stands at `v` (the other
+    /// joints anywhere); `false` where the table cannot tell.
+    ///
+    /// A turned end is rotation-invariant about its joint's axis, and so is a cylinder about
+    /// that axis inside it ([`inner_cylinder`]): that cylinder stays inside the body whatever
+    /// the turned joint's value. At a sample, the cylinder shrunk by `δ` is found overlapping
+    /// the other end (its own body, or its cylinder). Over half a spacing `h/2` from the
+    /// sample, a point common to both moves relative to the other end by at most `L·h/2` (`L`
+    /// the table's Lipschitz constant, the smaller reach of the two ends from the joint's axis,
+    /// which the common point lies within); `δ` exceeds it, so the point stays inside the
+    /// unshrunk cylinder, and the bodies overlap.
+    #[inline]
+    pub fn touches(&self, v: f64) -> bool {
+        let n = self.contact.len();
+        if n == 0 || !v.is_finite() {
+            return false;
+        }
+        let mut x = v - self.lo;
+        if let Some(p) = self.period {
+            x = x.rem_euclid(p);
+        }
+        let g = (x / self.step).round();
+        // Outside the sampled range nothing is known.
+        if !(0.0..n as f64).contains(&g) {
+            return false;
+        }
+        self.contact[g as usize]
     }
 
     /// The least bound (m, 0 where the table says nothing) over the joint's values within
@@ -135,7 +177,8 @@ impl PairTable {
 /// axis (body frame).
 enum End {
     Own,
-    Turned(Revolved),
+    /// Turned, with cylinders about the axis inside the body (none when none fits).
+    Turned(Revolved, Vec<Cylinder>),
 }
 
 /// The table of bodies `i` and `j` of `arm` (see the module documentation), or `None` when it
@@ -168,11 +211,11 @@ pub fn pair_table(arm: &Arm, i: usize, j: usize) -> Option<PairTable> {
     let turned = |body: usize, k: usize| -> Option<End> {
         let (o, d) = axis(k)?;
         let to_body = poses.get(body)?.inverse();
-        Some(End::Turned(Revolved::new(
-            &points(body)?,
-            to_body.transform_point(o),
-            to_body.rotation * d,
-        )?))
+        let (pts, o, d) = (points(body)?, to_body.transform_point(o), to_body.rotation * d);
+        Some(End::Turned(
+            Revolved::new(&pts, o, d)?,
+            inner_cylinders(&pts, o, d, CYLINDER_HALF_HEIGHT),
+        ))
     };
     let (pn, pf) = (points(near)?, points(far)?);
     let options = if m == 2 {
@@ -220,7 +263,7 @@ fn sample(
                 .iter()
                 .map(|p| (pose.transform_point(*p) - o).cross(d).length())
                 .fold(0.0, f64::max),
-            End::Turned(r) => {
+            End::Turned(r, _) => {
                 let to_body = pose.inverse();
                 r.reach_from(to_body.transform_point(o), to_body.rotation * d)
             }
@@ -239,8 +282,24 @@ fn sample(
     };
     let n = ((span * lipschitz / (2.0 * LOSS)).ceil() as usize + 1).clamp(MIN_SAMPLES, MAX_SAMPLES);
     let step = span / (n - 1) as f64;
+    // The proof of contact: one end's cylinder shrunk by how far half a spacing moves the
+    // ends (see [`PairTable::touches`]), against the other end as it stays whatever its
+    // turned joint's value: its own body, or its cylinder.
+    let shrink = 0.5 * lipschitz * step + CONTACT_SLACK;
+    let shrunk = |cs: &[Cylinder]| -> Vec<Cylinder> { cs.iter().filter_map(|c| c.eroded(shrink)).collect() };
+    // The shrunk cylinders and what they are tried against: on the near end, against the
+    // far end's cylinders when it is turned (`Some`) or its own body; on the far end, against
+    // the near end's own body.
+    let proof: Option<Proof> = match (en, ef) {
+        (End::Turned(_, c), End::Turned(_, other)) => Some((shrunk(c), true, Some(&other[..]))),
+        (End::Turned(_, c), End::Own) => Some((shrunk(c), true, None)),
+        (End::Own, End::Turned(_, c)) => Some((shrunk(c), false, None)),
+        _ => None,
+    }
+    .filter(|(cs, _, other)| !cs.is_empty() && other.is_none_or(|o| !o.is_empty()));
     let mut cq = q.to_vec();
     let mut values = Vec::with_capacity(n);
+    let mut contact = Vec::with_capacity(if proof.is_some() { n } else { 0 });
     for g in 0..n {
         cq[free] = lo + step * g as f64;
         arm.body_poses(&cq, &mut links, &mut poses);
@@ -249,6 +308,19 @@ fn sample(
             placed(arm, far, *poses.get(far)?, ef)?,
         );
         values.push(convex_distance(&pa, sa, &pb, sb, TABLE_CAP) - DISTANCE_SLACK);
+        if let Some((cylinders, on_near, other)) = &proof {
+            let (pn, pf) = (*poses.get(near)?, *poses.get(far)?);
+            let touching = cylinders.iter().any(|c| match (on_near, other) {
+                (true, Some(other)) => other.iter().any(|o| convex_overlap(&pn, c, &pf, o)),
+                (true, None) => convex_overlap(&pn, c, &pb, sb),
+                (false, _) => convex_overlap(&pa, sa, &pf, c),
+            });
+            contact.push(touching);
+        }
+    }
+    // A table that proves nothing keeps no flags.
+    if !contact.contains(&true) {
+        contact.clear();
     }
     Some(PairTable {
         joint: free,
@@ -257,8 +329,13 @@ fn sample(
         period,
         lipschitz,
         values,
+        contact,
     })
 }
+
+/// How a table proves contact: shrunk cylinders, whether on the near end, and the far end's
+/// cylinders they are tried against (`None`: the other end's own body).
+type Proof<'a> = (Vec<Cylinder>, bool, Option<&'a [Cylinder]>);
 
 /// End `e` of body `body` (at `pose`) as a support map and its pose in the world.
 fn placed<'s>(arm: &Arm<'s>, body: usize, pose: Pose, e: &'s End) -> Option<(Pose, &'s dyn SupportMap)> {
@@ -267,7 +344,7 @@ fn placed<'s>(arm: &Arm<'s>, body: usize, pose: Pose, e: &'s End) -> Option<(Pos
             let (s, local) = arm.world.body_support(arm.group, body)?;
             (pose * local, s)
         }
-        End::Turned(r) => (pose, r as &dyn SupportMap),
+        End::Turned(r, _) => (pose, r as &dyn SupportMap),
     })
 }
 
@@ -339,6 +416,15 @@ impl PairTables {
     pub fn get(&self, i: usize, j: usize) -> Option<&PairTable> {
         let s = *self.slots.get(self.index(i, j)?)?;
         self.tables.get(s as usize)
+    }
+
+    /// Whether some table proves its pair in contact at `q` ([`PairTable::touches`]): then
+    /// `q` is invalid, whatever else holds.
+    #[inline]
+    pub fn prove_contact(&self, q: &[f64]) -> bool {
+        self.tables
+            .iter()
+            .any(|t| !t.contact.is_empty() && q.get(t.joint).is_some_and(|&v| t.touches(v)))
     }
 
     /// The number of tables.
