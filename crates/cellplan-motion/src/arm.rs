@@ -179,6 +179,25 @@ impl Clone for PartHint {
     }
 }
 
+/// [`ArmValidity::order`] for `moving` bodies and checked self pairs `pairs` (parts `moving..`):
+/// the pairs [`PairTables::likely_contacts`] lists, in its order, then the moving bodies, then
+/// the other pairs.
+fn part_order(arm: &Arm, moving: usize, pairs: &[(usize, usize)]) -> Vec<usize> {
+    let likely: Vec<usize> = arm.pair_tables.map_or(Vec::new(), |t| {
+        t.likely_contacts()
+            .iter()
+            .filter_map(|p| pairs.iter().position(|q| q == p))
+            .collect()
+    });
+    let rest = (0..pairs.len()).filter(|k| !likely.contains(k));
+    likely
+        .iter()
+        .map(|k| moving + k)
+        .chain(0..moving)
+        .chain(rest.map(|k| moving + k))
+        .collect()
+}
+
 /// A checked self pair `(i, j)` with the joints between its bodies and the radii that bound
 /// their relative motion ([`pair_radii`]).
 type CheckedPair = (usize, usize, Range<usize>, Vec<f64>);
@@ -223,6 +242,10 @@ pub struct ArmValidity<'a> {
     axes: Vec<Option<(usize, DVec3)>>,
     /// The part that last proved a configuration invalid (asked first next time).
     last_failed: PartHint,
+    /// The order in which [`Self::is_valid`] asks the other parts ([`part_order`]): a part
+    /// likely to fail before the many that rarely do. Only the work depends on it, never the
+    /// answer.
+    order: Vec<usize>,
     /// Per part (the moving bodies, then the pairs): the chain links it needs posed, `0..end`
     /// (its bodies', which hold its clusters' too).
     part_links: Vec<usize>,
@@ -275,6 +298,7 @@ impl<'a> ArmValidity<'a> {
             })
             .collect();
         let pair_bodies: Vec<(usize, usize)> = pairs.iter().map(|&(i, j, _, _)| (i, j)).collect();
+        let order = part_order(&arm, moving.len(), &pair_bodies);
         let clusters = Clusters::new(&arm, &broad, &moving, &pair_bodies);
         let end = |i: usize| arm.body_links.get(i).map_or(usize::MAX, |&l| l.saturating_add(1));
         let part_links = moving
@@ -296,6 +320,7 @@ impl<'a> ArmValidity<'a> {
             pair_far,
             axes,
             last_failed: PartHint::default(),
+            order,
             moving,
             body_radii,
             pairs,
@@ -486,8 +511,12 @@ impl<'a> ArmValidity<'a> {
         placed: &PlacedCovers,
         sets: &[Cell<Settled>; 2],
     ) -> bool {
-        let parts = self.moving.len() + self.pairs.len();
-        match (0..parts).find(|&k| k != first && !self.part_clear(k, q, bodies, placed, sets)) {
+        match self
+            .order
+            .iter()
+            .copied()
+            .find(|&k| k != first && !self.part_clear(k, q, bodies, placed, sets))
+        {
             Some(k) => {
                 self.last_failed.set(k);
                 false

@@ -633,3 +633,43 @@ fn pair_tables_prove_only_real_contacts() {
     let t = tables.get(0, 2).expect("a table for the base and the upper arm");
     assert!(!t.touches(f64::NAN) && !t.touches(f64::INFINITY));
 }
+
+/// The parts a check asks after its hint come in an order led by the self pairs most likely in
+/// contact: every part once; the pairs `likely_contacts` lists first, in its order (the base
+/// and the upper arm among them, every one in contact at some random configuration), then
+/// the moving bodies; the same list every time.
+#[test]
+fn part_order_asks_likely_contacts_first() {
+    let setup = ur5();
+    let arm = setup.arm();
+    let tables = crate::arm::PairTables::build(&arm);
+    let likely = tables.likely_contacts().to_vec();
+    assert_eq!(likely, crate::arm::PairTables::build(&arm).likely_contacts());
+    assert!(likely.contains(&(0, 2)) && likely.len() >= 3, "{likely:?}");
+    let v = super::ArmValidity::new(arm, 0.0, Vec::new());
+    let (m, p) = (v.moving.len(), v.pairs.len());
+    let mut sorted = v.order.clone();
+    sorted.sort_unstable();
+    assert_eq!(sorted, (0..m + p).collect::<Vec<_>>());
+    let first: Vec<(usize, usize)> = v.order[..likely.len()]
+        .iter()
+        .map(|&k| (v.pairs[k - m].0, v.pairs[k - m].1))
+        .collect();
+    assert_eq!(first, likely);
+    assert_eq!(
+        v.order[likely.len()..likely.len() + m],
+        (0..m).collect::<Vec<_>>()[..]
+    );
+    // Each listed pair is in contact somewhere: at some of 2,000 random configurations.
+    let mut rng = ChaCha8Rng::seed_from_u64(4);
+    let (mut links, mut poses) = (Vec::new(), Vec::<Pose>::new());
+    let mut seen = vec![false; likely.len()];
+    for _ in 0..2000 {
+        let q = random_q(&arm, &mut rng);
+        arm.body_poses(&q, &mut links, &mut poses);
+        for (s, &(i, j)) in seen.iter_mut().zip(&likely) {
+            *s |= arm.world.pair_distance(arm.group, i, j, &poses, 1e-6) <= 0.0;
+        }
+    }
+    assert!(seen.iter().all(|&s| s), "{seen:?}");
+}

@@ -348,6 +348,68 @@ fn placed<'s>(arm: &Arm<'s>, body: usize, pose: Pose, e: &'s End) -> Option<(Pos
     })
 }
 
+/// Configurations sampled for [`likely_contacts`].
+const ORDER_PROBES: usize = 512;
+
+/// The self pairs of `arm` in the order a validity check should ask them, after the tables'
+/// proofs of contact ([`PairTables::prove_contact`]), to find a contact soonest in a random
+/// configuration: over [`ORDER_PROBES`] configurations spread over the limits (a fixed
+/// sequence) that the tables do not prove invalid, the pair in contact in the most of them,
+/// then the pair in contact in the most of the rest, and so on (the greedy order of a set
+/// cover). Contacts are found with the covers first, the exact distance only where they
+/// overlap.
+fn likely_contacts(arm: &Arm, broad: &BroadPhase, tables: &PairTables) -> Vec<(usize, usize)> {
+    let mut rng = ChaCha8Rng::seed_from_u64(0x006f_7264_6572);
+    let mut placed = PlacedCovers::default();
+    let (mut links, mut poses) = (Vec::new(), Vec::new());
+    // Per probe configuration, the pairs (indices into `self_pairs`) in contact there.
+    let mut touching: Vec<Vec<usize>> = Vec::new();
+    for _ in 0..ORDER_PROBES {
+        let q: Vec<f64> = arm
+            .chain
+            .joints
+            .iter()
+            .map(|j| {
+                if j.lower.is_finite() && j.upper.is_finite() && j.upper > j.lower {
+                    rng.random_range(j.lower..=j.upper)
+                } else {
+                    j.mid()
+                }
+            })
+            .collect();
+        if tables.prove_contact(&q) {
+            continue;
+        }
+        arm.body_poses(&q, &mut links, &mut poses);
+        broad.place(&poses, &mut placed);
+        let pairs: Vec<usize> = (0..arm.self_pairs.len())
+            .filter(|&k| {
+                let (i, j) = arm.self_pairs[k];
+                broad.pair_bound(i, j, &placed, 1e-6) <= 0.0
+                    && arm.world.pair_distance(arm.group, i, j, &poses, 1e-6) <= 0.0
+            })
+            .collect();
+        if !pairs.is_empty() {
+            touching.push(pairs);
+        }
+    }
+    let mut order = Vec::new();
+    let mut count = vec![0usize; arm.self_pairs.len()];
+    while !touching.is_empty() {
+        count.iter_mut().for_each(|c| *c = 0);
+        for k in touching.iter().flatten() {
+            count[*k] += 1;
+        }
+        // The most often in contact; the first of those on a tie.
+        let Some(best) = (0..count.len()).max_by_key(|&k| (count[k], std::cmp::Reverse(k))) else {
+            break;
+        };
+        order.push(arm.self_pairs[best]);
+        touching.retain(|pairs| !pairs.contains(&best));
+    }
+    order
+}
+
 /// The tables of an arm's close self pairs (see the module documentation), shared by every
 /// checker of the arm.
 #[derive(Clone, Debug, Default)]
@@ -356,6 +418,9 @@ pub struct PairTables {
     /// Per pair `(i, j)`, `i < j`, at `i * bodies + j`: its index in `tables`, or `u32::MAX`.
     slots: Vec<u32>,
     tables: Vec<PairTable>,
+    /// The self pairs in the order a check should ask them to find a contact soonest (see
+    /// [`likely_contacts`]).
+    likely: Vec<(usize, usize)>,
 }
 
 impl PairTables {
@@ -367,6 +432,7 @@ impl PairTables {
             bodies,
             slots: vec![u32::MAX; n],
             tables: Vec::new(),
+            likely: Vec::new(),
         };
         let broad = BroadPhase::new(arm.world, arm.group, &[]);
         let mut placed = PlacedCovers::default();
@@ -402,6 +468,7 @@ impl PairTables {
             out.slots[k] = out.tables.len() as u32;
             out.tables.push(t);
         }
+        out.likely = likely_contacts(arm, &broad, &out);
         out
     }
 
@@ -425,6 +492,12 @@ impl PairTables {
         self.tables
             .iter()
             .any(|t| !t.contact.is_empty() && q.get(t.joint).is_some_and(|&v| t.touches(v)))
+    }
+
+    /// The self pairs that make random configurations invalid, in the order that finds a
+    /// contact soonest (see [`likely_contacts`]); pairs never seen in contact are not listed.
+    pub fn likely_contacts(&self) -> &[(usize, usize)] {
+        &self.likely
     }
 
     /// The number of tables.
