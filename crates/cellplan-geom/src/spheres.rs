@@ -34,6 +34,22 @@ pub struct Sphere {
     pub radius: f64,
 }
 
+impl Sphere {
+    /// Whether the two spheres are at least `gap` apart (surface to surface): `|c₁ − c₂| ≥
+    /// r₁ + r₂ + gap`, compared squared (no square root, the hot test of the broad phase);
+    /// false for a non-finite centre.
+    #[inline]
+    pub fn apart_by(&self, other: &Sphere, gap: f64) -> bool {
+        let reach = self.radius + other.radius + gap;
+        let d2 = (self.centre - other.centre).length_squared();
+        if reach <= 0.0 {
+            d2 >= 0.0
+        } else {
+            d2 >= reach * reach
+        }
+    }
+}
+
 /// A body's cover with a sphere holding the whole cover (for a first test).
 #[derive(Clone, Debug, Default)]
 pub struct Cover {

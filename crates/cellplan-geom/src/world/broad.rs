@@ -593,7 +593,7 @@ impl BroadPhase {
         if !finite_a || !finite_b {
             return Some((0.0, DVec3::ZERO));
         }
-        if (oa.centre - ob.centre).length() - oa.radius - ob.radius >= best {
+        if oa.apart_by(&ob, best) {
             return Some((best, DVec3::ZERO));
         }
         None
@@ -622,7 +622,12 @@ impl BroadPhase {
             } => {
                 for (k, s) in spheres.iter().map(Cell::get).enumerate() {
                     let p = *to_local * (s.centre - *centre);
-                    let d = (p.abs() - *half).max(DVec3::ZERO).length() - s.radius;
+                    let gap = (p.abs() - *half).max(DVec3::ZERO);
+                    // Only a sphere that comes closer than `b` needs its square root.
+                    if !closer_than(gap.length_squared(), b + s.radius) {
+                        continue;
+                    }
+                    let d = gap.length() - s.radius;
                     if d < b {
                         (b, arg) = (d, k);
                     }
@@ -657,7 +662,11 @@ impl BroadPhase {
             }
             Kind::Ball { centre, radius } => {
                 for (k, s) in spheres.iter().map(Cell::get).enumerate() {
-                    let d = (s.centre - *centre).length() - radius - s.radius;
+                    let v = s.centre - *centre;
+                    if !closer_than(v.length_squared(), b + radius + s.radius) {
+                        continue;
+                    }
+                    let d = v.length() - radius - s.radius;
                     if d < b {
                         (b, arg) = (d, k);
                     }
@@ -721,7 +730,12 @@ fn spheres_bound<B: SphereRead>(
             continue;
         }
         for (ka, sa) in a.iter().map(Cell::get).enumerate() {
-            let d = (sb.centre - sa.centre).length() - sa.radius - sb.radius;
+            let v = sb.centre - sa.centre;
+            // Only a pair that comes closer than `least` needs its square root.
+            if !closer_than(v.length_squared(), least + sa.radius + sb.radius) {
+                continue;
+            }
+            let d = v.length() - sa.radius - sb.radius;
             if d < least {
                 (least, arg) = (d, (ka, kb));
             }
@@ -732,6 +746,15 @@ fn spheres_bound<B: SphereRead>(
         _ => DVec3::ZERO,
     };
     (least.max(0.0), towards)
+}
+
+/// Whether a point at squared distance `d2` may be nearer than `reach`: false only where
+/// `√d2 ≥ reach` for sure (a negative reach is never met); NaN may be nearer. The square roots of
+/// the sphere bounds are taken only where this holds (most spheres of a cover are farther than
+/// the bound so far).
+#[inline(always)]
+fn closer_than(d2: f64, reach: f64) -> bool {
+    reach > 0.0 && (d2 < reach * reach || d2.is_nan())
 }
 
 /// A sphere as stored: placed lazily (in a [`Cell`]) or fixed.

@@ -138,7 +138,7 @@ impl Clusters {
     pub(super) fn group_apart(&self, g: usize, bodies: &[Pose], best: f64) -> bool {
         let (a, b) = self.groups[g];
         let (sa, sb) = (self.placed(a, bodies), self.placed(b, bodies));
-        (sa.centre - sb.centre).length() - sa.radius - sb.radius >= best.max(0.0)
+        sa.apart_by(&sb, best.max(0.0))
     }
 }
 
