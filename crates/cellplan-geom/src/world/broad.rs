@@ -28,9 +28,22 @@ use std::cell::Cell;
 use std::ops::Range;
 
 /// Distance from `p` to a box, 0 inside.
-#[inline]
+#[cfg(test)]
 fn point_box_distance(p: DVec3, mins: DVec3, maxs: DVec3) -> f64 {
     (mins - p).max(p - maxs).max(DVec3::ZERO).length()
+}
+
+/// Whether a sphere about `p` of radius `r` is at least `gap` from a box: `point_box_distance
+/// − r ≥ gap`, compared squared (no square root); false for a non-finite centre.
+#[inline]
+fn sphere_box_apart(p: DVec3, r: f64, mins: DVec3, maxs: DVec3, gap: f64) -> bool {
+    let reach = r + gap;
+    let d2 = (mins - p).max(p - maxs).max(DVec3::ZERO).length_squared();
+    if reach <= 0.0 {
+        d2 >= 0.0
+    } else {
+        d2 >= reach * reach
+    }
 }
 
 /// What an object is, for a sphere's distance to it.
@@ -386,11 +399,11 @@ impl BroadPhase {
         };
         for (mins, maxs, run) in &self.runs {
             // The whole run is farther than what is asked.
-            if point_box_distance(outer.centre, *mins, *maxs) - outer.radius >= best {
+            if sphere_box_apart(outer.centre, outer.radius, *mins, *maxs, best) {
                 continue;
             }
             for object in &self.objects[run.clone()] {
-                if point_box_distance(outer.centre, object.mins, object.maxs) - outer.radius >= best {
+                if sphere_box_apart(outer.centre, outer.radius, object.mins, object.maxs, best) {
                     continue;
                 }
                 let (bound, towards) = self.object_bound(world, object, self.cover(placed, i), outer, best);
@@ -469,7 +482,7 @@ impl BroadPhase {
         let best = sanitize_margin(best);
         self.runs
             .iter()
-            .all(|(mins, maxs, _)| point_box_distance(sphere.centre, *mins, *maxs) - sphere.radius >= best)
+            .all(|(mins, maxs, _)| sphere_box_apart(sphere.centre, sphere.radius, *mins, *maxs, best))
     }
 
     /// A lower bound on the distance from body `i` to every object, capped at `cap` (the cover
@@ -481,11 +494,11 @@ impl BroadPhase {
             Err(answer) => return answer,
         };
         for (mins, maxs, run) in &self.runs {
-            if point_box_distance(outer.centre, *mins, *maxs) - outer.radius >= best {
+            if sphere_box_apart(outer.centre, outer.radius, *mins, *maxs, best) {
                 continue;
             }
             for object in &self.objects[run.clone()] {
-                if point_box_distance(outer.centre, object.mins, object.maxs) - outer.radius >= best {
+                if sphere_box_apart(outer.centre, outer.radius, object.mins, object.maxs, best) {
                     continue;
                 }
                 best = best.min(
@@ -682,7 +695,7 @@ impl BroadPhase {
                 };
                 let solid = shape.as_trimesh().is_none();
                 for s in spheres.iter().map(Cell::get) {
-                    if point_box_distance(s.centre, object.mins, object.maxs) - s.radius >= b {
+                    if sphere_box_apart(s.centre, s.radius, object.mins, object.maxs, b) {
                         continue;
                     }
                     let reach = b + s.radius;

@@ -285,3 +285,60 @@ fn a_holding_sphere_changes_no_bound() {
     }
     assert!(passed > 1000 && passed < asked, "{passed} of {asked} passed over");
 }
+
+/// The squared tests of spheres against spheres and boxes give the answers of the distances
+/// they stand for (random spheres, boxes and gaps, away from the boundary by more than
+/// rounding), and a non-finite centre is never apart.
+#[test]
+fn squared_sphere_tests_agree_with_distances() {
+    use crate::Sphere;
+    let mut rng = ChaCha8Rng::seed_from_u64(12);
+    let mut v = |s: f64| {
+        DVec3::new(
+            rng.random_range(-s..s),
+            rng.random_range(-s..s),
+            rng.random_range(-s..s),
+        )
+    };
+    let (mut yes, mut no) = (0, 0);
+    for _ in 0..20_000 {
+        let a = Sphere {
+            centre: v(1.0),
+            radius: v(0.3).x.abs(),
+        };
+        let b = Sphere {
+            centre: v(1.0),
+            radius: v(0.3).y.abs(),
+        };
+        let gap = v(0.3).z;
+        let d = (a.centre - b.centre).length() - a.radius - b.radius;
+        if (d - gap).abs() > 1e-12 {
+            assert_eq!(a.apart_by(&b, gap), d >= gap, "{a:?} {b:?} {gap}");
+            if d >= gap { yes += 1 } else { no += 1 }
+        }
+        let (lo, size) = (v(1.0), v(0.5).abs());
+        let hi = lo + size;
+        let d = super::point_box_distance(a.centre, lo, hi) - a.radius;
+        if (d - gap).abs() > 1e-12 {
+            assert_eq!(super::sphere_box_apart(a.centre, a.radius, lo, hi, gap), d >= gap);
+        }
+    }
+    assert!(yes > 1000 && no > 200, "{yes} {no}");
+    let nan = Sphere {
+        centre: DVec3::splat(f64::NAN),
+        radius: 0.1,
+    };
+    let one = Sphere {
+        centre: DVec3::ZERO,
+        radius: 0.1,
+    };
+    assert!(!nan.apart_by(&one, 0.0) && !nan.apart_by(&one, -1.0));
+    // (A box test with a non-finite centre sees it inside: apart only for a negative reach.)
+    assert!(!super::sphere_box_apart(
+        nan.centre,
+        0.1,
+        DVec3::ZERO,
+        DVec3::ONE,
+        0.0
+    ));
+}
