@@ -394,7 +394,7 @@ impl<'a> LazyBody<'a> {
 /// held by `oa` comes within `d` of the sphere `ob`.
 pub(super) fn outers_apart(oa: Option<Sphere>, ob: Option<Sphere>, d: f64) -> bool {
     match (oa, ob) {
-        (Some(oa), Some(ob)) => (oa.centre - ob.centre).length() - oa.radius - ob.radius >= d + OUTER_SLACK,
+        (Some(oa), Some(ob)) => oa.apart_by(&ob, d + OUTER_SLACK),
         _ => false,
     }
 }
