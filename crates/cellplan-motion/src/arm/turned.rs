@@ -348,6 +348,22 @@ fn placed<'s>(arm: &Arm<'s>, body: usize, pose: Pose, e: &'s End) -> Option<(Pos
     })
 }
 
+/// A configuration drawn uniformly within the joint limits (a joint without finite limits at
+/// its middle).
+fn random_configuration(arm: &Arm, rng: &mut ChaCha8Rng) -> Vec<f64> {
+    arm.chain
+        .joints
+        .iter()
+        .map(|j| {
+            if j.lower.is_finite() && j.upper.is_finite() && j.upper > j.lower {
+                rng.random_range(j.lower..=j.upper)
+            } else {
+                j.mid()
+            }
+        })
+        .collect()
+}
+
 /// Configurations sampled for [`likely_contacts`].
 const ORDER_PROBES: usize = 512;
 
@@ -365,18 +381,7 @@ fn likely_contacts(arm: &Arm, broad: &BroadPhase, tables: &PairTables) -> Vec<(u
     // Per probe configuration, the pairs (indices into `self_pairs`) in contact there.
     let mut touching: Vec<Vec<usize>> = Vec::new();
     for _ in 0..ORDER_PROBES {
-        let q: Vec<f64> = arm
-            .chain
-            .joints
-            .iter()
-            .map(|j| {
-                if j.lower.is_finite() && j.upper.is_finite() && j.upper > j.lower {
-                    rng.random_range(j.lower..=j.upper)
-                } else {
-                    j.mid()
-                }
-            })
-            .collect();
+        let q = random_configuration(arm, &mut rng);
         if tables.prove_contact(&q) {
             continue;
         }
@@ -440,18 +445,7 @@ impl PairTables {
         let (mut links, mut poses) = (Vec::new(), Vec::new());
         let mut close = vec![0usize; arm.self_pairs.len()];
         for _ in 0..PROBES {
-            let q: Vec<f64> = arm
-                .chain
-                .joints
-                .iter()
-                .map(|j| {
-                    if j.lower.is_finite() && j.upper.is_finite() && j.upper > j.lower {
-                        rng.random_range(j.lower..=j.upper)
-                    } else {
-                        j.mid()
-                    }
-                })
-                .collect();
+            let q = random_configuration(arm, &mut rng);
             arm.body_poses(&q, &mut links, &mut poses);
             broad.place(&poses, &mut placed);
             for (c, &(i, j)) in close.iter_mut().zip(arm.self_pairs) {
