@@ -668,7 +668,7 @@ impl StateValidity for ArmValidity<'_> {
     /// the others' queries), then the self pairs; each queried part's motion bounded where the
     /// arm stands (`posed_bound`) when that is tighter.
     fn segment_step(&self, q: &[f64], motion: &SegmentMotion, floor: f64, limit: f64) -> Option<f64> {
-        if !self.arm.chain.within_limits(q, 1e-9) || self.proven_contact(q) {
+        if !self.arm.chain.within_limits(q, 1e-9) {
             return None;
         }
         // Each part's bound depends on the segment alone: made at its first sample (moving
