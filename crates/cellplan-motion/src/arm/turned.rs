@@ -90,7 +90,7 @@ impl PairTable {
     /// joints anywhere); `false` where the table cannot tell.
     ///
     /// A turned end is rotation-invariant about its joint's axis, and so is a cylinder about
-    /// that axis inside it ([`inner_cylinder`]): that cylinder stays inside the body whatever
+    /// that axis inside it ([`inner_cylinders`]): that cylinder stays inside the body whatever
     /// the turned joint's value. At a sample, the cylinder shrunk by `δ` is found overlapping
     /// the other end (its own body, or its cylinder). Over half a spacing `h/2` from the
     /// sample, a point common to both moves relative to the other end by at most `L·h/2` (`L`
@@ -489,7 +489,8 @@ impl PairTables {
     }
 
     /// The self pairs that make random configurations invalid, in the order that finds a
-    /// contact soonest (see [`likely_contacts`]); pairs never seen in contact are not listed.
+    /// contact soonest (a greedy set cover of the contacts at random configurations the tables
+    /// do not prove invalid); pairs never seen in contact are not listed.
     pub fn likely_contacts(&self) -> &[(usize, usize)] {
         &self.likely
     }
