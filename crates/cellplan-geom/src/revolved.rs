@@ -101,7 +101,7 @@ impl SupportMap for Revolved {
 /// A solid cylinder about a line: its centre on the line, the unit direction of the line,
 /// and its half height along it and radius across it. As a support map, it stands in a body
 /// turned about its axis for proofs of contact: a cylinder about a joint's axis inside a body
-/// stays inside it whatever the joint's value ([`inner_cylinder`]).
+/// stays inside it whatever the joint's value ([`inner_cylinders`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Cylinder {
     /// The centre, on the axis.
@@ -141,11 +141,11 @@ impl SupportMap for Cylinder {
     }
 }
 
-/// Heights tried for each end of [`inner_cylinder`]'s cylinder.
+/// Heights tried for each end of [`inner_cylinders`]' cylinders.
 const INNER_HEIGHTS: usize = 24;
 
 /// Cylinders about the line through `origin` along `axis` inside the convex hull of `points`,
-/// their ends at [`INNER_HEIGHTS`] heights spread over the line's stretch inside the hull: the
+/// their ends at 24 heights spread over the line's stretch inside the hull: the
 /// one of largest volume, and the widest of those at least `2·min_half_height` long (when it
 /// is another). Every point of them stays inside the hull however the hull is turned about the
 /// line (a cylinder is a solid of revolution about it), so a body turned about a joint keeps
