@@ -36,17 +36,25 @@ pub struct Sphere {
 
 impl Sphere {
     /// Whether the two spheres are at least `gap` apart (surface to surface): `|c₁ − c₂| ≥
-    /// r₁ + r₂ + gap`, compared squared (no square root, the hot test of the broad phase);
-    /// false for a non-finite centre.
+    /// r₁ + r₂ + gap`, compared squared ([`reaches`]; no square root, the hot test of the broad
+    /// phase); false for a NaN centre.
     #[inline]
     pub fn apart_by(&self, other: &Sphere, gap: f64) -> bool {
-        let reach = self.radius + other.radius + gap;
-        let d2 = (self.centre - other.centre).length_squared();
-        if reach <= 0.0 {
-            d2 >= 0.0
-        } else {
-            d2 >= reach * reach
-        }
+        reaches(
+            (self.centre - other.centre).length_squared(),
+            self.radius + other.radius + gap,
+        )
+    }
+}
+
+/// Whether a distance whose square is `d2` is at least `reach` (`√d2 ≥ reach`), without the
+/// square root: any distance reaches a reach of zero or less; a NaN `d2` reaches nothing.
+#[inline(always)]
+pub(crate) fn reaches(d2: f64, reach: f64) -> bool {
+    if reach <= 0.0 {
+        d2 >= 0.0
+    } else {
+        d2 >= reach * reach
     }
 }
 

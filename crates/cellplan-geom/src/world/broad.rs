@@ -22,7 +22,7 @@
 //! query whose bound already reaches the cap changes no answer.
 use super::distance::outers_apart;
 use super::{CollisionWorld, GroupId, sanitize_margin};
-use crate::spheres::Sphere;
+use crate::spheres::{Sphere, reaches};
 use crate::{DMat3, DVec3, Pose};
 use std::cell::Cell;
 use std::ops::Range;
@@ -34,16 +34,14 @@ fn point_box_distance(p: DVec3, mins: DVec3, maxs: DVec3) -> f64 {
 }
 
 /// Whether a sphere about `p` of radius `r` is at least `gap` from a box: `point_box_distance
-/// − r ≥ gap`, compared squared (no square root); false for a non-finite centre.
+/// − r ≥ gap`, compared squared ([`reaches`]). A NaN centre counts as inside the box (apart only
+/// for a reach of zero or less).
 #[inline]
 fn sphere_box_apart(p: DVec3, r: f64, mins: DVec3, maxs: DVec3, gap: f64) -> bool {
-    let reach = r + gap;
-    let d2 = (mins - p).max(p - maxs).max(DVec3::ZERO).length_squared();
-    if reach <= 0.0 {
-        d2 >= 0.0
-    } else {
-        d2 >= reach * reach
-    }
+    reaches(
+        (mins - p).max(p - maxs).max(DVec3::ZERO).length_squared(),
+        r + gap,
+    )
 }
 
 /// What an object is, for a sphere's distance to it.
@@ -636,8 +634,9 @@ impl BroadPhase {
                 for (k, s) in spheres.iter().map(Cell::get).enumerate() {
                     let p = *to_local * (s.centre - *centre);
                     let gap = (p.abs() - *half).max(DVec3::ZERO);
-                    // Only a sphere that comes closer than `b` needs its square root.
-                    if !closer_than(gap.length_squared(), b + s.radius) {
+                    // Only a sphere that comes closer than `b` needs its square root (most of a
+                    // cover's are farther than the bound so far).
+                    if reaches(gap.length_squared(), b + s.radius) {
                         continue;
                     }
                     let d = gap.length() - s.radius;
@@ -676,7 +675,7 @@ impl BroadPhase {
             Kind::Ball { centre, radius } => {
                 for (k, s) in spheres.iter().map(Cell::get).enumerate() {
                     let v = s.centre - *centre;
-                    if !closer_than(v.length_squared(), b + radius + s.radius) {
+                    if reaches(v.length_squared(), b + radius + s.radius) {
                         continue;
                     }
                     let d = v.length() - radius - s.radius;
@@ -745,7 +744,7 @@ fn spheres_bound<B: SphereRead>(
         for (ka, sa) in a.iter().map(Cell::get).enumerate() {
             let v = sb.centre - sa.centre;
             // Only a pair that comes closer than `least` needs its square root.
-            if !closer_than(v.length_squared(), least + sa.radius + sb.radius) {
+            if reaches(v.length_squared(), least + sa.radius + sb.radius) {
                 continue;
             }
             let d = v.length() - sa.radius - sb.radius;
@@ -759,15 +758,6 @@ fn spheres_bound<B: SphereRead>(
         _ => DVec3::ZERO,
     };
     (least.max(0.0), towards)
-}
-
-/// Whether a point at squared distance `d2` may be nearer than `reach`: false only where
-/// `√d2 ≥ reach` for sure (a negative reach is never met); NaN may be nearer. The square roots of
-/// the sphere bounds are taken only where this holds (most spheres of a cover are farther than
-/// the bound so far).
-#[inline(always)]
-fn closer_than(d2: f64, reach: f64) -> bool {
-    reach > 0.0 && (d2 < reach * reach || d2.is_nan())
 }
 
 /// A sphere as stored: placed lazily (in a [`Cell`]) or fixed.

@@ -287,16 +287,15 @@ fn sample(
     // turned joint's value: its own body, or its cylinder.
     let shrink = 0.5 * lipschitz * step + CONTACT_SLACK;
     let shrunk = |cs: &[Cylinder]| -> Vec<Cylinder> { cs.iter().filter_map(|c| c.eroded(shrink)).collect() };
-    // The shrunk cylinders and what they are tried against: on the near end, against the
-    // far end's cylinders when it is turned (`Some`) or its own body; on the far end, against
-    // the near end's own body.
-    let proof: Option<Proof> = match (en, ef) {
-        (End::Turned(_, c), End::Turned(_, other)) => Some((shrunk(c), true, Some(&other[..]))),
-        (End::Turned(_, c), End::Own) => Some((shrunk(c), true, None)),
-        (End::Own, End::Turned(_, c)) => Some((shrunk(c), false, None)),
+    let proof = match (en, ef) {
+        (End::Turned(_, c), End::Turned(_, other)) if !other.is_empty() => {
+            Some(Proof::NearOnFarCylinders(shrunk(c), other))
+        }
+        (End::Turned(_, c), End::Own) => Some(Proof::NearOnFar(shrunk(c))),
+        (End::Own, End::Turned(_, c)) => Some(Proof::FarOnNear(shrunk(c))),
         _ => None,
     }
-    .filter(|(cs, _, other)| !cs.is_empty() && other.is_none_or(|o| !o.is_empty()));
+    .filter(|p| !p.cylinders().is_empty());
     let mut cq = q.to_vec();
     let mut values = Vec::with_capacity(n);
     let mut contact = Vec::with_capacity(if proof.is_some() { n } else { 0 });
@@ -308,12 +307,12 @@ fn sample(
             placed(arm, far, *poses.get(far)?, ef)?,
         );
         values.push(convex_distance(&pa, sa, &pb, sb, TABLE_CAP) - DISTANCE_SLACK);
-        if let Some((cylinders, on_near, other)) = &proof {
+        if let Some(proof) = &proof {
             let (pn, pf) = (*poses.get(near)?, *poses.get(far)?);
-            let touching = cylinders.iter().any(|c| match (on_near, other) {
-                (true, Some(other)) => other.iter().any(|o| convex_overlap(&pn, c, &pf, o)),
-                (true, None) => convex_overlap(&pn, c, &pb, sb),
-                (false, _) => convex_overlap(&pa, sa, &pf, c),
+            let touching = proof.cylinders().iter().any(|c| match proof {
+                Proof::NearOnFarCylinders(_, other) => other.iter().any(|o| convex_overlap(&pn, c, &pf, o)),
+                Proof::NearOnFar(_) => convex_overlap(&pn, c, &pb, sb),
+                Proof::FarOnNear(_) => convex_overlap(&pa, sa, &pf, c),
             });
             contact.push(touching);
         }
@@ -333,9 +332,24 @@ fn sample(
     })
 }
 
-/// How a table proves contact: shrunk cylinders, whether on the near end, and the far end's
-/// cylinders they are tried against (`None`: the other end's own body).
-type Proof<'a> = (Vec<Cylinder>, bool, Option<&'a [Cylinder]>);
+/// How a table proves contact: one end's shrunk cylinders (body frame) against the other end
+/// as it stays whatever its turned joint's value.
+enum Proof<'a> {
+    /// The near end's, against the far end's own body.
+    NearOnFar(Vec<Cylinder>),
+    /// The near end's, against the far end's cylinders (both ends turned).
+    NearOnFarCylinders(Vec<Cylinder>, &'a [Cylinder]),
+    /// The far end's, against the near end's own body.
+    FarOnNear(Vec<Cylinder>),
+}
+
+impl Proof<'_> {
+    fn cylinders(&self) -> &[Cylinder] {
+        match self {
+            Proof::NearOnFar(c) | Proof::NearOnFarCylinders(c, _) | Proof::FarOnNear(c) => c,
+        }
+    }
+}
 
 /// End `e` of body `body` (at `pose`) as a support map and its pose in the world.
 fn placed<'s>(arm: &Arm<'s>, body: usize, pose: Pose, e: &'s End) -> Option<(Pose, &'s dyn SupportMap)> {
@@ -485,7 +499,7 @@ impl PairTables {
     pub fn prove_contact(&self, q: &[f64]) -> bool {
         self.tables
             .iter()
-            .any(|t| !t.contact.is_empty() && q.get(t.joint).is_some_and(|&v| t.touches(v)))
+            .any(|t| q.get(t.joint).is_some_and(|&v| t.touches(v)))
     }
 
     /// The self pairs that make random configurations invalid, in the order that finds a
