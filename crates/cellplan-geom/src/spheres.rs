@@ -36,7 +36,7 @@ pub struct Sphere {
 
 impl Sphere {
     /// Whether the two spheres are at least `gap` apart (surface to surface): `|c₁ − c₂| ≥
-    /// r₁ + r₂ + gap`, compared squared ([`reaches`]; no square root, the hot test of the broad
+    /// r₁ + r₂ + gap`, compared squared (`reaches`; no square root, the hot test of the broad
     /// phase); false for a NaN centre.
     #[inline]
     pub fn apart_by(&self, other: &Sphere, gap: f64) -> bool {
