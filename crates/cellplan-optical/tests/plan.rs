@@ -323,7 +323,7 @@ fn a_hand_over_coordinated_far_worse_is_not_sequenced_again() {
 
 #[test]
 fn rebalancing_hands_tasks_from_the_robot_ending_last_until_the_robots_end_sooner() {
-    use plan::rebalance::{REBALANCE_PLANS, ends, makespan};
+    use plan::rebalance::{MORE_PLANS, REBALANCE_PLANS, ends, makespan};
     // The nearest-robot allocation ignores how long each robot works (5 to 14 MPs here).
     let (cell, table, s, mut cache, base) = readme_nearest();
     let before = makespan(&base);
@@ -358,7 +358,10 @@ fn rebalancing_hands_tasks_from_the_robot_ending_last_until_the_robots_end_soone
         .zip(&base.allocated.tasks)
         .map(|(a, b)| a.iter().filter(|t| !b.contains(t)).count())
         .sum();
-    assert!((1..=REBALANCE_PLANS).contains(&moved), "{moved} tasks moved");
+    assert!(
+        (1..=REBALANCE_PLANS + MORE_PLANS).contains(&moved),
+        "{moved} tasks moved"
+    );
     for (r, tasks) in o.allocated.tasks.iter().enumerate() {
         assert!(tasks.len() <= cell.planning.task_cap);
         for &t in tasks {
@@ -457,7 +460,9 @@ fn judged_waiting(
 /// robot with room for them (none here: see the next test).
 #[test]
 fn a_robot_the_last_one_waits_for_is_relieved_when_the_hand_overs_do_not_help() {
-    use plan::rebalance::{REBALANCE_JUDGED, RELIEF_JUDGED, RELIEF_PLANS, ends, makespan, rebalance};
+    use plan::rebalance::{
+        MORE_JUDGED, REBALANCE_JUDGED, RELIEF_JUDGED, RELIEF_PLANS, ends, makespan, rebalance,
+    };
     let (cell, table, s, mut cache, base) = readme_nearest();
     let m = cell.robots.len();
     // As if coordination had made the robot that ends last wait 5 s for the busiest other one.
@@ -493,9 +498,23 @@ fn a_robot_the_last_one_waits_for_is_relieved_when_the_hand_overs_do_not_help() 
     let reliefs = kinds[direct..].iter().take_while(|k| k.0 != stuck).count();
     let relief = &kinds[direct..direct + reliefs];
     // No group: the busiest robot has no room under the cap for the last one's tasks (the
-    // next test gives the wait to a robot that has).
-    assert_eq!(seen.len(), direct + reliefs, "{kinds:?}");
+    // next test gives the wait to a robot that has). Then more direct hand-overs (the README
+    // cell is small enough), on their own budget.
+    let more = &kinds[direct + reliefs..];
     assert!(direct <= REBALANCE_JUDGED, "{direct} direct hand-overs judged");
+    assert!(
+        (1..=MORE_JUDGED).contains(&more.len()) && more.iter().all(|k| k.0 == stuck),
+        "{kinds:?}"
+    );
+    // None of them is one judged before.
+    for (i, o) in seen.iter().enumerate().skip(direct + reliefs) {
+        assert!(
+            seen[..direct]
+                .iter()
+                .all(|p| p.allocated.tasks != o.allocated.tasks),
+            "plan {i} judged again"
+        );
+    }
     assert!(
         (1..=RELIEF_JUDGED.min(RELIEF_PLANS)).contains(&relief.len()),
         "{} reliefs judged: {kinds:?}",
@@ -513,7 +532,8 @@ fn a_robot_the_last_one_waits_for_is_relieved_when_the_hand_overs_do_not_help() 
         build_checked(&cell, &table, o, &fixed);
     }
     // The caller's work budget is asked before every plan, with `true` for a relief or a group
-    // (which may go beyond it) and `false` for a hand-over: the hand-overs' asks first.
+    // (which may go beyond it) and `false` for a hand-over: the hand-overs' asks first, then
+    // the reliefs', then the more hand-overs'.
     let asked = std::cell::RefCell::new(Vec::new());
     let mut judge =
         |_: &plan::Outcome, _: Option<(&plan::Outcome, &())>| -> Option<(f64, Vec<f64>, ())> { None };
@@ -533,9 +553,11 @@ fn a_robot_the_last_one_waits_for_is_relieved_when_the_hand_overs_do_not_help() 
     .unwrap();
     let asked = asked.into_inner();
     let hand_overs = asked.iter().take_while(|r| !**r).count();
+    let beyond = asked[hand_overs..].iter().take_while(|r| **r).count();
     assert!(hand_overs >= direct, "{asked:?}");
+    assert!(beyond >= relief.len(), "{asked:?}");
     assert!(
-        asked[hand_overs..].iter().all(|r| *r) && asked.len() - hand_overs >= relief.len(),
+        asked[hand_overs + beyond..].iter().all(|r| !*r) && asked.len() - hand_overs - beyond >= more.len(),
         "{asked:?}"
     );
 }
@@ -607,7 +629,7 @@ fn the_last_robot_hands_groups_of_tasks_to_the_robot_it_waits_for() {
 /// plans of one allocation, the kept one first, and never the same plan twice; the budgets hold.
 #[test]
 fn a_hand_over_that_does_not_help_is_tried_with_every_robot_sequenced_again() {
-    use plan::rebalance::{REBALANCE_JUDGED, REBALANCE_PLANS};
+    use plan::rebalance::{MORE_JUDGED, MORE_PLANS, REBALANCE_JUDGED, REBALANCE_PLANS};
     let (cell, table, s, mut cache, base) = readme_nearest();
     let mut seen: Vec<plan::Outcome> = Vec::new();
     // A judge that no plan satisfies: every hand-over's plans are judged, none kept.
@@ -618,7 +640,7 @@ fn a_hand_over_that_does_not_help_is_tried_with_every_robot_sequenced_again() {
     let (found, clock) = rebalanced(&cell, &table, &base, &s, &mut cache, &mut judge);
     assert!(found.is_none() && !clock);
     assert!(
-        (2..=REBALANCE_JUDGED).contains(&seen.len()),
+        (2..=REBALANCE_JUDGED + MORE_JUDGED).contains(&seen.len()),
         "{} judged",
         seen.len()
     );
@@ -642,7 +664,7 @@ fn a_hand_over_that_does_not_help_is_tried_with_every_robot_sequenced_again() {
         }
     }
     assert!(pairs >= 1, "no allocation was tried both ways");
-    assert!(seen.len() <= REBALANCE_PLANS);
+    assert!(seen.len() <= REBALANCE_PLANS + MORE_PLANS);
     for o in &seen {
         let fixed = PlanSettings {
             tasks: Some(o.allocated.tasks.clone()),

@@ -35,6 +35,24 @@ pub const FAR_WORSE: f64 = 0.05;
 /// Plans [`rebalance`] hands its judge at most (a coordination each: the costly part).
 pub const REBALANCE_JUDGED: usize = 5;
 
+/// Plans [`rebalance`] makes at most for more direct hand-overs, once the reliefs and groups
+/// have not helped either, on cells of at most [`MORE_HANDOVERS_MAX_PAIRS`] tasks × robots (a
+/// budget of its own, after the others: the search up to there is the one without it, so its
+/// plan is never longer before blending). Ten hard cells × seeds 0–2 (`bench/cells/README.md`,
+/// fiftieth session): door-opening-4r 1.609 / 1.865 / 1.954 → 1.429 / 1.767 / 1.852 with
+/// these hand-overs as the first ones; there the hand-over that balances the two robots at the
+/// door is ranked beyond the fifth.
+pub const MORE_PLANS: usize = 20;
+
+/// Of those, plans it hands its judge at most.
+pub const MORE_JUDGED: usize = 10;
+
+/// The cells (tasks × robots) on which [`rebalance`] makes the hand-overs of [`MORE_PLANS`]:
+/// each judge is a coordination, seconds on the crowded 8-robot cells (dense-8r-250, 2,000:
+/// 5.4 s each, and its seeds gained 0.00–0.06 in ratio from ten more); dense-8r-120 (960) and
+/// the smaller ones make them.
+pub const MORE_HANDOVERS_MAX_PAIRS: usize = 1_000;
+
 /// Plans [`rebalance`] makes at most for hand-overs that lighten a robot the last one waits
 /// for, once the direct hand-overs are spent (a budget of its own: see [`rebalance`]).
 pub const RELIEF_PLANS: usize = 8;
@@ -363,8 +381,10 @@ fn groups(cell: &Cell, o: &Outcome, end: &[f64], waits: &[Vec<f64>]) -> Vec<Move
 /// the judged waits, `base_waits` for `base` and `waits_of` for what the judge made of a plan
 /// (`w[r][s]`: seconds robot `r` waits for robot `s`; none given, no relief). After them the
 /// round's group hand-overs (`groups`), on a budget of their own too ([`GROUP_PLANS`],
-/// [`GROUP_JUDGED`]; `may_judge` asked with `true`, as for a relief). A relief or a group
-/// taken starts a new round, its hand-overs first while their budget lasts.
+/// [`GROUP_JUDGED`]; `may_judge` asked with `true`, as for a relief). Then, on cells of at most
+/// [`MORE_HANDOVERS_MAX_PAIRS`] tasks × robots, more direct hand-overs on a budget of their own
+/// ([`MORE_PLANS`], [`MORE_JUDGED`]; `may_judge` asked with `false`). A relief, a group or one
+/// of those taken starts a new round, its hand-overs first while their budget lasts.
 /// Returns the best plan found with its settings and what the judge made of it, or `None` when
 /// no hand-over beat `base_score`, and whether the deadline stopped the search with hand-overs
 /// left to try (the plan then depends on the machine's speed). Plans that fail only lose their
@@ -387,11 +407,18 @@ pub fn rebalance<J>(
     let (mut score, mut judged_ends) = (base_score, base_ends.to_vec());
     let mut waits = base_waits.to_vec();
     let mut tried: Vec<Vec<Vec<TaskId>>> = vec![base.allocated.tasks.clone()];
-    // The direct hand-overs' budget, then the reliefs', then the groups' (each its own).
+    // The direct hand-overs' budget, then the reliefs', then the groups', then more direct
+    // hand-overs' on cells small enough (each its own).
+    let more = if cell.tasks.len() * cell.robots.len() <= MORE_HANDOVERS_MAX_PAIRS {
+        Budget::new(MORE_PLANS, MORE_JUDGED)
+    } else {
+        Budget::new(0, 0)
+    };
     let mut budgets = [
         Budget::new(REBALANCE_PLANS, REBALANCE_JUDGED),
         Budget::new(RELIEF_PLANS, RELIEF_JUDGED),
         Budget::new(GROUP_PLANS, GROUP_JUDGED),
+        more,
     ];
     'rounds: loop {
         let current = best.as_ref().map_or(base, |b| &b.0);
@@ -401,10 +428,13 @@ pub fn rebalance<J>(
                 continue;
             }
             let list = match phase {
-                0 => moves(cell, current, &judged_ends),
                 1 => reliefs(cell, current, &judged_ends, &waits),
-                _ => groups(cell, current, &judged_ends, &waits),
+                2 => groups(cell, current, &judged_ends, &waits),
+                _ => moves(cell, current, &judged_ends),
             };
+            // A relief or a group may go beyond the caller's budget (see `may_judge`); a
+            // direct hand-over, first or more, may not.
+            let beyond = phase == 1 || phase == 2;
             for mv in list {
                 if budget.spent() {
                     break;
@@ -429,7 +459,7 @@ pub fn rebalance<J>(
                 // less.
                 let mut kept: Option<Outcome> = None;
                 for keep in [true, false] {
-                    if !may_judge(phase >= 1) {
+                    if !may_judge(beyond) {
                         break 'rounds;
                     }
                     if budget.spent() {
