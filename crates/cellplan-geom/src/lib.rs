@@ -33,3 +33,14 @@ pub use world::{
     BodyContact, BroadPhase, CollisionWorld, GroupBody, GroupId, PlacedCovers, RayHit, StaticId,
     convex_distance, convex_overlap,
 };
+
+/// A vector with each coordinate uniform in `(-s, s)`, for the tests.
+#[cfg(test)]
+pub(crate) fn random_vector(rng: &mut rand_chacha::ChaCha8Rng, s: f64) -> DVec3 {
+    use rand::RngExt;
+    DVec3::new(
+        rng.random_range(-s..s),
+        rng.random_range(-s..s),
+        rng.random_range(-s..s),
+    )
+}

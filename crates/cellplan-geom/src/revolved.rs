@@ -145,7 +145,7 @@ impl SupportMap for Cylinder {
 const INNER_HEIGHTS: usize = 24;
 
 /// Cylinders about the line through `origin` along `axis` inside the convex hull of `points`,
-/// their ends at 24 heights spread over the line's stretch inside the hull: the
+/// their ends at `INNER_HEIGHTS` heights spread over the line's stretch inside the hull: the
 /// one of largest volume, and the widest of those at least `2·min_half_height` long (when it
 /// is another). Every point of them stays inside the hull however the hull is turned about the
 /// line (a cylinder is a solid of revolution about it), so a body turned about a joint keeps
@@ -306,13 +306,7 @@ mod tests {
     #[test]
     fn inner_cylinders_stay_inside_the_turned_hull() {
         let mut rng = ChaCha8Rng::seed_from_u64(8);
-        let mut v = |s: f64| {
-            DVec3::new(
-                rng.random_range(-s..s),
-                rng.random_range(-s..s),
-                rng.random_range(-s..s),
-            )
-        };
+        let mut v = |s: f64| crate::random_vector(&mut rng, s);
         let mut found = 0;
         for _ in 0..40 {
             let points: Vec<DVec3> = (0..30).map(|_| v(0.3)).collect();

@@ -38,10 +38,11 @@ pub const REBALANCE_JUDGED: usize = 5;
 /// Plans [`rebalance`] makes at most for more direct hand-overs, once the reliefs and groups
 /// have not helped either, on cells of at most [`MORE_HANDOVERS_MAX_PAIRS`] tasks × robots (a
 /// budget of its own, after the others: the search up to there is the one without it, so its
-/// plan is never longer before blending). Ten hard cells × seeds 0–2 (`bench/cells/README.md`,
-/// fiftieth session): door-opening-4r 1.609 / 1.865 / 1.954 → 1.429 / 1.767 / 1.852 with
-/// these hand-overs as the first ones; there the hand-over that balances the two robots at the
-/// door is ranked beyond the fifth.
+/// plan is never longer before blending). On door-opening-4r the hand-over that balances the
+/// two robots at the door is ranked beyond the fifth. Ten hard cells × seeds 0–2
+/// (`bench/cells/README.md`, fiftieth session): mean ratio 1.392 → 1.371; door-opening-4r
+/// 1.609 / 1.865 / 1.954 → 1.494 / 1.860 / 1.737. (Made before the reliefs and groups instead,
+/// they lost those that had won: crowded-6r seed 2 1.495 → 1.641.)
 pub const MORE_PLANS: usize = 20;
 
 /// Of those, plans it hands its judge at most.
@@ -49,8 +50,8 @@ pub const MORE_JUDGED: usize = 10;
 
 /// The cells (tasks × robots) on which [`rebalance`] makes the hand-overs of [`MORE_PLANS`]:
 /// each judge is a coordination, seconds on the crowded 8-robot cells (dense-8r-250, 2,000:
-/// 5.4 s each, and its seeds gained 0.00–0.06 in ratio from ten more); dense-8r-120 (960) and
-/// the smaller ones make them.
+/// 5.4 s each; ten more, made before the reliefs and groups, gained its seeds 0.00–0.06 in
+/// ratio, its runs taking 181–227 s beside other work); dense-8r-120 (960) and the smaller ones make them.
 pub const MORE_HANDOVERS_MAX_PAIRS: usize = 1_000;
 
 /// Plans [`rebalance`] makes at most for hand-overs that lighten a robot the last one waits

@@ -27,21 +27,18 @@ use crate::{DMat3, DVec3, Pose};
 use std::cell::Cell;
 use std::ops::Range;
 
-/// Distance from `p` to a box, 0 inside.
-#[cfg(test)]
-fn point_box_distance(p: DVec3, mins: DVec3, maxs: DVec3) -> f64 {
-    (mins - p).max(p - maxs).max(DVec3::ZERO).length()
+/// From a box to `p`, per axis (0 inside): its length is the distance.
+#[inline]
+fn box_gap(p: DVec3, mins: DVec3, maxs: DVec3) -> DVec3 {
+    (mins - p).max(p - maxs).max(DVec3::ZERO)
 }
 
-/// Whether a sphere about `p` of radius `r` is at least `gap` from a box: `point_box_distance
-/// − r ≥ gap`, compared squared ([`reaches`]). A NaN centre counts as inside the box (apart only
-/// for a reach of zero or less).
+/// Whether a sphere about `p` of radius `r` is at least `gap` from a box: `|box_gap| − r ≥
+/// gap`, compared squared ([`reaches`]). A NaN centre counts as inside the box (apart only for
+/// a reach of zero or less).
 #[inline]
 fn sphere_box_apart(p: DVec3, r: f64, mins: DVec3, maxs: DVec3, gap: f64) -> bool {
-    reaches(
-        (mins - p).max(p - maxs).max(DVec3::ZERO).length_squared(),
-        r + gap,
-    )
+    reaches(box_gap(p, mins, maxs).length_squared(), r + gap)
 }
 
 /// What an object is, for a sphere's distance to it.

@@ -1,4 +1,5 @@
 //! The arm's motion bounds and its proof of pairs apart, on the MBM UR5 (bench/motion).
+use super::turned::random_configuration;
 use super::{Arm, apart_everywhere, body_radii, moved_by, pair_radii, pairs_that_may_touch};
 use crate::problem::{ArmSetup, read_problems};
 use cellplan_geom::{DVec3, Pose};
@@ -9,14 +10,6 @@ use std::path::Path;
 fn ur5() -> ArmSetup {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../bench/motion/mbm-ur5/table_pick.json");
     ArmSetup::load(&read_problems(&path).unwrap()).unwrap()
-}
-
-fn random_q(arm: &Arm, rng: &mut ChaCha8Rng) -> Vec<f64> {
-    arm.chain
-        .joints
-        .iter()
-        .map(|j| rng.random_range(j.lower..=j.upper))
-        .collect()
 }
 
 /// Each body's hull vertices in its own frame (none for a body without shapes).
@@ -55,7 +48,7 @@ fn body_and_pair_radii_bound_the_motion() {
     let (mut links, mut poses) = (Vec::new(), Vec::<Pose>::new());
     let mut tightest = vec![0.0f64; n];
     for _ in 0..60 {
-        let a = random_q(&arm, &mut rng);
+        let a = random_configuration(&arm, &mut rng);
         let b: Vec<f64> = a.iter().map(|x| x + rng.random_range(-0.2..0.2)).collect();
         let steps = 40;
         let mut travelled = vec![0.0; n];
@@ -147,7 +140,7 @@ fn pairs_proven_apart_never_touch() {
     let (mut links, mut poses) = (Vec::new(), Vec::<Pose>::new());
     let mut touched = std::collections::BTreeSet::new();
     for _ in 0..5000 {
-        let q = random_q(&all, &mut rng);
+        let q = random_configuration(&all, &mut rng);
         all.body_poses(&q, &mut links, &mut poses);
         for &(i, j) in all.self_pairs {
             if all.world.bodies_within(all.group, i, j, &poses, 0.0) {
@@ -185,7 +178,7 @@ fn point_speed_weights_bound_the_vertices_speeds_and_are_tight() {
     let (mut links, mut lo, mut hi) = (Vec::new(), Vec::<Pose>::new(), Vec::<Pose>::new());
     let eps = 1e-6;
     for _ in 0..30 {
-        let q = random_q(&arm, &mut rng);
+        let q = random_configuration(&arm, &mut rng);
         let w = super::point_speed_weights(&arm, &q);
         assert_eq!(w.len(), arm.chain.dof());
         for j in 0..arm.chain.dof() {
@@ -230,7 +223,7 @@ fn clear_by_answers_as_the_clearances_compared() {
     for margin in [0.0, 0.01] {
         let validity = setup.validity(margin);
         for k in 0..150 {
-            let mut q = random_q(&arm, &mut rng);
+            let mut q = random_configuration(&arm, &mut rng);
             if k % 25 == 0 {
                 q[1] = arm.chain.joints[1].upper + 0.1;
             }
@@ -280,7 +273,7 @@ fn pair_tables_bound_the_exact_distances() {
         let k = t.joint();
         let mut positive = 0;
         for _ in 0..150 {
-            let q = random_q(&arm, &mut rng);
+            let q = random_configuration(&arm, &mut rng);
             arm.body_poses(&q, &mut links, &mut poses);
             let exact = arm.world.pair_distance(arm.group, i, j, &poses, 1.0);
             let at = t.least_within(q[k], 0.0);
@@ -347,12 +340,12 @@ fn pair_tables_change_no_answer() {
     let space = crate::arm::joint_space(&plain, &[1.0; 6]);
     let mut rng = ChaCha8Rng::seed_from_u64(9);
     for _ in 0..400 {
-        let q = random_q(&plain, &mut rng);
+        let q = random_configuration(&plain, &mut rng);
         assert_eq!(a.is_valid(&q), b.is_valid(&q));
     }
     let (mut calls_a, mut calls_b, mut valid) = (0, 0, 0);
     for _ in 0..300 {
-        let p = random_q(&plain, &mut rng);
+        let p = random_configuration(&plain, &mut rng);
         let r: Vec<f64> = p.iter().map(|x| x + rng.random_range(-0.5..0.5)).collect();
         let (ca, cb) = (
             crate::plan::check_segment(&space, &a, &p, &r, 1e-9),
@@ -395,7 +388,7 @@ fn clusters_change_no_answer() {
     let mut rng = ChaCha8Rng::seed_from_u64(17);
     let (mut valid, mut steps) = (0, 0);
     for _ in 0..400 {
-        let q = random_q(&setup.arm(), &mut rng);
+        let q = random_configuration(&setup.arm(), &mut rng);
         let v = with.is_valid(&q);
         assert_eq!(v, without.is_valid(&q), "{q:?}");
         valid += usize::from(v);
@@ -420,7 +413,7 @@ fn clusters_change_no_answer() {
     let links = setup.arm().body_links;
     let mut held = 0;
     for _ in 0..50 {
-        let q = random_q(&setup.arm(), &mut rng);
+        let q = random_configuration(&setup.arm(), &mut rng);
         let (mut bl, mut bodies) = (Vec::new(), Vec::new());
         setup.arm().body_poses(&q, &mut bl, &mut bodies);
         for (c, &(first, _)) in cl_spheres(&with).iter().enumerate() {
@@ -478,7 +471,7 @@ fn posed_bounds_bound_the_motion() {
     let mut axes = super::PosedAxes::default();
     let (mut posed_sum, mut static_sum) = (0.0, 0.0);
     for _ in 0..80 {
-        let q = random_q(&arm, &mut rng);
+        let q = random_configuration(&arm, &mut rng);
         let delta: Vec<f64> = q.iter().map(|_| rng.random_range(-1.5..1.5)).collect();
         let motion = SegmentMotion::new(&space.radii, &delta);
         let t = rng.random_range(0.02..0.6);
@@ -591,7 +584,7 @@ fn pair_tables_prove_only_real_contacts() {
     let (mut links, mut poses) = (Vec::new(), Vec::<Pose>::new());
     let (mut base_contacts, mut base_proven, mut proofs) = (0, 0, 0);
     for _ in 0..3000 {
-        let mut q = random_q(&arm, &mut rng);
+        let mut q = random_configuration(&arm, &mut rng);
         for &(i, j) in arm.self_pairs {
             let Some(t) = tables.get(i, j) else { continue };
             let k = t.joint();
@@ -665,7 +658,7 @@ fn part_order_asks_likely_contacts_first() {
     let (mut links, mut poses) = (Vec::new(), Vec::<Pose>::new());
     let mut seen = vec![false; likely.len()];
     for _ in 0..2000 {
-        let q = random_q(&arm, &mut rng);
+        let q = random_configuration(&arm, &mut rng);
         arm.body_poses(&q, &mut links, &mut poses);
         for (s, &(i, j)) in seen.iter_mut().zip(&likely) {
             *s |= arm.world.pair_distance(arm.group, i, j, &poses, 1e-6) <= 0.0;

@@ -364,7 +364,7 @@ fn placed<'s>(arm: &Arm<'s>, body: usize, pose: Pose, e: &'s End) -> Option<(Pos
 
 /// A configuration drawn uniformly within the joint limits (a joint without finite limits at
 /// its middle).
-fn random_configuration(arm: &Arm, rng: &mut ChaCha8Rng) -> Vec<f64> {
+pub(super) fn random_configuration(arm: &Arm, rng: &mut ChaCha8Rng) -> Vec<f64> {
     arm.chain
         .joints
         .iter()

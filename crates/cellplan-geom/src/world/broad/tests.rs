@@ -89,7 +89,7 @@ fn a_sphere_of_bodies_holds_their_outer_spheres_and_clears_as_the_boxes_say() {
         let gap = broad
             .runs
             .iter()
-            .map(|(lo, hi, _)| super::point_box_distance(sphere.centre, *lo, *hi) - sphere.radius)
+            .map(|(lo, hi, _)| super::box_gap(sphere.centre, *lo, *hi).length() - sphere.radius)
             .fold(f64::INFINITY, f64::min);
         assert_eq!(
             broad.sphere_clears_scene(sphere, best),
@@ -293,13 +293,7 @@ fn a_holding_sphere_changes_no_bound() {
 fn squared_sphere_tests_agree_with_distances() {
     use crate::Sphere;
     let mut rng = ChaCha8Rng::seed_from_u64(12);
-    let mut v = |s: f64| {
-        DVec3::new(
-            rng.random_range(-s..s),
-            rng.random_range(-s..s),
-            rng.random_range(-s..s),
-        )
-    };
+    let mut v = |s: f64| crate::random_vector(&mut rng, s);
     let (mut yes, mut no) = (0, 0);
     for _ in 0..20_000 {
         let a = Sphere {
@@ -318,7 +312,7 @@ fn squared_sphere_tests_agree_with_distances() {
         }
         let (lo, size) = (v(1.0), v(0.5).abs());
         let hi = lo + size;
-        let d = super::point_box_distance(a.centre, lo, hi) - a.radius;
+        let d = super::box_gap(a.centre, lo, hi).length() - a.radius;
         if (d - gap).abs() > 1e-12 {
             assert_eq!(super::sphere_box_apart(a.centre, a.radius, lo, hi, gap), d >= gap);
         }
