@@ -606,7 +606,7 @@ pub fn coordinate(
     // where the coordination of the plan it was made from ended (the start's, for the first).
     let handovers = |start: &Tried,
                      cache: &mut plan::PlanCache,
-                     may_judge: &dyn Fn(bool) -> bool|
+                     may_judge: &dyn Fn(plan::rebalance::Ask) -> bool|
      -> Result<(Option<Tried>, bool), PlanError> {
         let (score, base_ends) = (cycle_and_delta(&start.2.timed).0, ends(&start.2));
         let base_turns = crate::coord::canonical_turns(&start.0, &start.2);
@@ -617,9 +617,9 @@ pub fn coordinate(
             count(&c);
             Some((cycle_and_delta(&c.timed).0, ends(&c), c))
         };
-        let base_waits = start.2.waits_for();
-        let base = (&start.0, score, base_ends.as_slice(), base_waits.as_slice());
-        let waits_of = |c: &Coordinated| c.waits_for();
+        let base_waits = start.2.waits();
+        let base = (&start.0, score, base_ends.as_slice(), &base_waits);
+        let waits_of = |c: &Coordinated| c.waits();
         plan::rebalance::rebalance(
             cell,
             table,
@@ -632,12 +632,12 @@ pub fn coordinate(
     };
     let mut handover_taken = false;
     let before_handovers = spent.get();
-    let first = handovers(&best, cache, &|relief: bool| {
-        affordable_beyond(if relief {
-            coord.ours_distances / RELIEF_EXTRA_DISTANCES
-        } else {
-            0
-        })
+    let first = handovers(&best, cache, &|ask: plan::rebalance::Ask| match ask {
+        plan::rebalance::Ask::Within => affordable(),
+        plan::rebalance::Ask::Beyond => affordable_beyond(coord.ours_distances / RELIEF_EXTRA_DISTANCES),
+        // Bounded by the reorders' own budget; refused only where one coordination costs more
+        // than a quarter of the budget, as every other plan is.
+        plan::rebalance::Ask::Reorder => costliest.get().saturating_mul(4) <= coord.ours_distances,
     });
     let mut second_start = false;
     if let Ok((found, clock_cut)) = first {
@@ -660,7 +660,7 @@ pub fn coordinate(
     if second_start && let Some(start) = runners_up.kept.first() {
         let allowed = spent.get() - before_handovers;
         let from = spent.get();
-        let may_judge = |_: bool| {
+        let may_judge = |_: plan::rebalance::Ask| {
             let costliest = costliest.get();
             spent.get() - from + costliest <= allowed && costliest.saturating_mul(4) <= coord.ours_distances
         };

@@ -184,7 +184,7 @@ fn zones_never_make_the_busiest_robot_busier_than_proximity() {
             .iter()
             .zip(&outcome.allocated.tasks)
             .map(|(g, tasks)| {
-                let order = plan::sequence::best_order(g, tasks, &Default::default(), 0, &[]);
+                let order = plan::sequence::best_order(g, tasks, &Default::default(), 0, &Default::default());
                 plan::sequence::order_cost(g, &Default::default(), &order)
             })
             .fold(0.0, f64::max);
@@ -254,11 +254,6 @@ fn strips_cut_the_mps_along_the_line_of_the_robots_and_each_robot_sweeps_its_str
     build_checked(&cell, &table, &outcome, &s);
 }
 
-/// A cell of the repository (path from its root), loaded.
-fn repo_cell(rel: &str) -> cellplan_model::Cell {
-    load(&repo_root().join(rel), &LoadOptions::default()).unwrap()
-}
-
 #[test]
 fn robots_facing_each_other_make_two_rows_along_the_part() {
     // facing-4r-roof: two robots on each side of the car, facing across it.
@@ -278,17 +273,6 @@ fn robots_facing_each_other_make_two_rows_along_the_part() {
     let (line, rows) = plan::robot_rows(&readme).unwrap();
     assert_eq!(rows, vec![vec![0, 1, 2, 3]]);
     assert!(line[1].abs() > 0.99, "{line:?}");
-}
-
-/// The README cell planned with the nearest-robot allocation: the cell, its candidates, the
-/// settings, the leg cache and the plan.
-fn readme_nearest() -> (Cell, CandidateTable, PlanSettings, plan::PlanCache, plan::Outcome) {
-    let cell = repo_cell("examples/autobody-4r/cell.toml");
-    let table = generate(&cell);
-    let s = settings(Allocation::Proximity);
-    let mut cache = plan::PlanCache::default();
-    let base = plan::plan_cached(&cell, &table, &s, &|_| {}, &mut cache).unwrap();
-    (cell, table, s, cache, base)
 }
 
 /// A hand-over whose plan, the other robots' programs kept, coordinates to a cycle far longer
@@ -429,7 +413,7 @@ fn judged_waiting(
     ),
     (stuck, waited, wait): (usize, usize, f64),
 ) -> Vec<plan::Outcome> {
-    use plan::rebalance::{ends, makespan, rebalance};
+    use plan::rebalance::{Waits, ends, makespan, rebalance};
     let m = cell.robots.len();
     let mut end = ends(base);
     end[stuck] += wait;
@@ -443,7 +427,15 @@ fn judged_waiting(
     let (found, clock) = rebalance(
         cell,
         table,
-        (base, makespan(base) + wait, &end, &waits),
+        (
+            base,
+            makespan(base) + wait,
+            &end,
+            &Waits {
+                totals: waits,
+                stalls: Vec::new(),
+            },
+        ),
         s,
         cache,
         &|_| true,
@@ -461,7 +453,7 @@ fn judged_waiting(
 #[test]
 fn a_robot_the_last_one_waits_for_is_relieved_when_the_hand_overs_do_not_help() {
     use plan::rebalance::{
-        MORE_JUDGED, REBALANCE_JUDGED, RELIEF_JUDGED, RELIEF_PLANS, ends, makespan, rebalance,
+        MORE_JUDGED, REBALANCE_JUDGED, RELIEF_JUDGED, RELIEF_PLANS, Waits, ends, makespan, rebalance,
     };
     let (cell, table, s, mut cache, base) = readme_nearest();
     let m = cell.robots.len();
@@ -531,9 +523,9 @@ fn a_robot_the_last_one_waits_for_is_relieved_when_the_hand_overs_do_not_help() 
         };
         build_checked(&cell, &table, o, &fixed);
     }
-    // The caller's work budget is asked before every plan, with `true` for a relief or a group
-    // (which may go beyond it) and `false` for a hand-over: the hand-overs' asks first, then
-    // the reliefs', then the more hand-overs'.
+    // The caller's work budget is asked before every plan, `Beyond` for a relief or a group
+    // and `Within` for a hand-over: the hand-overs' asks first, then the reliefs', then the
+    // more hand-overs' (no reorder: no wait names its task).
     let asked = std::cell::RefCell::new(Vec::new());
     let mut judge =
         |_: &plan::Outcome, _: Option<(&plan::Outcome, &())>| -> Option<(f64, Vec<f64>, ())> { None };
@@ -541,11 +533,19 @@ fn a_robot_the_last_one_waits_for_is_relieved_when_the_hand_overs_do_not_help() 
     rebalance(
         &cell,
         &table,
-        (&base, makespan(&base) + 5.0, &end, &waits),
+        (
+            &base,
+            makespan(&base) + 5.0,
+            &end,
+            &Waits {
+                totals: waits,
+                stalls: Vec::new(),
+            },
+        ),
         &s,
         &mut cache,
-        &|relief| {
-            asked.borrow_mut().push(relief);
+        &|ask| {
+            asked.borrow_mut().push(ask == plan::rebalance::Ask::Beyond);
             true
         },
         (&mut judge, &|_| unreachable!("no plan is taken")),

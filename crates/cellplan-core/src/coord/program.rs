@@ -489,3 +489,42 @@ impl Program {
         })
     }
 }
+
+impl super::Coordinated {
+    /// Its waits for [`crate::plan::rebalance`]: per robot pair the seconds in all
+    /// ([`super::Coordinated::waits_for`]) and each wait that names the robot it waits for,
+    /// with the task the waiting robot is on its way to and where the other robot is (or is
+    /// going) when the wait ends.
+    pub fn waits(&self) -> crate::plan::rebalance::Waits {
+        let task_of = |r: usize, leg: usize| self.programs.get(r)?.visits.get(leg).map(|v| v.task);
+        let mut stalls = Vec::new();
+        for (r, (p, t)) in self.programs.iter().zip(&self.timed).enumerate() {
+            for (wait, &start) in p.waits.iter().zip(&t.wait_starts) {
+                let Some(s) = wait.for_robot.filter(|&s| s < self.timed.len()) else {
+                    continue;
+                };
+                let other = &self.timed[s];
+                let blocker = match other
+                    .spans
+                    .get(other.span_at(start + wait.duration))
+                    .map(|x| x.what)
+                {
+                    Some(Activity::Measure { visit }) => task_of(s, visit),
+                    Some(Activity::Move { leg, .. } | Activity::Wait { leg, .. }) => task_of(s, leg),
+                    None => None,
+                };
+                stalls.push(crate::plan::rebalance::Stall {
+                    robot: r,
+                    heading: task_of(r, wait.leg),
+                    seconds: wait.duration,
+                    for_robot: s,
+                    blocker,
+                });
+            }
+        }
+        crate::plan::rebalance::Waits {
+            totals: self.waits_for(),
+            stalls,
+        }
+    }
+}

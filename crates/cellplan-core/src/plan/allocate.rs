@@ -200,7 +200,14 @@ impl Tour {
     fn new(graph: &RobotGraph, tasks: &[TaskId], seed: u64) -> Tour {
         // Long tours get fewer kicks: the work per kick grows with the tour.
         let kicks = (ZONE_TOUR_WORK / (tasks.len() + 1)).clamp(20, ZONE_TOUR_ITERATIONS);
-        let nodes = super::sequence::best_order_with(graph, tasks, &Default::default(), seed, kicks, &[]);
+        let nodes = super::sequence::best_order_with(
+            graph,
+            tasks,
+            &Default::default(),
+            seed,
+            kicks,
+            &Default::default(),
+        );
         let time = super::sequence::order_cost(graph, &Default::default(), &nodes);
         Tour { nodes, time }
     }

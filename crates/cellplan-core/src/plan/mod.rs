@@ -16,7 +16,7 @@ pub mod sequence;
 pub use allocate::{Allocation, CoverMethod};
 pub use cache::PlanCache;
 pub use graph::MoveModel;
-pub use rows::{robot_rows, sweep_keys};
+pub use rows::{order_rule, robot_rows, sweep_keys};
 
 use crate::candidates::CandidateTable;
 use crate::coord::Program;
@@ -92,6 +92,11 @@ pub struct PlanSettings {
     /// caller keeps it within the caps and to robots able to do each task; see
     /// [`rebalance::rebalance`].
     pub tasks: Option<Vec<Vec<TaskId>>>,
+    /// Tasks each robot visits after all its others, wherever some order can (none by
+    /// default): where a robot waits for a neighbour on its way to a task, the same tour with
+    /// that task at its end may pass when the neighbour has gone (see
+    /// [`rebalance::rebalance`]'s reorders).
+    pub late: Vec<TaskId>,
     /// Also prove the route bound ([`allocate::route_bound`]) with this work budget, in arcs
     /// its pricings look at (`None`: the leg bound alone, as by default). The plan states the
     /// larger bound, and the verifier derives the route bound again under the same budget.
@@ -139,6 +144,7 @@ impl Default for PlanSettings {
             task_penalty: Vec::new(),
             sweep: None,
             tasks: None,
+            late: Vec::new(),
             route_bound_work: None,
             deadline: None,
         }
@@ -561,10 +567,12 @@ pub fn plan_keeping(
             sequence,
         };
         // What the robot had in `prior`, if its tasks are the same (on the final allocation:
-        // the balanced one may have changed it, dropped tasks moved).
+        // the balanced one may have changed it, dropped tasks moved) and its order leaves the
+        // late ones to the end.
         let kept = prior
             .filter(|p| p.allocated.tasks.get(r) == allocated.tasks.get(r))
-            .and_then(|p| p.robots.get(r));
+            .and_then(|p| p.robots.get(r))
+            .filter(|k| late_last(graph, &k.sequence.nodes, &settings.late));
         let result = match kept {
             Some(k) if k.program.duration() <= new.program.duration() + 1e-9 => k.clone(),
             _ => new,
@@ -580,6 +588,12 @@ pub fn plan_keeping(
         unreached,
         time_limit_hit: clock_cut || sequences_cut,
     })
+}
+
+/// Whether an order (`nodes` of `graph`) visits no task of `late` before one that is not.
+fn late_last(graph: &RobotGraph, nodes: &[usize], late: &[TaskId]) -> bool {
+    let is_late = |n: &usize| graph.node_task[*n].is_some_and(|(t, _)| late.contains(&t));
+    nodes.iter().skip_while(|n| !is_late(n)).all(is_late)
 }
 
 /// The tasks the robots gave up (no path), each tried on the other robots that have
@@ -686,7 +700,7 @@ fn sequence_all(
                     tasks,
                     planned,
                     sequence::order_seed(settings, robot),
-                    &sweep_keys(cell, settings.sweep),
+                    &order_rule(cell, settings),
                 );
                 let time = sequence::order_cost(graph, planned, &order);
                 (order, time)

@@ -12,6 +12,10 @@
 //! time. Where neither helps, a group of the last robot's tasks goes to the robot it waits for
 //! (`groups`): on a crowded cell one MP moved at a time changes the coordinated cycle
 //! erratically, while a share of the space both reach, moved at once, can end the waiting.
+//! Last come the reorders (`reorders`): the allocation kept, the task a robot waits on the way
+//! to, or the one the robot it waits for is at, left to the end of its robot's tour
+//! ([`PlanSettings::late`]): coordination delays a robot or runs its tour backwards, but cannot
+//! move one visit of it past a neighbour's.
 use super::{Outcome, PlanCache, PlanError, PlanSettings, dwell, plan_keeping};
 use crate::candidates::CandidateTable;
 use cellplan_model::Cell;
@@ -75,8 +79,17 @@ pub const GROUP_JUDGED: usize = 2;
 /// Most tasks one group hand-over moves.
 const GROUP_MAX: usize = 8;
 
+/// Plans [`rebalance`] makes at most for reorders (a task a robot waits on the way to, or the
+/// task the robot it waits for is at, left to the end of its robot's tour; see `reorders`),
+/// once the other kinds are spent, on a budget of their own.
+pub const REORDER_PLANS: usize = 6;
+
+/// Of those, plans it hands its judge at most.
+pub const REORDER_JUDGED: usize = 4;
+
 /// One hand-over: the tasks (one, or a group), from which robot, to which, and the ends it is
-/// expected to give the two (s).
+/// expected to give the two (s). From a robot to itself: a reorder, the tasks left to the end
+/// of its tour ([`PlanSettings::late`]).
 #[derive(Clone, Debug, PartialEq)]
 struct Move {
     tasks: Vec<TaskId>,
@@ -93,9 +106,50 @@ pub type Judged<J> = (f64, Vec<f64>, J);
 /// what the judge made of that (`None`: made from the base).
 pub type Judge<'a, J> = dyn FnMut(&Outcome, Option<(&Outcome, &J)>) -> Option<Judged<J>> + 'a;
 
-/// What [`rebalance`] reads off what its judge made of a plan: `w[r][s]`, the seconds robot `r`
-/// waits for robot `s` (see `coord::Coordinated::waits_for`).
-pub type WaitsOf<'a, J> = dyn Fn(&J) -> Vec<Vec<f64>> + 'a;
+/// What [`rebalance`] asks its caller's budget of work before a plan (`may_judge`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Ask {
+    /// A direct hand-over's plan: within the budget. Refused, only the reorders are left.
+    Within,
+    /// A relief's or a group's plan, or a reorder's on a cell larger than
+    /// [`MORE_HANDOVERS_MAX_PAIRS`] tasks × robots: the budget may allow it beyond itself.
+    /// Refused, the search ends.
+    Beyond,
+    /// A reorder's plan on a smaller cell: its own budget ([`REORDER_JUDGED`]) bounds it, and
+    /// the caller may still refuse (where even one coordination is too costly). Refused, the
+    /// search ends.
+    Reorder,
+}
+
+/// A robot's stop in a judged plan: robot `robot` waits `seconds` on its way to `heading`
+/// (`None`: home) for robot `for_robot`, which is at `blocker` when the wait ends or on its
+/// way there (`None`: home).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Stall {
+    /// The robot that waits.
+    pub robot: usize,
+    /// The task it is on its way to.
+    pub heading: Option<TaskId>,
+    /// How long (s).
+    pub seconds: f64,
+    /// The robot it waits for.
+    pub for_robot: usize,
+    /// Where that robot is (or is going) when the wait ends.
+    pub blocker: Option<TaskId>,
+}
+
+/// The waits of a judged plan: `totals[r][s]`, the seconds robot `r` waits for robot `s` in
+/// all, and each wait that names the robot it waits for.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Waits {
+    /// `totals[r][s]`: seconds robot `r` waits for robot `s`.
+    pub totals: Vec<Vec<f64>>,
+    /// The waits one by one.
+    pub stalls: Vec<Stall>,
+}
+
+/// What [`rebalance`] reads off what its judge made of a plan (see `coord::Coordinated::waits`).
+pub type WaitsOf<'a, J> = dyn Fn(&J) -> Waits + 'a;
 
 /// A rebalanced plan: the plan, the settings it was made with (its fixed allocation) and what
 /// the judge made of it.
@@ -363,6 +417,42 @@ fn groups(cell: &Cell, o: &Outcome, end: &[f64], waits: &[Vec<f64>]) -> Vec<Move
     ranked(out)
 }
 
+/// The reorders of `o`: where a robot waits at least [`RELIEF_MIN_WAIT`] for another
+/// (`stalls`, as judged), the task it waits on the way to left to the end of its tour (the
+/// other robot has gone by then), and the task the other robot is at left to the end of that
+/// robot's (the waiting robot passes first); coordination can only delay a robot or run its
+/// tour the other way, not move one visit of it. Ranked by how far below the latest end (by
+/// `end`) the waiting robot would end without the wait (for the robot that ends last, the wait
+/// itself): on crowded-6r, seed 1, a 14 s wait of a robot ending 0.6 s before the last one
+/// comes before the last one's 5 s; the longest wait alone would put a robot that ends early
+/// first. A task already late (in `late`) is not moved again.
+fn reorders(o: &Outcome, end: &[f64], stalls: &[Stall], late: &[TaskId]) -> Vec<Move> {
+    let latest = end.iter().copied().fold(0.0, f64::max);
+    let gain = |s: &Stall| s.seconds - (latest - end.get(s.robot).copied().unwrap_or(0.0));
+    let mut waits: Vec<&Stall> = stalls
+        .iter()
+        .filter(|s| s.for_robot != s.robot && s.robot < end.len() && s.seconds >= RELIEF_MIN_WAIT)
+        .collect();
+    waits.sort_by(|a, b| gain(b).total_cmp(&gain(a)).then(a.robot.cmp(&b.robot)));
+    let mut out: Vec<Move> = Vec::new();
+    for s in waits {
+        for (robot, task) in [(s.robot, s.heading), (s.for_robot, s.blocker)] {
+            let Some(task) = task else { continue };
+            let holds = o.allocated.tasks.get(robot).is_some_and(|t| t.contains(&task));
+            let again = out.iter().any(|m| m.from == robot && m.tasks == [task]);
+            if holds && !late.contains(&task) && !again {
+                out.push(Move {
+                    tasks: vec![task],
+                    from: robot,
+                    to: robot,
+                    expected: latest - gain(s).max(0.0),
+                });
+            }
+        }
+    }
+    out
+}
+
 /// `base` (planned with `settings`; `judge` said `base_score` and `base_ends` of it) balanced
 /// on its real times. Up to [`REBALANCE_PLANS`] times, the best expected hand-over not tried
 /// yet (one task of the robot that ends last as judged to another robot, ranked by the ends it
@@ -372,20 +462,25 @@ fn groups(cell: &Cell, o: &Outcome, end: &[f64], waits: &[Vec<f64>]) -> Vec<Move
 /// same as the one before is not judged again).
 /// A plan whose robots end, without coordination, sooner than the best score (the judge's
 /// score is never below that end) goes to `judge`, with the hand-over plan it was made from
-/// and what the judge made of that (`None`: made from `base`) — at most [`REBALANCE_JUDGED`] plans, and
-/// the search ends once `may_judge` says no before a plan (the caller's budget of work, asked
-/// with `true` before a relief's plans, which it may allow beyond, `false` before a
-/// hand-over's); the
-/// first it scores below the best is kept and the next hand-overs start from it and its ends.
+/// and what the judge made of that (`None`: made from `base`) — at most [`REBALANCE_JUDGED`]
+/// plans — while `may_judge` says yes before each plan (the caller's budget of work, asked
+/// with an [`Ask`]: [`Ask::Within`] before a hand-over's plans, [`Ask::Beyond`] before a
+/// relief's or a group's, which it may allow beyond; `Within` refused leaves only the
+/// reorders, another refused ends the search);
+/// the first it scores below the best is kept and the next hand-overs start from it and its ends.
 /// When a round's hand-overs are spent (or their budget is) without help, its reliefs are
 /// tried the same way on a budget of their own ([`RELIEF_PLANS`], [`RELIEF_JUDGED`]): they need
 /// the judged waits, `base_waits` for `base` and `waits_of` for what the judge made of a plan
-/// (`w[r][s]`: seconds robot `r` waits for robot `s`; none given, no relief). After them the
-/// round's group hand-overs (`groups`), on a budget of their own too ([`GROUP_PLANS`],
-/// [`GROUP_JUDGED`]; `may_judge` asked with `true`, as for a relief). Then, on cells of at most
-/// [`MORE_HANDOVERS_MAX_PAIRS`] tasks × robots, more direct hand-overs on a budget of their own
-/// ([`MORE_PLANS`], [`MORE_JUDGED`]; `may_judge` asked with `false`). A relief, a group or one
-/// of those taken starts a new round, its hand-overs first while their budget lasts.
+/// ([`Waits`]; none given, no relief). After them the round's group hand-overs (`groups`), on
+/// a budget of their own too ([`GROUP_PLANS`], [`GROUP_JUDGED`]; asked as a relief). Then, on
+/// cells of at most [`MORE_HANDOVERS_MAX_PAIRS`] tasks × robots, more direct hand-overs on a
+/// budget of their own ([`MORE_PLANS`], [`MORE_JUDGED`]; asked `Within`). Last the reorders
+/// (`reorders`, from the judged [`Waits::stalls`]: the allocation kept, a task left to the end
+/// of its robot's tour, the other robots keeping their programs) on a budget of their own
+/// ([`REORDER_PLANS`], [`REORDER_JUDGED`]), asked [`Ask::Reorder`] on cells of at most
+/// [`MORE_HANDOVERS_MAX_PAIRS`] tasks × robots and `Beyond` on larger ones. A relief, a group, one of the more hand-overs or a reorder
+/// taken starts a new round, its hand-overs first while their budget lasts; the late tasks of
+/// the plan kept stay late in the plans made from it, but for a task handed to another robot.
 /// Returns the best plan found with its settings and what the judge made of it, or `None` when
 /// no hand-over beat `base_score`, and whether the deadline stopped the search with hand-overs
 /// left to try (the plan then depends on the machine's speed). Plans that fail only lose their
@@ -395,10 +490,10 @@ fn groups(cell: &Cell, o: &Outcome, end: &[f64], waits: &[Vec<f64>]) -> Vec<Move
 pub fn rebalance<J>(
     cell: &Cell,
     table: &CandidateTable,
-    (base, base_score, base_ends, base_waits): (&Outcome, f64, &[f64], &[Vec<f64>]),
+    (base, base_score, base_ends, base_waits): (&Outcome, f64, &[f64], &Waits),
     settings: &PlanSettings,
     cache: &mut PlanCache,
-    may_judge: &dyn Fn(bool) -> bool,
+    may_judge: &dyn Fn(Ask) -> bool,
     (judge, waits_of): (&mut Judge<'_, J>, &WaitsOf<'_, J>),
 ) -> Result<(Option<Rebalanced<J>>, bool), PlanError> {
     if cell.robots.len() < 2 {
@@ -406,11 +501,13 @@ pub fn rebalance<J>(
     }
     let mut best: Option<Rebalanced<J>> = None;
     let (mut score, mut judged_ends) = (base_score, base_ends.to_vec());
-    let mut waits = base_waits.to_vec();
-    let mut tried: Vec<Vec<Vec<TaskId>>> = vec![base.allocated.tasks.clone()];
+    let mut waits = base_waits.clone();
+    let mut tried: Vec<(Vec<Vec<TaskId>>, Vec<TaskId>)> =
+        vec![(base.allocated.tasks.clone(), settings.late.clone())];
     // The direct hand-overs' budget, then the reliefs', then the groups', then more direct
     // hand-overs' on cells small enough (each its own).
-    let more = if cell.tasks.len() * cell.robots.len() <= MORE_HANDOVERS_MAX_PAIRS {
+    let small = cell.tasks.len() * cell.robots.len() <= MORE_HANDOVERS_MAX_PAIRS;
+    let more = if small {
         Budget::new(MORE_PLANS, MORE_JUDGED)
     } else {
         Budget::new(0, 0)
@@ -420,22 +517,32 @@ pub fn rebalance<J>(
         Budget::new(RELIEF_PLANS, RELIEF_JUDGED),
         Budget::new(GROUP_PLANS, GROUP_JUDGED),
         more,
+        Budget::new(REORDER_PLANS, REORDER_JUDGED),
     ];
+    let mut refused = false;
     'rounds: loop {
         let current = best.as_ref().map_or(base, |b| &b.0);
         let from_tasks = current.allocated.tasks.clone();
-        for (phase, budget) in budgets.iter_mut().enumerate() {
-            if budget.spent() {
+        let from_late = best.as_ref().map_or(&settings.late, |b| &b.1.late).clone();
+        'phases: for (phase, budget) in budgets.iter_mut().enumerate() {
+            // Once the caller's budget has refused a hand-over, only the reorders are left.
+            if budget.spent() || (refused && phase != 4) {
                 continue;
             }
             let list = match phase {
-                1 => reliefs(cell, current, &judged_ends, &waits),
-                2 => groups(cell, current, &judged_ends, &waits),
+                1 => reliefs(cell, current, &judged_ends, &waits.totals),
+                2 => groups(cell, current, &judged_ends, &waits.totals),
+                4 => reorders(current, &judged_ends, &waits.stalls, &from_late),
                 _ => moves(cell, current, &judged_ends),
             };
-            // A relief or a group may go beyond the caller's budget (see `may_judge`); a
-            // direct hand-over, first or more, may not.
-            let beyond = phase == 1 || phase == 2;
+            // A relief, a group or a reorder may go beyond the caller's budget (see [`Ask`]);
+            // a direct hand-over, first or more, may not.
+            let ask = match phase {
+                1 | 2 => Ask::Beyond,
+                4 if small => Ask::Reorder,
+                4 => Ask::Beyond,
+                _ => Ask::Within,
+            };
             for mv in list {
                 if budget.spent() {
                     break;
@@ -443,25 +550,42 @@ pub fn rebalance<J>(
                 if settings.deadline.is_some_and(|d| Instant::now() >= d) {
                     return Ok((best, true));
                 }
+                let reorder = mv.from == mv.to;
                 let mut tasks = from_tasks.clone();
-                tasks[mv.from].retain(|t| !mv.tasks.contains(t));
-                tasks[mv.to].extend(&mv.tasks);
-                if tried.contains(&tasks) {
+                let mut late = from_late.clone();
+                if reorder {
+                    late.extend(&mv.tasks);
+                } else {
+                    tasks[mv.from].retain(|t| !mv.tasks.contains(t));
+                    tasks[mv.to].extend(&mv.tasks);
+                    late.retain(|t| !mv.tasks.contains(t));
+                }
+                let key = (tasks, late);
+                if tried.contains(&key) {
                     continue;
                 }
-                tried.push(tasks.clone());
+                tried.push(key.clone());
+                let (tasks, late) = key;
                 let next = PlanSettings {
                     tasks: Some(tasks),
+                    late,
                     ..settings.clone()
                 };
                 // First the robots whose tasks did not change keep their programs unless the
                 // new ones are shorter (and so, mostly, the diagrams of their pairs); when that
                 // does not help, every robot is sequenced again: other paths, which may meet
-                // less.
+                // less. A reorder is made the first way only: it is one robot's new order.
                 let mut kept: Option<Outcome> = None;
                 for keep in [true, false] {
-                    if !may_judge(beyond) {
-                        break 'rounds;
+                    if reorder && !keep {
+                        break;
+                    }
+                    if !may_judge(ask) {
+                        if ask != Ask::Within {
+                            break 'rounds;
+                        }
+                        refused = true;
+                        continue 'phases;
                     }
                     if budget.spent() {
                         break;

@@ -65,3 +65,12 @@ pub fn sweep_keys(cell: &Cell, sweep: Option<[f64; 2]>) -> Vec<f64> {
             .collect(),
     }
 }
+
+/// What every robot's order must respect under `settings`: the sweep's keys
+/// ([`super::PlanSettings::sweep`]) and the late tasks ([`super::PlanSettings::late`]).
+pub fn order_rule(cell: &Cell, settings: &super::PlanSettings) -> super::sequence::OrderRule {
+    super::sequence::OrderRule {
+        sweep: sweep_keys(cell, settings.sweep),
+        late: settings.late.clone(),
+    }
+}

@@ -15,7 +15,7 @@ use std::time::Instant;
 
 mod order;
 mod reach;
-pub use order::{SWEEP_GROUPS, best_order, best_order_with};
+pub use order::{OrderRule, SWEEP_GROUPS, best_order, best_order_with};
 pub use reach::Reach;
 
 /// A planned leg between two nodes of a robot graph.
@@ -196,7 +196,7 @@ fn attempt(
                 tasks,
                 planned,
                 order_seed(settings, robot),
-                &super::sweep_keys(cell, settings.sweep),
+                &super::order_rule(cell, settings),
             ),
         };
         let optimistic = order_cost(graph, planned, &nodes);

@@ -12,7 +12,7 @@ use cellplan_core::plan::{self, Allocation, PlanSettings};
 use cellplan_model::robot::Scratch;
 use cellplan_model::{Cell, LoadOptions};
 use cellplan_optical::load;
-use cellplan_optical::testing::example_copy;
+use cellplan_optical::testing::{example_copy, repo_root};
 use cellplan_verify::{VerifySettings, verify};
 use std::collections::BTreeMap;
 use std::path::PathBuf;
@@ -230,15 +230,31 @@ pub fn rebalanced(
     cache: &mut plan::PlanCache,
     judge: &mut plan::rebalance::Judge<'_, ()>,
 ) -> (Option<plan::rebalance::Rebalanced<()>>, bool) {
-    use plan::rebalance::{ends, makespan, rebalance};
+    use plan::rebalance::{Waits, ends, makespan, rebalance};
     rebalance(
         cell,
         table,
-        (base, makespan(base), &ends(base), &[]),
+        (base, makespan(base), &ends(base), &Waits::default()),
         settings,
         cache,
         &|_| true,
-        (judge, &|_| Vec::new()),
+        (judge, &|_| Waits::default()),
     )
     .unwrap()
+}
+
+/// A cell of the repository (path from its root), loaded.
+pub fn repo_cell(rel: &str) -> cellplan_model::Cell {
+    load(&repo_root().join(rel), &LoadOptions::default()).unwrap()
+}
+
+/// The README cell planned with the nearest-robot allocation: the cell, its candidates, the
+/// settings, the leg cache and the plan.
+pub fn readme_nearest() -> (Cell, CandidateTable, PlanSettings, plan::PlanCache, plan::Outcome) {
+    let cell = repo_cell("examples/autobody-4r/cell.toml");
+    let table = generate(&cell);
+    let s = settings(Allocation::Proximity);
+    let mut cache = plan::PlanCache::default();
+    let base = plan::plan_cached(&cell, &table, &s, &|_| {}, &mut cache).unwrap();
+    (cell, table, s, cache, base)
 }

@@ -1,5 +1,5 @@
 //! The best order of a robot's tasks: a GTSP over their candidates under the current costs,
-//! optionally sweeping the tasks along a line.
+//! optionally sweeping the tasks along a line and leaving some of them to the end.
 use super::{NO_PATH, Planned};
 use crate::plan::graph::RobotGraph;
 use cellplan_model::tasks::TaskId;
@@ -11,36 +11,66 @@ const GTSP_ITERATIONS: usize = 400;
 /// ... and stop after this many kicks in a row that did not shorten the best order.
 const GTSP_STALL: usize = 100;
 
+/// What a robot's order must respect, wherever some order can (see
+/// [`crate::plan::order_rule`]).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct OrderRule {
+    /// Each task's place along the sweep, indexed by task (empty: no sweep; see
+    /// [`crate::plan::PlanSettings::sweep`]).
+    pub sweep: Vec<f64>,
+    /// Tasks visited after every other task of their robot (see
+    /// [`crate::plan::PlanSettings::late`]).
+    pub late: Vec<TaskId>,
+}
+
 /// The best order (GTSP over the tasks' candidates) under the current costs: planned legs at
-/// their real time, the others at their lower bound; with `sweep` keys per task (see
-/// [`crate::plan::PlanSettings::sweep`], [`crate::plan::sweep_keys`]), the order that sweeps
-/// the tasks in [`SWEEP_GROUPS`] groups of rising key wherever that is possible.
+/// their real time, the others at their lower bound; with `rule`'s sweep keys, the order that
+/// sweeps the tasks in [`SWEEP_GROUPS`] groups of rising key, and with its late tasks, the
+/// order that visits them after the others, wherever that is possible.
 pub fn best_order(
     graph: &RobotGraph,
     tasks: &[TaskId],
     planned: &Planned,
     seed: u64,
-    sweep: &[f64],
+    rule: &OrderRule,
 ) -> Vec<usize> {
-    best_order_with(graph, tasks, planned, seed, GTSP_ITERATIONS, sweep)
+    best_order_with(graph, tasks, planned, seed, GTSP_ITERATIONS, rule)
 }
 
 /// Groups of a sweep: a robot's tasks in this many groups of equal size by their sweep keys.
 pub const SWEEP_GROUPS: usize = 3;
 
-/// Added to the cost of a move from a task back to a task of an earlier sweep group, in the
-/// GTSP only (the order's time is its real time): longer than any leg, so that an order sweeps
-/// its groups one after the other whenever some order can.
+/// Added to the cost of a move from a task back to a task of an earlier group (of a sweep, or
+/// the late tasks' after the others), in the GTSP only (the order's time is its real time):
+/// longer than any leg, so that an order visits its groups one after the other whenever some
+/// order can.
 const SWEEP_PENALTY: f64 = 100.0;
 
-/// Each task's sweep group (`usize::MAX` for none), indexed by task: `tasks` sorted by their
-/// `sweep` keys (then by id) and cut into [`SWEEP_GROUPS`] groups of equal size.
-fn sweep_groups(tasks: &[TaskId], sweep: &[f64]) -> Vec<usize> {
-    let mut group = vec![usize::MAX; sweep.len()];
-    let mut sorted: Vec<TaskId> = tasks.iter().copied().filter(|t| t.0 < sweep.len()).collect();
+/// Each task's group (`usize::MAX` for none), indexed by task: the tasks that are not late
+/// sorted by their sweep keys (then by id) and cut into [`SWEEP_GROUPS`] groups of equal size
+/// (without a sweep, one group when some task is late, else none), the late ones after them.
+fn order_groups(tasks: &[TaskId], rule: &OrderRule) -> Vec<usize> {
+    let late = |t: &TaskId| rule.late.contains(t);
+    let any_late = tasks.iter().any(late);
+    let mut group = vec![usize::MAX; tasks.iter().map(|t| t.0 + 1).max().unwrap_or(0)];
+    let sweep = &rule.sweep;
+    let mut sorted: Vec<TaskId> = tasks
+        .iter()
+        .copied()
+        .filter(|t| t.0 < sweep.len() && !late(t))
+        .collect();
     sorted.sort_by(|a, b| sweep[a.0].total_cmp(&sweep[b.0]).then(a.0.cmp(&b.0)));
     for (rank, t) in sorted.iter().enumerate() {
         group[t.0] = rank * SWEEP_GROUPS / sorted.len();
+    }
+    if any_late {
+        for t in tasks {
+            if late(t) {
+                group[t.0] = SWEEP_GROUPS;
+            } else if group[t.0] == usize::MAX {
+                group[t.0] = 0;
+            }
+        }
     }
     group
 }
@@ -52,12 +82,12 @@ pub fn best_order_with(
     planned: &Planned,
     seed: u64,
     iterations: usize,
-    sweep: &[f64],
+    rule: &OrderRule,
 ) -> Vec<usize> {
     if tasks.is_empty() {
         return Vec::new();
     }
-    let groups = sweep_groups(tasks, sweep);
+    let groups = order_groups(tasks, rule);
     let mut local = vec![0usize];
     let mut group_of = vec![usize::MAX];
     let mut clusters = Vec::with_capacity(tasks.len());
@@ -122,4 +152,43 @@ pub fn best_order_with(
         },
     );
     sol.tour.nodes.iter().map(|&i| local[i]).collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn late_tasks_form_the_last_group() {
+        let t = |i: usize| TaskId(i);
+        let tasks = [t(0), t(1), t(2), t(5)];
+        // No rule: no groups.
+        assert!(
+            order_groups(&tasks, &OrderRule::default())
+                .iter()
+                .all(|&g| g == usize::MAX)
+        );
+        // Late tasks after one group of the others; tasks of other robots have none.
+        let late = OrderRule {
+            late: vec![t(2), t(4)],
+            ..OrderRule::default()
+        };
+        let g = order_groups(&tasks, &late);
+        assert_eq!((g[0], g[1], g[2], g[5]), (0, 0, SWEEP_GROUPS, 0));
+        assert_eq!((g[3], g[4]), (usize::MAX, usize::MAX));
+        // With a sweep: the others in its groups by key, the late ones after them all.
+        let keys = vec![3.0, 2.0, 0.0, 0.0, 0.0, 1.0];
+        let both = OrderRule {
+            sweep: keys.clone(),
+            late: vec![t(2)],
+        };
+        let g = order_groups(&tasks, &both);
+        assert_eq!((g[5], g[1], g[0], g[2]), (0, 1, 2, SWEEP_GROUPS));
+        let sweep = OrderRule {
+            sweep: keys,
+            late: Vec::new(),
+        };
+        let g = order_groups(&tasks, &sweep);
+        assert_eq!((g[2], g[5], g[1], g[0]), (0, 0, 1, 2));
+    }
 }
