@@ -459,9 +459,7 @@ fn a_robot_the_last_one_waits_for_is_relieved_when_the_hand_overs_do_not_help() 
     let m = cell.robots.len();
     // As if coordination had made the robot that ends last wait 5 s for the busiest other one.
     let mut end = ends(&base);
-    let stuck = (0..m)
-        .max_by(|&a, &b| end[a].total_cmp(&end[b]).then(b.cmp(&a)))
-        .unwrap();
+    let stuck = last_robot(&end);
     let waited = (0..m)
         .filter(|&r| r != stuck)
         .max_by_key(|&r| base.allocated.tasks[r].len())
@@ -571,9 +569,7 @@ fn the_last_robot_hands_groups_of_tasks_to_the_robot_it_waits_for() {
     let (cell, table, s, mut cache, base) = readme_nearest();
     let m = cell.robots.len();
     let end = ends(&base);
-    let stuck = (0..m)
-        .max_by(|&a, &b| end[a].total_cmp(&end[b]).then(b.cmp(&a)))
-        .unwrap();
+    let stuck = last_robot(&end);
     // The robot that can take most of the last one's tasks (within its room under the cap)
     // waited for 5 s.
     let can = |r: usize| {

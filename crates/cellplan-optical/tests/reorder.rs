@@ -54,9 +54,7 @@ fn a_wait_is_tried_with_the_tasks_it_is_about_left_to_the_end() {
     let (cell, table, s, mut cache, base) = readme_nearest();
     let m = cell.robots.len();
     let mut end = ends(&base);
-    let stuck = (0..m)
-        .max_by(|&a, &b| end[a].total_cmp(&end[b]).then(b.cmp(&a)))
-        .unwrap();
+    let stuck = last_robot(&end);
     let waited = (stuck + 1) % m;
     // As if the last robot had waited 5 s on its way to its second task for the other robot,
     // then at its third task.

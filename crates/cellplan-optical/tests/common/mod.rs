@@ -258,3 +258,10 @@ pub fn readme_nearest() -> (Cell, CandidateTable, PlanSettings, plan::PlanCache,
     let base = plan::plan_cached(&cell, &table, &s, &|_| {}, &mut cache).unwrap();
     (cell, table, s, cache, base)
 }
+
+/// The robot that ends last by `end` (the higher index on a tie, as `rebalance` takes it).
+pub fn last_robot(end: &[f64]) -> usize {
+    (0..end.len())
+        .max_by(|&a, &b| end[a].total_cmp(&end[b]).then(b.cmp(&a)))
+        .expect("robots")
+}
