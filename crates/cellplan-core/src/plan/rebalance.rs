@@ -427,7 +427,8 @@ fn groups(cell: &Cell, o: &Outcome, end: &[f64], waits: &[Vec<f64>]) -> Vec<Move
 /// `end`) the waiting robot would end without the wait (for the robot that ends last, the wait
 /// itself): on crowded-6r, seed 1, a 14 s wait of a robot ending 0.6 s before the last one
 /// comes before the last one's 5 s; the longest wait alone would put a robot that ends early
-/// first. A task already late (in `late`) is not moved again.
+/// first. A task already late (in `late`) is not moved again. (Coordination may still run
+/// the new tour backwards: the task then comes first, which the judge weighs the same way.)
 fn reorders(o: &Outcome, end: &[f64], stalls: &[Stall], late: &[TaskId]) -> Vec<Move> {
     let latest = end.iter().copied().fold(0.0, f64::max);
     let gain = |s: &Stall| s.seconds - (latest - end.get(s.robot).copied().unwrap_or(0.0));
