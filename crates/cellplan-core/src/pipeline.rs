@@ -471,10 +471,10 @@ pub fn coordinate(
     };
     // `extra`: work allowed beyond the budget (the reliefs' and the groups', see
     // [`RELIEF_EXTRA_DISTANCES`]).
+    // No coordination may ask more than a quarter of the budget.
+    let not_too_costly = || costliest.get().saturating_mul(4) <= coord.ours_distances;
     let affordable_beyond = |extra: usize| {
-        let (spent, costliest) = (spent.get(), costliest.get());
-        spent + costliest <= coord.ours_distances.saturating_add(extra)
-            && costliest.saturating_mul(4) <= coord.ours_distances
+        spent.get() + costliest.get() <= coord.ours_distances.saturating_add(extra) && not_too_costly()
     };
     let affordable = || affordable_beyond(0);
     // The coordinated plans that lost, the shortest few (on small cells): blending can reorder
@@ -635,9 +635,9 @@ pub fn coordinate(
     let first = handovers(&best, cache, &|ask: plan::rebalance::Ask| match ask {
         plan::rebalance::Ask::Within => affordable(),
         plan::rebalance::Ask::Beyond => affordable_beyond(coord.ours_distances / RELIEF_EXTRA_DISTANCES),
-        // Bounded by the reorders' own budget; refused only where one coordination costs more
-        // than a quarter of the budget, as every other plan is.
-        plan::rebalance::Ask::Reorder => costliest.get().saturating_mul(4) <= coord.ours_distances,
+        // Bounded by the reorders' own budget; refused only where a coordination is too
+        // costly, as every other plan is.
+        plan::rebalance::Ask::Reorder => not_too_costly(),
     });
     let mut second_start = false;
     if let Ok((found, clock_cut)) = first {
@@ -660,10 +660,8 @@ pub fn coordinate(
     if second_start && let Some(start) = runners_up.kept.first() {
         let allowed = spent.get() - before_handovers;
         let from = spent.get();
-        let may_judge = |_: plan::rebalance::Ask| {
-            let costliest = costliest.get();
-            spent.get() - from + costliest <= allowed && costliest.saturating_mul(4) <= coord.ours_distances
-        };
+        let may_judge =
+            |_: plan::rebalance::Ask| spent.get() - from + costliest.get() <= allowed && not_too_costly();
         if let Ok((found, clock_cut)) = handovers(start, cache, &may_judge) {
             if let Some(found) = found {
                 handover_taken |= runners_up.offer_to(&mut best, found);

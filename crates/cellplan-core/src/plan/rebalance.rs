@@ -90,8 +90,8 @@ pub const REORDER_PLANS: usize = 6;
 pub const REORDER_JUDGED: usize = 4;
 
 /// One hand-over: the tasks (one, or a group), from which robot, to which, and the ends it is
-/// expected to give the two (s). From a robot to itself: a reorder, the tasks left to the end
-/// of its tour ([`PlanSettings::late`]).
+/// expected to give the two (s). A reorder's is from its robot to itself: the tasks left to the
+/// end of its tour ([`PlanSettings::late`]).
 #[derive(Clone, Debug, PartialEq)]
 struct Move {
     tasks: Vec<TaskId>,
@@ -481,9 +481,10 @@ fn reorders(o: &Outcome, end: &[f64], stalls: &[Stall], late: &[TaskId]) -> Vec<
 /// (`reorders`, from the judged [`Waits::stalls`]: the allocation kept, a task left to the end
 /// of its robot's tour, the other robots keeping their programs) on a budget of their own
 /// ([`REORDER_PLANS`], [`REORDER_JUDGED`]), asked [`Ask::Reorder`] on cells of at most
-/// [`MORE_HANDOVERS_MAX_PAIRS`] tasks × robots and `Beyond` on larger ones. A relief, a group, one of the more hand-overs or a reorder
-/// taken starts a new round, its hand-overs first while their budget lasts; the late tasks of
-/// the plan kept stay late in the plans made from it, but for a task handed to another robot.
+/// [`MORE_HANDOVERS_MAX_PAIRS`] tasks × robots and `Beyond` on larger ones. A relief, a group,
+/// one of the more hand-overs or a reorder taken starts a new round, its hand-overs first
+/// while their budget lasts; the late tasks of the plan kept stay late in the plans made from
+/// it, but for a task handed to another robot.
 /// Returns the best plan found with its settings and what the judge made of it, or `None` when
 /// no hand-over beat `base_score`, and whether the deadline stopped the search with hand-overs
 /// left to try (the plan then depends on the machine's speed). Plans that fail only lose their
@@ -516,35 +517,36 @@ pub fn rebalance<J>(
         Budget::new(0, 0)
     };
     let mut budgets = [
-        Budget::new(REBALANCE_PLANS, REBALANCE_JUDGED),
-        Budget::new(RELIEF_PLANS, RELIEF_JUDGED),
-        Budget::new(GROUP_PLANS, GROUP_JUDGED),
-        more,
-        Budget::new(REORDER_PLANS, REORDER_JUDGED),
+        (Kind::Direct, Budget::new(REBALANCE_PLANS, REBALANCE_JUDGED)),
+        (Kind::Relief, Budget::new(RELIEF_PLANS, RELIEF_JUDGED)),
+        (Kind::Group, Budget::new(GROUP_PLANS, GROUP_JUDGED)),
+        (Kind::More, more),
+        (Kind::Reorder, Budget::new(REORDER_PLANS, REORDER_JUDGED)),
     ];
     let mut refused = false;
     'rounds: loop {
         let current = best.as_ref().map_or(base, |b| &b.0);
         let from_tasks = current.allocated.tasks.clone();
         let from_late = best.as_ref().map_or(&settings.late, |b| &b.1.late).clone();
-        'phases: for (phase, budget) in budgets.iter_mut().enumerate() {
+        'phases: for (kind, budget) in budgets.iter_mut() {
+            let (kind, reorder) = (*kind, *kind == Kind::Reorder);
             // Once the caller's budget has refused a hand-over, only the reorders are left.
-            if budget.spent() || (refused && phase != 4) {
+            if budget.spent() || (refused && !reorder) {
                 continue;
             }
-            let list = match phase {
-                1 => reliefs(cell, current, &judged_ends, &waits.totals),
-                2 => groups(cell, current, &judged_ends, &waits.totals),
-                4 => reorders(current, &judged_ends, &waits.stalls, &from_late),
-                _ => moves(cell, current, &judged_ends),
+            let list = match kind {
+                Kind::Relief => reliefs(cell, current, &judged_ends, &waits.totals),
+                Kind::Group => groups(cell, current, &judged_ends, &waits.totals),
+                Kind::Reorder => reorders(current, &judged_ends, &waits.stalls, &from_late),
+                Kind::Direct | Kind::More => moves(cell, current, &judged_ends),
             };
             // A relief, a group or a reorder may go beyond the caller's budget (see [`Ask`]);
             // a direct hand-over, first or more, may not.
-            let ask = match phase {
-                1 | 2 => Ask::Beyond,
-                4 if small => Ask::Reorder,
-                4 => Ask::Beyond,
-                _ => Ask::Within,
+            let ask = match kind {
+                Kind::Relief | Kind::Group => Ask::Beyond,
+                Kind::Reorder if small => Ask::Reorder,
+                Kind::Reorder => Ask::Beyond,
+                Kind::Direct | Kind::More => Ask::Within,
             };
             for mv in list {
                 if budget.spent() {
@@ -553,7 +555,6 @@ pub fn rebalance<J>(
                 if settings.deadline.is_some_and(|d| Instant::now() >= d) {
                     return Ok((best, true));
                 }
-                let reorder = mv.from == mv.to;
                 let mut tasks = from_tasks.clone();
                 let mut late = from_late.clone();
                 if reorder {
@@ -631,6 +632,21 @@ pub fn rebalance<J>(
         break;
     }
     Ok((best, false))
+}
+
+/// The kinds of change [`rebalance`] tries, in this order, each on a budget of its own.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Kind {
+    /// Tasks of the robot that ends last handed over one at a time (`moves`).
+    Direct,
+    /// A task of a robot the last one waits for to a third robot (`reliefs`).
+    Relief,
+    /// Several of the last robot's tasks to a robot it waits for (`groups`).
+    Group,
+    /// More direct hand-overs, on small cells ([`MORE_PLANS`]).
+    More,
+    /// A task left to the end of its robot's tour (`reorders`).
+    Reorder,
 }
 
 /// Plans made and judged against their caps.
