@@ -628,6 +628,13 @@ impl StateValidity for ArmValidity<'_> {
         ArmValidity::is_valid(self, q)
     }
 
+    /// [`ArmValidity::clear_by`] with the floor for both parts: each part asked only as far as
+    /// the floor.
+    fn clear_of(&self, q: &[f64], floor: f64) -> bool {
+        // NaN fails, as the comparison of the default does.
+        !floor.is_nan() && self.clear_by(q, floor, floor)
+    }
+
     fn clearance(&self, q: &[f64]) -> f64 {
         CLEARANCES.with_borrow_mut(|out| {
             self.clearances(q, out);

@@ -1,6 +1,7 @@
 //! The arm's motion bounds and its proof of pairs apart, on the MBM UR5 (bench/motion).
 use super::turned::random_configuration;
 use super::{Arm, apart_everywhere, body_radii, moved_by, pair_radii, pairs_that_may_touch};
+use crate::plan::StateValidity;
 use crate::problem::{ArmSetup, read_problems};
 use cellplan_geom::{DVec3, Pose};
 use rand::{RngExt, SeedableRng};
@@ -213,7 +214,8 @@ fn point_speed_weights_bound_the_vertices_speeds_and_are_tight() {
 
 /// `clear_by` answers as `scene_and_self_clearance` compared with the thresholds, for
 /// thresholds on both sides of each configuration's clearances (the value itself, one ulp
-/// either way, a millimetre either way, and far) and for configurations outside the limits, with and without a margin.
+/// either way, a millimetre either way, and far) and for configurations outside the limits, with and without a margin;
+/// `clear_of` as the clearance compared with a floor.
 #[test]
 fn clear_by_answers_as_the_clearances_compared() {
     let setup = ur5();
@@ -247,6 +249,11 @@ fn clear_by_answers_as_the_clearances_compared() {
                 let expected = scene >= s && own >= o;
                 assert_eq!(validity.clear_by(&q, s, o), expected, "{q:?} {s} {o}");
                 if expected { yes += 1 } else { no += 1 }
+            }
+            // The planners' test of a query's ends: the clearance compared with the floor.
+            let c = StateValidity::clearance(&validity, &q);
+            for floor in [near(c, &mut rng), 1e-4] {
+                assert_eq!(validity.clear_of(&q, floor), c >= floor, "{q:?} {floor}");
             }
         }
     }

@@ -165,10 +165,12 @@ pub struct PlanResult {
     pub goal: Option<usize>,
     /// Whether the path is the direct segment (two waypoints, no search).
     pub straight: bool,
-    /// Clearance of the start (negative infinity outside the joint limits).
+    /// Clearance of the start where it is invalid (below the floor; negative infinity outside
+    /// the joint limits); NaN where it is valid: the ends are tested against the floor, and
+    /// measured only where they fail it.
     pub start_clearance: f64,
-    /// Clearance of each goal (negative infinity outside the joint limits; NaN when not
-    /// measured because the start is invalid).
+    /// Clearance of each invalid goal, as the start's; NaN for a valid goal, and for every goal
+    /// when the start is invalid (not tested).
     pub goal_clearances: Vec<f64>,
     /// The work and time spent.
     pub work: Work,
@@ -242,8 +244,9 @@ impl<'a> Run<'a> {
         segment_valid(self.space, self.validity, a, b, self.floor, &mut self.calls)
     }
 
-    /// The clearance of `q`, negative infinity outside the space (one call inside).
-    pub fn clearance(&mut self, q: &[f64]) -> f64 {
+    /// The clearance of `q`, negative infinity outside the space (one call inside): the
+    /// report of a state [`Run::state_valid`] has failed.
+    pub fn measure(&mut self, q: &[f64]) -> f64 {
         if self.space.contains(q) {
             self.calls += 1;
             self.validity.clearance(q)
@@ -252,10 +255,13 @@ impl<'a> Run<'a> {
         }
     }
 
-    /// Whether `q` is in the space and valid.
+    /// Whether `q` is in the space and its clearance reaches the floor (one call inside).
     pub fn state_valid(&mut self, q: &[f64]) -> bool {
-        let c = self.clearance(q);
-        !c.is_nan() && c >= self.floor
+        if !self.space.contains(q) {
+            return false;
+        }
+        self.calls += 1;
+        self.validity.clear_of(q, self.floor)
     }
 
     /// Why the search must stop now, ignoring the sample budget (validity calls, clock).
@@ -327,17 +333,18 @@ pub(crate) fn solve_with(
         goal_clearances: vec![f64::NAN; problem.goals.len()],
         work: Work::default(),
     };
-    result.start_clearance = run.clearance(problem.start);
-    let usable = |c: f64| !c.is_nan() && c >= run.floor;
-    let found = if !usable(result.start_clearance) {
+    // The ends are tested against the floor (each part asked only as far as it), and measured
+    // only where they fail it, for the report.
+    let found = if !run.state_valid(problem.start) {
+        result.start_clearance = run.measure(problem.start);
         Found::none(Status::InvalidStart)
     } else {
         let mut valid = Vec::new();
         for (i, g) in problem.goals.iter().enumerate() {
-            let c = run.clearance(g);
-            result.goal_clearances[i] = c;
-            if !c.is_nan() && c >= run.floor {
+            if run.state_valid(g) {
                 valid.push(i);
+            } else {
+                result.goal_clearances[i] = run.measure(g);
             }
         }
         if valid.is_empty() {

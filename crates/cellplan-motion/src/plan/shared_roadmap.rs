@@ -141,7 +141,7 @@ impl SharedRoadmap {
                 continue;
             }
             calls += 1;
-            if validity.clearance(q) >= floor {
+            if validity.clear_of(q, floor) {
                 nodes.push(q.clone());
             }
         }
@@ -166,7 +166,7 @@ impl SharedRoadmap {
                 })
                 .collect();
             calls += 1;
-            if validity.is_valid(&q) && validity.clearance(&q) >= floor {
+            if validity.is_valid(&q) && validity.clear_of(&q, floor) {
                 calls += 1;
                 nodes.push(q);
             }

@@ -57,6 +57,16 @@ pub trait StateValidity: Sync {
         self.clearance(q) > 0.0
     }
 
+    /// Whether `q`'s clearance is at least `floor` (`clearance(q) >= floor`, NaN failing): a
+    /// yes-or-no test, which an implementation may answer faster than
+    /// [`StateValidity::clearance`] measures, asking each part only as far as the floor. The
+    /// planners check the ends of a query and their roadmap nodes with it. Default: the
+    /// comparison.
+    fn clear_of(&self, q: &[f64], floor: f64) -> bool {
+        let c = self.clearance(q);
+        !c.is_nan() && c >= floor
+    }
+
     /// The radius, in segment parameter, of the piece of a segment around `q` proven valid:
     /// `min_k distance_k / motion.bound(joints_k)` over [`StateValidity::clearances`], at
     /// most `limit`; `None` when some distance is below `floor` (or NaN). `motion` says how far
