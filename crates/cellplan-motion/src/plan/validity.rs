@@ -13,6 +13,14 @@ const PROBE_SPACING: f64 = 0.02;
 /// Most probes of one segment before it is covered.
 const MAX_PROBES: usize = 15;
 
+/// A covering sample goes this share of the smaller neighbouring radius past the gap's left
+/// end: a sample whose radius comes out a little below its neighbours' then still reaches back
+/// to the gap's end, instead of leaving a sliver that costs a sample of its own (the samples'
+/// covers overlap by 41 % on the MBM UR5's valid segments; 0.8 against 1: 12.4 → 11.9 samples
+/// per valid segment, planning instructions −1.3 % / −0.6 % on two sets of problems, the same
+/// paths; 0.5–0.7 and 1.2 make more samples).
+const PLACE: f64 = 0.8;
+
 /// One clearance with the joints whose motion can reduce it (see
 /// [`StateValidity::clearances`]).
 #[derive(Clone, Debug, PartialEq)]
@@ -369,7 +377,7 @@ fn segment_valid_counted(
         if lo >= hi {
             continue;
         }
-        let guess = r0.min(r1);
+        let guess = PLACE * r0.min(r1);
         let s = if std::mem::take(&mut first) || hi - lo <= 2.0 * guess {
             0.5 * (lo + hi)
         } else {
