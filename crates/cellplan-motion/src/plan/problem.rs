@@ -313,10 +313,11 @@ pub(crate) fn range_of(space: &JointSpace, params: &PlannerParams, share: f64) -
     }
 }
 
-/// Runs one query the way every planner does: checks the start and the goals (one validity
-/// call each; an invalid start or all goals invalid end the run), calls `search` with the run
-/// and the indices of the valid goals, then post-processes a found path with [`shortcut_with`]
-/// when `params.simplify` is set, and fills in the work.
+/// Runs one query the way every planner does: tests the start and the goals against the floor
+/// ([`StateValidity::clear_of`], one validity call each, and one more to measure an end that
+/// fails, for the report; an invalid start or all goals invalid end the run), calls `search`
+/// with the run and the indices of the valid goals, then post-processes a found path with
+/// [`shortcut_with`] when `params.simplify` is set, and fills in the work.
 pub(crate) fn solve_with(
     problem: &Problem,
     stop: &Termination,
