@@ -628,11 +628,16 @@ impl StateValidity for ArmValidity<'_> {
         ArmValidity::is_valid(self, q)
     }
 
-    /// [`ArmValidity::clear_by`] with the floor for both parts: each part asked only as far as
-    /// the floor.
+    /// [`ArmValidity::clear_by`] with the floor for both parts (each part asked only as far as
+    /// the floor), after the pair tables' proofs of contact, as [`ArmValidity::is_valid`] asks
+    /// them: a contact is below any positive floor.
     fn clear_of(&self, q: &[f64], floor: f64) -> bool {
         // NaN fails, as the comparison of the default does.
-        !floor.is_nan() && self.clear_by(q, floor, floor)
+        if floor.is_nan() || (floor > 0.0 && self.arm.chain.within_limits(q, 1e-9) && self.proven_contact(q))
+        {
+            return false;
+        }
+        self.clear_by(q, floor, floor)
     }
 
     fn clearance(&self, q: &[f64]) -> f64 {

@@ -166,8 +166,7 @@ impl SharedRoadmap {
                 })
                 .collect();
             calls += 1;
-            if validity.is_valid(&q) && validity.clear_of(&q, floor) {
-                calls += 1;
+            if validity.clear_of(&q, floor) {
                 nodes.push(q);
             }
         }
