@@ -301,12 +301,16 @@ pub fn check_segment(
 /// The check of [`check_segment`]; counts the clearance calls into `calls`.
 ///
 /// The segment is covered by parameter intervals proven valid, one around each sample (its
-/// radius from [`StateValidity::segment_step`]). Gaps between covered pieces are kept in a
-/// first-in first-out list; a gap wider than two of its ends' radii is entered one radius
-/// past its left end (where, the radius being 1-Lipschitz in the parameter, the new ball
-/// about touches the covered piece: each sample covers about twice its radius, where a walk
-/// would cover one), a narrower gap is sampled in its middle. The check ends at the first
-/// contact or when no gap is left.
+/// radius from [`StateValidity::segment_step`]). Gaps between covered pieces are kept on a
+/// stack, the gap nearer the start on top; a gap wider than two of its ends' radii is entered
+/// [`PLACE`] of the smaller radius past its left end (where, the radius being 1-Lipschitz in
+/// the parameter, the new ball about touches the covered piece: each sample covers about twice
+/// its radius, where a walk would cover one), a narrower gap is sampled in its middle. The
+/// check ends at the first contact or when no gap is left. A gap is split by its own ends
+/// alone, so the order the gaps are taken in changes neither the samples of a valid segment
+/// nor any answer, only how soon a contact is met: nearest the start first, where contacts
+/// lie most often (see [`MAX_PROBES`]; first-in first-out took 0.7 % / 0.1 % more MBM
+/// planning instructions).
 pub(crate) fn segment_valid(
     space: &JointSpace,
     validity: &dyn StateValidity,
@@ -373,12 +377,12 @@ fn segment_valid_counted(
         return false;
     };
     // Gaps (left end, its radius, right end, its radius).
-    let mut gaps = std::collections::VecDeque::from([(0.0, ra, 1.0, rb)]);
+    let mut gaps = vec![(0.0, ra, 1.0, rb)];
     let mut q = Vec::with_capacity(n);
     // The first sample goes to the middle, the point farthest from both (valid) ends, where
     // a contact is likeliest.
     let mut first = true;
-    while let Some((s0, r0, s1, r1)) = gaps.pop_front() {
+    while let Some((s0, r0, s1, r1)) = gaps.pop() {
         let (lo, hi) = (s0 + r0, s1 - r1);
         if lo >= hi {
             continue;
@@ -394,8 +398,8 @@ fn segment_valid_counted(
         let Some(r) = measure(&q, (s - s0).max(s1 - s)) else {
             return false;
         };
-        gaps.push_back((s0, r0, s, r));
-        gaps.push_back((s, r, s1, r1));
+        gaps.push((s, r, s1, r1));
+        gaps.push((s0, r0, s, r));
     }
     true
 }
