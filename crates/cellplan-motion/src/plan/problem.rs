@@ -2,6 +2,7 @@
 //! more goals), when to stop ([`Termination`]), and the outcome ([`PlanResult`] with a
 //! [`Status`] and the [`Work`] spent). Also the bookkeeping every planner shares: counting
 //! samples and validity calls against the budget, checking the ends, post-processing.
+use super::validity::{DIRECT_PROBES, MAX_PROBES};
 use super::{JointSpace, PlannerParams, StateValidity, segment_valid, shortcut_with};
 use rand_chacha::ChaCha8Rng;
 use std::time::{Duration, Instant};
@@ -241,7 +242,27 @@ impl<'a> Run<'a> {
 
     /// Whether the straight segment `a → b` is proven valid (counts its calls).
     pub fn segment(&mut self, a: &[f64], b: &[f64]) -> bool {
-        segment_valid(self.space, self.validity, a, b, self.floor, &mut self.calls)
+        segment_valid(
+            self.space,
+            self.validity,
+            (a, b),
+            self.floor,
+            MAX_PROBES,
+            &mut self.calls,
+        )
+    }
+
+    /// [`Run::segment`] for a query's direct segment, start to goal, probed more densely
+    /// ([`DIRECT_PROBES`]): the same answer.
+    pub fn direct_segment(&mut self, a: &[f64], b: &[f64]) -> bool {
+        segment_valid(
+            self.space,
+            self.validity,
+            (a, b),
+            self.floor,
+            DIRECT_PROBES,
+            &mut self.calls,
+        )
     }
 
     /// The clearance of `q`, negative infinity outside the space (one call inside): the

@@ -20,7 +20,7 @@ pub(crate) fn search(run: &mut Run, start: &[f64], goals: &[Vec<f64>], valid: &[
         {
             return Found::none(why);
         }
-        if run.segment(start, &goals[g]) {
+        if run.direct_segment(start, &goals[g]) {
             let mut found = Found::path(vec![start.to_vec(), goals[g].clone()], g);
             found.straight = true;
             return found;
