@@ -242,25 +242,23 @@ impl<'a> Run<'a> {
 
     /// Whether the straight segment `a → b` is proven valid (counts its calls).
     pub fn segment(&mut self, a: &[f64], b: &[f64]) -> bool {
-        segment_valid(
-            self.space,
-            self.validity,
-            (a, b),
-            self.floor,
-            MAX_PROBES,
-            &mut self.calls,
-        )
+        self.segment_probed(a, b, MAX_PROBES)
     }
 
     /// [`Run::segment`] for a query's direct segment, start to goal, probed more densely
     /// ([`DIRECT_PROBES`]): the same answer.
     pub fn direct_segment(&mut self, a: &[f64], b: &[f64]) -> bool {
+        self.segment_probed(a, b, DIRECT_PROBES)
+    }
+
+    /// [`Run::segment`] with at most `max_probes` probes.
+    fn segment_probed(&mut self, a: &[f64], b: &[f64], max_probes: usize) -> bool {
         segment_valid(
             self.space,
             self.validity,
             (a, b),
             self.floor,
-            DIRECT_PROBES,
+            max_probes,
             &mut self.calls,
         )
     }

@@ -8,6 +8,11 @@ use super::*;
 #[test]
 fn probes_change_the_work_not_the_answer() {
     let space = square(2, 10.0);
+    // The answer and the calls (probes included) of one check with at most `probes` probes.
+    let check = |v: &Discs, (a, b): (&[f64], &[f64]), probes: usize| {
+        let mut calls = 0;
+        (segment_valid(&space, v, (a, b), 1e-4, probes, &mut calls), calls)
+    };
     let discs: Vec<(Vec<f64>, f64)> = (0..40)
         .map(|k| {
             let (x, y) = ((k * 37 % 97) as f64 / 9.7, (k * 61 % 89) as f64 / 8.9);
@@ -26,10 +31,7 @@ fn probes_change_the_work_not_the_answer() {
         }
         let answers: Vec<bool> = [0, validity::MAX_PROBES, validity::DIRECT_PROBES]
             .into_iter()
-            .map(|probes| {
-                let mut calls = 0;
-                segment_valid(&space, &v, (&a, &b), 1e-4, probes, &mut calls)
-            })
+            .map(|probes| check(&v, (&a, &b), probes).0)
             .collect();
         assert!(
             answers.iter().all(|&x| x == answers[0]),
@@ -46,23 +48,9 @@ fn probes_change_the_work_not_the_answer() {
     // it, the direct ones reach the 32nds and find it.
     let thin = Discs::new(vec![(vec![10.0 * 17.0 / 32.0, 5.0], 0.1)], 0.0);
     let (a, b) = ([0.0, 5.0], [10.0, 5.0]);
-    let (mut usual, mut direct) = (0, 0);
-    assert!(!segment_valid(
-        &space,
-        &thin,
-        (&a, &b),
-        1e-4,
-        validity::MAX_PROBES,
-        &mut usual
-    ));
-    assert!(!segment_valid(
-        &space,
-        &thin,
-        (&a, &b),
-        1e-4,
-        validity::DIRECT_PROBES,
-        &mut direct
-    ));
+    let (usual_valid, usual) = check(&thin, (&a, &b), validity::MAX_PROBES);
+    let (direct_valid, direct) = check(&thin, (&a, &b), validity::DIRECT_PROBES);
+    assert!(!usual_valid && !direct_valid);
     // The usual check covers after its nine probes; the direct one meets the disc at its 24th
     // probe (the 15 up to the 16ths, then 1/32, 3/32, …, 17/32), with no covering.
     assert!(usual > validity::MAX_PROBES, "usual {usual} calls");
