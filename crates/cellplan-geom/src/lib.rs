@@ -30,7 +30,7 @@ pub use parry3d_f64::math::Pose;
 pub use shape::ShapeSpec;
 pub use spheres::Sphere;
 pub use world::{
-    BodyContact, BroadPhase, CollisionWorld, GroupBody, GroupId, PlacedCovers, RayHit, StaticId,
+    BodyContact, BroadPhase, CollisionWorld, GroupBody, GroupId, PlacedCovers, Precision, RayHit, StaticId,
     convex_distance, convex_overlap,
 };
 

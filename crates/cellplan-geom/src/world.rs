@@ -541,6 +541,7 @@ mod rays;
 
 pub use broad::{BroadPhase, PlacedCovers};
 pub use distance::{convex_distance, convex_overlap};
+pub use narrow::Precision;
 
 use narrow::{convex_within, static_within};
 

@@ -52,7 +52,7 @@
 //! the same paths (`bench/motion/README.md`, twenty-fourth session).
 use crate::plan::{Clearance, JointSpace, SegmentMotion, StateValidity};
 use cellplan_geom::spheres::Sphere;
-use cellplan_geom::{BroadPhase, CollisionWorld, DVec3, GroupId, PlacedCovers, Pose};
+use cellplan_geom::{BroadPhase, CollisionWorld, DVec3, GroupId, PlacedCovers, Pose, Precision};
 use cellplan_kin::Chain;
 use std::cell::{Cell, RefCell};
 use std::ops::Range;
@@ -97,6 +97,15 @@ const CAP_PAST: f64 = 1e-9;
 /// planning instructions −11 % at 0.4–0.6, the same paths; 0 asks the exact query only below
 /// the floor and makes 20 % more samples).
 const ENOUGH_SHARE: f64 = 0.5;
+
+/// A segment step's exact queries may fall short of the distance by this share of its excess
+/// over what the step needs (a [`Precision`] whose `above` is the part's floor, so that every
+/// answer is the exact one's: [`ArmValidity::capped_step`]): GJK stops once its lower bound is
+/// within it of its upper one, where it would run on to the last bits. The step comes out at
+/// most that much shorter. MBM UR5 planning instructions on two sets of problems, the same
+/// paths: −7.8 % / −3.7 % against exact queries (0.01: −6.7 % / −3.1 %; 0.25: −8.2 % / −3.7 %,
+/// with more samples).
+const STEP_SHARE: f64 = 0.1;
 
 /// The measured distance whose trusted part is `t` (the inverse of [`trusted`]).
 #[inline]
@@ -396,14 +405,21 @@ impl<'a> ArmValidity<'a> {
         })
     }
 
-    /// Distance of moving body `i` to the scene and the parked groups, of `(cap, enough)` capped
-    /// at `cap`: through the broad phase when it is on — where a cover bound reaching `enough`
-    /// answers without the exact query ([`BroadPhase::scene_distance_enough`]) — else exact for
-    /// every object.
-    fn scene_part(&self, i: usize, bodies: &[Pose], placed: &PlacedCovers, (cap, enough): (f64, f64)) -> f64 {
+    /// Distance of moving body `i` to the scene and the parked groups, of `(cap, enough,
+    /// precision)` capped at `cap`: through the broad phase when it is on — where a cover bound
+    /// reaching `enough` answers without the exact query, and that query may fall short by the
+    /// share `precision` ([`BroadPhase::scene_distance_enough`]) — else exact for every object.
+    fn scene_part(
+        &self,
+        i: usize,
+        bodies: &[Pose],
+        placed: &PlacedCovers,
+        ask: (f64, f64, Precision),
+    ) -> f64 {
+        let cap = ask.0;
         if self.broad_phase {
             self.broad
-                .scene_distance_enough(self.arm.world, i, bodies, placed, (cap, enough))
+                .scene_distance_enough(self.arm.world, i, bodies, placed, ask)
         } else {
             self.body_scene_distance(i, bodies, cap)
         }
@@ -420,8 +436,9 @@ impl<'a> ArmValidity<'a> {
         q: &[f64],
         bodies: &[Pose],
         placed: &PlacedCovers,
-        (cap, enough): (f64, f64),
+        ask: (f64, f64, Precision),
     ) -> f64 {
+        let cap = ask.0;
         if self.broad_phase {
             let table = || {
                 self.arm
@@ -431,7 +448,7 @@ impl<'a> ArmValidity<'a> {
                     .unwrap_or(0.0)
             };
             self.broad
-                .pair_distance_or(self.arm.world, i, j, bodies, placed, (cap, enough), table)
+                .pair_distance_or(self.arm.world, i, j, bodies, placed, ask, table)
         } else {
             self.arm.world.pair_distance(self.arm.group, i, j, bodies, cap)
         }
@@ -559,7 +576,7 @@ impl<'a> ArmValidity<'a> {
             {
                 return true;
             }
-            self.scene_part(*i, bodies, placed, (need + tiny, need + tiny)) > need
+            self.scene_part(*i, bodies, placed, (need + tiny, need + tiny, Precision::EXACT)) > need
         } else if let Some(&(i, j, _, _)) = self.pairs.get(k - m) {
             if self.pair_groups(k - m).any(|&g| {
                 settled(&sets[1], g, &|| {
@@ -568,7 +585,14 @@ impl<'a> ArmValidity<'a> {
             }) {
                 return true;
             }
-            self.pair_part(i, j, q, bodies, placed, (apart + tiny, apart + tiny)) > apart
+            self.pair_part(
+                i,
+                j,
+                q,
+                bodies,
+                placed,
+                (apart + tiny, apart + tiny, Precision::EXACT),
+            ) > apart
         } else {
             true
         }
@@ -609,16 +633,14 @@ impl<'a> ArmValidity<'a> {
         let past = |x: f64| measured_for(x) + CAP_PAST;
         self.posed(q, |bodies, placed| {
             let cap = past(scene).min(self.cap) + margin;
-            let scene_clear = self
-                .moving
-                .iter()
-                .all(|(i, _)| trusted(self.scene_part(*i, bodies, placed, (cap, cap))) - margin >= scene);
+            let scene_clear = self.moving.iter().all(|(i, _)| {
+                trusted(self.scene_part(*i, bodies, placed, (cap, cap, Precision::EXACT))) - margin >= scene
+            });
             let cap = past(own).min(self.cap);
             scene_clear
-                && self
-                    .pairs
-                    .iter()
-                    .all(|(i, j, _, _)| trusted(self.pair_part(*i, *j, q, bodies, placed, (cap, cap))) >= own)
+                && self.pairs.iter().all(|(i, j, _, _)| {
+                    trusted(self.pair_part(*i, *j, q, bodies, placed, (cap, cap, Precision::EXACT))) >= own
+                })
         })
     }
 }
@@ -659,14 +681,19 @@ impl StateValidity for ArmValidity<'_> {
         let margin = self.margin.max(0.0);
         self.posed(q, |bodies, placed| {
             for (i, joints) in &self.moving {
-                let d = self.scene_part(*i, bodies, placed, (self.cap + margin, self.cap + margin));
+                let d = self.scene_part(
+                    *i,
+                    bodies,
+                    placed,
+                    (self.cap + margin, self.cap + margin, Precision::EXACT),
+                );
                 out.push(Clearance {
                     distance: trusted(d) - margin,
                     joints: joints.clone(),
                 });
             }
             for (i, j, joints, _) in &self.pairs {
-                let d = self.pair_part(*i, *j, q, bodies, placed, (self.cap, self.cap));
+                let d = self.pair_part(*i, *j, q, bodies, placed, (self.cap, self.cap, Precision::EXACT));
                 out.push(Clearance {
                     distance: trusted(d),
                     joints: joints.clone(),

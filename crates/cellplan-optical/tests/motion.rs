@@ -359,7 +359,7 @@ fn accepted_segments_pass_the_dense_recheck() {
 /// The robot's capped `segment_step` agrees with the default built on `clearances`: the same
 /// contact verdict, a step never longer (up to GJK's tolerance) and, where a part was taken at
 /// a cover bound that is enough (`ENOUGH_SHARE` in cellplan-motion's arm.rs), shorter but not by
-/// much over all — at candidates (close to the body) and at random configurations, for random
+/// much over all (its exact queries stop within a tenth, `STEP_SHARE`) — at candidates (close to the body) and at random configurations, for random
 /// segment bounds.
 #[test]
 fn capped_segment_step_agrees_with_the_default() {
@@ -400,7 +400,9 @@ fn capped_segment_step_agrees_with_the_default() {
                         "capped step {a}, default {b}"
                     );
                     checked += 1;
-                    shorter += usize::from(a < b - 1e-5 * b - 1e-9);
+                    // Its exact queries stop within a tenth of the distance above the floor
+                    // (`STEP_SHARE`): shorter than that only where a cover bound was taken.
+                    shorter += usize::from(a < 0.9 * b - 1e-5 * b - 1e-9);
                     fast_sum += a;
                     slow_sum += b;
                 }

@@ -21,7 +21,7 @@
 //! Bounds never exceed exact distances (the covers contain the bodies), so skipping an exact
 //! query whose bound already reaches the cap changes no answer.
 use super::distance::outers_apart;
-use super::{CollisionWorld, GroupId, sanitize_margin};
+use super::{CollisionWorld, GroupId, Precision, sanitize_margin};
 use crate::spheres::{Sphere, reaches};
 use crate::{DMat3, DVec3, Pose};
 use std::cell::Cell;
@@ -373,19 +373,21 @@ impl BroadPhase {
         placed: &PlacedCovers,
         cap: f64,
     ) -> f64 {
-        self.scene_distance_enough(world, i, poses, placed, (cap, cap))
+        self.scene_distance_enough(world, i, poses, placed, (cap, cap, Precision::EXACT))
     }
 
     /// [`BroadPhase::scene_distance`] capped at `cap`, settling for less: an object whose cover
     /// bound reaches `enough` is taken at that bound (a lower bound of its distance) without the
-    /// exact query. With `enough >= cap`, the same answer as `scene_distance`.
+    /// exact query, and the exact query may fall short of the distance as `precision` allows
+    /// ([`Precision`]). With `enough >= cap` and [`Precision::EXACT`], the same answer as
+    /// `scene_distance`.
     pub fn scene_distance_enough(
         &self,
         world: &CollisionWorld,
         i: usize,
         poses: &[Pose],
         placed: &PlacedCovers,
-        (cap, enough): (f64, f64),
+        (cap, enough, precision): (f64, f64, Precision),
     ) -> f64 {
         let mut best = sanitize_margin(cap);
         let outer = match self.placed_body(i, placed, best) {
@@ -419,7 +421,14 @@ impl BroadPhase {
                     } => (world.body_body_distance(self.group, i, poses, *group, *body, pose, best + extra)
                         - extra)
                         .max(0.0),
-                    _ => world.body_object_distance_hinted(self.group, i, poses, object.index, best, towards),
+                    _ => world.body_object_distance_hinted(
+                        self.group,
+                        i,
+                        poses,
+                        object.index,
+                        (best, precision),
+                        towards,
+                    ),
                 };
                 best = best.min(d);
                 if best <= 0.0 {
@@ -520,15 +529,17 @@ impl BroadPhase {
         placed: &PlacedCovers,
         cap: f64,
     ) -> f64 {
-        self.pair_distance_or(world, i, j, poses, placed, (cap, cap), || 0.0)
+        self.pair_distance_or(world, i, j, poses, placed, (cap, cap, Precision::EXACT), || 0.0)
     }
 
     /// [`BroadPhase::pair_distance`] with another lower bound on the pair's distance, `other`,
     /// asked only when the outer spheres fall short — after the covers, or before them when
     /// `enough >= cap` —: where it reaches the cap, the exact query is skipped too (the same
     /// answer, when `other` never exceeds the distance). Of `(cap,
-    /// enough)`, a bound reaching `enough` is answered without the exact query (a lower bound
-    /// of the distance; with `enough >= cap`, the same answer as [`BroadPhase::pair_distance`]).
+    /// enough, precision)`, a bound reaching `enough` is answered without the exact query (a
+    /// lower bound of the distance), and the exact query may fall short of the distance as
+    /// `precision` allows ([`Precision`]); with `enough >= cap` and [`Precision::EXACT`], the
+    /// same answer as [`BroadPhase::pair_distance`].
     #[allow(clippy::too_many_arguments)]
     pub fn pair_distance_or(
         &self,
@@ -537,7 +548,7 @@ impl BroadPhase {
         j: usize,
         poses: &[Pose],
         placed: &PlacedCovers,
-        (cap, enough): (f64, f64),
+        (cap, enough, precision): (f64, f64, Precision),
         other: impl FnOnce() -> f64,
     ) -> f64 {
         let best = sanitize_margin(cap);
@@ -556,7 +567,7 @@ impl BroadPhase {
                 if bound.max(other) >= best {
                     return best;
                 }
-                return world.pair_distance_hinted(self.group, i, j, poses, best, towards);
+                return world.pair_distance_hinted(self.group, i, j, poses, (best, precision), towards);
             }
             None => spheres_bound(self.cover(placed, i), None, self.cover(placed, j), best),
         };
@@ -570,7 +581,7 @@ impl BroadPhase {
         if bound >= enough {
             return bound;
         }
-        world.pair_distance_hinted(self.group, i, j, poses, best, towards)
+        world.pair_distance_hinted(self.group, i, j, poses, (best, precision), towards)
     }
 
     /// A lower bound on the distance between bodies `i` and `j`, capped at `cap` (covers only).

@@ -1,6 +1,6 @@
 //! Distance queries of the collision world: capped, exact (certified from below) distances
 //! between bodies and the static scene, between bodies of one group and of two groups.
-use super::narrow::{hinted_distance, static_distance, static_distance_hinted};
+use super::narrow::{Precision, hinted_distance, static_distance, static_distance_hinted};
 use super::{CollisionWorld, GroupId, Placed, Placement, aabb_distance, place, place_with, sanitize_margin};
 use crate::{DVec3, Pose, Sphere};
 use parry3d_f64::shape::SupportMap;
@@ -199,20 +199,22 @@ impl CollisionWorld {
     /// `cap` (as [`CollisionWorld::body_static_distance`] measures each object). The cap for an
     /// object without geometry, a missing pose or a body without shapes; 0 at a non-finite pose.
     pub fn body_object_distance(&self, g: GroupId, i: usize, poses: &[Pose], object: usize, cap: f64) -> f64 {
-        self.body_object_distance_hinted(g, i, poses, object, cap, DVec3::ZERO)
+        self.body_object_distance_hinted(g, i, poses, object, (cap, Precision::EXACT), DVec3::ZERO)
     }
 
     /// [`CollisionWorld::body_object_distance`] with a guess of the separating direction:
     /// `towards`, in the world, from the body towards the object (zero for none). Any
     /// direction gives a lower bound (the gap between the supports), which answers when it
-    /// reaches the cap; else it seeds GJK. Meshes keep their own axis cache and ignore it.
+    /// reaches the cap; else it seeds GJK. Meshes keep their own axis cache and ignore it. Of
+    /// `(cap, precision)`, the answer may fall short of `min(distance, cap)` as the
+    /// [`Precision`] allows, and GJK stops sooner.
     pub fn body_object_distance_hinted(
         &self,
         g: GroupId,
         i: usize,
         poses: &[Pose],
         object: usize,
-        cap: f64,
+        (cap, precision): (f64, Precision),
         towards: DVec3,
     ) -> f64 {
         let best = sanitize_margin(cap);
@@ -234,7 +236,7 @@ impl CollisionWorld {
                 if boxed && aabb_distance(&p.aabb, &s.aabb) >= best {
                     return best;
                 }
-                static_distance_hinted(s, shape, &p, best, towards).map_or(best, |d| d.min(best))
+                static_distance_hinted(s, shape, &p, best, towards, precision).map_or(best, |d| d.min(best))
             }
         }
     }
@@ -287,20 +289,19 @@ impl CollisionWorld {
     /// at `cap`: `min(true distance, cap)`, 0 when they touch or a pose is not finite. The cap
     /// (at least 0) when `i == j`, a body has no shapes or a pose is missing.
     pub fn pair_distance(&self, g: GroupId, i: usize, j: usize, poses: &[Pose], cap: f64) -> f64 {
-        self.pair_distance_hinted(g, i, j, poses, cap, DVec3::ZERO)
+        self.pair_distance_hinted(g, i, j, poses, (cap, Precision::EXACT), DVec3::ZERO)
     }
 
     /// [`CollisionWorld::pair_distance`] with a guess of the separating direction: `towards`,
     /// in the world, from body `i` towards body `j` (zero for none; see
-    /// [`CollisionWorld::body_object_distance_hinted`]).
-    #[allow(clippy::too_many_arguments)]
+    /// [`CollisionWorld::body_object_distance_hinted`], which says what `precision` allows).
     pub fn pair_distance_hinted(
         &self,
         g: GroupId,
         i: usize,
         j: usize,
         poses: &[Pose],
-        cap: f64,
+        (cap, precision): (f64, Precision),
         towards: DVec3,
     ) -> f64 {
         let group = self.group(g);
@@ -326,7 +327,13 @@ impl CollisionWorld {
                     return best;
                 }
                 let seed = a.pose.rotation.inverse() * towards;
-                hinted_distance(&a.pose.inv_mul(&b.pose), a.support, b.support, best, seed)
+                hinted_distance(
+                    &a.pose.inv_mul(&b.pose),
+                    a.support,
+                    b.support,
+                    (best, precision),
+                    seed,
+                )
             }
         }
     }
@@ -422,7 +429,13 @@ fn placed_distance(a: &Placed, b: &Placed, best: f64) -> f64 {
     if aabb_distance(&a.aabb, &b.aabb) >= best {
         return best;
     }
-    hinted_distance(&a.pose.inv_mul(&b.pose), a.support, b.support, best, DVec3::ZERO)
+    hinted_distance(
+        &a.pose.inv_mul(&b.pose),
+        a.support,
+        b.support,
+        (best, Precision::EXACT),
+        DVec3::ZERO,
+    )
 }
 
 /// Distance between two convex support maps at poses `pa` and `pb` (world), capped at `cap`
@@ -433,7 +446,13 @@ pub fn convex_distance(pa: &Pose, a: &dyn SupportMap, pb: &Pose, b: &dyn Support
     if !(pa.is_finite() && pb.is_finite()) {
         return 0.0;
     }
-    hinted_distance(&pa.inv_mul(pb), a, b, sanitize_margin(cap), DVec3::ZERO)
+    hinted_distance(
+        &pa.inv_mul(pb),
+        a,
+        b,
+        (sanitize_margin(cap), Precision::EXACT),
+        DVec3::ZERO,
+    )
 }
 
 /// Whether two convex support maps at poses `pa` and `pb` (world) overlap, as GJK finds the

@@ -203,26 +203,27 @@ impl AxisCache {
 /// Exact distance between a static object and a placed body (0 when they overlap), if it is
 /// below `best`; `None` otherwise.
 pub(super) fn static_distance(s: &StaticObject, shape: &dyn Shape, b: &Placed, best: f64) -> Option<f64> {
-    static_distance_hinted(s, shape, b, best, DVec3::ZERO)
+    static_distance_hinted(s, shape, b, best, DVec3::ZERO, Precision::EXACT)
 }
 
 /// [`static_distance`] with a guess of the separating direction for convex objects:
 /// `towards`, in the world, from the body towards the object (zero for none; see
-/// [`hinted_distance`]).
+/// [`hinted_distance`]), to `precision` (see there).
 pub(super) fn static_distance_hinted(
     s: &StaticObject,
     shape: &dyn Shape,
     b: &Placed,
     best: f64,
     towards: DVec3,
+    precision: Precision,
 ) -> Option<f64> {
     let pos12 = s.pose.inv_mul(&b.pose);
     if let Some(c) = shape.as_support_map() {
         // From the object (shape 1) towards the body, in the object's frame.
         let seed = s.pose.rotation.inverse() * -towards;
-        Some(hinted_distance(&pos12, c, b.support, best, seed)).filter(|&d| d < best)
+        Some(hinted_distance(&pos12, c, b.support, (best, precision), seed)).filter(|&d| d < best)
     } else if let Some(mesh) = shape.as_trimesh() {
-        mesh_distance(&pos12, mesh, b.support, best)
+        mesh_distance(&pos12, mesh, b.support, (best, precision))
     } else {
         let d = query::distance(&s.pose, shape, &b.pose, b.shape).map_or(0.0, |d| d.distance);
         (d < best).then_some(d.max(0.0))
@@ -230,14 +231,21 @@ pub(super) fn static_distance_hinted(
 }
 
 /// Exact distance between a triangle mesh (frame 1) and a convex shape (at `pos12` in the
-/// mesh's frame), 0 when they touch, if below `best`; `None` otherwise.
+/// mesh's frame), 0 when they touch, if below `best`; `None` otherwise. With a [`Precision`]
+/// whose share is positive each triangle's GJK stops as [`distance_within`] does, and the
+/// answer may fall short of the distance as that allows.
 ///
 /// The BVH is searched nearest box first. Every axis that separated a triangle from the
 /// convex shape (the GJK witness direction, or the direction that proved a triangle beyond
 /// `best`) is cached with the shape's lowest projection on it: the gap along such an axis is
 /// a lower bound on the distance of any other triangle or BVH node, usually a tight one for
 /// the neighbours of the nearest triangle, so most of them are dismissed without GJK.
-pub(super) fn mesh_distance(pos12: &Pose, mesh: &TriMesh, convex: &dyn SupportMap, best: f64) -> Option<f64> {
+pub(super) fn mesh_distance(
+    pos12: &Pose,
+    mesh: &TriMesh,
+    convex: &dyn SupportMap,
+    (best, precision): (f64, Precision),
+) -> Option<f64> {
     let query = support_aabb(convex, pos12);
     let cache = RefCell::new(AxisCache::default());
     let convex = Recording {
@@ -266,6 +274,14 @@ pub(super) fn mesh_distance(pos12: &Pose, mesh: &TriMesh, convex: &dyn SupportMa
                 let t = mesh.triangle(i);
                 if cache.borrow().triangle_gap(&t) >= best {
                     return None;
+                }
+                if precision.share > 0.0 {
+                    // The direction of the bound found separates the triangle by it.
+                    let (d, dir) = distance_within(pos12, &t, &convex, (best, precision), DVec3::ZERO);
+                    if dir != DVec3::ZERO {
+                        remember(dir);
+                    }
+                    return (d < best).then_some(d);
                 }
                 match convex_gjk(pos12, &t, &convex, best, true, None) {
                     GJKResult::ClosestPoints(p1, p2, _) => {
@@ -312,18 +328,29 @@ impl SupportMap for Recording<'_> {
     }
 }
 
-/// Exact distance between two convex shapes capped at `best` (0 when they overlap), certified
+/// Distance between two convex shapes capped at `best` (0 when they overlap), certified
 /// from below (never above the true distance; see the witness gap below), with a guess of the
 /// separating direction: `seed` (in `g1`'s frame, from `g1` towards `g2`; zero for none) is
 /// tried first — the gap between the two shapes' supports along any direction is a lower
 /// bound on their distance, so a gap that reaches `best` answers without GJK — then seeds GJK.
-/// The answer is a function of the shapes, their placement, `best` and `seed` alone.
-pub(super) fn hinted_distance<G1, G2>(pos12: &Pose, g1: &G1, g2: &G2, best: f64, seed: DVec3) -> f64
+/// With [`Precision::EXACT`] the answer is the exact distance (GJK run to convergence, less its
+/// tolerance); else it may fall short of it as `precision` allows ([`distance_within`]). The answer is a function of the shapes, their placement,
+/// `best`, `precision` and `seed` alone.
+pub(super) fn hinted_distance<G1, G2>(
+    pos12: &Pose,
+    g1: &G1,
+    g2: &G2,
+    (best, precision): (f64, Precision),
+    seed: DVec3,
+) -> f64
 where
     G1: ?Sized + SupportMap,
     G2: ?Sized + SupportMap,
 {
     let seed = seed.try_normalize().unwrap_or(DVec3::ZERO);
+    if precision.share > 0.0 {
+        return distance_within(pos12, g1, g2, (best, precision), seed).0;
+    }
     if seed != DVec3::ZERO {
         let gap = seed.dot(g2.support_point(pos12, -seed)) - seed.dot(g1.local_support_point(seed));
         if gap >= best {
@@ -347,4 +374,94 @@ where
         GJKResult::Intersection => 0.0,
         GJKResult::NoIntersection(_) | GJKResult::Proximity(_) => best,
     }
+}
+
+/// How close to the exact distance a capped query must come. Its answer is never above the
+/// distance; with `share` 0 ([`Precision::EXACT`]) it is the distance (less GJK's tolerance),
+/// else it may fall short by `share` of the distance's excess over `above`: at least
+/// `above + (1 − share)·(distance − above)` where the distance reaches `above`, below `above`
+/// where it does not — a caller comparing the answer with `above` decides as the exact
+/// distance would, and a segment step whose floor is `above` takes the same steps to within
+/// the share ([`crate::BroadPhase::scene_distance_enough`]). GJK converges fast at first and
+/// slowly at the end: the last bits of a distance far above `above` cost the most.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Precision {
+    /// The share of the excess over `above` the answer may lose (0 to 1; 0: exact).
+    pub share: f64,
+    /// The distance (m) the answer must be exact about: below it or not.
+    pub above: f64,
+}
+
+impl Precision {
+    /// The exact distance.
+    pub const EXACT: Precision = Precision {
+        share: 0.0,
+        above: 0.0,
+    };
+}
+
+/// Most GJK iterations of [`distance_within`] (a run that has not converged by then answers
+/// with the lower bound it has).
+const WITHIN_ITERATIONS: usize = 64;
+
+/// [`hinted_distance`] to a [`Precision`] whose share is positive (the seed normalised or
+/// zero): GJK on the shapes' difference, where each support query gives a lower bound on the
+/// distance (the gap of the two supports along the query direction, the largest one so far
+/// kept) and the simplex's nearest point an upper bound (the simplex lies in the difference).
+/// It stops as soon as the lower bound reaches `best` (answer `best`), the upper one falls
+/// below `above`, or the two come within `share` of the upper one's excess over `above`, and
+/// answers the lower bound: never above the distance, below `above` where the distance is, and
+/// else at least `above + (1 − share)·(min(distance, best) − above)`. The origin reached
+/// answers 0, a contact; a run that stalls or reaches [`WITHIN_ITERATIONS`] answers the lower
+/// bound it has (0 if none is positive: on the safe side). With the answer, the unit direction
+/// (from `g1` towards `g2`) whose gap gave it (zero where the answer is 0 without one).
+fn distance_within<G1, G2>(
+    pos12: &Pose,
+    g1: &G1,
+    g2: &G2,
+    (best, precision): (f64, Precision),
+    seed: DVec3,
+) -> (f64, DVec3)
+where
+    G1: ?Sized + SupportMap,
+    G2: ?Sized + SupportMap,
+{
+    // From g1 towards g2: the difference g1 − g2 lies the other way from the origin, and its
+    // support along this direction is its point nearest the origin along it.
+    let first = if seed != DVec3::ZERO {
+        seed
+    } else {
+        pos12.translation.try_normalize().unwrap_or(DVec3::X)
+    };
+    let point = CsoPoint::from_shapes(pos12, g1, g2, first);
+    let (mut lower, mut along) = (-first.dot(point.point), first);
+    if lower >= best {
+        return (best, along);
+    }
+    let mut simplex = VoronoiSimplex::new();
+    simplex.reset(point);
+    for _ in 0..WITHIN_ITERATIONS {
+        let nearest = simplex.project_origin_and_reduce();
+        let upper = nearest.length();
+        if upper.is_nan() || upper <= 0.0 {
+            return (0.0, DVec3::ZERO);
+        }
+        let dir = -nearest / upper;
+        let point = CsoPoint::from_shapes(pos12, g1, g2, dir);
+        let gap = -dir.dot(point.point);
+        if gap > lower {
+            (lower, along) = (gap, dir);
+        }
+        if lower >= best {
+            return (best, along);
+        }
+        // Below `above` for certain, or within the share of the excess over it.
+        if upper < precision.above
+            || upper - lower <= precision.share * (upper - precision.above)
+            || !simplex.add_point(point)
+        {
+            break;
+        }
+    }
+    (lower.clamp(0.0, best), along)
 }

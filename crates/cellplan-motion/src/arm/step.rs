@@ -4,9 +4,9 @@
 //! that is tighter ([`ArmValidity::posed_bound`]).
 use super::clusters::Settled;
 use super::radii::PosedAxes;
-use super::{ArmValidity, ENOUGH_SHARE, measured_for, trusted};
+use super::{ArmValidity, ENOUGH_SHARE, STEP_SHARE, measured_for, trusted};
 use crate::plan::{SegmentMotion, narrow_step};
-use cellplan_geom::{PlacedCovers, Pose};
+use cellplan_geom::{PlacedCovers, Pose, Precision};
 use std::ops::Range;
 
 impl ArmValidity<'_> {
@@ -77,16 +77,17 @@ impl ArmValidity<'_> {
 
     /// The step after one part, asked only as far as it matters: `wanted` is the clearance
     /// that would not shorten the step (the step so far times the part's bound, or the floor
-    /// when the part cannot move), at most [`Self::cap`]; `query((cap, enough))` is the part's
-    /// distance capped at `cap` (the broad phase inside it skips every exact query whose bound
-    /// reaches the cap), or a bound of it that reaches `enough` ([`ENOUGH_SHARE`] of `wanted`,
-    /// at least the floor, so that a part is never failed on a bound). A part at its cap gives
+    /// when the part cannot move), at most [`Self::cap`]; `query((cap, enough, precision))` is
+    /// the part's distance capped at `cap` (the broad phase inside it skips every exact query
+    /// whose bound reaches the cap), or a bound of it that reaches `enough` ([`ENOUGH_SHARE`] of
+    /// `wanted`, at least the floor, so that a part is never failed on a bound), its exact
+    /// queries to [`STEP_SHARE`] of the excess over the floor. A part at its cap gives
     /// [`Self::step_at_cap`]; one below it `narrow_step` by its clearance (`None`: below the
     /// floor).
     #[inline]
     fn capped_step(
         &self,
-        query: impl FnOnce((f64, f64)) -> f64,
+        query: impl FnOnce((f64, f64, Precision)) -> f64,
         offset: f64,
         bound: f64,
         step: f64,
@@ -95,7 +96,17 @@ impl ArmValidity<'_> {
         let wanted = self.wanted(bound, step, floor);
         let cap = measured_for(wanted + offset);
         let enough = measured_for((ENOUGH_SHARE * wanted).max(floor) + offset).min(cap);
-        let d = query((cap, enough));
+        // Exact about the floor (every answer as the exact distance's), within
+        // [`STEP_SHARE`] above it.
+        let above = measured_for(floor + offset);
+        let d = query((
+            cap,
+            enough,
+            Precision {
+                share: STEP_SHARE,
+                above,
+            },
+        ));
         if d >= cap {
             Some(self.step_at_cap(bound, step, floor))
         } else {
@@ -167,7 +178,7 @@ impl ArmValidity<'_> {
             }
             let b = self.posed_bound(b, drift, *i, joints, bodies, axes, motion, step);
             step = self.capped_step(
-                |cap| self.scene_part(*i, bodies, placed, cap),
+                |ask| self.scene_part(*i, bodies, placed, ask),
                 margin,
                 b,
                 step,
@@ -203,7 +214,7 @@ impl ArmValidity<'_> {
             }
             let b = self.posed_bound(b, drift, far, joints, bodies, axes, motion, step);
             step = self.capped_step(
-                |cap| self.pair_part(*i, *j, q, bodies, placed, cap),
+                |ask| self.pair_part(*i, *j, q, bodies, placed, ask),
                 0.0,
                 b,
                 step,

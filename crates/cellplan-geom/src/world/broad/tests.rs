@@ -111,7 +111,8 @@ fn a_sphere_of_bodies_holds_their_outer_spheres_and_clears_as_the_boxes_say() {
 /// queries: to every object kind, to a parked group, between two bodies, under any cap —
 /// up to GJK's tolerance: a seeded run stops at another point of its convergence, which is
 /// slow against curved shapes (the ball: a few 1e-4 of the distance). Both answers are
-/// certified lower bounds (see `hinted_distance`), so neither is ever too large.
+/// certified lower bounds (see `hinted_distance`), so neither is ever too large. Asked to a
+/// precision, they stay below the exact ones and within that share of them.
 #[test]
 fn broad_phase_distances_equal_the_exact_ones() {
     let mut world = CollisionWorld::new();
@@ -162,7 +163,7 @@ fn broad_phase_distances_equal_the_exact_ones() {
     assert_eq!(broad.object_count(), 5);
     let mut rng = ChaCha8Rng::seed_from_u64(5);
     let mut placed = super::PlacedCovers::default();
-    let (mut near, mut touching) = (0, 0);
+    let (mut near, mut touching, mut coarse) = (0, 0, 0);
     for _ in 0..4000 {
         let poses = [random_pose(&mut rng, 0.8), random_pose(&mut rng, 0.8)];
         let cap = if rng.random_bool(0.5) {
@@ -187,6 +188,32 @@ fn broad_phase_distances_equal_the_exact_ones() {
             }
             touching += usize::from(exact == 0.0);
         }
+        // To a precision: never above the distance, never below it by more than the share of
+        // its excess over `above`, and on the same side of `above` as the distance.
+        for share in [1e-2, 0.1] {
+            let above = rng.random_range(0.0..0.05);
+            let precision = crate::Precision { share, above };
+            // The exact answers' own tolerance (see `close`).
+            let check = |within: f64, exact: f64, what: &str| {
+                let slack = 1e-9 + 1e-3 * exact;
+                let low = above + (1.0 - share) * (exact - above) - slack;
+                assert!(within <= exact + slack, "{what}: {within} above {exact}");
+                if exact >= above + slack {
+                    assert!(within >= low, "{what}: {within} vs {exact} to {precision:?}");
+                } else if exact < above - slack {
+                    assert!(within < above, "{what}: {within} vs {exact} to {precision:?}");
+                }
+                usize::from(within < exact - slack)
+            };
+            let exact = world
+                .body_static_distance(g, 0, &poses, cap)
+                .min(world.body_group_distance(g, 0, &poses, other, &parked_poses, cap));
+            let within = broad.scene_distance_enough(&world, 0, &poses, &placed, (cap, cap, precision));
+            coarse += check(within, exact, "scene");
+            let exact = world.pair_distance(g, 0, 1, &poses, cap);
+            let within = broad.pair_distance_or(&world, 0, 1, &poses, &placed, (cap, cap, precision), || 0.0);
+            coarse += check(within, exact, "pair");
+        }
         let exact = world.pair_distance(g, 0, 1, &poses, cap);
         let fast = broad.pair_distance(&world, 0, 1, &poses, &placed, cap);
         assert!(close(fast, exact), "pair: {fast} vs {exact} (cap {cap})");
@@ -204,7 +231,15 @@ fn broad_phase_distances_equal_the_exact_ones() {
             let exact = world.pair_distance(g, 0, 1, &poses, cap);
             let other = || exact * share;
             for enough in [cap, cap + 1.0] {
-                let with = broad.pair_distance_or(&world, 0, 1, &poses, &placed, (cap, enough), other);
+                let with = broad.pair_distance_or(
+                    &world,
+                    0,
+                    1,
+                    &poses,
+                    &placed,
+                    (cap, enough, crate::Precision::EXACT),
+                    other,
+                );
                 assert!(
                     close(with, exact),
                     "pair with another bound: {with} vs {exact} (cap {cap})"
@@ -213,8 +248,9 @@ fn broad_phase_distances_equal_the_exact_ones() {
         }
     }
     assert!(
-        near > 50 && touching > 50,
-        "the test places bodies near and on the objects ({near}, {touching})"
+        near > 50 && touching > 50 && coarse > 50,
+        "the test places bodies near and on the objects ({near}, {touching}), and a precision \
+         stops GJK short of the distance ({coarse})"
     );
     // A non-finite pose is at distance 0, bound and exact alike.
     let bad = [Pose::translation(f64::NAN, 0.0, 0.0), Pose::IDENTITY];
