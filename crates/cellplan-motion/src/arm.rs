@@ -103,8 +103,8 @@ const ENOUGH_SHARE: f64 = 0.5;
 /// answer is the exact one's: [`ArmValidity::capped_step`]): GJK stops once its lower bound is
 /// within it of its upper one, where it would run on to the last bits. The step comes out at
 /// most that much shorter. MBM UR5 planning instructions on two sets of problems, the same
-/// paths: −7.8 % / −3.7 % against exact queries (0.01: −6.7 % / −3.1 %; 0.25: −8.2 % / −3.7 %,
-/// with more samples).
+/// paths: −7.5 % / −3.4 % against exact queries (0.01: about −6.7 % / −3.1 %; 0.25: −8.2 % /
+/// −3.7 %, with more samples); the README cell's legs −3.0 %, the same plan.
 const STEP_SHARE: f64 = 0.1;
 
 /// The measured distance whose trusted part is `t` (the inverse of [`trusted`]).
