@@ -245,7 +245,10 @@ impl SharedRoadmap {
         extra.push((s, g, direct));
         // Verdicts of the query's own edges; an invalid one is set aside.
         let mut extra_verdict = vec![UNKNOWN; extra.len()];
-        let mut set_aside: BTreeSet<u32> = BTreeSet::new();
+        // Per roadmap edge, whether this query set it aside; per node, its heuristic once
+        // worked out (the A* runs of one query share both).
+        let mut set_aside = vec![false; self.edges.len()];
+        let mut to_goal = vec![f64::NAN; n + 2];
         let (mut examined, mut calls) = (0, 0);
         let point = |i: usize| -> &[f64] {
             if i == s {
@@ -257,7 +260,13 @@ impl SharedRoadmap {
             }
         };
         let waypoints = 'search: loop {
-            let Some(path) = self.shortest(space, start, goal, &extra, &extra_verdict, &set_aside) else {
+            let Some(path) = self.shortest(
+                space,
+                (start, goal),
+                (&extra, &extra_verdict),
+                &set_aside,
+                &mut to_goal,
+            ) else {
                 break 'search None;
             };
             for &(hop, _) in &path {
@@ -287,7 +296,7 @@ impl SharedRoadmap {
                             slot.store(v, Ordering::Relaxed);
                         }
                         if v != VALID {
-                            set_aside.insert(e);
+                            set_aside[e as usize] = true;
                         }
                         v == VALID
                     }
@@ -309,26 +318,29 @@ impl SharedRoadmap {
 
     /// A* from the start (node `n`) to the goal (`n + 1`) over the roadmap's edges and the
     /// query's own (`extra`), leaving out those set aside and the query edges found invalid;
-    /// the hops in order, each with the node it reaches.
+    /// the hops in order, each with the node it reaches. `to_goal` keeps each node's heuristic
+    /// (NaN: not worked out yet).
     fn shortest(
         &self,
         space: &JointSpace,
-        start: &[f64],
-        goal: &[f64],
-        extra: &[(usize, usize, f64)],
-        extra_verdict: &[u8],
-        set_aside: &BTreeSet<u32>,
+        (start, goal): (&[f64], &[f64]),
+        (extra, extra_verdict): (&[(usize, usize, f64)], &[u8]),
+        set_aside: &[bool],
+        to_goal: &mut [f64],
     ) -> Option<Vec<(Hop, usize)>> {
         let n = self.nodes.len();
         let (s, g) = (n, n + 1);
-        let h = |i: usize| -> f64 {
-            if i == g {
-                0.0
-            } else if i == s {
-                space.distance(start, goal)
-            } else {
-                space.distance(&self.nodes[i], goal)
+        let mut h = |i: usize| -> f64 {
+            if to_goal[i].is_nan() {
+                to_goal[i] = if i == g {
+                    0.0
+                } else if i == s {
+                    space.distance(start, goal)
+                } else {
+                    space.distance(&self.nodes[i], goal)
+                };
             }
+            to_goal[i]
         };
         // The query's edges by node.
         let mut query_at: Vec<Vec<(usize, usize)>> = vec![Vec::new(); n + 2];
@@ -373,7 +385,7 @@ impl SharedRoadmap {
             }
             if i < n {
                 for &(j, e) in &self.adjacent[i] {
-                    if !set_aside.contains(&e) {
+                    if !set_aside[e as usize] {
                         relax(j as usize, self.edges[e as usize].2, Hop::Roadmap(e), &mut queue);
                     }
                 }
