@@ -232,8 +232,9 @@ pub(super) fn static_distance_hinted(
 
 /// Exact distance between a triangle mesh (frame 1) and a convex shape (at `pos12` in the
 /// mesh's frame), 0 when they touch, if below `best`; `None` otherwise. With a [`Precision`]
-/// whose share is positive each triangle's GJK stops as [`distance_within`] does, and the
-/// answer may fall short of the distance as that allows.
+/// whose share is positive each triangle's GJK stops as [`distance_within`] does, seeded with
+/// the axis cached last (a neighbour's), and the answer may fall short of the distance as that
+/// allows.
 ///
 /// The BVH is searched nearest box first. Every axis that separated a triangle from the
 /// convex shape (the GJK witness direction, or the direction that proved a triangle beyond
@@ -277,7 +278,8 @@ pub(super) fn mesh_distance(
                 }
                 if precision.share > 0.0 {
                     // The direction of the bound found separates the triangle by it.
-                    let (d, dir) = distance_within(pos12, &t, &convex, (best, precision), DVec3::ZERO);
+                    let seed = cache.borrow().last_dir().unwrap_or(DVec3::ZERO);
+                    let (d, dir) = distance_within(pos12, &t, &convex, (best, precision), seed);
                     if dir != DVec3::ZERO {
                         remember(dir);
                     }
