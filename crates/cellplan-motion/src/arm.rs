@@ -107,6 +107,13 @@ const ENOUGH_SHARE: f64 = 0.5;
 /// −3.7 %, with more samples); the README cell's legs −3.0 %, the same plan.
 const STEP_SHARE: f64 = 0.1;
 
+/// What a part is asked when its distance must be exact up to `cap` (no bound taken for it, no
+/// precision short of it): the `(cap, enough, precision)` of [`ArmValidity::scene_part`].
+#[inline]
+fn exact(cap: f64) -> (f64, f64, Precision) {
+    (cap, cap, Precision::EXACT)
+}
+
 /// The measured distance whose trusted part is `t` (the inverse of [`trusted`]).
 #[inline]
 fn measured_for(t: f64) -> f64 {
@@ -407,8 +414,9 @@ impl<'a> ArmValidity<'a> {
 
     /// Distance of moving body `i` to the scene and the parked groups, of `(cap, enough,
     /// precision)` capped at `cap`: through the broad phase when it is on — where a cover bound
-    /// reaching `enough` answers without the exact query, and that query may fall short by the
-    /// share `precision` ([`BroadPhase::scene_distance_enough`]) — else exact for every object.
+    /// reaching `enough` answers without the exact query, and that query may fall short as the
+    /// [`Precision`] allows ([`BroadPhase::scene_distance_enough`]) — else exact for every
+    /// object.
     fn scene_part(
         &self,
         i: usize,
@@ -576,7 +584,7 @@ impl<'a> ArmValidity<'a> {
             {
                 return true;
             }
-            self.scene_part(*i, bodies, placed, (need + tiny, need + tiny, Precision::EXACT)) > need
+            self.scene_part(*i, bodies, placed, exact(need + tiny)) > need
         } else if let Some(&(i, j, _, _)) = self.pairs.get(k - m) {
             if self.pair_groups(k - m).any(|&g| {
                 settled(&sets[1], g, &|| {
@@ -585,14 +593,7 @@ impl<'a> ArmValidity<'a> {
             }) {
                 return true;
             }
-            self.pair_part(
-                i,
-                j,
-                q,
-                bodies,
-                placed,
-                (apart + tiny, apart + tiny, Precision::EXACT),
-            ) > apart
+            self.pair_part(i, j, q, bodies, placed, exact(apart + tiny)) > apart
         } else {
             true
         }
@@ -633,14 +634,16 @@ impl<'a> ArmValidity<'a> {
         let past = |x: f64| measured_for(x) + CAP_PAST;
         self.posed(q, |bodies, placed| {
             let cap = past(scene).min(self.cap) + margin;
-            let scene_clear = self.moving.iter().all(|(i, _)| {
-                trusted(self.scene_part(*i, bodies, placed, (cap, cap, Precision::EXACT))) - margin >= scene
-            });
+            let scene_clear = self
+                .moving
+                .iter()
+                .all(|(i, _)| trusted(self.scene_part(*i, bodies, placed, exact(cap))) - margin >= scene);
             let cap = past(own).min(self.cap);
             scene_clear
-                && self.pairs.iter().all(|(i, j, _, _)| {
-                    trusted(self.pair_part(*i, *j, q, bodies, placed, (cap, cap, Precision::EXACT))) >= own
-                })
+                && self
+                    .pairs
+                    .iter()
+                    .all(|(i, j, _, _)| trusted(self.pair_part(*i, *j, q, bodies, placed, exact(cap))) >= own)
         })
     }
 }
@@ -681,19 +684,14 @@ impl StateValidity for ArmValidity<'_> {
         let margin = self.margin.max(0.0);
         self.posed(q, |bodies, placed| {
             for (i, joints) in &self.moving {
-                let d = self.scene_part(
-                    *i,
-                    bodies,
-                    placed,
-                    (self.cap + margin, self.cap + margin, Precision::EXACT),
-                );
+                let d = self.scene_part(*i, bodies, placed, exact(self.cap + margin));
                 out.push(Clearance {
                     distance: trusted(d) - margin,
                     joints: joints.clone(),
                 });
             }
             for (i, j, joints, _) in &self.pairs {
-                let d = self.pair_part(*i, *j, q, bodies, placed, (self.cap, self.cap, Precision::EXACT));
+                let d = self.pair_part(*i, *j, q, bodies, placed, exact(self.cap));
                 out.push(Clearance {
                     distance: trusted(d),
                     joints: joints.clone(),

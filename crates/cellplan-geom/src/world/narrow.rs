@@ -336,8 +336,8 @@ impl SupportMap for Recording<'_> {
 /// tried first — the gap between the two shapes' supports along any direction is a lower
 /// bound on their distance, so a gap that reaches `best` answers without GJK — then seeds GJK.
 /// With [`Precision::EXACT`] the answer is the exact distance (GJK run to convergence, less its
-/// tolerance); else it may fall short of it as `precision` allows ([`distance_within`]). The answer is a function of the shapes, their placement,
-/// `best`, `precision` and `seed` alone.
+/// tolerance); else it may fall short of it as `precision` allows ([`distance_within`]). The
+/// answer is a function of the shapes, their placement, `best`, `precision` and `seed` alone.
 pub(super) fn hinted_distance<G1, G2>(
     pos12: &Pose,
     g1: &G1,
