@@ -16,14 +16,18 @@
 //! - **Cached edges.** An edge is checked ([`super::check_segment`]) the first time a query
 //!   needs it and its verdict kept (one atomic byte per edge). A verdict depends only on the
 //!   edge, so concurrent first checks store the same value.
-//! - **Queries that do not see the cache's history.** A query links its start and goal to
-//!   their nearest nodes and runs lazy PRM (Bohlin & Kavraki 2000): the shortest path under
-//!   the edges it has not itself found invalid, its edges checked from the start on (through
-//!   the cache), the first invalid one set aside, search again. It does not skip the edges that
-//!   other queries found invalid, so the sequence of paths it tries — and its budget, counted
-//!   in edges examined — is the same with a cold or a warm cache: only the cost of the checks
-//!   differs. The answer, the shortest valid path of the roadmap within the budget, depends on
-//!   the query alone.
+//! - **Answers that do not depend on the cache's history.** A query links its start and goal
+//!   to their nearest nodes and runs lazy PRM (Bohlin & Kavraki 2000): the shortest path under
+//!   the edges not known invalid — those it found invalid itself and those the cache already
+//!   holds as invalid, whichever query checked them —, its edges checked from the start on
+//!   (through the cache), the first invalid one set aside, search again. Every edge left out is
+//!   invalid, so every valid path stays in the graph searched, and the path a search returns
+//!   whole valid is the shortest valid path of the roadmap: the same answer with a cold or a
+//!   warm cache, in any thread, whichever queries ran before (two valid paths of exactly equal
+//!   length aside). There is no budget to bind: each search that fails leaves out one more
+//!   edge, so a query ends within the roadmap's edge count of searches, and over all queries
+//!   each edge is checked about once (twice when two threads race to it); only the work, not
+//!   the answer, depends on what other queries checked first.
 use super::prm::Key;
 use super::{JointSpace, StateValidity, check_segment};
 use rand::SeedableRng;
@@ -51,8 +55,6 @@ pub struct SharedRoadmapSettings {
     pub neighbours: usize,
     /// A query's start and goal are each linked to this many nearest nodes.
     pub connect: usize,
-    /// A query gives up after examining this many edges (cached or not).
-    pub max_edges: usize,
     /// Seed of the samples.
     pub seed: u64,
     /// Clearance (m) below which a configuration counts as invalid (as in
@@ -66,7 +68,6 @@ impl Default for SharedRoadmapSettings {
             samples: 600,
             neighbours: 10,
             connect: 10,
-            max_edges: 300,
             seed: 0,
             min_clearance: 1e-4,
         }
@@ -88,10 +89,9 @@ pub struct SharedRoadmap {
 /// The outcome of a [`SharedRoadmap::query`].
 #[derive(Clone, Debug, PartialEq)]
 pub struct RoadmapPath {
-    /// From the start to the goal, inclusive; `None` when the roadmap has no path within the
-    /// budget.
+    /// From the start to the goal, inclusive; `None` when the roadmap has no valid path.
     pub waypoints: Option<Vec<Vec<f64>>>,
-    /// Edges examined (the budget's measure: the same whatever the cache holds).
+    /// Edges examined (fewer when other queries found invalid edges first).
     pub edges_examined: usize,
     /// Validity calls made by this query (fewer when other queries checked its edges first).
     pub validity_calls: usize,
@@ -270,9 +270,6 @@ impl SharedRoadmap {
                 break 'search None;
             };
             for &(hop, _) in &path {
-                if examined >= self.settings.max_edges {
-                    break 'search None;
-                }
                 examined += 1;
                 // The verdict from the query's own cache or the shared one, checked if unknown.
                 let mut check = |a: usize, b: usize| {
@@ -317,7 +314,8 @@ impl SharedRoadmap {
     }
 
     /// A* from the start (node `n`) to the goal (`n + 1`) over the roadmap's edges and the
-    /// query's own (`extra`), leaving out those set aside and the query edges found invalid;
+    /// query's own (`extra`), leaving out those set aside, those the shared cache holds invalid
+    /// and the query edges found invalid;
     /// the hops in order, each with the node it reaches. `to_goal` keeps each node's heuristic
     /// (NaN: not worked out yet).
     fn shortest(
@@ -385,7 +383,8 @@ impl SharedRoadmap {
             }
             if i < n {
                 for &(j, e) in &self.adjacent[i] {
-                    if !set_aside[e as usize] {
+                    if !set_aside[e as usize] && self.verdicts[e as usize].load(Ordering::Relaxed) != INVALID
+                    {
                         relax(j as usize, self.edges[e as usize].2, Hop::Roadmap(e), &mut queue);
                     }
                 }
@@ -420,6 +419,125 @@ mod tests {
         JointSpace::new(vec![0.0, 0.0], vec![1.0, 1.0], vec![1.0, 1.0])
     }
 
+    /// The shortest valid path's length from `start` to `goal` by brute force: every edge of
+    /// the roadmap and of the query checked, then Dijkstra.
+    fn brute_force(roadmap: &SharedRoadmap, space: &JointSpace, start: &[f64], goal: &[f64]) -> Option<f64> {
+        let n = roadmap.len();
+        let point = |i: usize| -> Vec<f64> {
+            match i {
+                i if i == n => start.to_vec(),
+                i if i == n + 1 => goal.to_vec(),
+                i => roadmap.nodes[i].clone(),
+            }
+        };
+        let mut edges: Vec<(usize, usize)> = roadmap
+            .edges
+            .iter()
+            .map(|&(a, b, _)| (a as usize, b as usize))
+            .collect();
+        for (end, q) in [(n, start), (n + 1, goal)] {
+            for (_, i) in nearest(space, &roadmap.nodes, q, roadmap.settings.connect, usize::MAX) {
+                edges.push((end, i));
+            }
+        }
+        edges.push((n, n + 1));
+        let mut adjacent = vec![Vec::new(); n + 2];
+        for (a, b) in edges {
+            if check_segment(space, &wall, &point(a), &point(b), 1e-4).valid {
+                let d = space.distance(&point(a), &point(b));
+                adjacent[a].push((b, d));
+                adjacent[b].push((a, d));
+            }
+        }
+        let mut dist = vec![f64::INFINITY; n + 2];
+        let mut queue = BinaryHeap::new();
+        dist[n] = 0.0;
+        queue.push(Reverse((Key(0.0), n)));
+        while let Some(Reverse((Key(d), i))) = queue.pop() {
+            if d > dist[i] {
+                continue;
+            }
+            for &(j, l) in &adjacent[i] {
+                if d + l < dist[j] {
+                    dist[j] = d + l;
+                    queue.push(Reverse((Key(d + l), j)));
+                }
+            }
+        }
+        dist[n + 1].is_finite().then_some(dist[n + 1])
+    }
+
+    fn length(space: &JointSpace, path: &[Vec<f64>]) -> f64 {
+        path.windows(2).map(|w| space.distance(&w[0], &w[1])).sum()
+    }
+
+    #[test]
+    fn queries_give_the_shortest_valid_path_whatever_other_queries_checked_first() {
+        let space = space();
+        let settings = SharedRoadmapSettings {
+            samples: 200,
+            neighbours: 6,
+            connect: 6,
+            seed: 11,
+            min_clearance: 1e-4,
+        };
+        let queries: Vec<(Vec<f64>, Vec<f64>)> = (0..12)
+            .map(|k| {
+                let t = k as f64 / 12.0;
+                (
+                    vec![0.05 + 0.35 * t, 0.05 + 0.7 * t],
+                    vec![0.95 - 0.3 * t, 0.1 + 0.6 * (1.0 - t)],
+                )
+            })
+            .collect();
+        let shared = SharedRoadmap::build(&space, &wall, &[], &settings).0;
+        let forward: Vec<RoadmapPath> = queries
+            .iter()
+            .map(|(a, b)| shared.query(&space, &wall, a, b))
+            .collect();
+        let backward = SharedRoadmap::build(&space, &wall, &[], &settings).0;
+        let mut reverse: Vec<RoadmapPath> = queries
+            .iter()
+            .rev()
+            .map(|(a, b)| backward.query(&space, &wall, a, b))
+            .collect();
+        reverse.reverse();
+        let (mut warmer, mut found) = (0, 0);
+        for (k, (a, b)) in queries.iter().enumerate() {
+            // Each query alone, on a cold cache.
+            let cold = SharedRoadmap::build(&space, &wall, &[], &settings)
+                .0
+                .query(&space, &wall, a, b);
+            assert_eq!(
+                forward[k].waypoints, cold.waypoints,
+                "query {k} after the earlier ones"
+            );
+            assert_eq!(
+                reverse[k].waypoints, cold.waypoints,
+                "query {k} after the later ones"
+            );
+            assert!(forward[k].edges_examined <= cold.edges_examined);
+            warmer += usize::from(forward[k].edges_examined < cold.edges_examined);
+            match (&cold.waypoints, brute_force(&shared, &space, a, b)) {
+                (Some(path), Some(best)) => {
+                    found += 1;
+                    for w in path.windows(2) {
+                        assert!(check_segment(&space, &wall, &w[0], &w[1], 1e-4).valid);
+                    }
+                    assert!(
+                        (length(&space, path) - best).abs() < 1e-9,
+                        "query {k}: {} against {best}",
+                        length(&space, path)
+                    );
+                }
+                (None, None) => {}
+                (got, best) => panic!("query {k}: {got:?} against the brute force's {best:?}"),
+            }
+        }
+        assert!(found >= 10, "most queries have a path ({found})");
+        assert!(warmer > 0, "a warm cache saves some query work");
+    }
+
     #[test]
     fn a_query_finds_a_valid_path_round_the_wall_whatever_the_cache_holds() {
         let space = space();
@@ -427,7 +545,6 @@ mod tests {
             samples: 300,
             neighbours: 8,
             connect: 8,
-            max_edges: 2000,
             seed: 3,
             min_clearance: 1e-4,
         };
@@ -443,7 +560,7 @@ mod tests {
         }
         // It goes over the wall's top.
         assert!(path.iter().any(|q| q[1] > 0.8));
-        // Warm: other queries have checked edges since; the answer and its budget are the same.
+        // Warm: other queries have checked edges since; the answer is the same, the work no more.
         for k in 0..10 {
             let a = vec![0.1 + 0.03 * k as f64, 0.1];
             let b = vec![0.9, 0.1 + 0.05 * k as f64];
@@ -451,33 +568,28 @@ mod tests {
         }
         let warm = roadmap.query(&space, &wall, &start, &goal);
         assert_eq!(warm.waypoints, cold.waypoints);
-        assert_eq!(warm.edges_examined, cold.edges_examined);
+        assert!(warm.edges_examined <= cold.edges_examined);
         assert!(warm.validity_calls <= cold.validity_calls);
         assert!(roadmap.checked_edges() > 0);
     }
 
     #[test]
-    fn a_budget_too_small_gives_no_path_and_seeds_become_nodes() {
+    fn a_roadmap_without_a_way_round_gives_no_path_and_seeds_become_nodes() {
         let space = space();
         let settings = SharedRoadmapSettings {
             samples: 0,
-            max_edges: 1,
             ..SharedRoadmapSettings::default()
         };
-        // Only the seeds: one valid each side of the wall, one inside it (dropped), a duplicate.
-        let seeds = vec![vec![0.2, 0.9], vec![0.8, 0.9], vec![0.5, 0.5], vec![0.2, 0.9]];
-        let (roadmap, _) = SharedRoadmap::build(&space, &wall, &seeds, &settings);
-        assert_eq!(roadmap.len(), 2);
-        assert_eq!(roadmap.edge_count(), 1);
+        // Only the seeds, one each side of the wall below its top: no way round.
+        let (roadmap, _) = SharedRoadmap::build(&space, &wall, &[vec![0.2, 0.5], vec![0.8, 0.5]], &settings);
+        assert_eq!((roadmap.len(), roadmap.edge_count()), (2, 1));
         let found = roadmap.query(&space, &wall, &[0.2, 0.2], &[0.8, 0.2]);
         assert_eq!(found.waypoints, None);
-        assert_eq!(found.edges_examined, 1);
-        // With a budget, over the two seeds.
-        let settings = SharedRoadmapSettings {
-            samples: 0,
-            ..SharedRoadmapSettings::default()
-        };
+        assert!(found.edges_examined >= 2, "it tried the way through the seeds");
+        // One valid each side of the wall above its top, one inside it (dropped), a duplicate.
+        let seeds = vec![vec![0.2, 0.9], vec![0.8, 0.9], vec![0.5, 0.5], vec![0.2, 0.9]];
         let (roadmap, _) = SharedRoadmap::build(&space, &wall, &seeds, &settings);
+        assert_eq!((roadmap.len(), roadmap.edge_count()), (2, 1));
         let path = roadmap
             .query(&space, &wall, &[0.2, 0.2], &[0.8, 0.2])
             .waypoints
