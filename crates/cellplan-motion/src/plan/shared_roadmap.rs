@@ -23,8 +23,8 @@
 //!   (through the cache), the first invalid one set aside, search again. Every edge left out is
 //!   invalid, so every valid path stays in the graph searched, and the path a search returns
 //!   whole valid is the shortest valid path of the roadmap: the same answer with a cold or a
-//!   warm cache, in any thread, whichever queries ran before (two valid paths of exactly equal
-//!   length aside). There is no budget to bind: each search that fails leaves out one more
+//!   warm cache, in any thread, whichever queries ran before (paths of equal length compare
+//!   by their hops: a start or goal that is a node ties exactly with the path skipping it). There is no budget to bind: each search that fails leaves out one more
 //!   edge, so a query ends within the roadmap's edge count of searches, and over all queries
 //!   each edge is checked about once (twice when two threads race to it); only the work, not
 //!   the answer, depends on what other queries checked first.
@@ -348,13 +348,16 @@ impl SharedRoadmap {
                 query_at[b].push((a, k));
             }
         }
-        let mut dist = vec![f64::INFINITY; n + 2];
+        // Paths compare by length, then by hops: the start or goal often is a node (a task
+        // candidate), and a path through it ties exactly with the one that skips it; the fewer
+        // hops win, so the answer does not hang on which the search met first.
+        let mut dist = vec![(f64::INFINITY, u32::MAX); n + 2];
         let mut prev: Vec<Option<(usize, Hop)>> = vec![None; n + 2];
         let mut closed = vec![false; n + 2];
         let mut queue = BinaryHeap::new();
-        dist[s] = 0.0;
-        queue.push(Reverse((Key(h(s)), s)));
-        while let Some(Reverse((_, i))) = queue.pop() {
+        dist[s] = (0.0, 0);
+        queue.push(Reverse((Key(h(s)), 0, s)));
+        while let Some(Reverse((_, _, i))) = queue.pop() {
             if closed[i] {
                 continue;
             }
@@ -370,12 +373,12 @@ impl SharedRoadmap {
                 return Some(hops);
             }
             let mut relax =
-                |j: usize, length: f64, hop: Hop, queue: &mut BinaryHeap<Reverse<(Key, usize)>>| {
-                    let nd = dist[i] + length;
-                    if nd < dist[j] {
+                |j: usize, length: f64, hop: Hop, queue: &mut BinaryHeap<Reverse<(Key, u32, usize)>>| {
+                    let nd = (dist[i].0 + length, dist[i].1 + 1);
+                    if nd.0 < dist[j].0 || (nd.0 == dist[j].0 && nd.1 < dist[j].1) {
                         dist[j] = nd;
                         prev[j] = Some((i, hop));
-                        queue.push(Reverse((Key(nd + h(j)), j)));
+                        queue.push(Reverse((Key(nd.0 + h(j)), nd.1, j)));
                     }
                 };
             for &(j, k) in &query_at[i] {
@@ -490,12 +493,20 @@ mod tests {
                 )
             })
             .collect();
-        let shared = SharedRoadmap::build(&space, &wall, &[], &settings).0;
+        // Half the queries start or end at a node (as a robot's legs run between its task
+        // candidates): their paths tie with those through that node.
+        let seeds: Vec<Vec<f64>> = queries
+            .iter()
+            .enumerate()
+            .map(|(k, (a, b))| if k % 2 == 0 { a.clone() } else { b.clone() })
+            .collect();
+        let build = || SharedRoadmap::build(&space, &wall, &seeds, &settings).0;
+        let shared = build();
         let forward: Vec<RoadmapPath> = queries
             .iter()
             .map(|(a, b)| shared.query(&space, &wall, a, b))
             .collect();
-        let backward = SharedRoadmap::build(&space, &wall, &[], &settings).0;
+        let backward = build();
         let mut reverse: Vec<RoadmapPath> = queries
             .iter()
             .rev()
@@ -505,9 +516,7 @@ mod tests {
         let (mut warmer, mut found) = (0, 0);
         for (k, (a, b)) in queries.iter().enumerate() {
             // Each query alone, on a cold cache.
-            let cold = SharedRoadmap::build(&space, &wall, &[], &settings)
-                .0
-                .query(&space, &wall, a, b);
+            let cold = build().query(&space, &wall, a, b);
             assert_eq!(
                 forward[k].waypoints, cold.waypoints,
                 "query {k} after the earlier ones"
