@@ -12,7 +12,9 @@
 //! clearance plus both reaches: no contact is missed between samples (the distance is bounded
 //! below by the robots' sphere covers, and measured exactly on the smallest rectangles only).
 //! Rectangles that cannot be proven free are halved (along the robot that moves more) down to [`MIN_CELL`]; those
-//! left are in conflict. Each pair of pieces (one of each path) keeps the bounding box of its
+//! left are in conflict. A body pair proven apart over a rectangle is apart over every
+//! rectangle inside it, so the halves ask only the body pairs their rectangle could not prove
+//! apart, and a pair of pieces only those whose swept spheres may meet. Each pair of pieces (one of each path) keeps the bounding box of its
 //! conflicts: a box per pair of pieces follows the shape of a long conflict as a staircase,
 //! where one bounding box of the whole would serialise the robots. A pair of pieces is worked
 //! out in the pieces' own positions, from each piece's own motion, so its answer depends on
@@ -33,7 +35,7 @@ mod spheres;
 pub use cache::DiagramCache;
 use cache::PieceKey;
 pub(crate) use cache::diagrams_reusing;
-use spheres::{Covers, Placed, body_spheres, close_pairs};
+use spheres::{Covers, Placed, SpherePair, body_spheres, close_pairs};
 
 /// A hasher for the diagram's keys by position (a robot flag and the bits of an `f64`): one
 /// multiply and rotate per word, as rustc's Fx hash; the keys are few and not adversarial.
@@ -344,8 +346,9 @@ struct PairDiagram<'a> {
     found: Option<LocalBox>,
     /// Placements in the current pair of pieces, by robot (first or not) and position.
     placed: ByPosition<Rc<Placed>>,
-    /// Room for the close body pairs of a smallest rectangle.
-    close: Vec<(usize, usize)>,
+    /// The body pairs still to be proven apart, one list per rectangle on the way down (see
+    /// [`Self::cell`]); at the bottom, those of the current pair of pieces' swept spheres.
+    pairs: Vec<SpherePair>,
     /// Room for the second cover's spheres near the first body (see [`close_pairs`]).
     near: Vec<(DVec3, f64)>,
     /// Configurations at positions in the current pair of pieces, as `placed` keys them.
@@ -447,34 +450,16 @@ impl<'a> PairDiagram<'a> {
         }
     }
 
-    /// The body pairs of the two placed robots whose sphere covers (body spheres first) come
-    /// within `need`, into `out`: every other pair is farther than `need` (the covers hold the
-    /// meshes). Without `out`, whether there is one (stops at the first).
-    fn close_pairs(
-        &mut self,
-        xa: &Placed,
-        xb: &Placed,
-        need: f64,
-        out: Option<&mut Vec<(usize, usize)>>,
-    ) -> bool {
-        close_pairs(
-            (&self.ca.ranges, &self.cb.ranges),
-            xa,
-            xb,
-            need,
-            out,
-            &mut self.near,
-        )
-    }
-
     /// Whether the two placed robots are farther apart than `need`, exactly (up to the convex
-    /// hulls), asking only the body pairs `close` (the others are farther by their covers).
-    fn apart(&mut self, xa: &Placed, xb: &Placed, close: &[(usize, usize)], need: f64) -> bool {
+    /// hulls), asking only the body pairs `self.pairs[close]` (the others are farther by their
+    /// covers).
+    fn apart(&mut self, xa: &Placed, xb: &Placed, close: std::ops::Range<usize>, need: f64) -> bool {
         self.work.distances += 1;
         let robots = &self.ctx.cell.robots;
         let (ga, gb) = (robots[self.pa.robot].group, robots[self.pb.robot].group);
         let world = &self.ctx.cell.world;
-        close.iter().all(|&(i, j)| {
+        self.pairs[close].iter().all(|&(i, j)| {
+            let (i, j) = (xa.bodies[i as usize], xb.bodies[j as usize]);
             world.body_body_distance(ga, i, &xa.poses, gb, j, &xb.poses[j], need + DISTANCE_SLACK) > need
         })
     }
@@ -508,8 +493,11 @@ impl<'a> PairDiagram<'a> {
     /// What rectangle `[a0, a1] × [b0, b1]` (of the two pieces' positions) is: free (the
     /// sphere covers, or the exact distance, exceed the clearance plus both robots' reach over
     /// it), to be halved (along the robot that moves more), or — once nothing is left to halve
-    /// — in conflict.
-    fn judge(&mut self, a: (f64, f64, bool), b: (f64, f64, bool)) -> Rect {
+    /// — in conflict. Only the body pairs `self.pairs[among]` are asked (every other is apart
+    /// over a rectangle holding this one); those not proven apart here are pushed onto
+    /// `self.pairs` for the halves to ask (the caller truncates it): a rectangle to be halved
+    /// asks up to the first close pair ([`close_pairs`] with `first`), a smallest one all.
+    fn judge(&mut self, a: (f64, f64, bool), b: (f64, f64, bool), among: std::ops::Range<usize>) -> Rect {
         self.work.cells += 1;
         let xa = self.place(true, 0.5 * (a.0 + a.1));
         let xb = self.place(false, 0.5 * (b.0 + b.1));
@@ -522,16 +510,25 @@ impl<'a> PairDiagram<'a> {
         // distance only where nothing is left to halve (halving is cheaper than GJK, and
         // the covers decide most rectangles once small), and only for the body pairs whose
         // covers come close.
-        if !(split_a || split_b) {
-            let mut close = std::mem::take(&mut self.close);
-            close.clear();
-            let free =
-                !self.close_pairs(&xa, &xb, need, Some(&mut close)) || self.apart(&xa, &xb, &close, need);
-            self.close = close;
-            return if free { Rect::Free } else { Rect::Conflict };
-        }
-        if !self.close_pairs(&xa, &xb, need, None) {
+        let mark = self.pairs.len();
+        close_pairs(
+            (&self.ca.ranges, &self.cb.ranges),
+            (&xa, &xb),
+            need,
+            (&mut self.pairs, among),
+            split_a || split_b,
+            &mut self.near,
+        );
+        let close = mark..self.pairs.len();
+        if close.is_empty() {
             return Rect::Free;
+        }
+        if !(split_a || split_b) {
+            return if self.apart(&xa, &xb, close, need) {
+                Rect::Free
+            } else {
+                Rect::Conflict
+            };
         }
         if split_a && (!split_b || ra >= rb) {
             Rect::HalveA
@@ -541,8 +538,10 @@ impl<'a> PairDiagram<'a> {
     }
 
     /// Rectangle `[a0, a1] × [b0, b1]` of the two pieces' positions: free, or halved, or
-    /// recorded as in conflict.
-    fn cell(&mut self, a: (f64, f64, bool), b: (f64, f64, bool)) {
+    /// recorded as in conflict, asking the body pairs `self.pairs[among]` only. A body pair
+    /// the covers prove apart over a rectangle is apart over every rectangle inside it, so
+    /// the halves ask only the pairs their rectangle could not prove apart.
+    fn cell(&mut self, a: (f64, f64, bool), b: (f64, f64, bool), among: std::ops::Range<usize>) {
         // Inside what is already in conflict: nothing to learn.
         if self
             .found
@@ -551,7 +550,8 @@ impl<'a> PairDiagram<'a> {
         {
             return;
         }
-        match self.judge(a, b) {
+        let mark = self.pairs.len();
+        match self.judge(a, b, among) {
             Rect::Free => {}
             Rect::Conflict => {
                 let f = self.found.get_or_insert(LocalBox {
@@ -562,26 +562,39 @@ impl<'a> PairDiagram<'a> {
                 f.a = (f.a.0.min(a.0), f.a.1.max(a.1));
                 f.b = (f.b.0.min(b.0), f.b.1.max(b.1));
             }
-            Rect::HalveA => self.halve_a(a, b),
-            Rect::HalveB => self.halve_b(a, b),
+            Rect::HalveA => {
+                let (m, close) = (0.5 * (a.0 + a.1), mark..self.pairs.len());
+                self.cell((a.0, m, a.2), b, close.clone());
+                self.cell((m, a.1, a.2), b, close);
+            }
+            Rect::HalveB => {
+                let (m, close) = (0.5 * (b.0 + b.1), mark..self.pairs.len());
+                self.cell(a, (b.0, m, b.2), close.clone());
+                self.cell(a, (m, b.1, b.2), close);
+            }
         }
+        self.pairs.truncate(mark);
     }
 
     /// Whether rectangle `[a0, a1] × [b0, b1]` is certified free (as [`Self::cell`] decides,
-    /// halving until it is or a smallest rectangle is not).
-    fn certify(&mut self, a: (f64, f64, bool), b: (f64, f64, bool)) -> bool {
-        match self.judge(a, b) {
+    /// halving until it is or a smallest rectangle is not), asking the body pairs
+    /// `self.pairs[among]` only.
+    fn certify(&mut self, a: (f64, f64, bool), b: (f64, f64, bool), among: std::ops::Range<usize>) -> bool {
+        let mark = self.pairs.len();
+        let free = match self.judge(a, b, among) {
             Rect::Free => true,
             Rect::Conflict => false,
             Rect::HalveA => {
-                let m = 0.5 * (a.0 + a.1);
-                self.certify((a.0, m, a.2), b) && self.certify((m, a.1, a.2), b)
+                let (m, close) = (0.5 * (a.0 + a.1), mark..self.pairs.len());
+                self.certify((a.0, m, a.2), b, close.clone()) && self.certify((m, a.1, a.2), b, close)
             }
             Rect::HalveB => {
-                let m = 0.5 * (b.0 + b.1);
-                self.certify(a, (b.0, m, b.2)) && self.certify(a, (m, b.1, b.2))
+                let (m, close) = (0.5 * (b.0 + b.1), mark..self.pairs.len());
+                self.certify(a, (b.0, m, b.2), close.clone()) && self.certify(a, (m, b.1, b.2), close)
             }
-        }
+        };
+        self.pairs.truncate(mark);
+        free
     }
 
     /// Marks the ends of `f` (found in the current pieces) at which a robot standing still is
@@ -593,46 +606,37 @@ impl<'a> PairDiagram<'a> {
     /// [`crate::motion::robot_validity`]); the rectangles, by contrast, are conservative by
     /// the robots' reach over a smallest rectangle and by [`super::REPLAY_SLACK`], and would
     /// otherwise let a robot's home seem to block a path that was planned past it.
-    fn open_ends(&mut self, f: &mut LocalBox, ends: PieceEnds) {
+    fn open_ends(&mut self, f: &mut LocalBox, ends: PieceEnds, among: std::ops::Range<usize>) {
         let (x, y) = (self.x, self.y);
+        let all = || among.clone();
         if x.moving {
             if f.a.0 <= 0.0 {
-                f.open[0] = ends.0[0] || self.certify((0.0, 0.0, false), (f.b.0, f.b.1, y.moving));
+                f.open[0] = ends.0[0] || self.certify((0.0, 0.0, false), (f.b.0, f.b.1, y.moving), all());
             }
             if f.a.1 >= x.len {
-                f.open[1] = ends.0[1] || self.certify((x.len, x.len, false), (f.b.0, f.b.1, y.moving));
+                f.open[1] = ends.0[1] || self.certify((x.len, x.len, false), (f.b.0, f.b.1, y.moving), all());
             }
         }
         if y.moving {
             if f.b.0 <= 0.0 {
-                f.open[2] = ends.1[0] || self.certify((f.a.0, f.a.1, x.moving), (0.0, 0.0, false));
+                f.open[2] = ends.1[0] || self.certify((f.a.0, f.a.1, x.moving), (0.0, 0.0, false), all());
             }
             if f.b.1 >= y.len {
-                f.open[3] = ends.1[1] || self.certify((f.a.0, f.a.1, x.moving), (y.len, y.len, false));
+                f.open[3] = ends.1[1] || self.certify((f.a.0, f.a.1, x.moving), (y.len, y.len, false), all());
             }
         }
     }
 
-    fn halve_a(&mut self, a: (f64, f64, bool), b: (f64, f64, bool)) {
-        let m = 0.5 * (a.0 + a.1);
-        self.cell((a.0, m, a.2), b);
-        self.cell((m, a.1, a.2), b);
-    }
-
-    fn halve_b(&mut self, a: (f64, f64, bool), b: (f64, f64, bool)) {
-        let m = 0.5 * (b.0 + b.1);
-        self.cell(a, (b.0, m, b.2));
-        self.cell(a, (m, b.1, b.2));
-    }
-
     /// The conflicts of pieces `x` and `y` in their own positions, and the work they took
-    /// (`ends`: whether each piece starts and ends its path, where the robot is at home).
+    /// (`ends`: whether each piece starts and ends its path, where the robot is at home),
+    /// asking only the body pairs whose swept spheres may meet (`self.pairs`, all of it).
     fn pieces(&mut self, x: &'a Piece, y: &'a Piece, ends: PieceEnds) -> (Option<LocalBox>, DiagramWork) {
         self.work = DiagramWork::default();
         (self.x, self.y) = (x, y);
-        self.cell((0.0, x.len, x.moving), (0.0, y.len, y.moving));
+        let swept = 0..self.pairs.len();
+        self.cell((0.0, x.len, x.moving), (0.0, y.len, y.moving), swept.clone());
         let found = self.found.take().map(|mut f| {
-            self.open_ends(&mut f, ends);
+            self.open_ends(&mut f, ends, swept);
             f
         });
         self.forget();
@@ -664,7 +668,7 @@ fn pair_boxes(ctx: &Ctx, pa: &RobotPath, pb: &RobotPath) -> (Vec<ConflictBox>, D
         y: y0,
         found: None,
         placed: ByPosition::default(),
-        close: Vec::new(),
+        pairs: Vec::new(),
         near: Vec::new(),
         positions: ByPosition::default(),
         pool: Vec::new(),
@@ -682,7 +686,11 @@ fn pair_boxes(ctx: &Ctx, pa: &RobotPath, pb: &RobotPath) -> (Vec<ConflictBox>, D
     let mut work = DiagramWork::default();
     for (x, sx) in pa.pieces.iter().zip(&swept_a) {
         for (y, sy) in pb.pieces.iter().zip(&swept_b) {
-            if !sx.may_meet(sy, margin) {
+            // The body pairs whose swept spheres come within the clearance: the others are
+            // apart wherever the two pieces are.
+            d.pairs.clear();
+            sx.meeting(sy, margin, &mut d.pairs);
+            if d.pairs.is_empty() {
                 continue;
             }
             let pair_ends = (ends(x, pa), ends(y, pb));
@@ -713,15 +721,20 @@ struct Swept {
 }
 
 impl Swept {
-    /// Whether the two could come within `margin` (false only when they cannot).
-    fn may_meet(&self, other: &Swept, margin: f64) -> bool {
+    /// The body pairs (sphere indices) of the two that could come within `margin` (every pair
+    /// left out cannot), pushed onto `out`.
+    fn meeting(&self, other: &Swept, margin: f64, out: &mut Vec<SpherePair>) {
         let apart = |a: &(DVec3, f64), b: &(DVec3, f64)| (a.0 - b.0).length() - a.1 - b.1 > margin;
         if apart(&self.all, &other.all) {
-            return false;
+            return;
         }
-        self.bodies
-            .iter()
-            .any(|a| other.bodies.iter().any(|b| !apart(a, b)))
+        for (i, a) in self.bodies.iter().enumerate() {
+            for (j, b) in other.bodies.iter().enumerate() {
+                if !apart(a, b) {
+                    out.push((i as u32, j as u32));
+                }
+            }
+        }
     }
 }
 

@@ -69,11 +69,18 @@ impl Covers {
 /// that no sphere [`close_pairs`] would pair is left out.
 const NEAR_SLACK: f64 = 1e-9;
 
-/// The body pairs of the placed robots `xa` and `xb` (body `i`'s cover at `ranges.0[i]` of
-/// `xa.covers`, and `ranges.1` of `xb`'s) whose sphere covers come within `need` of each
-/// other: a pair whose body spheres come that close, and in which a sphere of the first cover
-/// comes that close to the second body's sphere and to a sphere of the second cover. Into
-/// `out`; without `out`, whether there is one (stops at the first).
+/// A pair of body spheres of two placed robots: the index into the first's
+/// [`Placed::spheres`] and into the second's (the same bodies at every placement).
+pub(super) type SpherePair = (u32, u32);
+
+/// Of the body pairs `pairs[among]` of the placed robots `xa` and `xb` (body `i`'s cover at
+/// `ranges.0[i]` of `xa.covers`, and `ranges.1` of `xb`'s), those whose sphere covers come
+/// within `need` of each other, pushed in order onto the end of `pairs`: a pair whose body
+/// spheres come that close, and in which a sphere of the first cover comes that close to the
+/// second body's sphere and to a sphere of the second cover. Every pair left out is farther
+/// than `need` (the covers hold the meshes). With `first`, it stops at the first close pair
+/// and pushes it with the pairs after it unasked (a rectangle that will be halved needs only
+/// one; its halves ask the close one first and skip those proven apart before it).
 ///
 /// Each body's sphere holds its cover, so a sphere of the second cover that comes within
 /// `need` of a sphere of the first comes within `need` of the first body's sphere too: the
@@ -81,49 +88,48 @@ const NEAR_SLACK: f64 = 1e-9;
 /// [`NEAR_SLACK`] against rounding, and the answer is that of every sphere against every one.
 pub(super) fn close_pairs(
     ranges: (&[std::ops::Range<usize>], &[std::ops::Range<usize>]),
-    xa: &Placed,
-    xb: &Placed,
+    (xa, xb): (&Placed, &Placed),
     need: f64,
-    mut out: Option<&mut Vec<(usize, usize)>>,
+    (pairs, among): (&mut Vec<SpherePair>, std::ops::Range<usize>),
+    first: bool,
     near: &mut Vec<(DVec3, f64)>,
-) -> bool {
+) {
     // Squared distances against squared reaches (all terms are non-negative): no square
     // root per sphere pair.
     let within = |c: DVec3, r: f64, d: DVec3, q: f64| {
         let reach = need + r + q;
         (c - d).length_squared() <= reach * reach
     };
-    let mut any = false;
-    for (i, &(ca, ra)) in xa.spheres.iter().enumerate() {
-        for (j, &(cb, rb)) in xb.spheres.iter().enumerate() {
-            if !within(ca, ra, cb, rb) {
-                continue;
-            }
-            let (bi, bj) = (xa.bodies[i], xb.bodies[j]);
-            near.clear();
-            near.extend(
-                xb.covers[ranges.1[bj].clone()]
-                    .iter()
-                    .filter(|&&(d, q)| within(ca, ra + NEAR_SLACK, d, q)),
-            );
-            if near.is_empty() {
-                continue;
-            }
-            // A sphere of the first cover farther than `need` from the second body's sphere
-            // is farther from every sphere it holds.
-            let close = xa.covers[ranges.0[bi].clone()]
+    let end = among.end;
+    for k in among {
+        let (i, j) = pairs[k];
+        let ((ca, ra), (cb, rb)) = (xa.spheres[i as usize], xb.spheres[j as usize]);
+        if !within(ca, ra, cb, rb) {
+            continue;
+        }
+        let (bi, bj) = (xa.bodies[i as usize], xb.bodies[j as usize]);
+        near.clear();
+        near.extend(
+            xb.covers[ranges.1[bj].clone()]
                 .iter()
-                .any(|&(c, r)| within(c, r, cb, rb) && near.iter().any(|&(d, q)| within(c, r, d, q)));
-            if close {
-                any = true;
-                match out.as_deref_mut() {
-                    Some(out) => out.push((bi, bj)),
-                    None => return true,
-                }
+                .filter(|&&(d, q)| within(ca, ra + NEAR_SLACK, d, q)),
+        );
+        if near.is_empty() {
+            continue;
+        }
+        // A sphere of the first cover farther than `need` from the second body's sphere
+        // is farther from every sphere it holds.
+        let close = xa.covers[ranges.0[bi].clone()]
+            .iter()
+            .any(|&(c, r)| within(c, r, cb, rb) && near.iter().any(|&(d, q)| within(c, r, d, q)));
+        if close {
+            pairs.push((i, j));
+            if first {
+                pairs.extend_from_within(k + 1..end);
+                return;
             }
         }
     }
-    any
 }
 
 #[cfg(test)]
@@ -132,6 +138,11 @@ mod tests {
     use cellplan_geom::DQuat;
     use rand::{RngExt, SeedableRng};
     use rand_chacha::ChaCha8Rng;
+
+    /// Every pair of the `na` body spheres of one robot and the `nb` of another, pushed onto `out`.
+    fn every_sphere_pair(na: usize, nb: usize, out: &mut Vec<SpherePair>) {
+        out.extend((0..na as u32).flat_map(|i| (0..nb as u32).map(move |j| (i, j))));
+    }
 
     /// Every sphere of the first cover against every sphere of the second: what
     /// [`close_pairs`] must answer.
@@ -228,14 +239,57 @@ mod tests {
             }
             for need in needs {
                 let want = every_pair((&ra, &rb), &xa, &xb, need);
-                let mut got = Vec::new();
-                let any = close_pairs((&ra, &rb), &xa, &xb, need, Some(&mut got), &mut near);
-                assert_eq!(got, want, "need {need}");
-                assert_eq!(any, !want.is_empty());
-                assert_eq!(
-                    close_pairs((&ra, &rb), &xa, &xb, need, None, &mut near),
-                    !want.is_empty()
+                let mut pairs = Vec::new();
+                every_sphere_pair(xa.spheres.len(), xb.spheres.len(), &mut pairs);
+                let all = pairs.len();
+                close_pairs(
+                    (&ra, &rb),
+                    (&xa, &xb),
+                    need,
+                    (&mut pairs, 0..all),
+                    false,
+                    &mut near,
                 );
+                let bodies = |p: &[SpherePair]| -> Vec<(usize, usize)> {
+                    p.iter()
+                        .map(|&(i, j)| (xa.bodies[i as usize], xb.bodies[j as usize]))
+                        .collect()
+                };
+                assert_eq!(bodies(&pairs[all..]), want, "need {need}");
+                // Among every other pair only (in reverse order): those of them, in that order.
+                let subset: Vec<SpherePair> = pairs[..all].iter().rev().step_by(2).copied().collect();
+                let mut among = subset.clone();
+                close_pairs(
+                    (&ra, &rb),
+                    (&xa, &xb),
+                    need,
+                    (&mut among, 0..subset.len()),
+                    false,
+                    &mut near,
+                );
+                let kept: Vec<(usize, usize)> =
+                    bodies(&subset).into_iter().filter(|p| want.contains(p)).collect();
+                assert_eq!(bodies(&among[subset.len()..]), kept, "need {need}, among some");
+                // Stopping at the first: it, then every pair after it, unasked.
+                let mut among = subset.clone();
+                close_pairs(
+                    (&ra, &rb),
+                    (&xa, &xb),
+                    need,
+                    (&mut among, 0..subset.len()),
+                    true,
+                    &mut near,
+                );
+                match kept.first() {
+                    None => assert_eq!(among.len(), subset.len()),
+                    Some(&k) => {
+                        let at = bodies(&subset)
+                            .iter()
+                            .position(|&p| p == k)
+                            .expect("kept from the subset");
+                        assert_eq!(&among[subset.len()..], &subset[at..], "need {need}, the first");
+                    }
+                }
                 if want.is_empty() {
                     none += 1;
                 } else {
