@@ -11,10 +11,11 @@
 //! of positions is therefore free when the distance of the two robots at its centre exceeds the
 //! clearance plus both reaches: no contact is missed between samples (the distance is bounded
 //! below by the robots' sphere covers, and measured exactly on the smallest rectangles only).
-//! Rectangles that cannot be proven free are halved (along the robot that moves more) down to [`MIN_CELL`]; those
-//! left are in conflict. A body pair proven apart over a rectangle is apart over every
-//! rectangle inside it, so the halves ask only the body pairs their rectangle could not prove
-//! apart, and a pair of pieces only those whose swept spheres may meet. Each pair of pieces (one of each path) keeps the bounding box of its
+//! Rectangles that cannot be proven free are halved (along the robot that moves more) down to
+//! [`MIN_CELL`]; those left are in conflict. A body pair proven apart over a rectangle is apart
+//! over every rectangle inside it, so the halves ask only the body pairs their rectangle could
+//! not prove apart, and a pair of pieces only those whose swept spheres may meet. Each pair of
+//! pieces (one of each path) keeps the bounding box of its
 //! conflicts: a box per pair of pieces follows the shape of a long conflict as a staircase,
 //! where one bounding box of the whole would serialise the robots. A pair of pieces is worked
 //! out in the pieces' own positions, from each piece's own motion, so its answer depends on
