@@ -245,9 +245,8 @@ impl SharedRoadmap {
         extra.push((s, g, direct));
         // Verdicts of the query's own edges; an invalid one is set aside.
         let mut extra_verdict = vec![UNKNOWN; extra.len()];
-        // Per roadmap edge, whether this query set it aside; per node, its heuristic once
-        // worked out (the A* runs of one query share both).
-        let mut set_aside = vec![false; self.edges.len()];
+        // Per node, its heuristic once worked out (the A* runs of one query share it). A roadmap
+        // edge found invalid is left out through the shared verdicts, stored before the next run.
         let mut to_goal = vec![f64::NAN; n + 2];
         let (mut examined, mut calls) = (0, 0);
         let point = |i: usize| -> &[f64] {
@@ -260,13 +259,8 @@ impl SharedRoadmap {
             }
         };
         let waypoints = 'search: loop {
-            let Some(path) = self.shortest(
-                space,
-                (start, goal),
-                (&extra, &extra_verdict),
-                &set_aside,
-                &mut to_goal,
-            ) else {
+            let Some(path) = self.shortest(space, (start, goal), (&extra, &extra_verdict), &mut to_goal)
+            else {
                 break 'search None;
             };
             for &(hop, _) in &path {
@@ -292,9 +286,6 @@ impl SharedRoadmap {
                             v = check(a as usize, b as usize);
                             slot.store(v, Ordering::Relaxed);
                         }
-                        if v != VALID {
-                            set_aside[e as usize] = true;
-                        }
                         v == VALID
                     }
                 };
@@ -314,16 +305,14 @@ impl SharedRoadmap {
     }
 
     /// A* from the start (node `n`) to the goal (`n + 1`) over the roadmap's edges and the
-    /// query's own (`extra`), leaving out those set aside, those the shared cache holds invalid
-    /// and the query edges found invalid;
-    /// the hops in order, each with the node it reaches. `to_goal` keeps each node's heuristic
+    /// query's own (`extra`), leaving out the roadmap edges the shared cache holds invalid and
+    /// the query edges found invalid; the hops in order, each with the node it reaches. `to_goal` keeps each node's heuristic
     /// (NaN: not worked out yet).
     fn shortest(
         &self,
         space: &JointSpace,
         (start, goal): (&[f64], &[f64]),
         (extra, extra_verdict): (&[(usize, usize, f64)], &[u8]),
-        set_aside: &[bool],
         to_goal: &mut [f64],
     ) -> Option<Vec<(Hop, usize)>> {
         let n = self.nodes.len();
@@ -386,8 +375,7 @@ impl SharedRoadmap {
             }
             if i < n {
                 for &(j, e) in &self.adjacent[i] {
-                    if !set_aside[e as usize] && self.verdicts[e as usize].load(Ordering::Relaxed) != INVALID
-                    {
+                    if self.verdicts[e as usize].load(Ordering::Relaxed) != INVALID {
                         relax(j as usize, self.edges[e as usize].2, Hop::Roadmap(e), &mut queue);
                     }
                 }

@@ -258,36 +258,32 @@ mod tests {
                 assert_eq!(bodies(&pairs[all..]), want, "need {need}");
                 // Among every other pair only (in reverse order): those of them, in that order.
                 let subset: Vec<SpherePair> = pairs[..all].iter().rev().step_by(2).copied().collect();
-                let mut among = subset.clone();
-                close_pairs(
-                    (&ra, &rb),
-                    (&xa, &xb),
-                    need,
-                    (&mut among, 0..subset.len()),
-                    false,
-                    &mut near,
-                );
+                // What the subset's asking pushes, asking all or stopping at the first.
+                let mut ask = |first: bool| -> Vec<SpherePair> {
+                    let mut among = subset.clone();
+                    close_pairs(
+                        (&ra, &rb),
+                        (&xa, &xb),
+                        need,
+                        (&mut among, 0..subset.len()),
+                        first,
+                        &mut near,
+                    );
+                    among.split_off(subset.len())
+                };
                 let kept: Vec<(usize, usize)> =
                     bodies(&subset).into_iter().filter(|p| want.contains(p)).collect();
-                assert_eq!(bodies(&among[subset.len()..]), kept, "need {need}, among some");
+                assert_eq!(bodies(&ask(false)), kept, "need {need}, among some");
                 // Stopping at the first: it, then every pair after it, unasked.
-                let mut among = subset.clone();
-                close_pairs(
-                    (&ra, &rb),
-                    (&xa, &xb),
-                    need,
-                    (&mut among, 0..subset.len()),
-                    true,
-                    &mut near,
-                );
+                let pushed = ask(true);
                 match kept.first() {
-                    None => assert_eq!(among.len(), subset.len()),
+                    None => assert!(pushed.is_empty()),
                     Some(&k) => {
                         let at = bodies(&subset)
                             .iter()
                             .position(|&p| p == k)
                             .expect("kept from the subset");
-                        assert_eq!(&among[subset.len()..], &subset[at..], "need {need}, the first");
+                        assert_eq!(&pushed[..], &subset[at..], "need {need}, the first");
                     }
                 }
                 if want.is_empty() {
