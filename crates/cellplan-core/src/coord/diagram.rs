@@ -320,6 +320,20 @@ pub(crate) struct DiagramWork {
     pub distances: usize,
 }
 
+/// An interval of one piece's positions, and whether the piece moves.
+type Span = (f64, f64, bool);
+
+/// The two halves of rectangle `a × b`, halved along `a` (or along `b`), the lower first.
+fn halves(a: Span, b: Span, along_a: bool) -> [(Span, Span); 2] {
+    if along_a {
+        let m = 0.5 * (a.0 + a.1);
+        [((a.0, m, a.2), b), ((m, a.1, a.2), b)]
+    } else {
+        let m = 0.5 * (b.0 + b.1);
+        [(a, (b.0, m, b.2)), (a, (m, b.1, b.2))]
+    }
+}
+
 /// What a rectangle of two pieces' positions is (see [`PairDiagram::judge`]).
 enum Rect {
     Free,
@@ -498,7 +512,7 @@ impl<'a> PairDiagram<'a> {
     /// over a rectangle holding this one); those not proven apart here are pushed onto
     /// `self.pairs` for the halves to ask (the caller truncates it): a rectangle to be halved
     /// asks up to the first close pair ([`close_pairs`] with `first`), a smallest one all.
-    fn judge(&mut self, a: (f64, f64, bool), b: (f64, f64, bool), among: std::ops::Range<usize>) -> Rect {
+    fn judge(&mut self, a: Span, b: Span, among: std::ops::Range<usize>) -> Rect {
         self.work.cells += 1;
         let xa = self.place(true, 0.5 * (a.0 + a.1));
         let xb = self.place(false, 0.5 * (b.0 + b.1));
@@ -542,7 +556,7 @@ impl<'a> PairDiagram<'a> {
     /// recorded as in conflict, asking the body pairs `self.pairs[among]` only. A body pair
     /// the covers prove apart over a rectangle is apart over every rectangle inside it, so
     /// the halves ask only the pairs their rectangle could not prove apart.
-    fn cell(&mut self, a: (f64, f64, bool), b: (f64, f64, bool), among: std::ops::Range<usize>) {
+    fn cell(&mut self, a: Span, b: Span, among: std::ops::Range<usize>) {
         // Inside what is already in conflict: nothing to learn.
         if self
             .found
@@ -563,15 +577,11 @@ impl<'a> PairDiagram<'a> {
                 f.a = (f.a.0.min(a.0), f.a.1.max(a.1));
                 f.b = (f.b.0.min(b.0), f.b.1.max(b.1));
             }
-            Rect::HalveA => {
-                let (m, close) = (0.5 * (a.0 + a.1), mark..self.pairs.len());
-                self.cell((a.0, m, a.2), b, close.clone());
-                self.cell((m, a.1, a.2), b, close);
-            }
-            Rect::HalveB => {
-                let (m, close) = (0.5 * (b.0 + b.1), mark..self.pairs.len());
-                self.cell(a, (b.0, m, b.2), close.clone());
-                self.cell(a, (m, b.1, b.2), close);
+            halve @ (Rect::HalveA | Rect::HalveB) => {
+                let close = mark..self.pairs.len();
+                for (a, b) in halves(a, b, matches!(halve, Rect::HalveA)) {
+                    self.cell(a, b, close.clone());
+                }
             }
         }
         self.pairs.truncate(mark);
@@ -580,18 +590,16 @@ impl<'a> PairDiagram<'a> {
     /// Whether rectangle `[a0, a1] × [b0, b1]` is certified free (as [`Self::cell`] decides,
     /// halving until it is or a smallest rectangle is not), asking the body pairs
     /// `self.pairs[among]` only.
-    fn certify(&mut self, a: (f64, f64, bool), b: (f64, f64, bool), among: std::ops::Range<usize>) -> bool {
+    fn certify(&mut self, a: Span, b: Span, among: std::ops::Range<usize>) -> bool {
         let mark = self.pairs.len();
         let free = match self.judge(a, b, among) {
             Rect::Free => true,
             Rect::Conflict => false,
-            Rect::HalveA => {
-                let (m, close) = (0.5 * (a.0 + a.1), mark..self.pairs.len());
-                self.certify((a.0, m, a.2), b, close.clone()) && self.certify((m, a.1, a.2), b, close)
-            }
-            Rect::HalveB => {
-                let (m, close) = (0.5 * (b.0 + b.1), mark..self.pairs.len());
-                self.certify(a, (b.0, m, b.2), close.clone()) && self.certify(a, (m, b.1, b.2), close)
+            halve @ (Rect::HalveA | Rect::HalveB) => {
+                let close = mark..self.pairs.len();
+                halves(a, b, matches!(halve, Rect::HalveA))
+                    .into_iter()
+                    .all(|(a, b)| self.certify(a, b, close.clone()))
             }
         };
         self.pairs.truncate(mark);

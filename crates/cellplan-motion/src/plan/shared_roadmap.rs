@@ -20,11 +20,12 @@
 //!   to their nearest nodes and runs lazy PRM (Bohlin & Kavraki 2000): the shortest path under
 //!   the edges not known invalid — those it found invalid itself and those the cache already
 //!   holds as invalid, whichever query checked them —, its edges checked from the start on
-//!   (through the cache), the first invalid one set aside, search again. Every edge left out is
-//!   invalid, so every valid path stays in the graph searched, and the path a search returns
-//!   whole valid is the shortest valid path of the roadmap: the same answer with a cold or a
-//!   warm cache, in any thread, whichever queries ran before (paths of equal length compare
-//!   by their hops: a start or goal that is a node ties exactly with the path skipping it). There is no budget to bind: each search that fails leaves out one more
+//!   (through the cache, which then holds the first invalid one), search again. Every edge
+//!   left out is invalid, so every valid path stays in the graph searched, and the path a
+//!   search returns whole valid is the shortest valid path of the roadmap: the same answer
+//!   with a cold or a warm cache, in any thread, whichever queries ran before (paths of equal
+//!   length compare by their hops: a start or goal that is a node ties exactly with the path
+//!   skipping it). There is no budget to bind: each search that fails leaves out one more
 //!   edge, so a query ends within the roadmap's edge count of searches, and over all queries
 //!   each edge is checked about once (twice when two threads race to it); only the work, not
 //!   the answer, depends on what other queries checked first.
@@ -306,8 +307,8 @@ impl SharedRoadmap {
 
     /// A* from the start (node `n`) to the goal (`n + 1`) over the roadmap's edges and the
     /// query's own (`extra`), leaving out the roadmap edges the shared cache holds invalid and
-    /// the query edges found invalid; the hops in order, each with the node it reaches. `to_goal` keeps each node's heuristic
-    /// (NaN: not worked out yet).
+    /// the query edges found invalid; the hops in order, each with the node it reaches.
+    /// `to_goal` keeps each node's heuristic (NaN: not worked out yet).
     fn shortest(
         &self,
         space: &JointSpace,
@@ -458,10 +459,6 @@ mod tests {
         dist[n + 1].is_finite().then_some(dist[n + 1])
     }
 
-    fn length(space: &JointSpace, path: &[Vec<f64>]) -> f64 {
-        path.windows(2).map(|w| space.distance(&w[0], &w[1])).sum()
-    }
-
     #[test]
     fn queries_give_the_shortest_valid_path_whatever_other_queries_checked_first() {
         let space = space();
@@ -522,9 +519,9 @@ mod tests {
                         assert!(check_segment(&space, &wall, &w[0], &w[1], 1e-4).valid);
                     }
                     assert!(
-                        (length(&space, path) - best).abs() < 1e-9,
+                        (crate::plan::path_length(&space, path) - best).abs() < 1e-9,
                         "query {k}: {} against {best}",
-                        length(&space, path)
+                        crate::plan::path_length(&space, path)
                     );
                 }
                 (None, None) => {}
