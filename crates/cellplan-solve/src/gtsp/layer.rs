@@ -87,14 +87,23 @@ pub(super) fn layer_pass(inst: &Inst, st: &mut State, memo: &mut LayerMemo) -> V
             here.fill(f64::INFINITY);
             columns.clear();
             columns.extend(cur.iter().map(|&v| inst.column(v)));
+            // A cluster whose nodes are numbered one after the other (as the planner's
+            // instances number them) reads each row as one slice: the same values in the same
+            // order, without a lookup per node.
+            let first = columns.first().copied().unwrap_or(0);
+            let run = columns.iter().enumerate().all(|(j, &c)| c == first + j);
             for (i, (&u, &vu)) in prev.iter().zip(before.iter()).enumerate() {
                 let row = inst.row(u);
-                for ((h, p), &c) in here.iter_mut().zip(parents.iter_mut()).zip(columns.iter()) {
-                    let x = vu + row[c];
-                    if x < *h {
-                        *h = x;
-                        *p = i;
-                    }
+                if run {
+                    relax(
+                        here,
+                        parents,
+                        row[first..first + columns.len()].iter().copied(),
+                        vu,
+                        i,
+                    );
+                } else {
+                    relax(here, parents, columns.iter().map(|&c| row[c]), vu, i);
                 }
             }
             // (Costs are finite: every node of `cur` got a parent from `prev`.)
@@ -133,4 +142,18 @@ pub(super) fn layer_pass(inst: &Inst, st: &mut State, memo: &mut LayerMemo) -> V
     }
     st.refresh(inst);
     changed
+}
+
+/// One row of a layer's table: every node `v` of the layer takes `vu + cost(u, v)` and `u`'s
+/// index `i` as its parent where that is strictly cheaper (so each keeps the first cheapest
+/// `u`), `costs` giving `cost(u, v)` in the layer's order.
+#[inline]
+fn relax(here: &mut [f64], parents: &mut [usize], costs: impl Iterator<Item = f64>, vu: f64, i: usize) {
+    for ((h, p), c) in here.iter_mut().zip(parents.iter_mut()).zip(costs) {
+        let x = vu + c;
+        if x < *h {
+            *h = x;
+            *p = i;
+        }
+    }
 }
