@@ -46,10 +46,10 @@ def run(cmd):
         fail(f"{' '.join(cmd[:3])} ... printed no JSON ({e})")
 
 
-def solved_times(rows, key):
+def solved_times(rows, key, who, k):
     times = [r[key] for r in rows if r.get("solved")]
     if not times:
-        fail("a run solved no query")
+        fail(f"{who} run of round {k} solved no query")
     return times
 
 
@@ -73,8 +73,8 @@ def main():
     for k in range(1, args.rounds + 1):
         ours_rows = run(ours_cmd)
         vamp_rows = run(vamp_cmd)
-        ours = solved_times(ours_rows, "time_s")
-        vamp = solved_times(vamp_rows, "vamp_time_s")
+        ours = solved_times(ours_rows, "time_s", "our", k)
+        vamp = solved_times(vamp_rows, "vamp_time_s", "VAMP's", k)
         ours_all += ours
         vamp_all += vamp
         r = {
