@@ -74,7 +74,10 @@ def main():
         cell_path = Path(args.cell or plan["cell_file"])
         if not cell_path.is_absolute() and not cell_path.exists():
             cell_path = Path(args.plan).parent / cell_path
-        cell = tomllib.loads(cell_path.read_text())
+        try:
+            cell = tomllib.loads(cell_path.read_text())
+        except OSError as e:
+            raise ValueError(f"{e} (the plan names its cell as given on the command line; pass it with --cell)")
         rows = []
         for r in plan["robots"]:
             vel, acc = limits(cell_path, cell, r["name"], r["joints"])
@@ -96,7 +99,10 @@ def main():
                 "work_on_bounds_s": bound + r["measuring_s"],
                 "end_s": r["end_s"],
             })
-    except (OSError, KeyError, ValueError, json.JSONDecodeError, tomllib.TOMLDecodeError, ET.ParseError) as e:
+    except KeyError as e:
+        print(f"plan_legs: {args.plan}: not an inspection plan (no field {e})", file=sys.stderr)
+        return 2
+    except (OSError, ValueError, json.JSONDecodeError, tomllib.TOMLDecodeError, ET.ParseError) as e:
         print(f"plan_legs: {e}", file=sys.stderr)
         return 2
     if args.json:
