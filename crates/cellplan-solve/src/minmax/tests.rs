@@ -513,9 +513,9 @@ fn the_duals_of_the_bound_certify_it() {
     assert!(certified >= 10, "{certified} of 20 certified");
 }
 
-/// The least `μ·time(r) − π(r)` over vehicle `v`'s elementary routes of at most its cap, the
-/// empty one (0) included: every set of tasks it can do, in its best order and nodes.
-fn least_reduced_cost(p: &MinMaxProblem, v: usize, pi: &[f64], mu: f64) -> f64 {
+/// The least `μ·time(r) − π(r)` over vehicle `v`'s elementary routes of at most `cap` tasks,
+/// the empty one (0) included: every set of tasks it can do, in its best order and nodes.
+fn least_reduced_cost(p: &MinMaxProblem, v: usize, pi: &[f64], mu: f64, cap: usize) -> f64 {
     let doable: Vec<usize> = (0..p.tasks).filter(|&t| p.can_do(v, t)).collect();
     let mut least: f64 = 0.0;
     for code in 1u32..(1 << doable.len()) {
@@ -523,7 +523,7 @@ fn least_reduced_cost(p: &MinMaxProblem, v: usize, pi: &[f64], mu: f64) -> f64 {
             .filter(|&i| code >> i & 1 == 1)
             .map(|i| doable[i])
             .collect();
-        if set.len() <= p.vehicles[v].cap {
+        if set.len() <= cap {
             let prices: f64 = set.iter().map(|&t| pi[t]).sum();
             least = least.min(mu * best_route(p, v, &set) - prices);
         }
@@ -536,10 +536,10 @@ fn exact_pricing_finds_the_least_reduced_cost_under_every_cap() {
     // With a memory as large as the tasks, ng-routes are the elementary routes, so the
     // Lagrangian bound at any duals is Σπ plus each vehicle's least reduced cost, found here
     // by enumeration. Caps from one task up make the labels' depth count (a route past its
-    // vehicle's cap is no route); high prices make long routes pay, so the caps bind, and
-    // make deeper labels cheaper than shallower ones at the same node.
+    // vehicle's cap is no route); high prices make long routes pay, so caps bind (counted),
+    // and make deeper labels cheaper than shallower ones at the same node.
     use rand::{RngExt, SeedableRng};
-    let mut below_cap = 0;
+    let mut binding = 0;
     for seed in 0..60u64 {
         let (m, n) = (1 + seed as usize % 3, 2 + seed as usize % 5);
         let mut p = random_asymmetric(m, n, seed);
@@ -556,15 +556,18 @@ fn exact_pricing_finds_the_least_reduced_cost_under_every_cap() {
             ..RouteBoundSettings::default()
         };
         let got = lagrangian_bound(&p, &pi, &mu, &settings).expect("feasible duals");
-        let want: f64 =
-            pi.iter().sum::<f64>() + (0..m).map(|v| least_reduced_cost(&p, v, &pi, mu[v])).sum::<f64>();
+        let least: Vec<f64> = (0..m)
+            .map(|v| least_reduced_cost(&p, v, &pi, mu[v], p.vehicles[v].cap))
+            .collect();
+        let want = pi.iter().sum::<f64>() + least.iter().sum::<f64>();
         assert!(
             (got - want).abs() <= 1e-9 * want.abs().max(1.0),
             "seed {seed}: priced {got}, enumerated {want}"
         );
-        below_cap += usize::from(p.vehicles.iter().any(|v| v.cap < n));
+        // The cap binds where the best route without it takes more tasks.
+        binding += usize::from((0..m).any(|v| least_reduced_cost(&p, v, &pi, mu[v], n) < least[v] - 1e-9));
     }
-    assert!(below_cap >= 30, "{below_cap} of 60 with a cap below the tasks");
+    assert!(binding >= 30, "a cap binds in {binding} of 60");
 }
 
 #[test]
