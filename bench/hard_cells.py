@@ -8,8 +8,9 @@ only):
 1. `cellplan plan CELL -o OUT --json --no-report --seed S`: exit code (0 every MP measured, 3 some MPs
    unmeasured — both fine; anything else is a failure and its last error line is reported),
    wall time and peak RSS (`/usr/bin/time -f '%e %M'`, else the clock and getrusage), cycle
-   time, lower bound, ratio, Δt, MPs, robots, unmeasured MPs, and the leg queries that found
-   no path (the plan's `stats.legs_failed`);
+   time, lower bound, ratio, Δt, MPs, robots, unmeasured MPs, the leg queries that found
+   no path (the plan's `stats.legs_failed`) and, with `--json`, the cycle of the same paths
+   without waits (`uncoordinated_cycle_time_s`);
 2. `cellplan verify OUT/plan.json CELL --json` must exit 0;
 3. `cellplan --threads 1 plan CELL -o OUT1 --json --no-report --seed S` must give the same exit code and a
    plan.json equal to the first apart from compute times (`compute_s` and wall-time fields are
@@ -203,6 +204,11 @@ def bench_cell(name, out_root, timeout, threads1, seed=0):
         doc = json.loads((out / "plan.json").read_text())
         stats = doc["stats"]
         row.update(legs_failed=stats["legs_failed"], legs_planned=stats["legs_planned"])
+        # The same paths without a wait (every leg stopping at its waypoints): what
+        # coordination cost, against the cycle.
+        coord = doc.get("coordination") or {}
+        if coord.get("uncoordinated_cycle_time_s") is not None:
+            row.update(uncoordinated_cycle_time_s=coord["uncoordinated_cycle_time_s"])
         # How ours went (plans that state it): counts, and the seconds of its parts.
         if stats.get("ours") and doc["compute_s"].get("ours"):
             row.update(ours=stats["ours"], ours_s=doc["compute_s"]["ours"])
