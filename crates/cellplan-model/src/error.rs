@@ -76,6 +76,18 @@ pub fn line_of(text: &str, offset: usize) -> usize {
         + 1
 }
 
+/// A number from the input as an error message shows it: as written (`1.5`, `-1`, `NaN`) while
+/// it is of a size people write, in scientific notation beyond (`1e300`, `2.5e-9`). Rust's
+/// own `{}` spells 1e300 out in 301 digits.
+pub fn shown(v: f64) -> String {
+    let a = v.abs();
+    if v.is_finite() && a != 0.0 && !(1e-4..1e9).contains(&a) {
+        format!("{v:e}")
+    } else {
+        format!("{v}")
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -87,6 +99,19 @@ mod tests {
         let e = InputError::at_span(Path::new("cell.toml"), text, at..at + 4, "bad value");
         assert_eq!(e.line, Some(3));
         assert_eq!(e.to_string(), "cell.toml:3: bad value");
+    }
+
+    #[test]
+    fn numbers_are_shown_short() {
+        assert_eq!(shown(1e300), "1e300");
+        assert_eq!(shown(-2.5e-9), "-2.5e-9");
+        assert_eq!(shown(6e9), "6e9");
+        assert_eq!(shown(1.5), "1.5");
+        assert_eq!(shown(-1.0), "-1");
+        assert_eq!(shown(0.0), "0");
+        assert_eq!(shown(123_456_789.0), "123456789");
+        assert_eq!(shown(f64::NAN), "NaN");
+        assert_eq!(shown(f64::INFINITY), "inf");
     }
 
     #[test]

@@ -30,6 +30,12 @@ pub enum PoseError {
     /// `xyz` (in metres) is not finite.
     #[error("the translation `xyz` is not finite")]
     Translation,
+    /// `xyz` (in metres) lies beyond [`crate::tasks::MAX_COORDINATE`] from the origin.
+    #[error("the translation `xyz` lies {} m from the origin, beyond {} m", crate::shown(*metres), crate::tasks::MAX_COORDINATE)]
+    Far {
+        /// Its largest coordinate's magnitude (m).
+        metres: f64,
+    },
     /// More than one of `rpy`, `quat`, `matrix`.
     #[error("give the rotation once: one of `rpy`, `quat` or `matrix`")]
     RotationTwice,
@@ -61,6 +67,11 @@ pub fn pose_from_spec(spec: &PoseSpec, to_m: f64, to_rad: f64) -> Result<Pose, P
     let t = DVec3::from_array(spec.xyz) * to_m;
     if !t.is_finite() {
         return Err(PoseError::Translation);
+    }
+    if t.abs().max_element() > crate::tasks::MAX_COORDINATE {
+        return Err(PoseError::Far {
+            metres: t.abs().max_element(),
+        });
     }
     let given = [spec.rpy.is_some(), spec.quat.is_some(), spec.matrix.is_some()]
         .iter()

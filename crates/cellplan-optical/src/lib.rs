@@ -95,7 +95,10 @@ fn positive(input: &ProcessInput, key: &str, v: f64) -> Result<f64, InputError> 
     if v.is_finite() && v > 0.0 {
         Ok(v)
     } else {
-        Err(input.error(key, format!("`{key}` must be positive, not {v}")))
+        Err(input.error(
+            key,
+            format!("`{key}` must be positive, not {}", cellplan_model::shown(v)),
+        ))
     }
 }
 
@@ -143,7 +146,10 @@ pub fn build(input: &ProcessInput) -> Result<Arc<dyn Process>, InputError> {
     ] {
         if v > 10.0 {
             return Err(input
-                .error(key, format!("`{key}` of {v:.3} m is beyond 10 m"))
+                .error(
+                    key,
+                    format!("`{key}` of {} m is beyond 10 m", cellplan_model::shown(v)),
+                )
                 .hint("an optical probe works at centimetres to a metre; check `units.length`"));
         }
     }
@@ -152,7 +158,10 @@ pub fn build(input: &ProcessInput) -> Result<Arc<dyn Process>, InputError> {
         Some(v) => {
             return Err(input.error(
                 "measure_time",
-                format!("`measure_time` must be between 0 and 3600 s, not {v}"),
+                format!(
+                    "`measure_time` must be between 0 and 3600 s, not {}",
+                    cellplan_model::shown(v)
+                ),
             ));
         }
         None => 1.5,

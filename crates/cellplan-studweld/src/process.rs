@@ -98,7 +98,10 @@ fn positive(input: &ProcessInput, key: &str, v: f64) -> Result<f64, InputError> 
     if v.is_finite() && v > 0.0 {
         Ok(v)
     } else {
-        Err(input.error(key, format!("`{key}` must be positive, not {v}")))
+        Err(input.error(
+            key,
+            format!("`{key}` must be positive, not {}", cellplan_model::shown(v)),
+        ))
     }
 }
 

@@ -285,6 +285,38 @@ const CASES: &[Case] = &[
         says: &["cell.toml:", "`task_cap` must be between 1"],
     },
     Case {
+        name: "a balance limit beyond a day, refused at its line (it once went through planning to a plan its own check refused)",
+        setup: |d| plan_args(cell_with(d, |c| c + "\n[planning]\nbalance_limit = 1e300\n"), d),
+        says: &[
+            "cell.toml:",
+            "`balance_limit` of 1e300 s is beyond 86400 s",
+            "leave `balance_limit` out",
+        ],
+    },
+    Case {
+        name: "a base far beyond any cell, with its size in short",
+        setup: |d| {
+            check_args(cell_with(d, |c| {
+                c.replace("base = { xyz = [0, 0, 0] }", "base = { xyz = [1e300, 0, 0] }")
+            }))
+        },
+        says: &["cell.toml:", "lies 1e297 m from the origin, beyond 10000 m"],
+    },
+    Case {
+        name: "an object larger than any cell",
+        setup: |d| {
+            check_args(cell_with(d, |c| {
+                c.replace("box = [600, 600, 600]", "box = [600, 6e9, 600]")
+            }))
+        },
+        says: &["cell.toml:", "`box` of 6000000 m is beyond 10000 m"],
+    },
+    Case {
+        name: "an absurd clearance, with its size in short",
+        setup: |d| check_args(cell_with(d, |c| c + "\n[planning]\nclearance = 1e300\n")),
+        says: &["cell.toml:", "`clearance` of 1e297 m is beyond 1 m"],
+    },
+    Case {
         name: "caps that cannot hold the tasks, in check as in plan",
         setup: |d| check_args(cell_with(d, |c| c + "\n[planning]\ntask_cap = 1\n")),
         says: &["cell.toml", "task_cap = 1", "no robot with room"],

@@ -114,7 +114,10 @@ impl Ctx<'_> {
         if !(v.is_finite() && v > 0.0 && v * self.to_m <= MAX_LENGTH) {
             return Err(self.err(
                 self.key(span, key),
-                format!("`{key}` = {v} must be a length above 0 and within {MAX_LENGTH} m"),
+                format!(
+                    "`{key}` = {} must be a length above 0 and within {MAX_LENGTH} m",
+                    cellplan_model::shown(v)
+                ),
             ));
         }
         Ok(v * self.to_m)
@@ -198,7 +201,10 @@ pub fn load(path: &Path) -> Result<CmmCell, InputError> {
         Some(v) => {
             return Err(ctx.err(
                 ctx.key(&ms, "rotation_speed"),
-                format!("`rotation_speed` = {v} must be above 0 and at most 3600 °/s"),
+                format!(
+                    "`rotation_speed` = {} must be above 0 and at most 3600 °/s",
+                    cellplan_model::shown(v)
+                ),
             ));
         }
     };

@@ -106,7 +106,10 @@ fn time(at: &dyn Fn() -> String, key: &str, v: f64) -> Result<(), DocumentError>
     } else {
         Err(invalid(
             at(),
-            format!("`{key}` is {v}; times lie between 0 and {MAX_TIME_S} s"),
+            format!(
+                "`{key}` is {}; times lie between 0 and {MAX_TIME_S} s",
+                cellplan_model::shown(v)
+            ),
         ))
     }
 }

@@ -495,9 +495,28 @@ fn positive(ctx: &Ctx, span: &Range<usize>, key: &str, v: f64) -> Result<f64, In
     } else {
         Err(ctx.err(
             ctx.key_span(span, key),
-            format!("`{key}` must be positive, not {v}"),
+            format!("`{key}` must be positive, not {}", crate::shown(v)),
         ))
     }
+}
+
+/// A shape's dimension `v` (file units): positive, and at most
+/// [`crate::tasks::MAX_COORDINATE`] metres.
+fn size(ctx: &Ctx, span: &Range<usize>, key: &str, v: f64) -> Result<f64, InputError> {
+    let v = positive(ctx, span, key, v)?;
+    if v * ctx.to_m > crate::tasks::MAX_COORDINATE {
+        return Err(ctx
+            .err(
+                ctx.key_span(span, key),
+                format!(
+                    "`{key}` of {} m is beyond {} m",
+                    crate::shown(v * ctx.to_m),
+                    crate::tasks::MAX_COORDINATE
+                ),
+            )
+            .hint("shape sizes are in the file's `units.length`"));
+    }
+    Ok(v)
 }
 
 /// Reads `[planning]` (defaults where absent).
@@ -510,13 +529,13 @@ fn planning(ctx: &Ctx, spec: Option<&Spanned<PlanningSpec>>) -> Result<Planning,
         if !(v.is_finite() && v >= 0.0) {
             return Err(ctx.err(
                 ctx.key_span(&span, "clearance"),
-                format!("`clearance` must be ≥ 0, not {v}"),
+                format!("`clearance` must be ≥ 0, not {}", crate::shown(v)),
             ));
         }
         out.clearance = v * ctx.to_m;
         if out.clearance > MAX_CLEARANCE {
             return Err(ctx
-                .err(ctx.key_span(&span, "clearance"), format!("`clearance` of {:.3} m is beyond {MAX_CLEARANCE} m", out.clearance))
+                .err(ctx.key_span(&span, "clearance"), format!("`clearance` of {} m is beyond {MAX_CLEARANCE} m", crate::shown(out.clearance)))
                 .hint("the clearance is the gap kept between robots and objects, a few millimetres to centimetres; check `units.length`"));
         }
     }
@@ -532,13 +551,24 @@ fn planning(ctx: &Ctx, spec: Option<&Spanned<PlanningSpec>>) -> Result<Planning,
         out.task_cap = v;
     }
     if let Some(v) = p.balance_limit {
-        out.balance_limit = Some(positive(ctx, &span, "balance_limit", v)?);
+        let v = positive(ctx, &span, "balance_limit", v)?;
+        if v > MAX_BALANCE_LIMIT {
+            return Err(ctx
+                .err(
+                    ctx.key_span(&span, "balance_limit"),
+                    format!("`balance_limit` of {} s is beyond {MAX_BALANCE_LIMIT} s", crate::shown(v)),
+                )
+                .hint("γ is the most the robots' cycle times may differ, in seconds; leave `balance_limit` out for no limit"));
+        }
+        out.balance_limit = Some(v);
     }
     Ok(out)
 }
 
 /// Largest `[planning] clearance` (m).
 pub const MAX_CLEARANCE: f64 = 1.0;
+/// Largest `[planning] balance_limit` (s): a day.
+pub const MAX_BALANCE_LIMIT: f64 = 86_400.0;
 /// Largest `[planning] task_cap`.
 pub const MAX_TASK_CAP: usize = 100_000;
 
@@ -567,19 +597,19 @@ fn shape(
     let m = ctx.to_m;
     let shape = if let Some(b) = e.box_size {
         for v in b {
-            positive(ctx, &span, "box", v)?;
+            size(ctx, &span, "box", v)?;
         }
         ShapeSpec::Box {
             half_extents: DVec3::from_array(b) * (m / 2.0),
         }
     } else if let Some(c) = e.cylinder {
         ShapeSpec::Cylinder {
-            radius: positive(ctx, &span, "cylinder", c.radius)? * m,
-            half_height: positive(ctx, &span, "cylinder", c.length)? * m / 2.0,
+            radius: size(ctx, &span, "cylinder", c.radius)? * m,
+            half_height: size(ctx, &span, "cylinder", c.length)? * m / 2.0,
         }
     } else if let Some(r) = e.sphere {
         ShapeSpec::Sphere {
-            radius: positive(ctx, &span, "sphere", r)? * m,
+            radius: size(ctx, &span, "sphere", r)? * m,
         }
     } else {
         let rel = e.mesh.as_deref().unwrap_or_default();

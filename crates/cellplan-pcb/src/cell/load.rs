@@ -138,7 +138,10 @@ impl Ctx<'_> {
                 return Err(self
                     .err(
                         self.key(span, "speed"),
-                        format!("speed {v} must be above 0 and at most 100 m/s"),
+                        format!(
+                            "speed {} must be above 0 and at most 100 m/s",
+                            cellplan_model::shown(v)
+                        ),
                     )
                     .hint("speeds are in length units per second (mm/s with units.length = \"mm\")"));
             }
@@ -174,7 +177,10 @@ impl Ctx<'_> {
         if !(v.is_finite() && v.abs() * self.to_m <= 100.0) {
             return Err(self.err(
                 self.key(span, key),
-                format!("`{key}` = {v} must be a finite length within 100 m"),
+                format!(
+                    "`{key}` = {} must be a finite length within 100 m",
+                    cellplan_model::shown(v)
+                ),
             ));
         }
         Ok(v * self.to_m)
