@@ -42,6 +42,12 @@ pub enum PoseError {
     /// `rpy` is not finite.
     #[error("`rpy` is not finite")]
     Rpy,
+    /// An `rpy` angle beyond [`MAX_ANGLE`].
+    #[error("`rpy` angle {} is beyond 100 turns", crate::shown(*value))]
+    RpyTurns {
+        /// The angle as written.
+        value: f64,
+    },
     /// `quat` is not of unit length.
     #[error("`quat` must be a unit quaternion [x, y, z, w]; its length is {length:.6}")]
     Quat {
@@ -60,6 +66,10 @@ pub enum PoseError {
     #[error("`matrix` is a reflection (determinant -1), not a rotation")]
     Reflection,
 }
+
+/// Largest magnitude of an `rpy` angle (rad): 100 turns. Beyond, the angle's sine and cosine
+/// keep none of the digits it was written with.
+pub const MAX_ANGLE: f64 = 200.0 * std::f64::consts::PI;
 
 /// Converts a pose spec with file units (metres per length unit, radians per angle unit).
 /// Errors say what is wrong with the rotation.
@@ -83,6 +93,9 @@ pub fn pose_from_spec(spec: &PoseSpec, to_m: f64, to_rad: f64) -> Result<Pose, P
     let rotation = if let Some(rpy) = spec.rpy {
         if rpy.iter().any(|v| !v.is_finite()) {
             return Err(PoseError::Rpy);
+        }
+        if let Some(&v) = rpy.iter().find(|v| (*v * to_rad).abs() > MAX_ANGLE) {
+            return Err(PoseError::RpyTurns { value: v });
         }
         rpy_to_quat([rpy[0] * to_rad, rpy[1] * to_rad, rpy[2] * to_rad])
     } else if let Some(q) = spec.quat {

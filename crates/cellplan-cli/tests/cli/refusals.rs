@@ -303,6 +303,18 @@ const CASES: &[Case] = &[
         says: &["cell.toml:", "lies 1e297 m from the origin, beyond 10000 m"],
     },
     Case {
+        name: "a base turned beyond 100 turns",
+        setup: |d| {
+            check_args(cell_with(d, |c| {
+                c.replace(
+                    "base = { xyz = [0, 0, 0] }",
+                    "base = { xyz = [0, 0, 0], rpy = [0, 0, 1e300] }",
+                )
+            }))
+        },
+        says: &["cell.toml:", "`rpy` angle 1e300 is beyond 100 turns"],
+    },
+    Case {
         name: "an object larger than any cell",
         setup: |d| {
             check_args(cell_with(d, |c| {
