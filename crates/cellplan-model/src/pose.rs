@@ -30,8 +30,8 @@ pub enum PoseError {
     /// `xyz` (in metres) is not finite.
     #[error("the translation `xyz` is not finite")]
     Translation,
-    /// `xyz` (in metres) lies beyond [`crate::tasks::MAX_COORDINATE`] from the origin.
-    #[error("the translation `xyz` lies {} m from the origin, beyond {} m", crate::shown(*metres), crate::tasks::MAX_COORDINATE)]
+    /// `xyz` (in metres) has a coordinate beyond [`crate::tasks::MAX_COORDINATE`].
+    #[error("the translation `xyz` lies {} m from its frame's origin, beyond {} m", crate::shown(*metres), crate::tasks::MAX_COORDINATE)]
     Far {
         /// Its largest coordinate's magnitude (m).
         metres: f64,
@@ -72,7 +72,7 @@ pub enum PoseError {
 pub const MAX_ANGLE: f64 = 200.0 * std::f64::consts::PI;
 
 /// Converts a pose spec with file units (metres per length unit, radians per angle unit).
-/// Errors say what is wrong with the rotation.
+/// Errors say what is wrong with the translation or the rotation.
 pub fn pose_from_spec(spec: &PoseSpec, to_m: f64, to_rad: f64) -> Result<Pose, PoseError> {
     let t = DVec3::from_array(spec.xyz) * to_m;
     if !t.is_finite() {

@@ -300,7 +300,10 @@ const CASES: &[Case] = &[
                 c.replace("base = { xyz = [0, 0, 0] }", "base = { xyz = [1e300, 0, 0] }")
             }))
         },
-        says: &["cell.toml:", "lies 1e297 m from the origin, beyond 10000 m"],
+        says: &[
+            "cell.toml:",
+            "lies 1e297 m from its frame's origin, beyond 10000 m",
+        ],
     },
     Case {
         name: "a base turned beyond 100 turns",
