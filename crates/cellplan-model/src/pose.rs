@@ -78,10 +78,9 @@ pub fn pose_from_spec(spec: &PoseSpec, to_m: f64, to_rad: f64) -> Result<Pose, P
     if !t.is_finite() {
         return Err(PoseError::Translation);
     }
-    if t.abs().max_element() > crate::tasks::MAX_COORDINATE {
-        return Err(PoseError::Far {
-            metres: t.abs().max_element(),
-        });
+    let far = t.abs().max_element();
+    if far > crate::tasks::MAX_COORDINATE {
+        return Err(PoseError::Far { metres: far });
     }
     let given = [spec.rpy.is_some(), spec.quat.is_some(), spec.matrix.is_some()]
         .iter()
