@@ -280,6 +280,20 @@ const CASES: &[Case] = &[
         says: &["cell.toml:", "task_cap", "[planning]"],
     },
     Case {
+        name: "a plan and its cell given the other way round",
+        setup: |d| {
+            let cell = cell_with(d, |c| c);
+            std::fs::write(d.join("plan.json"), "{\n  \"format\": \"cellplan-plan\"\n}\n").unwrap();
+            vec!["verify".into(), cell, d.join("plan.json").display().to_string()]
+        },
+        says: &[
+            "plan.json:1",
+            "invalid cell file",
+            "is it a plan?",
+            "the plan first",
+        ],
+    },
+    Case {
         name: "task cap of zero",
         setup: |d| check_args(cell_with(d, |c| c + "\n[planning]\ntask_cap = 0\n")),
         says: &["cell.toml:", "`task_cap` must be between 1"],

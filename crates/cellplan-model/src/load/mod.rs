@@ -174,7 +174,7 @@ pub fn process_kind(path: &Path) -> Result<String, InputError> {
             e.span().unwrap_or(0..0),
             format!("invalid cell file: {}", e.message().trim()),
         )
-        .hint("docs/cell-format.md lists every key and its type")
+        .hint(parse_hint(&text, "docs/cell-format.md"))
     })?;
     let Some(process) = head.process else {
         return Err(InputError::new(path, "the cell file has no `[process]` table")
@@ -212,9 +212,19 @@ pub fn read_cell_toml<S: serde::de::DeserializeOwned>(
             span,
             format!("invalid cell file: {}", e.message().trim()),
         )
-        .hint(format!("{docs} lists every key and its type"))
+        .hint(parse_hint(&text, docs))
     })?;
     Ok((text, spec))
+}
+
+/// What to do about a cell file that does not parse (`docs`: the page of its format): a file
+/// that starts like JSON was most likely a plan given where the cell goes.
+fn parse_hint(text: &str, docs: &str) -> String {
+    if text.trim_start().starts_with('{') {
+        "this file is JSON, not a cell file's TOML: is it a plan? Commands that take both take the plan first, then the cell (`cellplan verify PLAN CELL`)".to_string()
+    } else {
+        format!("{docs} lists every key and its type")
+    }
 }
 
 /// Reads `[tools]`: each tool's TCP and shapes, by name.
