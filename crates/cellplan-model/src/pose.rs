@@ -43,7 +43,7 @@ pub enum PoseError {
     #[error("`rpy` is not finite")]
     Rpy,
     /// An `rpy` angle beyond [`MAX_ANGLE`].
-    #[error("`rpy` angle {} is beyond 100 turns", crate::shown(*value))]
+    #[error("`rpy` angle {} is beyond {MAX_TURNS} turns", crate::shown(*value))]
     RpyTurns {
         /// The angle as written.
         value: f64,
@@ -67,9 +67,12 @@ pub enum PoseError {
     Reflection,
 }
 
-/// Largest magnitude of an `rpy` angle (rad): 100 turns. Beyond, the angle's sine and cosine
-/// keep none of the digits it was written with.
-pub const MAX_ANGLE: f64 = 200.0 * std::f64::consts::PI;
+/// Largest magnitude of an `rpy` angle in turns. Beyond, the angle's sine and cosine keep none
+/// of the digits it was written with.
+pub const MAX_TURNS: f64 = 100.0;
+
+/// [`MAX_TURNS`] in radians.
+pub const MAX_ANGLE: f64 = MAX_TURNS * std::f64::consts::TAU;
 
 /// Converts a pose spec with file units (metres per length unit, radians per angle unit).
 /// Errors say what is wrong with the translation or the rotation.
