@@ -26,7 +26,7 @@ pub mod tasks;
 pub(crate) mod testing;
 
 pub use cell::{Cell, Object, Planning};
-pub use error::{InputError, shown};
+pub use error::{InputError, other_separator, shown};
 pub use load::{LoadOptions, load, process_kind};
 pub use process::{
     ColumnUnit, Figure, Process, ProcessEntry, ProcessInput, ProcessReason, Registry, Rejection, Relation,

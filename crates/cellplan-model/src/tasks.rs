@@ -110,6 +110,13 @@ pub fn parse_tasks(
     to_rad: f64,
     columns: &[TaskColumn],
 ) -> Result<Vec<Task>, InputError> {
+    if text
+        .lines()
+        .all(|l| l.trim().is_empty() || l.trim_start().starts_with('#'))
+    {
+        return Err(InputError::at_line(path, Some(1), "the task list is empty")
+            .hint("the first line names the columns (id,x,y,z,nx,ny,nz), one task per line below it"));
+    }
     let mut reader = csv::ReaderBuilder::new()
         .trim(csv::Trim::All)
         .comment(Some(b'#'))
@@ -131,7 +138,10 @@ pub fn parse_tasks(
     let column = |name: &str| headers.iter().position(|h| h.eq_ignore_ascii_case(name));
     let mut index = [0usize; 7];
     for (slot, name) in index.iter_mut().zip(REQUIRED) {
-        *slot = column(name).ok_or_else(|| header_error(format!("no column `{name}` in the header")))?;
+        *slot = column(name).ok_or_else(|| match crate::other_separator(text) {
+            Some((message, hint)) => InputError::at_line(path, Some(1), message).hint(hint),
+            None => header_error(format!("no column `{name}` in the header")),
+        })?;
     }
     let feature_col = column("feature");
     let value_cols: Vec<Option<usize>> = columns.iter().map(|c| column(c.name)).collect();
@@ -352,6 +362,21 @@ mod tests {
         let e = parse("id,x,y,z,nx,ny,nz\nM1,0,0,0,0,0\n").unwrap_err();
         assert_eq!(e.line, Some(2));
         assert!(e.message.contains("missing value for `nz`"), "{e}");
+    }
+
+    #[test]
+    fn empty_lists_and_other_separators_are_named() {
+        for text in ["", "\n\n", "# tasks\n"] {
+            let e = parse(text).unwrap_err();
+            assert!(e.message.contains("the task list is empty"), "{e}");
+            assert_eq!(e.line, Some(1));
+        }
+        let e = parse("id;x;y;z;nx;ny;nz\nM1;0,5;0;0;0;0;1\n").unwrap_err();
+        assert!(e.message.contains("separated by `;`"), "{e}");
+        assert_eq!(e.line, Some(1));
+        // A header with commas and a missing column says which.
+        let e = parse("id,x,y,z,nx,ny\n").unwrap_err();
+        assert!(e.message.contains("no column `nz`"), "{e}");
     }
 
     #[test]

@@ -316,9 +316,10 @@ pub fn read_positions(path: &Path, text: &str) -> Result<Board, InputError> {
         headers
             .iter()
             .position(|h| h.trim().eq_ignore_ascii_case(name))
-            .ok_or_else(|| {
-                InputError::at_line(path, Some(1), format!("the position file has no `{name}` column"))
-                    .hint("KiCad writes `Ref,Val,Package,PosX,PosY,Rot,Side`; export with `kicad-cli pcb export pos --format csv --units mm`")
+            .ok_or_else(|| match cellplan_model::other_separator(text) {
+                Some((message, hint)) => InputError::at_line(path, Some(1), message).hint(hint),
+                None => InputError::at_line(path, Some(1), format!("the position file has no `{name}` column"))
+                    .hint("KiCad writes `Ref,Val,Package,PosX,PosY,Rot,Side`; export with `kicad-cli pcb export pos --format csv --units mm`"),
             })
     };
     let (c_ref, c_val, c_pkg, c_x, c_y, c_rot, c_side) = (
@@ -534,5 +535,12 @@ mod tests {
         assert_eq!(e.line, Some(2));
         let e = read_positions(Path::new("p.csv"), "Ref,Val,PosX\nR1,1k,1\n").unwrap_err();
         assert!(e.message.contains("Package"));
+        // A spreadsheet's export with `;` between the columns is named as such.
+        let e = read_positions(
+            Path::new("p.csv"),
+            "Ref;Val;Package;PosX;PosY;Rot;Side\nR1;1k;R;1,5;2;0;top\n",
+        )
+        .unwrap_err();
+        assert!(e.message.contains("separated by `;`") && e.line == Some(1), "{e}");
     }
 }
