@@ -341,6 +341,46 @@ const CASES: &[Case] = &[
         says: &["cell.toml:", "`box` of 6000000 m is beyond 10000 m"],
     },
     Case {
+        name: "a joint speed beyond any robot's, given in the cell",
+        setup: |d| {
+            check_args(cell_with(d, |c| {
+                c.replace(
+                    "home = [0, -30, 0, 0, -60, 0]",
+                    "home = [0, -30, 0, 0, -60, 0]\nmax_velocity = [100, 100, 100, 100, 100, 1e9]",
+                )
+            }))
+        },
+        says: &[
+            "cell.toml:",
+            "`max_velocity` of joint `joint_6`, 1e9, is 1.745e7 rad/s: beyond 100 rad/s",
+        ],
+    },
+    Case {
+        name: "a URDF velocity limit beyond any robot's (the timeline's samples would mean nothing)",
+        setup: |d| {
+            let urdf = root().join("data/robots/fanuc_r2000ic/urdf/r2000ic125l.urdf");
+            let text = std::fs::read_to_string(urdf).unwrap();
+            let at = text.find("velocity=\"").unwrap() + "velocity=\"".len();
+            let end = text[at..].find('"').unwrap() + at;
+            std::fs::write(
+                d.join("fast.urdf"),
+                format!("{}1e300{}", &text[..at], &text[end..]),
+            )
+            .unwrap();
+            let fast = d.join("fast.urdf").display().to_string();
+            check_args(cell_with(d, |c| {
+                let from = c.find("urdf = \"").unwrap();
+                let to = c[from..].find('\n').unwrap() + from;
+                format!("{}urdf = \"{fast}\"{}", &c[..from], &c[to..])
+            }))
+        },
+        says: &[
+            "cell.toml:",
+            "joint `joint_1` has a velocity limit of 1e300 rad/s in the URDF, beyond 100 rad/s",
+            "<limit velocity>",
+        ],
+    },
+    Case {
         name: "an absurd clearance, with its size in short",
         setup: |d| check_args(cell_with(d, |c| c + "\n[planning]\nclearance = 1e300\n")),
         says: &["cell.toml:", "`clearance` of 1e297 m is beyond 1 m"],

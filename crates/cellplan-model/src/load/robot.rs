@@ -4,7 +4,7 @@ use super::{Ctx, DEFAULT_ACCELERATION_TIME};
 use crate::io::read_bounded;
 use crate::robot::{IkKind, Robot, RobotId, Tool};
 use crate::spec::{OpwSpec, RobotSpec};
-use crate::{InputError, error::line_of};
+use crate::{InputError, error::line_of, shown};
 use cellplan_geom::Pose;
 use cellplan_kin::{
     Chain, DlsIk, DlsParams, IkSolver, JointKind, KinError, OpwIk, OpwParameters, ParallelIk, RobotModel,
@@ -326,18 +326,55 @@ fn joint_limits(
             ),
         ));
     }
+    let most = if key == "max_acceleration" {
+        MAX_JOINT_ACCELERATION
+    } else {
+        MAX_JOINT_SPEED
+    };
     v.get_ref()
         .iter()
         .enumerate()
         .map(|(j, &x)| {
-            if x.is_finite() && x > 0.0 {
-                Ok(x * joint_scale(ctx, chain, j))
-            } else {
-                Err(ctx.err(v.span(), format!("`{key}` values must be positive")))
+            if !(x.is_finite() && x > 0.0) {
+                return Err(ctx.err(v.span(), format!("`{key}` values must be positive")));
             }
+            let si = x * joint_scale(ctx, chain, j);
+            if si > most {
+                let unit = si_unit(chain, j, key == "max_acceleration");
+                return Err(ctx
+                    .err(
+                        v.span(),
+                        format!(
+                            "`{key}` of joint `{}`, {}, is {si:.3e} {unit}: beyond {} {unit}",
+                            chain.joints[j].name,
+                            shown(x),
+                            shown(most)
+                        ),
+                    )
+                    .hint("check the values and the cell's units (`units.angle`, `units.length`)"));
+            }
+            Ok(si)
         })
         .collect::<Result<Vec<_>, _>>()
         .map(Some)
+}
+
+/// Fastest joint a robot may have (rad/s, or m/s for a prismatic joint): beyond, a limit is
+/// refused as a mistake (the fastest wrists turn at about 35 rad/s). The verifier samples the
+/// timeline at its time step, which means something only at speeds of this order.
+pub const MAX_JOINT_SPEED: f64 = 100.0;
+
+/// Largest joint acceleration a robot may have (rad/s², or m/s²), as [`MAX_JOINT_SPEED`].
+pub const MAX_JOINT_ACCELERATION: f64 = 10_000.0;
+
+/// The SI unit of joint `j`'s speed (or acceleration).
+fn si_unit(chain: &Chain, j: usize, acceleration: bool) -> &'static str {
+    match (chain.joints[j].kind, acceleration) {
+        (JointKind::Prismatic, false) => "m/s",
+        (JointKind::Prismatic, true) => "m/s²",
+        (_, false) => "rad/s",
+        (_, true) => "rad/s²",
+    }
 }
 
 /// Joint velocity limits: `max_velocity`, else the URDF's (refused where a joint has none).
@@ -357,6 +394,25 @@ fn max_velocity(ctx: &Ctx, entry: &Spanned<RobotSpec>, chain: &Chain) -> Result<
                 format!("joint `{}` has no velocity limit in the URDF", j.name),
             )
             .hint("give `max_velocity` for the robot in the cell file"));
+    }
+    if let Some((j, joint)) = chain
+        .joints
+        .iter()
+        .enumerate()
+        .find(|(_, j)| j.max_velocity > MAX_JOINT_SPEED)
+    {
+        let unit = si_unit(chain, j, false);
+        return Err(ctx
+            .err(
+                ctx.key_span(&entry.span(), "urdf"),
+                format!(
+                    "joint `{}` has a velocity limit of {} {unit} in the URDF, beyond {} {unit}",
+                    joint.name,
+                    shown(joint.max_velocity),
+                    shown(MAX_JOINT_SPEED)
+                ),
+            )
+            .hint("fix the joint's <limit velocity> (rad/s, m/s for a prismatic joint), or give `max_velocity` for the robot in the cell file"));
     }
     Ok(chain.joints.iter().map(|j| j.max_velocity).collect())
 }
