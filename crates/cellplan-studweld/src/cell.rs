@@ -88,8 +88,9 @@ impl<'a> WeldCell<'a> {
         };
         let dof = robot.dof();
         if process.max_torque.len() != dof {
-            return Err(InputError::new(
+            return Err(InputError::at_line(
                 &cell.path,
+                process.max_torque_line,
                 format!(
                     "`max_torque` gives {} values, robot `{}` has {dof} joints",
                     process.max_torque.len(),

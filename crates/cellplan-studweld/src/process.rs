@@ -77,6 +77,8 @@ pub struct StudWeld {
     pub rotation_step: f64,
     /// Torque limits (N·m), one per joint.
     pub max_torque: Vec<f64>,
+    /// The cell file's line of `max_torque` (`None`: not known).
+    pub max_torque_line: Option<usize>,
     /// DMOC steps per move.
     pub steps: usize,
     /// Most optimal-control problems one plan solves.
@@ -105,17 +107,53 @@ fn positive(input: &ProcessInput, key: &str, v: f64) -> Result<f64, InputError> 
     }
 }
 
+/// `v` where it is positive and at most `most` (`unit`, with its leading space, or empty), else
+/// an error at `key`.
+fn within(input: &ProcessInput, key: &str, v: f64, most: f64, unit: &str) -> Result<f64, InputError> {
+    let v = positive(input, key, v)?;
+    if v > most {
+        return Err(input.error(
+            key,
+            format!(
+                "`{key}` of {}{unit} is beyond {}{unit}",
+                cellplan_model::shown(v),
+                cellplan_model::shown(most)
+            ),
+        ));
+    }
+    Ok(v)
+}
+
+/// Longest weld (s): an hour, as the CMM's longest inspection.
+pub const MAX_WELD_TIME: f64 = 3600.0;
+
+/// Largest torque limit (N·m): ten times the largest industrial robots' base axes.
+pub const MAX_TORQUE: f64 = 1e6;
+
+/// Heaviest gun (kg): beyond the payload of any industrial robot.
+pub const MAX_GUN_MASS: f64 = 10_000.0;
+
+/// Largest cost weight: the weights scale time (s), effort (N²·m²·s) and speed (rad²/s) into
+/// one cost; beyond this one term swamps the others to rounding.
+pub const MAX_WEIGHT: f64 = 1e9;
+
 /// Builds the process from its `[process]` table.
 pub fn build(input: &ProcessInput) -> Result<Arc<dyn Process>, InputError> {
     let s: StudWeldSpec = input.parse()?;
-    let weld_time = positive(input, "weld_time", s.weld_time)?;
+    let weld_time = within(input, "weld_time", s.weld_time, MAX_WELD_TIME, " s")?;
     let d = Weights::default();
     let weights = match &s.cost {
         None => d,
         Some(c) => Weights {
-            time: positive(input, "time", c.time.unwrap_or(d.time))?,
-            effort: positive(input, "effort", c.effort.unwrap_or(d.effort))?,
-            velocity: positive(input, "velocity", c.velocity.unwrap_or(d.velocity))?,
+            time: within(input, "time", c.time.unwrap_or(d.time), MAX_WEIGHT, "")?,
+            effort: within(input, "effort", c.effort.unwrap_or(d.effort), MAX_WEIGHT, "")?,
+            velocity: within(
+                input,
+                "velocity",
+                c.velocity.unwrap_or(d.velocity),
+                MAX_WEIGHT,
+                "",
+            )?,
         },
     };
     let rotation_step = positive(input, "gun_rotation_step", s.gun_rotation_step)? * input.to_rad;
@@ -126,7 +164,7 @@ pub fn build(input: &ProcessInput) -> Result<Arc<dyn Process>, InputError> {
         ));
     }
     for &t in &s.max_torque {
-        positive(input, "max_torque", t)?;
+        within(input, "max_torque", t, MAX_TORQUE, " N·m")?;
     }
     if s.max_torque.is_empty() {
         return Err(input
@@ -139,16 +177,29 @@ pub fn build(input: &ProcessInput) -> Result<Arc<dyn Process>, InputError> {
     }
     let ocp_budget = s.ocp_budget.unwrap_or(1500);
     let gun_mass = s.gun_mass.unwrap_or(0.0);
-    if !(gun_mass.is_finite() && gun_mass >= 0.0) {
+    if !(gun_mass.is_finite() && (0.0..=MAX_GUN_MASS).contains(&gun_mass)) {
         return Err(input.error(
             "gun_mass",
-            format!("`gun_mass` must be 0 or more, not {gun_mass}"),
+            format!(
+                "`gun_mass` must be 0 to {} kg, not {}",
+                cellplan_model::shown(MAX_GUN_MASS),
+                cellplan_model::shown(gun_mass)
+            ),
         ));
     }
     let gun_com = DVec3::from_array(s.gun_com.unwrap_or([0.0; 3])) * input.to_m;
-    if !gun_com.is_finite() {
-        return Err(input.error("gun_com", "`gun_com` must be finite"));
+    if !gun_com.is_finite() || gun_com.abs().max_element() > cellplan_model::tasks::MAX_COORDINATE {
+        return Err(input.error(
+            "gun_com",
+            format!(
+                "`gun_com` must be finite and within {} m of the tip link",
+                cellplan_model::tasks::MAX_COORDINATE
+            ),
+        ));
     }
+    // Where `max_torque` is written, for the check against the robot's joints (see
+    // [`crate::WeldCell::new`]).
+    let max_torque_line = input.error("max_torque", "").line;
     Ok(Arc::new(StudWeld {
         gun_mass,
         gun_com,
@@ -156,6 +207,7 @@ pub fn build(input: &ProcessInput) -> Result<Arc<dyn Process>, InputError> {
         weights,
         rotation_step,
         max_torque: s.max_torque,
+        max_torque_line,
         steps,
         ocp_budget,
     }))
@@ -298,6 +350,7 @@ mod tests {
             weights: Weights::default(),
             rotation_step: 45f64.to_radians(),
             max_torque: vec![1.0],
+            max_torque_line: None,
             steps: 12,
             ocp_budget: 1,
             gun_mass: 0.0,

@@ -69,6 +69,21 @@ fn cmm_with(dir: &Path, edit: impl Fn(String) -> String, tasks: impl Fn(String) 
     dir.join("cell.toml").display().to_string()
 }
 
+/// The stud-weld example's cell with `edit` applied, written into `dir` (its robot and studs
+/// read from the repository).
+fn studweld_with(dir: &Path, edit: impl Fn(String) -> String) -> String {
+    let r = root().display().to_string();
+    let cell = std::fs::read_to_string(root().join("examples/studweld-kr210/cell.toml"))
+        .unwrap()
+        .replace("../../", &format!("{r}/"))
+        .replace(
+            "\"studs.csv\"",
+            &format!("\"{r}/examples/studweld-kr210/studs.csv\""),
+        );
+    std::fs::write(dir.join("cell.toml"), edit(cell)).unwrap();
+    dir.join("cell.toml").display().to_string()
+}
+
 /// A CMM plan of the example written into `dir/out`, for the reuse cases.
 fn cmm_plan(dir: &Path) -> String {
     let out = dir.join("planned");
@@ -378,6 +393,28 @@ const CASES: &[Case] = &[
             "cell.toml:",
             "joint `joint_1` has a velocity limit of 1e300 rad/s in the URDF, beyond 100 rad/s",
             "<limit velocity>",
+        ],
+    },
+    Case {
+        name: "a stud-weld time beyond an hour (1e300 s ran without end)",
+        setup: |d| {
+            check_args(studweld_with(d, |c| {
+                c.replace("weld_time = 2.0 ", "weld_time = 1e300 ")
+            }))
+        },
+        says: &["cell.toml:9", "`weld_time` of 1e300 s is beyond 3600 s"],
+    },
+    Case {
+        name: "a torque limit per joint short of the robot's joints, at its line",
+        setup: |d| {
+            plan_args(
+                studweld_with(d, |c| c.replace("max_torque = [20000, ", "max_torque = [")),
+                d,
+            )
+        },
+        says: &[
+            "cell.toml:14",
+            "`max_torque` gives 5 values, robot `KR210` has 6 joints",
         ],
     },
     Case {
