@@ -32,9 +32,9 @@ use std::time::Instant;
     about = "Plans the work of multi-robot manufacturing cells"
 )]
 struct Cli {
-    /// Worker threads (default: all cores). Results do not depend on it.
-    #[arg(long, global = true)]
-    threads: Option<usize>,
+    /// Worker threads, 1 to 1024 (default: all cores). Results do not depend on it.
+    #[arg(long, global = true, value_parser = clap::value_parser!(u16).range(1..=MAX_THREADS))]
+    threads: Option<u16>,
     #[command(subcommand)]
     command: Command,
 }
@@ -237,6 +237,27 @@ pub(crate) fn plan_output_dir(
     };
     ensure_writable(&dir)?;
     Ok(dir)
+}
+
+/// Refuses an output file that cannot be written (a folder there, or a parent folder that cannot
+/// take files) before any work: a usage error naming it and `flag`, the option that gave it.
+pub(crate) fn ensure_file_target(path: &std::path::Path, flag: &str) -> Result<(), Failure> {
+    if path.is_dir() {
+        return Err(Failure::Usage(format!(
+            "{} is a folder; give a file path with {flag}",
+            path.display()
+        )));
+    }
+    let parent = match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => std::path::Path::new("."),
+    };
+    cellplan_model::io::check_writable(parent).map_err(|e| {
+        Failure::Usage(format!(
+            "cannot write {}: {e}; give a file in a writable folder with {flag}",
+            path.display()
+        ))
+    })
 }
 
 /// Refuses an output folder that cannot take files (a usage error naming it).
@@ -644,6 +665,10 @@ fn print_json<T: serde::Serialize>(value: &T) -> Result<(), Failure> {
     Ok(())
 }
 
+/// Most worker threads `--threads` takes: a machine with more cores than this gains nothing
+/// from more, and a pool of a hundred thousand threads takes minutes to start.
+const MAX_THREADS: i64 = 1024;
+
 fn main() -> ExitCode {
     // Long messages stay on one line, so that they can be searched for.
     let _ = miette::set_hook(Box::new(|_| {
@@ -652,7 +677,7 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     if let Some(n) = cli.threads {
         let _ = rayon::ThreadPoolBuilder::new()
-            .num_threads(n.max(1))
+            .num_threads(usize::from(n))
             .build_global();
     }
     let result = match &cli.command {

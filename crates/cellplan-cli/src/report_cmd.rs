@@ -147,13 +147,14 @@ pub fn run_report(args: &ReportArgs) -> Result<(), Failure> {
         (crate::cmm_cmd::is_cmm, crate::cmm_cmd::report),
         (crate::studweld_cmd::is_studweld, crate::studweld_cmd::report),
     ];
+    let out = args
+        .output
+        .clone()
+        .unwrap_or_else(|| args.plan.parent().unwrap_or(Path::new(".")).join("report.html"));
+    crate::ensure_file_target(&out, "-o")?;
     if let Some(cell) = &args.cell {
         for (is_kind, page) in pages {
             if is_kind(cell)? {
-                let out = args
-                    .output
-                    .clone()
-                    .unwrap_or_else(|| args.plan.parent().unwrap_or(Path::new(".")).join("report.html"));
                 page(&args.plan, cell, &out)?;
                 eprintln!("report written to {}", out.display());
                 return Ok(());
@@ -168,10 +169,6 @@ pub fn run_report(args: &ReportArgs) -> Result<(), Failure> {
     let verdict = (!args.no_verify).then(|| verify::verify(&cell, &plan, &VerifySettings::default()));
     let verify_s = lap.elapsed().as_secs_f64();
     let lap = Instant::now();
-    let out = args
-        .output
-        .clone()
-        .unwrap_or_else(|| args.plan.parent().unwrap_or(Path::new(".")).join("report.html"));
     let bytes = write_report(
         &out,
         &args.plan,
@@ -201,6 +198,24 @@ pub fn run_export(args: &ExportArgs) -> Result<(), Failure> {
         return Err(Failure::Usage(
             "nothing to export: give --gltf FILE and/or --csv DIR".into(),
         ));
+    }
+    // Both targets checked first: one that cannot be written leaves the other unwritten.
+    if let Some(path) = &args.gltf {
+        crate::ensure_file_target(path, "--gltf")?;
+    }
+    if let Some(dir) = &args.csv {
+        if dir.is_file() {
+            return Err(Failure::Usage(format!(
+                "{} is a file; give a folder with --csv",
+                dir.display()
+            )));
+        }
+        crate::ensure_writable(dir).map_err(|_| {
+            Failure::Usage(format!(
+                "cannot write into {}; give a writable folder with --csv",
+                dir.display()
+            ))
+        })?;
     }
     let plan = read_plan(&args.plan)?;
     let cell = load_cell(&args.plan, &plan, &args.cell)?;

@@ -418,6 +418,37 @@ const CASES: &[Case] = &[
         ],
     },
     Case {
+        name: "a pool of a hundred thousand threads (it took minutes to start)",
+        setup: |d| {
+            let cell = cell_with(d, |c| c);
+            vec!["--threads".into(), "100000".into(), "check".into(), cell]
+        },
+        says: &["--threads", "100000 is not in 1..=1024"],
+    },
+    Case {
+        name: "a report written onto a folder, refused before any work (it exited 1 after it)",
+        setup: |d| {
+            let plan = d.join("plan.json").display().to_string();
+            vec!["report".into(), plan, "-o".into(), d.display().to_string()]
+        },
+        says: &["is a folder; give a file path with -o"],
+    },
+    Case {
+        name: "an export whose CSV folder is a file: the glTF is not written either",
+        setup: |d| {
+            std::fs::write(d.join("taken"), "x").unwrap();
+            vec![
+                "export".into(),
+                d.join("plan.json").display().to_string(),
+                "--gltf".into(),
+                d.join("plan.glb").display().to_string(),
+                "--csv".into(),
+                d.join("taken").display().to_string(),
+            ]
+        },
+        says: &["taken is a file; give a folder with --csv"],
+    },
+    Case {
         name: "an absurd clearance, with its size in short",
         setup: |d| check_args(cell_with(d, |c| c + "\n[planning]\nclearance = 1e300\n")),
         says: &["cell.toml:", "`clearance` of 1e297 m is beyond 1 m"],
