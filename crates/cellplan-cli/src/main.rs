@@ -174,8 +174,15 @@ fn parse_region(s: &str) -> Result<(usize, f64, f64), String> {
             v.trim().parse().map_err(|_| format!("`{v}` is not a number"))
         }
     };
-    Ok((axis, bound(lo, f64::NEG_INFINITY)?, bound(hi, f64::INFINITY)?))
+    let (lo, hi) = (bound(lo, f64::NEG_INFINITY)?, bound(hi, f64::INFINITY)?);
+    if lo.is_nan() || hi.is_nan() || lo > hi {
+        return Err(format!("the range `{range}` is empty: LO must be at most HI"));
+    }
+    Ok((axis, lo, hi))
 }
+
+/// Largest `gen tasks --translate` component (mesh units): 10 km in millimetres.
+const MAX_TRANSLATE: f64 = 1e7;
 
 fn parse_direction(s: &str) -> Result<DVec3, String> {
     let d = match s.trim() {
@@ -452,8 +459,22 @@ fn run_gen_tasks(args: &GenTasksArgs) -> Result<(), Failure> {
     if !(args.max_angle.is_finite() && (0.0..=180.0).contains(&args.max_angle)) {
         return Err(Failure::Usage(format!(
             "--max-angle must be between 0 and 180 degrees, not {}",
-            args.max_angle
+            cellplan_model::shown(args.max_angle)
         )));
+    }
+    if let Some(t) = args.translate
+        && t.abs().max_element() > MAX_TRANSLATE
+    {
+        return Err(Failure::Usage(format!(
+            "--translate {},{},{} is beyond {} (mesh units: 10 km in mm)",
+            cellplan_model::shown(t.x),
+            cellplan_model::shown(t.y),
+            cellplan_model::shown(t.z),
+            cellplan_model::shown(MAX_TRANSLATE)
+        )));
+    }
+    if let Some(path) = &args.out {
+        ensure_file_target(path, "-o")?;
     }
     let mut opts = GenOptions::new(args.count, args.seed);
     for &(axis, lo, hi) in &args.region {

@@ -449,6 +449,47 @@ const CASES: &[Case] = &[
         says: &["taken is a file; give a folder with --csv"],
     },
     Case {
+        name: "generated tasks moved beyond any cell (they were written, for the cell to refuse)",
+        setup: |d| {
+            let mesh = root()
+                .join("data/parts/body-in-white/car5.obj")
+                .display()
+                .to_string();
+            let out = d.join("tasks.csv").display().to_string();
+            [
+                "gen",
+                "tasks",
+                "--mesh",
+                &mesh,
+                "--count",
+                "3",
+                "--translate",
+                "1e300,0,0",
+                "-o",
+                &out,
+            ]
+            .map(String::from)
+            .to_vec()
+        },
+        says: &["--translate 1e300,0,0 is beyond 10000000"],
+    },
+    Case {
+        name: "an empty region for generated tasks, named as such",
+        setup: |d| {
+            let mesh = root()
+                .join("data/parts/body-in-white/car5.obj")
+                .display()
+                .to_string();
+            let out = d.join("tasks.csv").display().to_string();
+            [
+                "gen", "tasks", "--mesh", &mesh, "--count", "3", "--region", "x=5..1", "-o", &out,
+            ]
+            .map(String::from)
+            .to_vec()
+        },
+        says: &["the range `5..1` is empty"],
+    },
+    Case {
         name: "an absurd clearance, with its size in short",
         setup: |d| check_args(cell_with(d, |c| c + "\n[planning]\nclearance = 1e300\n")),
         says: &["cell.toml:", "`clearance` of 1e297 m is beyond 1 m"],
