@@ -42,6 +42,17 @@ printf 'v 0 0 0\nv 1 1 1\nv 2 2 2\nf 1 2 3\n' > "$T/flat.obj"
 run "OBJ of zero-area triangles" gen tasks --mesh "$T/flat.obj" --count 3
 printf 'v 0 0 0\nv 1e30 0 0\nv 0 1 0\nf 1 2 3\n' > "$T/far.obj"
 run "OBJ vertex at 1e30" gen tasks --mesh "$T/far.obj" --count 3
+# Sixtieth session: separators, joint speeds, stud-weld magnitudes, thread counts, outputs.
+printf 'id;x;y;z;nx;ny;nz\nA;1,5;2;3;0;0;1\n' > "$T/semi.csv"
+run "task CSV separated by ';'" check "$(cell semi "s#$R/examples/autobody-2r/tasks.csv#$T/semi.csv#")"
+run "max_velocity of 1e9 deg/s" check "$(cell fast 's/^home = \(.*\)/home = \1\nmax_velocity = [100, 100, 100, 100, 100, 1e9]/')"
+mkdir -p "$T/weld"
+sed -e "s#\.\./\.\./#$R/#g" -e "s#\"studs.csv\"#\"$R/examples/studweld-kr210/studs.csv\"#" \
+    -e 's/^weld_time = 2.0 /weld_time = 1e300 /' examples/studweld-kr210/cell.toml > "$T/weld/cell.toml"
+run "stud-weld weld_time = 1e300" check "$T/weld/cell.toml"
+run "--threads 100000" --threads 100000 check "$(cell th 's/x/x/')"
+run "report onto a folder" report "$T/none.json" -o "$T"
+run "gen tasks --translate 1e300,0,0" gen tasks --mesh "$R/data/parts/body-in-white/car5.obj" --count 3 --translate 1e300,0,0 -o "$T/t.csv"
 # Edited plans: a real plan of the 4r example in which robots wait (fixed-priority), each
 # edit verified (exit 2: refused when read, naming the place; exit 4: rejected, with the
 # verifier's first violation).

@@ -35,7 +35,7 @@ pub fn run(args: &VerifyArgs) -> Result<(), Failure> {
     if !(args.time_step.is_finite() && (1e-4..=1.0).contains(&args.time_step)) {
         return Err(Failure::Usage(format!(
             "--time-step must be between 0.0001 and 1 s, not {}",
-            args.time_step
+            cellplan_model::shown(args.time_step)
         )));
     }
     let plan = crate::report_cmd::read_plan(&args.plan)?;
