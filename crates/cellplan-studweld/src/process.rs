@@ -199,7 +199,8 @@ pub fn build(input: &ProcessInput) -> Result<Arc<dyn Process>, InputError> {
     }
     // Where `max_torque` is written, for the check against the robot's joints (see
     // [`crate::WeldCell::new`]).
-    let max_torque_line = input.error("max_torque", "").line;
+    let at = cellplan_model::process::key_span(input.text, &input.span, "max_torque");
+    let max_torque_line = Some(cellplan_model::error::line_of(input.text, at.start));
     Ok(Arc::new(StudWeld {
         gun_mass,
         gun_com,
