@@ -247,7 +247,8 @@ pub(crate) fn plan_output_dir(
 }
 
 /// Refuses an output file that cannot be written (a folder there, or a parent folder that cannot
-/// take files) before any work: a usage error naming it and `flag`, the option that gave it.
+/// take files) before any work, making nothing: a usage error naming it and `flag`, the option
+/// that gave it.
 pub(crate) fn ensure_file_target(path: &std::path::Path, flag: &str) -> Result<(), Failure> {
     if path.is_dir() {
         return Err(Failure::Usage(format!(
@@ -259,7 +260,7 @@ pub(crate) fn ensure_file_target(path: &std::path::Path, flag: &str) -> Result<(
         Some(p) if !p.as_os_str().is_empty() => p,
         _ => std::path::Path::new("."),
     };
-    cellplan_model::io::check_writable(parent).map_err(|e| {
+    cellplan_model::io::check_creatable(parent).map_err(|e| {
         Failure::Usage(format!(
             "cannot write {}: {e}; give a file in a writable folder with {flag}",
             path.display()

@@ -210,9 +210,9 @@ pub fn run_export(args: &ExportArgs) -> Result<(), Failure> {
                 dir.display()
             )));
         }
-        crate::ensure_writable(dir).map_err(|_| {
+        cellplan_model::io::check_creatable(dir).map_err(|e| {
             Failure::Usage(format!(
-                "cannot write into {}; give a writable folder with --csv",
+                "cannot write into {}: {e}; give a writable folder with --csv",
                 dir.display()
             ))
         })?;

@@ -56,9 +56,49 @@ pub fn check_writable(dir: &Path) -> std::io::Result<()> {
     Ok(())
 }
 
+/// Checks, before any work, that files can be made in `dir`, without making anything that
+/// stays: where `dir` does not exist yet, in the nearest folder above it that does (writing
+/// there will create it). An error where that is a file, or where a temporary file cannot be
+/// written in it.
+pub fn check_creatable(dir: &Path) -> std::io::Result<()> {
+    let mut at = dir;
+    while !at.exists() {
+        match at.parent() {
+            Some(p) if !p.as_os_str().is_empty() => at = p,
+            _ => {
+                at = Path::new(".");
+                break;
+            }
+        }
+    }
+    if !at.is_dir() {
+        return Err(std::io::Error::new(
+            std::io::ErrorKind::NotADirectory,
+            format!("{} is a file, not a folder", at.display()),
+        ));
+    }
+    tempfile::Builder::new()
+        .prefix(".cellplan-probe-")
+        .tempfile_in(at)?;
+    Ok(())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn creatable_folders_are_checked_without_making_them() {
+        let dir = tempfile::tempdir().unwrap();
+        let deep = dir.path().join("a/b/c");
+        check_creatable(&deep).unwrap();
+        assert!(!dir.path().join("a").exists(), "nothing made");
+        let file = dir.path().join("file");
+        std::fs::write(&file, b"x").unwrap();
+        let e = check_creatable(&file.join("below")).unwrap_err();
+        assert_eq!(e.kind(), std::io::ErrorKind::NotADirectory);
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1, "no probe left");
+    }
 
     #[test]
     fn writes_whole_file_and_leaves_no_temporary() {

@@ -490,6 +490,18 @@ const CASES: &[Case] = &[
         says: &["the range `5..1` is empty"],
     },
     Case {
+        name: "an export of a missing plan makes no CSV folder",
+        setup: |d| {
+            vec![
+                "export".into(),
+                d.join("missing.json").display().to_string(),
+                "--csv".into(),
+                d.join("new/csv").display().to_string(),
+            ]
+        },
+        says: &["missing.json"],
+    },
+    Case {
         name: "an absurd clearance, with its size in short",
         setup: |d| check_args(cell_with(d, |c| c + "\n[planning]\nclearance = 1e300\n")),
         says: &["cell.toml:", "`clearance` of 1e297 m is beyond 1 m"],
