@@ -45,6 +45,10 @@ pub struct ExportArgs {
     /// Triangle budget per exported mesh (larger meshes are decimated).
     #[arg(long, default_value_t = MESH_BUDGET)]
     mesh_budget: usize,
+    /// Export without running the verifier first (by default a plan that does not hold for the
+    /// cell, e.g. one made for another cell's robots, is not exported: exit 4).
+    #[arg(long)]
+    no_verify: bool,
 }
 
 /// Reads and validates a plan document, with errors that name the file, the line or the
@@ -219,6 +223,22 @@ pub fn run_export(args: &ExportArgs) -> Result<(), Failure> {
     }
     let plan = read_plan(&args.plan)?;
     let cell = load_cell(&args.plan, &plan, &args.cell)?;
+    // What a controller is given is checked first: a plan that does not hold for this cell (its
+    // robots' bases, tools, the scene) would run other poses than the ones planned.
+    if !args.no_verify {
+        let verdict = verify::verify(&cell, &plan, &VerifySettings::default());
+        if !verdict.ok {
+            for v in verdict.violations.iter().take(5) {
+                eprintln!("{}", crate::verify_cmd::describe(v));
+            }
+            eprintln!(
+                "NOT OK: {} violation(s) of the plan on {}; nothing exported (`cellplan verify` lists them, --no-verify exports anyway)",
+                verdict.violations.len(),
+                cell.path.display()
+            );
+            return Err(Failure::Rejected);
+        }
+    }
     let scene = Scene::new(&cell, args.mesh_budget.max(12));
     if let Some(path) = &args.gltf {
         let start = Instant::now();

@@ -189,6 +189,37 @@ fn plan_writes_a_report_and_export_writes_gltf_and_csv() {
     let prog = std::fs::read_to_string(csv_dir.join("R1-program.csv")).unwrap();
     assert_eq!(prog.lines().filter(|l| l.contains(",measure,")).count(), 3);
 
+    // The cell with its robot moved: the plan does not hold there, and is not exported (exit
+    // 4, nothing written) unless asked to be.
+    let moved = dir.join("moved.toml");
+    let text = std::fs::read_to_string(&cell).unwrap();
+    assert!(text.contains("base = { xyz = [0, 0, 0] }"));
+    std::fs::write(
+        &moved,
+        text.replace("base = { xyz = [0, 0, 0] }", "base = { xyz = [0, 300, 0] }"),
+    )
+    .unwrap();
+    let moved_csv = dir.join("moved-csv");
+    let args = [
+        "export",
+        plan.to_str().unwrap(),
+        moved.to_str().unwrap(),
+        "--csv",
+        moved_csv.to_str().unwrap(),
+    ];
+    let out = cellplan(&args, &dir);
+    assert_eq!(
+        out.status.code(),
+        Some(4),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(String::from_utf8_lossy(&out.stderr).contains("nothing exported"));
+    assert!(!moved_csv.exists());
+    let out = cellplan(&[&args[..], &["--no-verify"]].concat(), &dir);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(moved_csv.join("R1-program.csv").exists());
+
     // Nothing asked: refused.
     let out = cellplan(&["export", plan.to_str().unwrap(), cell.to_str().unwrap()], &dir);
     assert_eq!(out.status.code(), Some(2));
