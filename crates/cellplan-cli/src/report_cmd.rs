@@ -208,12 +208,6 @@ pub fn run_export(args: &ExportArgs) -> Result<(), Failure> {
         crate::ensure_file_target(path, "--gltf")?;
     }
     if let Some(dir) = &args.csv {
-        if dir.is_file() {
-            return Err(Failure::Usage(format!(
-                "{} is a file; give a folder with --csv",
-                dir.display()
-            )));
-        }
         cellplan_model::io::check_creatable(dir).map_err(|e| {
             Failure::Usage(format!(
                 "cannot write into {}: {e}; give a writable folder with --csv",

@@ -446,7 +446,7 @@ const CASES: &[Case] = &[
                 d.join("taken").display().to_string(),
             ]
         },
-        says: &["taken is a file; give a folder with --csv"],
+        says: &["taken is a file, not a folder; give a writable folder with --csv"],
     },
     Case {
         name: "generated tasks moved beyond any cell (they were written, for the cell to refuse)",
