@@ -69,7 +69,7 @@ pub(super) fn robot(
     let home = home(ctx, r, chain)?;
     let tool = robot_tool(ctx, r, tools)?;
     let max_velocity = max_velocity(ctx, entry, chain)?;
-    let max_acceleration = match joint_limits(ctx, r, chain, &r.max_acceleration, "max_acceleration")? {
+    let max_acceleration = match joint_limits(ctx, r, chain, &r.max_acceleration, true)? {
         Some(a) => a,
         None => max_velocity
             .iter()
@@ -306,14 +306,21 @@ fn robot_tool(ctx: &Ctx, r: &RobotSpec, tools: &BTreeMap<String, Tool>) -> Resul
     })
 }
 
-/// Per-joint limits given under `key` (one positive value per joint, in file units), in SI.
+/// Per-joint limits given under `max_acceleration` (with `acceleration`) or `max_velocity`
+/// (one positive value per joint, in file units, at most [`MAX_JOINT_ACCELERATION`] or
+/// [`MAX_JOINT_SPEED`] in SI), in SI.
 fn joint_limits(
     ctx: &Ctx,
     r: &RobotSpec,
     chain: &Chain,
     given: &Option<Spanned<Vec<f64>>>,
-    key: &str,
+    acceleration: bool,
 ) -> Result<Option<Vec<f64>>, InputError> {
+    let (key, most) = if acceleration {
+        ("max_acceleration", MAX_JOINT_ACCELERATION)
+    } else {
+        ("max_velocity", MAX_JOINT_SPEED)
+    };
     let dof = chain.dof();
     let Some(v) = given else { return Ok(None) };
     if v.get_ref().len() != dof {
@@ -326,11 +333,6 @@ fn joint_limits(
             ),
         ));
     }
-    let most = if key == "max_acceleration" {
-        MAX_JOINT_ACCELERATION
-    } else {
-        MAX_JOINT_SPEED
-    };
     v.get_ref()
         .iter()
         .enumerate()
@@ -340,7 +342,7 @@ fn joint_limits(
             }
             let si = x * joint_scale(ctx, chain, j);
             if si > most {
-                let unit = si_unit(chain, j, key == "max_acceleration");
+                let unit = si_unit(chain, j, acceleration);
                 return Err(ctx
                     .err(
                         v.span(),
@@ -380,7 +382,7 @@ fn si_unit(chain: &Chain, j: usize, acceleration: bool) -> &'static str {
 /// Joint velocity limits: `max_velocity`, else the URDF's (refused where a joint has none).
 fn max_velocity(ctx: &Ctx, entry: &Spanned<RobotSpec>, chain: &Chain) -> Result<Vec<f64>, InputError> {
     let r = entry.get_ref();
-    if let Some(v) = joint_limits(ctx, r, chain, &r.max_velocity, "max_velocity")? {
+    if let Some(v) = joint_limits(ctx, r, chain, &r.max_velocity, false)? {
         return Ok(v);
     }
     if let Some(j) = chain
