@@ -88,10 +88,10 @@ pub fn shown(v: f64) -> String {
     }
 }
 
-/// Where a comma-separated file's first line (`text`'s) has no comma but another separator a
-/// spreadsheet writes (`;`, a tab, `|`), why its columns cannot be found: the message and its
-/// hint. `None` where it has a comma or none of those.
-pub fn other_separator(text: &str) -> Option<(String, String)> {
+/// Where a comma-separated file's first line (`text`'s, read from `path`) has no comma but
+/// another separator a spreadsheet writes (`;`, a tab, `|`), the error to give at that line:
+/// its columns cannot be found. `None` where it has a comma or none of those.
+pub fn other_separator(path: &Path, text: &str) -> Option<InputError> {
     let first = text
         .lines()
         .find(|l| !l.trim().is_empty() && !l.trim_start().starts_with('#'))?;
@@ -101,12 +101,17 @@ pub fn other_separator(text: &str) -> Option<(String, String)> {
     let (_, name) = [(';', "`;`"), ('\t', "tabs"), ('|', "`|`")]
         .into_iter()
         .find(|(c, _)| first.contains(*c))?;
-    Some((
-        format!("the header's columns are separated by {name}, not by commas"),
-        "save the file as comma-separated values with `.` as the decimal mark (a spreadsheet set to a \
-         language that writes `;` and `,` needs that chosen in its CSV export)"
-            .to_string(),
-    ))
+    Some(
+        InputError::at_line(
+            path,
+            Some(1),
+            format!("the header's columns are separated by {name}, not by commas"),
+        )
+        .hint(
+            "save the file as comma-separated values with `.` as the decimal mark (a spreadsheet set to a \
+             language that writes `;` and `,` needs that chosen in its CSV export)",
+        ),
+    )
 }
 
 #[cfg(test)]
@@ -115,13 +120,14 @@ mod tests {
 
     #[test]
     fn other_separators_are_named() {
-        let (m, _) = other_separator("id;x;y;z;nx;ny;nz\nM1;0,5;0;0;0;0;1\n").unwrap();
-        assert!(m.contains("`;`"), "{m}");
-        let (m, _) = other_separator("# made by hand\nid\tx\ty\n").unwrap();
-        assert!(m.contains("tabs"), "{m}");
-        assert!(other_separator("id,x;y\n").is_none());
-        assert!(other_separator("id x y\n").is_none());
-        assert!(other_separator("").is_none());
+        let p = Path::new("t.csv");
+        let e = other_separator(p, "id;x;y;z;nx;ny;nz\nM1;0,5;0;0;0;0;1\n").unwrap();
+        assert!(e.message.contains("`;`") && e.line == Some(1), "{e}");
+        let e = other_separator(p, "# made by hand\nid\tx\ty\n").unwrap();
+        assert!(e.message.contains("tabs"), "{e}");
+        assert!(other_separator(p, "id,x;y\n").is_none());
+        assert!(other_separator(p, "id x y\n").is_none());
+        assert!(other_separator(p, "").is_none());
     }
 
     #[test]

@@ -138,9 +138,9 @@ pub fn parse_tasks(
     let column = |name: &str| headers.iter().position(|h| h.eq_ignore_ascii_case(name));
     let mut index = [0usize; 7];
     for (slot, name) in index.iter_mut().zip(REQUIRED) {
-        *slot = column(name).ok_or_else(|| match crate::other_separator(text) {
-            Some((message, hint)) => InputError::at_line(path, Some(1), message).hint(hint),
-            None => header_error(format!("no column `{name}` in the header")),
+        *slot = column(name).ok_or_else(|| {
+            crate::other_separator(path, text)
+                .unwrap_or_else(|| header_error(format!("no column `{name}` in the header")))
         })?;
     }
     let feature_col = column("feature");

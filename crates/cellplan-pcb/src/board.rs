@@ -316,10 +316,11 @@ pub fn read_positions(path: &Path, text: &str) -> Result<Board, InputError> {
         headers
             .iter()
             .position(|h| h.trim().eq_ignore_ascii_case(name))
-            .ok_or_else(|| match cellplan_model::other_separator(text) {
-                Some((message, hint)) => InputError::at_line(path, Some(1), message).hint(hint),
-                None => InputError::at_line(path, Some(1), format!("the position file has no `{name}` column"))
-                    .hint("KiCad writes `Ref,Val,Package,PosX,PosY,Rot,Side`; export with `kicad-cli pcb export pos --format csv --units mm`"),
+            .ok_or_else(|| {
+                cellplan_model::other_separator(path, text).unwrap_or_else(|| {
+                    InputError::at_line(path, Some(1), format!("the position file has no `{name}` column"))
+                        .hint("KiCad writes `Ref,Val,Package,PosX,PosY,Rot,Side`; export with `kicad-cli pcb export pos --format csv --units mm`")
+                })
             })
     };
     let (c_ref, c_val, c_pkg, c_x, c_y, c_rot, c_side) = (
