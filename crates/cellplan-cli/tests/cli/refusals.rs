@@ -371,6 +371,21 @@ const CASES: &[Case] = &[
         ],
     },
     Case {
+        name: "a joint acceleration beyond any robot's, given in the cell",
+        setup: |d| {
+            check_args(cell_with(d, |c| {
+                c.replace(
+                    "home = [0, -30, 0, 0, -60, 0]",
+                    "home = [0, -30, 0, 0, -60, 0]\nmax_acceleration = [1e7, 100, 100, 100, 100, 100]",
+                )
+            }))
+        },
+        says: &[
+            "cell.toml:",
+            "`max_acceleration` of joint `joint_1`, 10000000, is 1.745e5 rad/s²: beyond 10000 rad/s²",
+        ],
+    },
+    Case {
         name: "a URDF velocity limit beyond any robot's (the timeline's samples would mean nothing)",
         setup: |d| {
             let urdf = root().join("data/robots/fanuc_r2000ic/urdf/r2000ic125l.urdf");
