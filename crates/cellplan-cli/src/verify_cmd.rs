@@ -17,7 +17,8 @@ pub struct VerifyArgs {
     /// Skip the robot–robot clearance check (for plans not coordinated yet).
     #[arg(long)]
     no_robot_robot: bool,
-    /// Time step of the robot–robot check (s).
+    /// Time step (s) with which the robot–robot check reports a contact's interval (between
+    /// contacts it steps as far as the robots' motion bound proves them apart).
     #[arg(long, value_name = "S", default_value_t = VerifySettings::default().time_step)]
     time_step: f64,
 }

@@ -247,6 +247,12 @@ impl CollisionWorld {
         }
     }
 
+    /// Whether body `i` of group `g` is left out of the static checks (see
+    /// [`CollisionWorld::set_static_exempt`]); false for an index out of range.
+    pub fn is_static_exempt(&self, g: GroupId, i: usize) -> bool {
+        self.group(g).exempt.get(i).copied().unwrap_or(false)
+    }
+
     /// Number of groups.
     pub fn group_count(&self) -> usize {
         self.groups.len()

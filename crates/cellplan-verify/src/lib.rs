@@ -25,6 +25,7 @@ mod paths;
 pub mod pcb;
 mod record;
 mod robots;
+pub use robots::PROOF_TOLERANCE;
 pub mod studweld;
 mod tasks;
 mod timing;
@@ -38,9 +39,15 @@ use serde::Serialize;
 /// The verifier's resolution.
 #[derive(Clone, Copy, Debug)]
 pub struct VerifySettings {
-    /// Largest joint step when re-sampling a leg's segments (rad or m).
+    /// The scale (rad or m) of the leg check's work: it measures a piece of a leg at most twice
+    /// per joint step of the piece's largest joint travel (and 2,000 times more) before it
+    /// reports the rest unproven, and a plan whose legs would need more than [`MAX_CHECKS`]
+    /// configurations at this step is refused as too large. The check itself steps as far as
+    /// the bodies' motion bound proves the robot clear (see `paths`).
     pub joint_step: f64,
-    /// Time step of the robot–robot check over the common timeline (s).
+    /// Time step (s) of the robot–robot check inside a contact: how finely its interval is
+    /// reported (between contacts the check steps as far as the motion bound allows, see
+    /// `robots`); it also sets the check's budget of instants per pair.
     pub time_step: f64,
     /// Relative tolerance on velocity and acceleration limits.
     pub limit_tolerance: f64,
@@ -333,6 +340,28 @@ fn pair_robots<'a>(
         }
     }
     robots
+}
+
+/// Per joint, a bound (m) on any point of the robot's bodies' distance from the joint's axis
+/// ([`cellplan_kin::Chain::joint_radii`]), each body's reach from its link's origin its shape's
+/// offset plus the shape's own reach (the shapes as the cell gives them, not the planner's
+/// covers): along any joint motion, the bodies' points move at most `Σ_j R_j·∫|dq_j|`.
+fn body_radii(robot: &Robot) -> Vec<f64> {
+    let bodies: Vec<(usize, f64)> = robot
+        .body_links
+        .iter()
+        .enumerate()
+        .map(|(i, &link)| (link, body_reach(robot, i)))
+        .collect();
+    robot.model.chain.joint_radii(&bodies)
+}
+
+/// The largest distance of body `i`'s points from the origin of the link it hangs on: its
+/// shape's offset plus the shape's own reach (infinite for a body without a shape).
+fn body_reach(robot: &Robot, i: usize) -> f64 {
+    robot.body_shapes.get(i).map_or(f64::INFINITY, |(shape, pose)| {
+        pose.translation.length() + shape.reach()
+    })
 }
 
 fn finish(violations: Vec<Violation>, cycle: f64, delta: f64, checked: usize) -> Report {

@@ -1,5 +1,6 @@
-//! The legs: chained home → tasks → home, naming their ends, re-sampled at the verifier's
-//! joint step against the static scene and the robot itself; and the trajectory walked
+//! The legs: chained home → tasks → home, naming their ends, proven clear of the static scene
+//! and of the robot itself between the configurations measured (conservative advancement on
+//! each body's and self pair's motion bound, see [`resample`]); and the trajectory walked
 //! forward along them, so that the motion checked is the motion timed.
 use super::{VerifySettings, Violation, ViolationKind};
 use cellplan_core::document::{LegOut, RobotPlan};
@@ -57,11 +58,12 @@ fn check_robot(
     }
     let mut checked = 0;
     let mut scratch = Scratch::default();
+    let gaps = gaps(cell, robot);
     let mut at: &[f64] = &rp.home;
     for (i, leg) in rp.legs.iter().enumerate() {
         let to: &[f64] = rp.tasks.get(i).map_or(&rp.home, |v| &v.q);
         check_ends(rp, i, leg, at, to, out);
-        checked += resample(cell, robot, rp, leg, settings, &mut scratch, out);
+        checked += resample(cell, robot, rp, leg, (settings, &gaps), &mut scratch, out);
         at = to;
     }
     if let Some((t, detail)) = follow_legs(robot, rp, settings.limit_tolerance) {
@@ -146,22 +148,91 @@ pub(super) fn name(leg: &LegOut) -> String {
     format!("{} → {}", leg.from.label(), leg.to.label())
 }
 
-/// Re-samples a leg's segments at the joint step; reports its first bad configuration and
-/// returns the configurations checked.
+/// Most configurations measured on one piece of a leg, per joint step of its largest joint
+/// travel (and [`MIN_PIECE_BUDGET`] more): a piece that grazes the clearance for long would
+/// otherwise be walked in ever shorter steps. Past it the rest of the piece is reported
+/// unproven.
+const PIECE_BUDGET_PER_STEP: usize = 2;
+const MIN_PIECE_BUDGET: usize = 2_000;
+
+/// Longest stretch (m of a part's travel) one distance measurement is asked to clear: the
+/// queries are capped at it, which keeps them cheap far from the scene.
+const MAX_ROOM: f64 = 0.25;
+
+/// One gap the leg check keeps: a body's from the scene (at least the clearance), or a checked
+/// self pair's (apart), with how far the joints can move the one relative to the other.
+#[derive(Clone, Debug)]
+pub(super) struct Gap {
+    what: GapOf,
+    /// Per joint, a bound on the distance from its axis of the points whose motion changes the
+    /// gap: a body's ([`cellplan_kin::Chain::body_radii`]), or for a self pair the later
+    /// body's over the joints between the two (the joints before move both alike).
+    radii: Vec<f64>,
+}
+
+#[derive(Clone, Copy, Debug)]
+enum GapOf {
+    Scene(usize),
+    Pair(usize, usize),
+}
+
+/// The gaps of `robot`'s legs: each body not exempt from the scene, and each checked self pair.
+/// Each body's reach from its link's origin is its shape's offset plus the shape's own reach
+/// (the shapes as the cell gives them, as in [`super::body_radii`]: this crate's own bound,
+/// not the planner's sphere covers).
+pub(super) fn gaps(cell: &Cell, robot: &Robot) -> Vec<Gap> {
+    let chain = &robot.model.chain;
+    let reach = |i: usize| super::body_reach(robot, i);
+    let link = |i: usize| robot.body_links.get(i).copied().unwrap_or(chain.links.len() - 1);
+    let moved_by = chain.joints_to();
+    let mut out: Vec<Gap> = (0..robot.body_links.len())
+        .filter(|&i| !cell.world.is_static_exempt(robot.group, i))
+        .map(|i| Gap {
+            what: GapOf::Scene(i),
+            radii: chain.body_radii(link(i), reach(i)),
+        })
+        .collect();
+    for &(i, j) in cell.world.self_pairs(robot.group) {
+        // The body moved by more joints is the later one.
+        let (early, late) = if moved_by[link(i)] <= moved_by[link(j)] {
+            (i, j)
+        } else {
+            (j, i)
+        };
+        let shared = moved_by[link(early)];
+        let mut radii = chain.body_radii(link(late), reach(late));
+        radii.iter_mut().take(shared).for_each(|r| *r = 0.0);
+        out.push(Gap {
+            what: GapOf::Pair(i, j),
+            radii,
+        });
+    }
+    out
+}
+
+/// Checks a leg's pieces (its straight segments whole — the blends cut their ends, which
+/// stay checked — then the blends' curves) by conservative advancement: at a configuration
+/// every gap of the robot ([`gaps`]) is measured, and the next configuration is the farthest
+/// along the piece at which no gap's travel bound (`Σ_j R_j·|Δq_j|`, exact along a line and a
+/// curve) has reached what that gap had to spare — beyond the clearance from the scene, beyond
+/// contact between the self pairs — plus [`crate::robots::PROOF_TOLERANCE`]. Every
+/// configuration measured keeps the clearance, and none between comes closer than the
+/// clearance less the tolerance. Joint limits: each piece lies in the box of its ends (a curve
+/// within the triangle of its control points, all on the checked segments), so its ends
+/// decide. Reports the leg's first bad configuration and returns the configurations measured.
 fn resample(
     cell: &Cell,
     robot: &Robot,
     rp: &RobotPlan,
     leg: &LegOut,
-    settings: &VerifySettings,
+    (settings, gaps): (&VerifySettings, &[Gap]),
     scratch: &mut Scratch,
     out: &mut Vec<Violation>,
 ) -> usize {
     let clearance = cell.planning.clearance;
+    let tol = crate::robots::PROOF_TOLERANCE;
+    let world = &cell.world;
     let mut checked = 0;
-    let mut reported = false;
-    // The straight segments whole (the blends cut their ends, which stay checked), then the
-    // blends' curves.
     let curves: Vec<Piece> = pieces(leg)
         .into_iter()
         .filter(|p| matches!(p, Piece::Curve(..)))
@@ -170,21 +241,112 @@ fn resample(
         .waypoints
         .windows(2)
         .map(|w| Piece::Line(w[0].clone(), w[1].clone()));
+    let mut report = |kind, detail: String| {
+        out.push(Violation::robot(
+            kind,
+            &rp.name,
+            Some(leg.start_s),
+            None,
+            format!("on leg {}: {detail}", name(leg)),
+        ));
+    };
+    // Per gap: what it may travel before the next measurement.
+    let mut room = vec![0.0; gaps.len()];
+    let mut moved = Vec::new();
     for piece in lines.chain(curves) {
-        let steps = (piece.max_joint_travel() / settings.joint_step).ceil().max(1.0) as usize;
-        for s in 0..=steps {
-            let q = piece.at(s as f64 / steps as f64);
-            checked += 1;
-            if !reported && let Some(v) = config_violation(cell, robot, &q, clearance, scratch) {
-                out.push(Violation::robot(
-                    v.0,
-                    &rp.name,
-                    Some(leg.start_s),
-                    None,
-                    format!("on leg {}: {}", name(leg), v.1),
-                ));
-                reported = true;
+        let dof = piece.dof();
+        // Each joint's travel from parameter `f0` to `f1`, into `moved`.
+        let mut travels = |f0: f64, f1: f64, moved: &mut Vec<f64>| {
+            moved.clear();
+            moved.extend((0..dof).map(|j| piece.travel(j, f0, f1)));
+        };
+        let bound = |g: &Gap, moved: &[f64]| -> f64 { g.radii.iter().zip(moved).map(|(r, m)| r * m).sum() };
+        let steps = (piece.max_joint_travel() / settings.joint_step).ceil() as usize;
+        let budget = steps
+            .saturating_mul(PIECE_BUDGET_PER_STEP)
+            .saturating_add(MIN_PIECE_BUDGET);
+        let mut f = 0.0;
+        let mut measured = 0;
+        loop {
+            if measured == budget {
+                report(
+                    ViolationKind::StaticClearance,
+                    format!(
+                        "clearance not proven past {:.0} % of a segment: it stays within {:.1} mm of \
+                         the scene or of touching itself, and the check stopped after {measured} \
+                         configurations",
+                        100.0 * f,
+                        tol * 1e3
+                    ),
+                );
+                return checked;
             }
+            measured += 1;
+            checked += 1;
+            let q = piece.at(f);
+            travels(f, 1.0, &mut moved);
+            let mut valid = robot.within_limits(&q);
+            if valid {
+                robot.body_poses(&q, scratch);
+                for (g, spare) in gaps.iter().zip(room.iter_mut()) {
+                    let rest = bound(g, &moved).min(MAX_ROOM);
+                    let (d, need) = match g.what {
+                        GapOf::Scene(i) => (
+                            world.body_static_distance(
+                                robot.group,
+                                i,
+                                &scratch.bodies,
+                                clearance + tol + rest,
+                            ),
+                            clearance,
+                        ),
+                        GapOf::Pair(i, j) => (
+                            world.pair_distance(robot.group, i, j, &scratch.bodies, tol + rest),
+                            0.0,
+                        ),
+                    };
+                    // A self pair touching (0) is a contact; the scene within the clearance too.
+                    if d < need || (need == 0.0 && d <= 0.0) {
+                        valid = false;
+                        break;
+                    }
+                    *spare = d - need + tol;
+                }
+            }
+            if !valid {
+                // The configuration's first problem, named.
+                let (kind, detail) = config_violation(cell, robot, &q, clearance, scratch)
+                    .unwrap_or((ViolationKind::StaticClearance, "closer than the clearance".into()));
+                report(kind, detail);
+                return checked;
+            }
+            if f >= 1.0 {
+                break;
+            }
+            // The farthest parameter every gap's travel stays within its room (travel grows
+            // along the piece: bisection).
+            let fits = |to: f64, moved: &mut Vec<f64>, travels: &mut dyn FnMut(f64, f64, &mut Vec<f64>)| {
+                travels(f, to, moved);
+                gaps.iter().zip(&room).all(|(g, r)| bound(g, moved) <= *r)
+            };
+            let next = if fits(1.0, &mut moved, &mut travels) {
+                1.0
+            } else {
+                let (mut lo, mut hi) = (f, 1.0);
+                for _ in 0..60 {
+                    let mid = 0.5 * (lo + hi);
+                    if mid <= lo || mid >= hi {
+                        break;
+                    }
+                    if fits(mid, &mut moved, &mut travels) {
+                        lo = mid;
+                    } else {
+                        hi = mid;
+                    }
+                }
+                lo
+            };
+            f = next.max(f + 1e-12).min(1.0);
         }
     }
     checked
