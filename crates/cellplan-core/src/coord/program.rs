@@ -388,12 +388,13 @@ impl Program {
 
     /// Time at the tasks, doing the work (s).
     pub fn working(&self) -> f64 {
-        self.visits.iter().map(|v| v.dwell).sum()
+        // `+ 0.0`: an empty sum is −0, which a table prints as "-0.00".
+        self.visits.iter().map(|v| v.dwell).sum::<f64>() + 0.0
     }
 
     /// Moving time (s).
     pub fn motion(&self) -> f64 {
-        self.legs.iter().map(ProgramLeg::duration).sum()
+        self.legs.iter().map(ProgramLeg::duration).sum::<f64>() + 0.0
     }
 
     /// The program's length without building its trajectory (s).
@@ -526,5 +527,24 @@ impl super::Coordinated {
             totals: self.waits_for(),
             stalls,
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn an_idle_robot_works_and_moves_zero_not_minus_zero() {
+        let idle = Program {
+            robot: 0,
+            home: vec![0.0; 6],
+            legs: Vec::new(),
+            visits: Vec::new(),
+            waits: Vec::new(),
+        };
+        assert!(idle.working() == 0.0 && idle.working().is_sign_positive());
+        assert!(idle.motion() == 0.0 && idle.motion().is_sign_positive());
+        assert_eq!(format!("{:.2}", idle.working()), "0.00");
     }
 }
