@@ -5,12 +5,16 @@
 //! - `tasks`: every task done exactly once by a robot that has it as a candidate, at a pose
 //!   the process accepts, with the figures the process gives; the unmeasured list exactly the
 //!   tasks no robot can do, with their reasons;
-//! - `paths`: the legs chained home → tasks → home, re-sampled at the verifier's resolution
-//!   against the static scene and the robot itself; the trajectory walked forward along them;
+//! - `paths`: the legs chained home → tasks → home, proven clear of the static scene and of
+//!   the robot itself (conservative advancement on each body's and self pair's motion bound,
+//!   from the bodies' shapes as the cell gives them: every configuration measured keeps the
+//!   clearance, none between comes within [`PROOF_TOLERANCE`] of less); the trajectory walked
+//!   forward along them;
 //! - `timing`: the trajectory samples at the stated step, within joint position, velocity and
 //!   acceleration limits; the program's clock (legs, waits, visits) re-derived and every robot
 //!   total recomputed; each wait a standstill;
-//! - `robots`: robot–robot clearance over the common timeline;
+//! - `robots`: robot–robot clearance over the common timeline, proven the same way pair by
+//!   pair (the robots' travel along their trajectories);
 //! - `record`: the settings the cell fixes, the cycle time, Δt, the lower bound (recomputed
 //!   from the candidates), the coordination record and the candidate count.
 //!

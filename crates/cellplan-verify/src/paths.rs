@@ -1,6 +1,6 @@
 //! The legs: chained home → tasks → home, naming their ends, proven clear of the static scene
 //! and of the robot itself between the configurations measured (conservative advancement on
-//! each body's and self pair's motion bound, see [`resample`]); and the trajectory walked
+//! each body's and self pair's motion bound, see [`check_leg`]); and the trajectory walked
 //! forward along them, so that the motion checked is the motion timed.
 use super::{VerifySettings, Violation, ViolationKind};
 use cellplan_core::document::{LegOut, RobotPlan};
@@ -63,7 +63,7 @@ fn check_robot(
     for (i, leg) in rp.legs.iter().enumerate() {
         let to: &[f64] = rp.tasks.get(i).map_or(&rp.home, |v| &v.q);
         check_ends(rp, i, leg, at, to, out);
-        checked += resample(cell, robot, rp, leg, (settings, &gaps), &mut scratch, out);
+        checked += check_leg(cell, robot, rp, leg, (settings, &gaps), &mut scratch, out);
         at = to;
     }
     if let Some((t, detail)) = follow_legs(robot, rp, settings.limit_tolerance) {
@@ -220,7 +220,7 @@ pub(super) fn gaps(cell: &Cell, robot: &Robot) -> Vec<Gap> {
 /// clearance less the tolerance. Joint limits: each piece lies in the box of its ends (a curve
 /// within the triangle of its control points, all on the checked segments), so its ends
 /// decide. Reports the leg's first bad configuration and returns the configurations measured.
-fn resample(
+fn check_leg(
     cell: &Cell,
     robot: &Robot,
     rp: &RobotPlan,
