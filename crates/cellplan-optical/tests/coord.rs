@@ -734,3 +734,58 @@ fn contacts_shorter_than_the_time_step_are_caught() {
         );
     }
 }
+
+#[test]
+fn the_robot_robot_check_is_proven_between_its_instants() {
+    // The uncoordinated plan with R2's trajectory started later by random delays (R2 waits at
+    // home first): some delays keep the robots apart, some not. Checked here every 1 ms: a plan
+    // the verifier passes keeps the clearance less its tolerance at every one of those times,
+    // and one that comes closer at any of them is reported.
+    use rand::{RngExt, SeedableRng};
+    let f = fixture();
+    let (good, _) = document(Coordination::None);
+    let clearance = f.cell.planning.clearance;
+    let floor = clearance - cellplan_verify::PROOF_TOLERANCE;
+    let position = |tr: &[output::Sample], t: f64| -> Vec<f64> {
+        let i = tr.partition_point(|s| s.t <= t);
+        if i == 0 {
+            return tr[0].q.clone();
+        }
+        let Some(b) = tr.get(i) else {
+            return tr[tr.len() - 1].q.clone();
+        };
+        let a = &tr[i - 1];
+        let w = if b.t > a.t { (t - a.t) / (b.t - a.t) } else { 0.0 };
+        a.q.iter().zip(&b.q).map(|(x, y)| x + w * (y - x)).collect()
+    };
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(11);
+    let (mut passed, mut caught) = (0, 0);
+    for case in 0..12 {
+        let mut doc = good.clone();
+        let delay = rng.random_range(0.0..12.0);
+        for s in &mut doc.robots[1].trajectory {
+            s.t += delay;
+        }
+        let (a, b) = (&doc.robots[0].trajectory, &doc.robots[1].trajectory);
+        let horizon = a.last().unwrap().t.max(b.last().unwrap().t);
+        let steps = (horizon / 1e-3).ceil() as usize;
+        let bad = (0..=steps).any(|k| {
+            let t = k as f64 * 1e-3;
+            distance(&position(a, t), &position(b, t)) < floor
+        });
+        let found = verify(&f.cell, &doc, &VerifySettings::default())
+            .violations
+            .iter()
+            .any(|v| v.kind == ViolationKind::RobotRobot);
+        if bad {
+            assert!(
+                found,
+                "case {case} (delay {delay:.3} s): within {floor} m and passed"
+            );
+            caught += 1;
+        } else if !found {
+            passed += 1;
+        }
+    }
+    assert!(passed > 0 && caught > 0, "{passed} passed, {caught} caught");
+}
