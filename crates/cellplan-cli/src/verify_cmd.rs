@@ -54,8 +54,8 @@ pub fn run(args: &VerifyArgs) -> Result<(), Failure> {
     }
     let report = verify(&cell, &plan, &settings);
     let summary = format!(
-        "cycle time {:.2} s, Δt {:.2} s (recomputed); {} configurations checked",
-        report.cycle_time_s, report.delta_t_s, report.configurations_checked
+        "cycle time {:.2} s, Δt {:.2} s (recomputed); {} configurations and {} robot-pair instants checked",
+        report.cycle_time_s, report.delta_t_s, report.configurations_checked, report.pair_instants_checked
     );
     print_verdict(
         &report,

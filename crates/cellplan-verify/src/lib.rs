@@ -179,6 +179,8 @@ pub struct Report {
     pub delta_t_s: f64,
     /// Configurations checked against the scene.
     pub configurations_checked: usize,
+    /// Instants at which a robot pair's distance was measured (summed over the pairs).
+    pub pair_instants_checked: usize,
 }
 
 /// The checks a plan needs at `settings`' resolution: (configurations of the legs,
@@ -249,7 +251,7 @@ pub fn verify_with(
             vec![Violation::plan(ViolationKind::Format, e.to_string())],
             0.0,
             0.0,
-            0,
+            (0, 0),
         );
     }
     if let Some(why) = too_large(plan, settings) {
@@ -260,7 +262,7 @@ pub fn verify_with(
             )],
             0.0,
             0.0,
-            0,
+            (0, 0),
         );
     }
     let generated;
@@ -276,11 +278,13 @@ pub fn verify_with(
     tasks::check(cell, table, plan, &robots, &mut out);
     let checked = paths::check(cell, &robots, settings, &mut out);
     let times = timing::check(plan, &robots, settings, &mut out);
-    if settings.robot_robot {
-        robots::check(cell, &robots, &times, settings, &mut out);
-    }
+    let instants = if settings.robot_robot {
+        robots::check(cell, &robots, &times, settings, &mut out)
+    } else {
+        0
+    };
     let (cycle, delta) = record::check(cell, table, plan, &robots, &times, &mut out);
-    finish(out, cycle, delta, checked)
+    finish(out, cycle, delta, (checked, instants))
 }
 
 /// The plan's robots matched to the cell's by name, in cell order; robots missing on either
@@ -368,12 +372,13 @@ fn body_reach(robot: &Robot, i: usize) -> f64 {
     })
 }
 
-fn finish(violations: Vec<Violation>, cycle: f64, delta: f64, checked: usize) -> Report {
+fn finish(violations: Vec<Violation>, cycle: f64, delta: f64, (checked, instants): (usize, usize)) -> Report {
     Report {
         ok: violations.is_empty(),
         violations,
         cycle_time_s: cycle,
         delta_t_s: delta,
         configurations_checked: checked,
+        pair_instants_checked: instants,
     }
 }

@@ -41,19 +41,21 @@ const MIN_STEP: f64 = 1e-7;
 const BUDGET_PER_STEP: usize = 2;
 const MIN_BUDGET: usize = 10_000;
 
-/// The robot–robot check; `times` are the robots' recomputed times.
+/// The robot–robot check; `times` are the robots' recomputed times. Returns the instants
+/// measured, over all pairs.
 pub(super) fn check(
     cell: &Cell,
     robots: &[(&Robot, &RobotPlan)],
     times: &[f64],
     settings: &VerifySettings,
     out: &mut Vec<Violation>,
-) {
+) -> usize {
     if robots.len() < 2 {
-        return;
+        return 0;
     }
     let clearance = cell.planning.clearance;
-    for found in contacts(cell, robots, times, settings.time_step) {
+    let (findings, instants) = contacts(cell, robots, times, settings.time_step);
+    for found in findings {
         let ((a, b), s) = (found.pair, found.start);
         let detail = match found.kind {
             Found::Contact { end } => {
@@ -78,6 +80,7 @@ pub(super) fn check(
             detail,
         });
     }
+    instants
 }
 
 /// What the walk of one pair found.
@@ -141,8 +144,14 @@ impl<'a> Travel<'a> {
     }
 }
 
-/// The contacts and unproven stretches of every pair, by start time (then pair).
-fn contacts(cell: &Cell, robots: &[(&Robot, &RobotPlan)], times: &[f64], time_step: f64) -> Vec<Finding> {
+/// The contacts and unproven stretches of every pair, by start time (then pair), and the
+/// instants measured.
+fn contacts(
+    cell: &Cell,
+    robots: &[(&Robot, &RobotPlan)],
+    times: &[f64],
+    time_step: f64,
+) -> (Vec<Finding>, usize) {
     let horizon = times.iter().copied().fold(0.0, f64::max);
     let travels: Vec<Travel> = robots
         .iter()
@@ -162,9 +171,11 @@ fn contacts(cell: &Cell, robots: &[(&Robot, &RobotPlan)], times: &[f64], time_st
         time_step,
         budget,
     };
-    let mut found: Vec<Finding> = pairs.par_iter().flat_map_iter(|&pair| walk.pair(pair)).collect();
+    let walked: Vec<(Vec<Finding>, usize)> = pairs.par_iter().map(|&pair| walk.pair(pair)).collect();
+    let instants = walked.iter().map(|w| w.1).sum();
+    let mut found: Vec<Finding> = walked.into_iter().flat_map(|w| w.0).collect();
     found.sort_by(|x, y| x.start.total_cmp(&y.start).then(x.pair.cmp(&y.pair)));
-    found
+    (found, instants)
 }
 
 /// What every pair's walk shares.
@@ -216,8 +227,8 @@ impl Walk<'_> {
         lo
     }
 
-    /// The walk of one pair through the timeline.
-    fn pair(&self, pair: (usize, usize)) -> Vec<Finding> {
+    /// The walk of one pair through the timeline: what it found and the instants measured.
+    fn pair(&self, pair: (usize, usize)) -> (Vec<Finding>, usize) {
         let (a, b) = pair;
         let (ra, rb) = (self.robots[a].0, self.robots[b].0);
         let world = &self.cell.world;
@@ -243,7 +254,7 @@ impl Walk<'_> {
                     start: t,
                     kind: Found::Unproven { checks },
                 });
-                return found;
+                return (found, checks);
             }
             checks += 1;
             ra.body_poses(&self.q(a, t), &mut sa);
@@ -266,7 +277,7 @@ impl Walk<'_> {
             t = next.min(self.horizon);
         }
         close(&mut open, &mut found);
-        found
+        (found, checks)
     }
 }
 

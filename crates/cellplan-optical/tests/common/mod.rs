@@ -87,6 +87,9 @@ pub fn verified(cell: &Cell, doc: &output::Plan) {
     let report = verify(cell, doc, &VerifySettings::default());
     assert!(report.ok, "{:#?}", report.violations);
     assert!(report.configurations_checked > 0);
+    // Every robot pair walked, from its first instant on.
+    let n = doc.robots.len();
+    assert!(report.pair_instants_checked >= n * n.saturating_sub(1) / 2);
 }
 
 /// The independent re-check of a plan.
