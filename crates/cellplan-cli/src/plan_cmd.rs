@@ -529,10 +529,13 @@ fn render(doc: &output::Plan, working: &str) -> String {
             c.route_bound
         );
     }
-    s += if doc.verified {
-        "verified: every MP once, probe constraints, limits, clearance to the scene and between robots\n"
+    s += &if doc.verified {
+        format!(
+            "verified: every MP once, probe constraints, limits, clearance to the scene and between robots (proven to within {} mm between the samples)\n",
+            cellplan_verify::PROOF_TOLERANCE * 1e3
+        )
     } else {
-        "NOT VERIFIED (written with --no-verify)\n"
+        "NOT VERIFIED (written with --no-verify)\n".to_string()
     };
     if !doc.unmeasured.is_empty() {
         s += "\nnot measured:\n";
