@@ -372,6 +372,28 @@ fn body_reach(robot: &Robot, i: usize) -> f64 {
     })
 }
 
+/// The farthest `x` in `[from, to]` at which `fits(x)` holds, for a `fits` that holds at `from`
+/// and, once false, stays false (a bound that only grows along the way): `to` when it holds
+/// there, else bisection to the last floating-point step.
+fn farthest(from: f64, to: f64, mut fits: impl FnMut(f64) -> bool) -> f64 {
+    if fits(to) {
+        return to;
+    }
+    let (mut lo, mut hi) = (from, to);
+    for _ in 0..60 {
+        let mid = 0.5 * (lo + hi);
+        if mid <= lo || mid >= hi {
+            break;
+        }
+        if fits(mid) {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    lo
+}
+
 fn finish(violations: Vec<Violation>, cycle: f64, delta: f64, (checked, instants): (usize, usize)) -> Report {
     Report {
         ok: violations.is_empty(),
@@ -380,5 +402,19 @@ fn finish(violations: Vec<Violation>, cycle: f64, delta: f64, (checked, instants
         delta_t_s: delta,
         configurations_checked: checked,
         pair_instants_checked: instants,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn farthest_finds_where_a_growing_bound_reaches_its_room() {
+        // The whole way when it fits there.
+        assert_eq!(super::farthest(0.2, 1.0, |x| x <= 2.0), 1.0);
+        // Else the last point that fits, to the floating-point step, and never past it.
+        let x = super::farthest(0.0, 1.0, |x| x * x <= 0.09);
+        assert!(x <= 0.3 && 0.3 - x < 1e-12, "{x}");
+        // Nothing beyond the start fits: the start.
+        assert_eq!(super::farthest(0.5, 1.0, |x| x <= 0.5), 0.5);
     }
 }

@@ -254,11 +254,10 @@ fn check_leg(
     let mut room = vec![0.0; gaps.len()];
     let mut moved = Vec::new();
     for piece in lines.chain(curves) {
-        let dof = piece.dof();
         // Each joint's travel from parameter `f0` to `f1`, into `moved`.
-        let mut travels = |f0: f64, f1: f64, moved: &mut Vec<f64>| {
+        let travels = |f0: f64, f1: f64, moved: &mut Vec<f64>| {
             moved.clear();
-            moved.extend((0..dof).map(|j| piece.travel(j, f0, f1)));
+            moved.extend((0..piece.dof()).map(|j| piece.travel(j, f0, f1)));
         };
         let bound = |g: &Gap, moved: &[f64]| -> f64 { g.radii.iter().zip(moved).map(|(r, m)| r * m).sum() };
         let steps = (piece.max_joint_travel() / settings.joint_step).ceil() as usize;
@@ -323,29 +322,11 @@ fn check_leg(
             if f >= 1.0 {
                 break;
             }
-            // The farthest parameter every gap's travel stays within its room (travel grows
-            // along the piece: bisection).
-            let fits = |to: f64, moved: &mut Vec<f64>, travels: &mut dyn FnMut(f64, f64, &mut Vec<f64>)| {
-                travels(f, to, moved);
-                gaps.iter().zip(&room).all(|(g, r)| bound(g, moved) <= *r)
-            };
-            let next = if fits(1.0, &mut moved, &mut travels) {
-                1.0
-            } else {
-                let (mut lo, mut hi) = (f, 1.0);
-                for _ in 0..60 {
-                    let mid = 0.5 * (lo + hi);
-                    if mid <= lo || mid >= hi {
-                        break;
-                    }
-                    if fits(mid, &mut moved, &mut travels) {
-                        lo = mid;
-                    } else {
-                        hi = mid;
-                    }
-                }
-                lo
-            };
+            // The farthest parameter at which every gap's travel stays within its room.
+            let next = super::farthest(f, 1.0, |to| {
+                travels(f, to, &mut moved);
+                gaps.iter().zip(&room).all(|(g, r)| bound(g, &moved) <= *r)
+            });
             f = next.max(f + 1e-12).min(1.0);
         }
     }

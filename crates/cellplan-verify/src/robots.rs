@@ -209,22 +209,7 @@ impl Walk<'_> {
     /// `t` (the travel only grows with time: bisection).
     fn reach(&self, pair: (usize, usize), t: f64, until: f64, room: f64) -> f64 {
         let limit = self.travel(pair, t) + room;
-        if self.travel(pair, until) <= limit {
-            return until;
-        }
-        let (mut lo, mut hi) = (t, until);
-        for _ in 0..60 {
-            let mid = 0.5 * (lo + hi);
-            if mid <= lo || mid >= hi {
-                break;
-            }
-            if self.travel(pair, mid) <= limit {
-                lo = mid;
-            } else {
-                hi = mid;
-            }
-        }
-        lo
+        super::farthest(t, until, |x| self.travel(pair, x) <= limit)
     }
 
     /// The walk of one pair through the timeline: what it found and the instants measured.
