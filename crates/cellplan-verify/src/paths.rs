@@ -162,7 +162,7 @@ const MAX_ROOM: f64 = 0.25;
 /// One gap the leg check keeps: a body's from the scene (at least the clearance), or a checked
 /// self pair's (apart), with how far the joints can move the one relative to the other.
 #[derive(Clone, Debug)]
-pub(super) struct Gap {
+struct Gap {
     what: GapOf,
     /// Per joint, a bound on the distance from its axis of the points whose motion changes the
     /// gap: a body's ([`cellplan_kin::Chain::body_radii`]), or for a self pair the later
@@ -180,7 +180,7 @@ enum GapOf {
 /// Each body's reach from its link's origin is its shape's offset plus the shape's own reach
 /// (the shapes as the cell gives them, as in [`super::body_radii`]: this crate's own bound,
 /// not the planner's sphere covers).
-pub(super) fn gaps(cell: &Cell, robot: &Robot) -> Vec<Gap> {
+fn gaps(cell: &Cell, robot: &Robot) -> Vec<Gap> {
     let chain = &robot.model.chain;
     let reach = |i: usize| super::body_reach(robot, i);
     let link = |i: usize| robot.body_links.get(i).copied().unwrap_or(chain.links.len() - 1);
