@@ -141,10 +141,26 @@ fn a_stud_out_of_reach_is_unweldable_and_the_rest_is_planned_and_verified() {
     bad.visits[0].q[5] += 0.01;
     let kinds: Vec<_> = verify_weld(&c, &bad).violations.iter().map(|v| v.kind).collect();
     assert!(kinds.contains(&WeldViolationKind::Weld), "{kinds:?}");
-    let mut bad = doc;
+    let mut bad = doc.clone();
     bad.totals.weld_cost *= 0.5;
     let kinds: Vec<_> = verify_weld(&c, &bad).violations.iter().map(|v| v.kind).collect();
     assert!(kinds.contains(&WeldViolationKind::Total), "{kinds:?}");
+    // A move bent down into the part between its ends: its clearance is not proven.
+    let mut bad = doc;
+    let leg = bad
+        .legs
+        .iter_mut()
+        .find(|l| matches!(l.motion, Motion::Ocp(_)))
+        .expect("an OCP leg");
+    if let Motion::Ocp(d) = &mut leg.motion {
+        let n = d.q.len();
+        for q in &mut d.q[1..n - 1] {
+            q[1] += 0.9;
+            q[2] += 0.9;
+        }
+    }
+    let kinds: Vec<_> = verify_weld(&c, &bad).violations.iter().map(|v| v.kind).collect();
+    assert!(kinds.contains(&WeldViolationKind::Collision), "{kinds:?}");
 }
 
 #[test]

@@ -162,7 +162,7 @@ const MAX_ROOM: f64 = 0.25;
 /// One gap the leg check keeps: a body's from the scene (at least the clearance), or a checked
 /// self pair's (apart), with how far the joints can move the one relative to the other.
 #[derive(Clone, Debug)]
-struct Gap {
+pub(crate) struct Gap {
     what: GapOf,
     /// Per joint, a bound on the distance from its axis of the points whose motion changes the
     /// gap: a body's ([`cellplan_kin::Chain::body_radii`]), or for a self pair the later
@@ -180,7 +180,7 @@ enum GapOf {
 /// Each body's reach from its link's origin is its shape's offset plus the shape's own reach
 /// (the shapes as the cell gives them, as in [`super::body_radii`]: this crate's own bound,
 /// not the planner's sphere covers).
-fn gaps(cell: &Cell, robot: &Robot) -> Vec<Gap> {
+pub(crate) fn gaps(cell: &Cell, robot: &Robot) -> Vec<Gap> {
     let chain = &robot.model.chain;
     let reach = |i: usize| super::body_reach(robot, i);
     let link = |i: usize| robot.body_links.get(i).copied().unwrap_or(chain.links.len() - 1);
@@ -211,15 +211,8 @@ fn gaps(cell: &Cell, robot: &Robot) -> Vec<Gap> {
 }
 
 /// Checks a leg's pieces (its straight segments whole — the blends cut their ends, which
-/// stay checked — then the blends' curves) by conservative advancement: at a configuration
-/// every gap of the robot ([`gaps`]) is measured, and the next configuration is the farthest
-/// along the piece at which no gap's travel bound (`Σ_j R_j·|Δq_j|`, exact along a line and a
-/// curve) has reached what that gap had to spare — beyond the clearance from the scene, beyond
-/// contact between the self pairs — plus [`crate::robots::PROOF_TOLERANCE`]. Every
-/// configuration measured keeps the clearance, and none between comes closer than the
-/// clearance less the tolerance. Joint limits: each piece lies in the box of its ends (a curve
-/// within the triangle of its control points, all on the checked segments), so its ends
-/// decide. Reports the leg's first bad configuration and returns the configurations measured.
+/// stay checked — then the blends' curves) with [`Prover::piece`]. Reports the leg's first bad
+/// configuration and returns the configurations measured.
 fn check_leg(
     cell: &Cell,
     robot: &Robot,
@@ -229,10 +222,6 @@ fn check_leg(
     scratch: &mut Scratch,
     out: &mut Vec<Violation>,
 ) -> usize {
-    let clearance = cell.planning.clearance;
-    let tol = crate::robots::PROOF_TOLERANCE;
-    let world = &cell.world;
-    let mut checked = 0;
     let curves: Vec<Piece> = pieces(leg)
         .into_iter()
         .filter(|p| matches!(p, Piece::Curve(..)))
@@ -241,26 +230,83 @@ fn check_leg(
         .waypoints
         .windows(2)
         .map(|w| Piece::Line(w[0].clone(), w[1].clone()));
-    let mut report = |kind, detail: String| {
-        out.push(Violation::robot(
-            kind,
-            &rp.name,
-            Some(leg.start_s),
-            None,
-            format!("on leg {}: {detail}", name(leg)),
-        ));
-    };
-    // Per gap: what it may travel before the next measurement.
-    let mut room = vec![0.0; gaps.len()];
-    let mut moved = Vec::new();
+    let mut prover = Prover::new(cell, robot, gaps, settings.joint_step);
     for piece in lines.chain(curves) {
+        if let Err((kind, detail)) = prover.piece(&piece, scratch) {
+            out.push(Violation::robot(
+                kind,
+                &rp.name,
+                Some(leg.start_s),
+                None,
+                format!("on leg {}: {detail}", name(leg)),
+            ));
+            break;
+        }
+    }
+    prover.measured
+}
+
+/// The proof that pieces of a robot's joint path keep the clearance from the scene and from
+/// the robot itself, by conservative advancement: at a configuration every gap of the robot
+/// ([`gaps`]) is measured, and the next configuration is the farthest along the piece at which
+/// no gap's travel bound (`Σ_j R_j·|Δq_j|`, exact along a line and a curve) has reached what
+/// that gap had to spare — beyond the clearance from the scene, beyond contact between the self
+/// pairs — plus [`crate::robots::PROOF_TOLERANCE`]. Every configuration measured keeps the
+/// clearance, and none between comes closer than the clearance less the tolerance. Joint
+/// limits: a piece lies in the box of its ends (a curve within the triangle of its control
+/// points), so the ends decide where the control points are measured too.
+pub(crate) struct Prover<'a> {
+    cell: &'a Cell,
+    robot: &'a Robot,
+    gaps: &'a [Gap],
+    /// The scale of a piece's budget (see [`VerifySettings::joint_step`]).
+    joint_step: f64,
+    /// Configurations measured so far.
+    pub measured: usize,
+    /// Per gap: what it may travel before the next measurement.
+    room: Vec<f64>,
+    /// Per joint: its travel over the step being tried.
+    moved: Vec<f64>,
+}
+
+impl<'a> Prover<'a> {
+    pub(crate) fn new(cell: &'a Cell, robot: &'a Robot, gaps: &'a [Gap], joint_step: f64) -> Self {
+        Prover {
+            cell,
+            robot,
+            gaps,
+            joint_step,
+            measured: 0,
+            room: vec![0.0; gaps.len()],
+            moved: Vec::new(),
+        }
+    }
+
+    /// The straight segment `a → b` (see [`Prover::piece`]).
+    pub(crate) fn segment(
+        &mut self,
+        a: &[f64],
+        b: &[f64],
+        scratch: &mut Scratch,
+    ) -> Result<(), (ViolationKind, String)> {
+        self.piece(&Piece::Line(a.to_vec(), b.to_vec()), scratch)
+    }
+
+    /// Proves `piece` clear, or gives its first bad configuration's problem (or why the proof
+    /// stopped: a piece that stays within the tolerance of its limits past a budget of
+    /// measurements, two per joint step of its largest joint travel and 2,000 more).
+    fn piece(&mut self, piece: &Piece, scratch: &mut Scratch) -> Result<(), (ViolationKind, String)> {
+        let (cell, robot, gaps) = (self.cell, self.robot, self.gaps);
+        let clearance = cell.planning.clearance;
+        let tol = crate::robots::PROOF_TOLERANCE;
+        let world = &cell.world;
         // Each joint's travel from parameter `f0` to `f1`, into `moved`.
         let travels = |f0: f64, f1: f64, moved: &mut Vec<f64>| {
             moved.clear();
             moved.extend((0..piece.dof()).map(|j| piece.travel(j, f0, f1)));
         };
         let bound = |g: &Gap, moved: &[f64]| -> f64 { g.radii.iter().zip(moved).map(|(r, m)| r * m).sum() };
-        let steps = (piece.max_joint_travel() / settings.joint_step).ceil() as usize;
+        let steps = (piece.max_joint_travel() / self.joint_step).ceil() as usize;
         let budget = steps
             .saturating_mul(PIECE_BUDGET_PER_STEP)
             .saturating_add(MIN_PIECE_BUDGET);
@@ -268,7 +314,7 @@ fn check_leg(
         let mut measured = 0;
         loop {
             if measured == budget {
-                report(
+                return Err((
                     ViolationKind::StaticClearance,
                     format!(
                         "clearance not proven past {:.0} % of a segment: it stays within {:.1} mm of \
@@ -277,18 +323,17 @@ fn check_leg(
                         100.0 * f,
                         tol * 1e3
                     ),
-                );
-                return checked;
+                ));
             }
             measured += 1;
-            checked += 1;
+            self.measured += 1;
             let q = piece.at(f);
-            travels(f, 1.0, &mut moved);
+            travels(f, 1.0, &mut self.moved);
             let mut valid = robot.within_limits(&q);
             if valid {
                 robot.body_poses(&q, scratch);
-                for (g, spare) in gaps.iter().zip(room.iter_mut()) {
-                    let rest = bound(g, &moved).min(MAX_ROOM);
+                for (g, spare) in gaps.iter().zip(self.room.iter_mut()) {
+                    let rest = bound(g, &self.moved).min(MAX_ROOM);
                     let (d, need) = match g.what {
                         GapOf::Scene(i) => (
                             world.body_static_distance(
@@ -314,27 +359,25 @@ fn check_leg(
             }
             if !valid {
                 // The configuration's first problem, named.
-                let (kind, detail) = config_violation(cell, robot, &q, clearance, scratch)
-                    .unwrap_or((ViolationKind::StaticClearance, "closer than the clearance".into()));
-                report(kind, detail);
-                return checked;
+                return Err(config_violation(cell, robot, &q, clearance, scratch)
+                    .unwrap_or((ViolationKind::StaticClearance, "closer than the clearance".into())));
             }
             if f >= 1.0 {
-                break;
+                return Ok(());
             }
             // The farthest parameter at which every gap's travel stays within its room.
+            let (room, moved) = (&self.room, &mut self.moved);
             let next = super::farthest(f, 1.0, |to| {
-                travels(f, to, &mut moved);
-                gaps.iter().zip(&room).all(|(g, r)| bound(g, &moved) <= *r)
+                travels(f, to, moved);
+                gaps.iter().zip(room).all(|(g, r)| bound(g, moved) <= *r)
             });
             f = next.max(f + 1e-12).min(1.0);
         }
     }
-    checked
 }
 
 /// The first problem of one configuration: joint limits, the scene, the robot itself.
-fn config_violation(
+pub(crate) fn config_violation(
     cell: &Cell,
     robot: &Robot,
     q: &[f64],

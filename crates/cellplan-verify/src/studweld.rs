@@ -10,14 +10,15 @@
 //! - every move (`legs`): joins the welds (home at both ends), satisfies the discrete
 //!   Euler–Lagrange equations of DMOC re-evaluated here with `cellplan_kin::dynamics` (the
 //!   planner's `cellplan-ocp` is not used), keeps joint, velocity and torque limits, and keeps
-//!   the clearance along the whole motion (each straight piece proven clear by the motion
-//!   core's conservative segment check); J and the duration re-derived;
+//!   the clearance along the whole motion (each straight piece proven clear by the verifier's
+//!   own conservative advancement, as inspection legs are: every position measured keeps the
+//!   clearance, none between comes within 1 mm of less); J and the duration re-derived;
 //! - the totals (travel, welding, J, cycle time) re-derived from the parts.
 mod legs;
 
-use cellplan_core::motion::robot_validity;
 use cellplan_geom::DVec3;
 use cellplan_kin::dynamics::{Dynamics, LinkInertia};
+use cellplan_model::robot::Scratch;
 use cellplan_model::{Cell, Robot};
 use cellplan_studweld::StudWeld;
 use cellplan_studweld::document::WeldPlan;
@@ -194,7 +195,7 @@ fn studs(c: &mut Ctx, plan: &WeldPlan) {
 
 /// The weld poses.
 fn welds(c: &mut Ctx, plan: &WeldPlan) {
-    let validity = robot_validity(c.cell, c.robot, c.cell.planning.clearance);
+    let mut scratch = Scratch::default();
     let wt = c.process.weights;
     for v in &plan.visits {
         let Some(task) = c.cell.tasks.iter().find(|t| t.name == v.stud) else {
@@ -224,7 +225,11 @@ fn welds(c: &mut Ctx, plan: &WeldPlan) {
                 format!("weld `{}` outside the joint limits", v.stud),
             );
         }
-        if !validity.is_valid(&v.q) {
+        c.robot.body_poses(&v.q, &mut scratch);
+        if c.robot
+            .contact_at(&c.cell.world, &scratch, c.cell.planning.clearance)
+            .is_some()
+        {
             c.fail(
                 WeldViolationKind::Collision,
                 format!("weld `{}` pose within the clearance", v.stud),

@@ -7,9 +7,9 @@
 //! at rest the boundary conditions of the discrete Legendre transform reduce to
 //! `D₁L_d(q₀, q₁) + (h/2) u_½ = 0` and `D₂L_d(q_{N−1}, q_N) + (h/2) u_{N−½} = 0`.
 use super::{Ctx, WeldViolationKind, close};
-use cellplan_core::motion::{joint_space, robot_validity};
+use crate::paths::{Prover, gaps};
 use cellplan_kin::dynamics::{Dual, Real};
-use cellplan_motion::plan::check_segment;
+use cellplan_model::robot::Scratch;
 use cellplan_studweld::document::WeldPlan;
 use cellplan_studweld::leg::Motion;
 
@@ -48,9 +48,15 @@ pub(super) fn check(c: &mut Ctx, plan: &WeldPlan) {
         );
         return;
     }
-    let space = joint_space(c.cell, c.robot);
-    let validity = robot_validity(c.cell, c.robot, c.cell.planning.clearance);
-    let min = cellplan_motion::plan::PlanSettings::default().min_clearance;
+    // The verifier's own proof of clearance (as for inspection legs), not the planner's check.
+    let gaps = gaps(c.cell, c.robot);
+    let mut prover = Prover::new(
+        c.cell,
+        c.robot,
+        &gaps,
+        crate::VerifySettings::default().joint_step,
+    );
+    let mut scratch = Scratch::default();
     let wt = c.process.weights;
     for (i, leg) in plan.legs.iter().enumerate() {
         let name = format!("move {i} ({} → {})", leg.from, leg.to);
@@ -81,11 +87,13 @@ pub(super) fn check(c: &mut Ctx, plan: &WeldPlan) {
         }
         for (k, s) in pieces.windows(2).enumerate() {
             c.segments += 1;
-            if !check_segment(&space, &validity, &s[0], &s[1], min).valid {
-                c.fail(
-                    WeldViolationKind::Collision,
-                    format!("{name}: piece {k} not proven clear"),
-                );
+            if let Err((kind, detail)) = prover.segment(&s[0], &s[1], &mut scratch) {
+                let kind = if kind == crate::ViolationKind::JointLimit {
+                    WeldViolationKind::JointLimit
+                } else {
+                    WeldViolationKind::Collision
+                };
+                c.fail(kind, format!("{name}: piece {k}: {detail}"));
                 break;
             }
         }
