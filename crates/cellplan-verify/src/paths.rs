@@ -262,7 +262,7 @@ pub(crate) struct Prover<'a> {
     /// The scale of a piece's budget (see [`VerifySettings::joint_step`]).
     joint_step: f64,
     /// Configurations measured so far.
-    pub measured: usize,
+    measured: usize,
     /// Per gap: what it may travel before the next measurement.
     room: Vec<f64>,
     /// Per joint: its travel over the step being tried.
@@ -377,7 +377,7 @@ impl<'a> Prover<'a> {
 }
 
 /// The first problem of one configuration: joint limits, the scene, the robot itself.
-pub(crate) fn config_violation(
+fn config_violation(
     cell: &Cell,
     robot: &Robot,
     q: &[f64],
