@@ -4,8 +4,8 @@
 //! plans). Heavy runs (the whole example) are `#[ignore]`.
 use cellplan_model::LoadOptions;
 use cellplan_studweld::cell::WeldCell;
-use cellplan_studweld::document::build;
-use cellplan_studweld::leg::{LegSettings, Motion};
+use cellplan_studweld::document::{WeldPlan, build};
+use cellplan_studweld::leg::{Dmoc, LegSettings, Motion};
 use cellplan_studweld::plan::run;
 use cellplan_studweld::sequence::Sequencer;
 use cellplan_verify::studweld::{WeldViolationKind, verify_weld};
@@ -125,42 +125,44 @@ fn a_stud_out_of_reach_is_unweldable_and_the_rest_is_planned_and_verified() {
     assert!(r.ok, "{:?}", r.violations);
     assert!(r.max_dynamics_residual < 1e-6);
 
-    // The verifier catches a changed torque, a moved weld pose and a wrong total.
+    // The verifier catches a changed torque, a moved weld pose, a wrong total and a move bent
+    // down into the part between its ends (its clearance is not proven).
+    let kinds = |p: &WeldPlan| -> Vec<WeldViolationKind> {
+        verify_weld(&c, p).violations.iter().map(|v| v.kind).collect()
+    };
     let mut bad = doc.clone();
-    let leg = bad
-        .legs
-        .iter_mut()
-        .find(|l| matches!(l.motion, Motion::Ocp(_)))
-        .expect("an OCP leg");
-    if let Motion::Ocp(d) = &mut leg.motion {
-        d.u[1][1] += 5.0;
-    }
-    let kinds: Vec<_> = verify_weld(&c, &bad).violations.iter().map(|v| v.kind).collect();
-    assert!(kinds.contains(&WeldViolationKind::Dynamics), "{kinds:?}");
+    first_ocp(&mut bad).u[1][1] += 5.0;
+    assert!(
+        kinds(&bad).contains(&WeldViolationKind::Dynamics),
+        "{:?}",
+        kinds(&bad)
+    );
     let mut bad = doc.clone();
     bad.visits[0].q[5] += 0.01;
-    let kinds: Vec<_> = verify_weld(&c, &bad).violations.iter().map(|v| v.kind).collect();
-    assert!(kinds.contains(&WeldViolationKind::Weld), "{kinds:?}");
+    assert!(
+        kinds(&bad).contains(&WeldViolationKind::Weld),
+        "{:?}",
+        kinds(&bad)
+    );
     let mut bad = doc.clone();
     bad.totals.weld_cost *= 0.5;
-    let kinds: Vec<_> = verify_weld(&c, &bad).violations.iter().map(|v| v.kind).collect();
-    assert!(kinds.contains(&WeldViolationKind::Total), "{kinds:?}");
-    // A move bent down into the part between its ends: its clearance is not proven.
+    assert!(
+        kinds(&bad).contains(&WeldViolationKind::Total),
+        "{:?}",
+        kinds(&bad)
+    );
     let mut bad = doc;
-    let leg = bad
-        .legs
-        .iter_mut()
-        .find(|l| matches!(l.motion, Motion::Ocp(_)))
-        .expect("an OCP leg");
-    if let Motion::Ocp(d) = &mut leg.motion {
-        let n = d.q.len();
-        for q in &mut d.q[1..n - 1] {
-            q[1] += 0.9;
-            q[2] += 0.9;
-        }
+    let d = first_ocp(&mut bad);
+    let n = d.q.len();
+    for q in &mut d.q[1..n - 1] {
+        q[1] += 0.9;
+        q[2] += 0.9;
     }
-    let kinds: Vec<_> = verify_weld(&c, &bad).violations.iter().map(|v| v.kind).collect();
-    assert!(kinds.contains(&WeldViolationKind::Collision), "{kinds:?}");
+    assert!(
+        kinds(&bad).contains(&WeldViolationKind::Collision),
+        "{:?}",
+        kinds(&bad)
+    );
 }
 
 #[test]
@@ -273,4 +275,15 @@ fn trust_regions_give_clear_trajectories_where_the_optimum_collides() {
         tried > 0,
         "no move of the first alternatives collides unconstrained"
     );
+}
+
+/// The first move of `p` solved as an optimal control problem, to edit.
+fn first_ocp(p: &mut WeldPlan) -> &mut Dmoc {
+    p.legs
+        .iter_mut()
+        .find_map(|l| match &mut l.motion {
+            Motion::Ocp(d) => Some(d),
+            _ => None,
+        })
+        .expect("an OCP leg")
 }
