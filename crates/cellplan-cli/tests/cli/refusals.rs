@@ -19,6 +19,12 @@ fn cell_with(dir: &Path, edit: impl Fn(String) -> String) -> String {
     dir.join("cell.toml").display().to_string()
 }
 
+/// The small cell's text with `line` added to its robot (after its `home`).
+fn with_robot_line(cell: String, line: &str) -> String {
+    let home = "home = [0, -30, 0, 0, -60, 0]";
+    cell.replace(home, &format!("{home}\n{line}"))
+}
+
 fn check_args(cell: String) -> Vec<String> {
     vec!["check".into(), cell]
 }
@@ -359,10 +365,7 @@ const CASES: &[Case] = &[
         name: "a joint speed beyond any robot's, given in the cell",
         setup: |d| {
             check_args(cell_with(d, |c| {
-                c.replace(
-                    "home = [0, -30, 0, 0, -60, 0]",
-                    "home = [0, -30, 0, 0, -60, 0]\nmax_velocity = [100, 100, 100, 100, 100, 1e9]",
-                )
+                with_robot_line(c, "max_velocity = [100, 100, 100, 100, 100, 1e9]")
             }))
         },
         says: &[
@@ -374,10 +377,7 @@ const CASES: &[Case] = &[
         name: "a joint acceleration beyond any robot's, given in the cell",
         setup: |d| {
             check_args(cell_with(d, |c| {
-                c.replace(
-                    "home = [0, -30, 0, 0, -60, 0]",
-                    "home = [0, -30, 0, 0, -60, 0]\nmax_acceleration = [1e7, 100, 100, 100, 100, 100]",
-                )
+                with_robot_line(c, "max_acceleration = [1e7, 100, 100, 100, 100, 100]")
             }))
         },
         says: &[
