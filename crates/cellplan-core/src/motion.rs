@@ -68,34 +68,12 @@ pub fn plan_leg(
     to: &[f64],
     settings: &PlanSettings,
 ) -> Result<PlannedPath, PlanError> {
-    plan_leg_with_margin(
-        cell,
-        robot,
-        from,
-        to,
-        cell.planning.clearance,
-        settings,
-        (None, Variants::InTurn),
-    )
+    plan_leg_with_margin(cell, robot, from, to, cell.planning.clearance, settings, None)
 }
 
 /// How far (m) a leg the sampler cannot solve backs the tool out along its axis at either end
 /// before sampling again, tried in turn.
 pub const RETRACT_DISTANCES: [f64; 2] = [0.1, 0.25];
-
-/// How [`plan_leg_with_margin`] runs the sampler's variants (the direct leg, then each
-/// retract): the answer is the same either way, the first of them, in turn, that succeeds.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Variants {
-    /// One after the other, each only once the one before has failed: for legs that mostly
-    /// succeed directly.
-    InTurn,
-    /// All at once, in parallel: for searches that mostly fail in every variant, as the
-    /// sequencer's full-budget retries do (a trapped end: on dense-8r-250, 33 of 38 direct
-    /// searches fail, and such a search is often the last leg of a robot's sequencing, with
-    /// the other cores idle). The retracts' work is wasted where the direct leg succeeds.
-    AtOnce,
-}
 
 /// The step (m) of the tool along its axis in a retract.
 const RETRACT_STEP: f64 = 0.01;
@@ -123,8 +101,7 @@ pub fn robot_roadmap(cell: &Cell, robot: &Robot, seeds: &[Vec<f64>], seed: u64) 
 /// ([`cellplan_motion::plan::plan_leg_via_with`]). When none of those succeeds and a
 /// `roadmap` of the robot is given (built by [`robot_roadmap`] with the same margin), the
 /// same variants are tried through its shortest valid paths. The first that succeeds is the
-/// leg; `variants` says whether the sampler's are run in turn or at once (the same leg). The
-/// roadmap is asked for lazily (built on first need).
+/// leg. The roadmap is asked for lazily (built on first need).
 pub fn plan_leg_with_margin<'r>(
     cell: &Cell,
     robot: &Robot,
@@ -132,7 +109,7 @@ pub fn plan_leg_with_margin<'r>(
     to: &[f64],
     margin: f64,
     settings: &PlanSettings,
-    (roadmap, variants): (Option<&dyn Fn() -> &'r SharedRoadmap>, Variants),
+    roadmap: Option<&dyn Fn() -> &'r SharedRoadmap>,
 ) -> Result<PlannedPath, PlanError> {
     let space = joint_space(cell, robot);
     let validity = robot_validity(cell, robot, margin);
@@ -163,38 +140,16 @@ pub fn plan_leg_with_margin<'r>(
         }),
     };
     let (mut samples, mut calls) = (0, 0);
-    // The sampler's variants at once when asked (see [`Variants::AtOnce`]); taken in turn below.
-    let at_once = (variants == Variants::AtOnce).then(|| {
-        use rayon::prelude::*;
-        let retracts = retracted();
-        let (direct, via) = rayon::join(
-            || sampler(from, to),
-            || {
-                retracts
-                    .par_iter()
-                    .map(|(exit, entry)| {
-                        plan::plan_leg_via_with(&space, &validity, exit, entry, settings, &sampler)
-                    })
-                    .collect::<Vec<_>>()
-            },
-        );
-        std::iter::once(direct).chain(via)
-    });
     // Every variant with the sampler first (the legs it solves keep its paths), then every
     // variant through the roadmap: the direct leg, then each retract.
     let passes: [&plan::LegPlanner; 2] = [&sampler, &through_roadmap];
-    let mut at_once = at_once.into_iter();
     for middle in passes.into_iter().take(if roadmap.is_some() { 2 } else { 1 }) {
         let direct = std::iter::once_with(|| middle(from, to));
         // Lazy: the retracts are made only when the direct leg has failed.
         let via = std::iter::once_with(retracted)
             .flatten()
             .map(|(exit, entry)| plan::plan_leg_via_with(&space, &validity, exit, entry, settings, middle));
-        let in_turn: Box<dyn Iterator<Item = Result<PlannedPath, PlanError>>> = match at_once.next() {
-            Some(done) => Box::new(done),
-            None => Box::new(direct.chain(via)),
-        };
-        for (k, result) in in_turn.enumerate() {
+        for (k, result) in direct.chain(via).enumerate() {
             match result {
                 Ok(mut path) => {
                     path.samples += samples;

@@ -713,17 +713,10 @@ pub fn coordinate(
     );
     // One context for all of them: the robots' checkers are built once.
     let ctx = crate::coord::Ctx::new(cell, table, &blending, None);
-    // Each blended on its own (in parallel), then compared in turn.
-    let candidates: Vec<Tried> = candidates.collect();
-    let blended = candidates.len();
-    let candidates = {
-        use rayon::prelude::*;
-        candidates
-            .into_par_iter()
-            .map(|(o, s, c)| Ok((o, s, crate::coord::blend::blend_with(&ctx, c)?)))
-            .collect::<Result<Vec<Tried>, PlanError>>()?
-    };
+    let mut blended = 0;
     for (o, s, c) in candidates {
+        blended += 1;
+        let c = crate::coord::blend::blend_with(&ctx, c)?;
         if chosen
             .as_ref()
             .is_none_or(|b| cycle_and_delta(&c.timed) < cycle_and_delta(&b.2.timed))

@@ -3,7 +3,7 @@
 //! every path re-checked densely (1 mm Cartesian steps) with `Robot::contact_at`.
 use cellplan_core::candidates::generate;
 use cellplan_core::motion::{
-    RobotValidity, Variants, joint_space, plan_leg, plan_leg_with_margin, robot_roadmap, robot_validity,
+    RobotValidity, joint_space, plan_leg, plan_leg_with_margin, robot_roadmap, robot_validity,
 };
 use cellplan_model::robot::Scratch;
 use cellplan_model::{Cell, LoadOptions, Robot, TaskId};
@@ -274,8 +274,7 @@ fn blocked_leg_is_solved_by_rrt_connect() {
 /// blocked) is found through the robot's shared roadmap, passes the dense re-check, and is the
 /// same from a fresh roadmap as from one that other legs have used (their edge checks cached)
 /// — the roadmap's answers do not depend on which legs were asked before, on which thread. The
-/// cell's leg planner with the roadmap gives a valid leg too, the same one (and the same
-/// counts) with the sampler's variants run at once as in turn.
+/// cell's leg planner with the roadmap gives a valid leg too.
 #[test]
 fn a_leg_the_sampler_gives_up_on_goes_through_the_roadmap() {
     use cellplan_motion::plan::{plan_leg as sample_leg, roadmap_leg};
@@ -316,33 +315,9 @@ fn a_leg_the_sampler_gives_up_on_goes_through_the_roadmap() {
             let again = roadmap_leg(&space, &v, &cold, &robot.home, goal, &s).unwrap();
             assert_eq!(again.waypoints, path.waypoints);
             let get = || &warm;
-            let leg = plan_leg_with_margin(
-                cell,
-                robot,
-                &robot.home,
-                goal,
-                margin(cell),
-                &s,
-                (Some(&get), Variants::InTurn),
-            )
-            .unwrap();
+            let leg =
+                plan_leg_with_margin(cell, robot, &robot.home, goal, margin(cell), &s, Some(&get)).unwrap();
             dense_contact_free(cell, robot, &leg.waypoints).unwrap();
-            // The sampler's variants run at once give the same leg, with the same counts.
-            let at_once = plan_leg_with_margin(
-                cell,
-                robot,
-                &robot.home,
-                goal,
-                margin(cell),
-                &s,
-                (Some(&get), Variants::AtOnce),
-            )
-            .unwrap();
-            assert_eq!(at_once.waypoints, leg.waypoints);
-            assert_eq!(
-                (at_once.samples, at_once.validity_calls),
-                (leg.samples, leg.validity_calls)
-            );
             solved += 1;
         }
     }

@@ -280,27 +280,19 @@ pub(crate) fn blend_all(
     let mut order: Vec<usize> = (0..programs.len()).collect();
     order.sort_by(|&x, &y| timed[y].end().total_cmp(&timed[x].end()).then(x.cmp(&y)));
     let all: Vec<usize> = (0..programs.len()).collect();
-    // Each robot's legs straightened and blended, then blended only (when straightening
-    // changed a leg): a robot's own program alone decides them, so all robots at once. (The
-    // plain blend first, so that the straightened program takes the legs straightening
-    // leaves alone from it.)
-    let blends = {
-        use rayon::prelude::*;
-        programs
-            .par_iter()
-            .map(|prog| {
-                let plain = blended_program(ctx, prog, deviation, None)?;
-                let straight =
-                    blended_program(ctx, prog, deviation, Some(plain.as_ref().map_or(prog, |p| &p.0)))?;
-                Ok((plain, straight))
-            })
-            .collect::<Result<Vec<_>, PlanError>>()?
-    };
-    let mut blends: Vec<_> = blends.into_iter().map(Some).collect();
     let mut blended_corners = 0;
     for r in order {
-        // Each variant with its waits as long as they were, then ending when they ended.
-        let (plain, straight) = blends[r].take().expect("each robot once");
+        // The legs straightened and blended, then blended only (when straightening changed
+        // a leg); each with its waits as long as they were, then ending when they ended.
+        // (The plain blend first, so that the straightened program takes the legs
+        // straightening leaves alone from it.)
+        let plain = blended_program(ctx, &programs[r], deviation, None)?;
+        let straight = blended_program(
+            ctx,
+            &programs[r],
+            deviation,
+            Some(plain.as_ref().map_or(&programs[r], |p| &p.0)),
+        )?;
         let mut variants = Vec::new();
         if let Some((p, corners, straightened)) = straight
             && straightened > 0

@@ -197,17 +197,6 @@ struct Tour {
 }
 
 impl Tour {
-    /// Every robot's tour ([`Tour::new`]), the robots in parallel (each tour is its own
-    /// search: the same tours on any number of threads).
-    fn all(graphs: &[RobotGraph], tasks: &[Vec<TaskId>], seed: u64) -> Vec<Tour> {
-        use rayon::prelude::*;
-        graphs
-            .par_iter()
-            .zip(tasks)
-            .map(|(graph, tasks)| Tour::new(graph, tasks, seed))
-            .collect()
-    }
-
     fn new(graph: &RobotGraph, tasks: &[TaskId], seed: u64) -> Tour {
         // Long tours get fewer kicks: the work per kick grows with the tour.
         let kicks = (ZONE_TOUR_WORK / (tasks.len() + 1)).clamp(20, ZONE_TOUR_ITERATIONS);
@@ -311,7 +300,7 @@ fn zones(
     let seed = settings.seed;
     let pen = |t: TaskId, r: usize| penalty(settings, t, r);
     let load = |r: usize, tasks: &[TaskId]| load(settings, r, tasks);
-    let mut tours = Tour::all(graphs, tasks, seed);
+    let mut tours: Vec<Tour> = (0..m).map(|r| Tour::new(&graphs[r], &tasks[r], seed)).collect();
     let sorted = |times: &[f64]| {
         let mut v = times.to_vec();
         v.sort_by(|a, b| b.total_cmp(a));
@@ -377,7 +366,9 @@ fn zones(
                 break;
             }
             (since, edited) = (0, false);
-            tours = Tour::all(graphs, tasks, seed);
+            for r in 0..m {
+                tours[r] = Tour::new(&graphs[r], &tasks[r], seed);
+            }
             continue;
         };
         hand_over(graphs, tasks, &mut tours, (from, to, TaskId(t)), &mut since, seed);
@@ -404,11 +395,8 @@ fn hand_over(
     *since += 1;
     if *since >= ZONE_REOPTIMISE_EVERY {
         *since = 0;
-        let (a, b) = rayon::join(
-            || Tour::new(&graphs[from], &tasks[from], seed),
-            || Tour::new(&graphs[to], &tasks[to], seed),
-        );
-        (tours[from], tours[to]) = (a, b);
+        tours[from] = Tour::new(&graphs[from], &tasks[from], seed);
+        tours[to] = Tour::new(&graphs[to], &tasks[to], seed);
     }
 }
 

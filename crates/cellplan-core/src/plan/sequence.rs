@@ -491,15 +491,7 @@ fn plan_leg(
             &graph.q[b],
             cell.planning.clearance,
             &motion,
-            (
-                settings.roadmap.then_some(&roadmap as &dyn Fn() -> _),
-                // The full-budget retries mostly fail in every variant (see `Variants::AtOnce`).
-                if settings.motion.max_samples >= settings.final_max_samples {
-                    crate::motion::Variants::AtOnce
-                } else {
-                    crate::motion::Variants::InTurn
-                },
-            ),
+            settings.roadmap.then_some(&roadmap as &dyn Fn() -> _),
         )?;
         let timed = time_path_exact(&path.waypoints, &graph.limits)?;
         Ok(Leg {

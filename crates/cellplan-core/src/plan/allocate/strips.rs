@@ -89,7 +89,7 @@ pub(super) fn strips(
     let pen = |t: TaskId, r: usize| penalty(settings, t, r);
     let load = |r: usize, tasks: &[TaskId]| load(settings, r, tasks);
     let seed = settings.seed;
-    let mut tours = Tour::all(graphs, tasks, seed);
+    let mut tours: Vec<Tour> = (0..m).map(|r| Tour::new(&graphs[r], &tasks[r], seed)).collect();
     let mut since = 0;
     let mut work = 0usize;
     for _ in 0..4 * n {
