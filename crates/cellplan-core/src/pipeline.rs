@@ -186,31 +186,23 @@ fn plan_try(
     table: &CandidateTable,
     more: &PlanSettings,
     cache: &mut plan::PlanCache,
-    bar: f64,
 ) -> Option<Outcome> {
-    let planned = if more.allocation == Allocation::Balanced {
-        plan::plan_below(cell, table, more, &|_| {}, &mut cache.graphs_only(), None, bar)
+    if more.allocation == Allocation::Balanced {
+        plan::plan_cached(cell, table, more, &|_| {}, &mut cache.graphs_only()).ok()
     } else {
-        plan::plan_below(cell, table, more, &|_| {}, cache, None, bar)
-    };
-    planned.ok().flatten()
+        plan::plan_cached(cell, table, more, &|_| {}, cache).ok()
+    }
 }
 
 /// After the strips planned with `more` (as `o`), the strips once more, each robot's estimates
 /// raised by what its legs took beyond their lower bounds in `o`; `None` after any other try.
 fn strips_again(cell: &Cell, more: &PlanSettings, o: &Outcome) -> Option<Try> {
-    strips_again_after(more).then(|| {
+    (more.sweep.is_some() && more.task_penalty.is_empty()).then(|| {
         Try::Plan(Box::new(PlanSettings {
             task_penalty: slowness_penalty(cell, o),
             ..more.clone()
         }))
     })
-}
-
-/// Whether a try planned with `more` is followed by the strips once more (see
-/// [`strips_again`]).
-fn strips_again_after(more: &PlanSettings) -> bool {
-    more.sweep.is_some() && more.task_penalty.is_empty()
 }
 
 /// Ours plans the balanced (min-max) allocation too on cells of at most this many MPs × robots
@@ -331,10 +323,7 @@ impl RunnersUp {
 /// legs with the others: it is planned and coordinated aside while they are, and judged at
 /// its turn, the last; on cells of more than `plan_first_pairs` it is a try like the others).
 /// A plan whose robots
-/// end no sooner than the best cycle so far even uncoordinated is not coordinated, and a try
-/// planned once there is such a bar (but the strips, whose plan the strips once more need) is
-/// given up as soon as its sequencing shows that it cannot end sooner
-/// ([`plan::plan_below`]); the hand-overs' plans likewise against the cycle to beat. The shortest
+/// end no sooner than the best cycle so far even uncoordinated is not coordinated. The shortest
 /// coordinated cycle (then Δt, then the earlier) wins; then [`plan::rebalance::rebalance`]
 /// hands tasks from the robot that ends last to others, one at a time, each hand-over kept
 /// when its plan, coordinated, ends sooner still, then the reliefs (a task of a robot the
@@ -452,7 +441,7 @@ pub fn coordinate(
                 continue;
             };
             let more = PlanSettings::clone(more);
-            let Some(o) = plan_try(cell, table, &more, cache, f64::INFINITY) else {
+            let Some(o) = plan_try(cell, table, &more, cache) else {
                 continue;
             };
             if let Some(again) = strips_again(cell, &more, &o) {
@@ -508,7 +497,7 @@ pub fn coordinate(
             let (out, aside_cache, diagrams, bar_now) =
                 (&mut aside_run, &mut aside_cache, &diagrams, &bar_now);
             scope.spawn(move |_| {
-                *out = plan_try(cell, table, &more, aside_cache, f64::INFINITY).map(|o| {
+                *out = plan_try(cell, table, &more, aside_cache).map(|o| {
                     let bar = f64::from_bits(bar_now.load(std::sync::atomic::Ordering::Relaxed));
                     let judged = (makespan(&o) < bar)
                         .then(|| coordinate_outcome_cached(cell, table, &o, coord, diagrams));
@@ -551,14 +540,7 @@ pub fn coordinate(
                     (makespan(o) < bar && may)
                         .then(|| coordinate_outcome_cached(cell, table, o, coord, &diagrams))
                 },
-                || {
-                    // A plan that cannot end sooner than the best cycle so far, even without
-                    // coordination, is not coordinated: it is not finished either. (Not the
-                    // strips: the strips once more are made from their plan.)
-                    let more = more.as_ref()?;
-                    let spawns = strips_again_after(more);
-                    plan_try(cell, table, more, cache, if spawns { f64::INFINITY } else { bar })
-                },
+                || plan_try(cell, table, more.as_ref()?, cache),
             );
             if let Some(Ok(c)) = &judged {
                 count(c);

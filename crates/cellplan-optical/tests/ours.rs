@@ -52,45 +52,6 @@ fn a_plan_on_shared_graphs_is_the_plan_made_afresh() {
     }
 }
 
-/// A plan asked to end below a bar (`plan::plan_below`, as ours plans its tries and
-/// hand-overs against the best cycle so far) is given up when it cannot: none for a bar no
-/// robot's work fits under; below a bar it clears, the plan `plan_cached` makes, the same
-/// orders and durations.
-#[test]
-fn a_plan_that_cannot_end_below_its_bar_is_given_up() {
-    use cellplan_core::plan::{self, PlanCache};
-    let f = fixture();
-    let (zones, _, outcome) = zones_plan(f);
-    let makespan = outcome
-        .robots
-        .iter()
-        .map(|r| r.program.duration())
-        .fold(0.0, f64::max);
-    assert!(makespan > 1.0, "{makespan}");
-    let below = |bar: f64| {
-        plan::plan_below(
-            &f.cell,
-            &f.table,
-            &zones,
-            &|_| {},
-            &mut PlanCache::default(),
-            None,
-            bar,
-        )
-        .unwrap()
-    };
-    // Some robot measures for longer than this (one MP's dwell alone).
-    assert!(below(1e-3).is_none());
-    for bar in [2.0 * makespan, f64::INFINITY] {
-        let again = below(bar).expect("a bar the plan clears");
-        assert_eq!(again.robots.len(), outcome.robots.len());
-        for (a, b) in outcome.robots.iter().zip(&again.robots) {
-            assert_eq!(a.sequence.nodes, b.sequence.nodes);
-            assert_eq!(a.program.duration(), b.program.duration());
-        }
-    }
-}
-
 /// Ours (`pipeline::coordinate` with `best` on the zones allocation) keeps the shortest of its
 /// plans: never longer than the zones plan coordinated alone, whichever of its plans wins (the
 /// zones again with the blocking penalties, or the nearest robots), and the plan verifies with

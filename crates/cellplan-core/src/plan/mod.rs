@@ -427,24 +427,6 @@ pub fn plan_keeping(
     cache: &mut PlanCache,
     prior: Option<&Outcome>,
 ) -> Result<Outcome, PlanError> {
-    let o = plan_below(cell, table, settings, progress, cache, prior, f64::INFINITY)?;
-    Ok(o.expect("no bar, so never beaten"))
-}
-
-/// [`plan_keeping`], given up (`None`) as soon as some robot's best order, on the legs planned
-/// so far and the lower bounds of the others, takes at least `bar` (s): a plan that cannot
-/// end sooner than `bar` is not finished (see [`sequence::sequence`]). The legs planned until
-/// then stay in `cache`. (The orders are judged before the final shortcutting of their legs,
-/// which may take a little off: a plan given up can, rarely, have ended just below `bar`.)
-pub fn plan_below(
-    cell: &Cell,
-    table: &CandidateTable,
-    settings: &PlanSettings,
-    progress: &(dyn Fn(Stage) + Sync),
-    cache: &mut PlanCache,
-    prior: Option<&Outcome>,
-    bar: f64,
-) -> Result<Option<Outcome>, PlanError> {
     let started = Instant::now();
     let deadline = settings.deadline.unwrap_or(settings.deadline_from(started));
     let mut compute = Vec::new();
@@ -474,20 +456,17 @@ pub fn plan_below(
     let mut planned: Vec<sequence::Planned> = std::mem::take(&mut cache.planned);
     planned.resize_with(cell.robots.len(), Default::default);
     let mut counts = vec![(0usize, 0usize, 0usize); cell.robots.len()];
-    let sequenced = sequence_all(
+    let mut sequences = sequence_all(
         cell,
         &graphs,
         &allocated.tasks,
         settings,
         deadline,
-        bar,
+        f64::INFINITY,
         &mut planned,
         &mut counts,
-    );
-    let Some(mut sequences) = sequenced? else {
-        cache.planned = planned;
-        return Ok(None);
-    };
+    )?
+    .expect("no bar, so never beaten");
     if settings.allocation == Allocation::Balanced {
         // Re-allocate on what is known now: planned legs at their real time (paper 002's lazy
         // costs, one level up); keep the better plan. An alternative is sequenced only as long
@@ -601,14 +580,14 @@ pub fn plan_below(
         robots.push(result);
     }
     tick(Stage::Timing, &mut compute);
-    Ok(Some(Outcome {
+    Ok(Outcome {
         graphs,
         allocated,
         robots,
         compute,
         unreached,
         time_limit_hit: clock_cut || sequences_cut,
-    }))
+    })
 }
 
 /// Whether an order (`nodes` of `graph`) visits no task of `late` before one that is not.

@@ -16,7 +16,7 @@
 //! to, or the one the robot it waits for is at, left to the end of its robot's tour
 //! ([`PlanSettings::late`]): coordination delays a robot or runs its tour backwards, but cannot
 //! move one visit of it past a neighbour's.
-use super::{Outcome, PlanCache, PlanError, PlanSettings, dwell, plan_below};
+use super::{Outcome, PlanCache, PlanError, PlanSettings, dwell, plan_keeping};
 use crate::candidates::CandidateTable;
 use cellplan_model::Cell;
 use cellplan_model::tasks::TaskId;
@@ -460,12 +460,11 @@ fn reorders(o: &Outcome, end: &[f64], stalls: &[Stall], late: &[TaskId]) -> Vec<
 /// on its real times. Up to [`REBALANCE_PLANS`] times, the best expected hand-over not tried
 /// yet (one task of the robot that ends last as judged to another robot, ranked by the ends it
 /// is expected to give the two) is planned with the allocation fixed ([`PlanSettings::tasks`]),
-/// first with the other robots keeping their programs ([`super::plan_keeping`]), then, when the judge
+/// first with the other robots keeping their programs ([`plan_keeping`]), then, when the judge
 /// does not take that plan, with every robot sequenced anew (each counts as a plan; a plan the
 /// same as the one before is not judged again).
 /// A plan whose robots end, without coordination, sooner than the best score (the judge's
-/// score is never below that end) goes to `judge` (one that cannot is given up as soon as its
-/// sequencing shows it, [`super::plan_below`]), with the hand-over plan it was made from
+/// score is never below that end) goes to `judge`, with the hand-over plan it was made from
 /// and what the judge made of that (`None`: made from `base`) — at most [`REBALANCE_JUDGED`]
 /// plans — while `may_judge` says yes before each plan (the caller's budget of work, asked
 /// with an [`Ask`]: [`Ask::Within`] before a hand-over's plans, [`Ask::Beyond`] before a
@@ -597,9 +596,7 @@ pub fn rebalance<J>(
                     }
                     budget.plans += 1;
                     let prior = if keep { Some(current) } else { None };
-                    // A plan that cannot end sooner than the best score is not judged (below):
-                    // it is not finished either.
-                    let Ok(Some(mut o)) = plan_below(cell, table, &next, &|_| {}, cache, prior, score) else {
+                    let Ok(mut o) = plan_keeping(cell, table, &next, &|_| {}, cache, prior) else {
                         continue;
                     };
                     // The judge's score is never below the robots' latest end without
