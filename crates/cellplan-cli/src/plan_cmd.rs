@@ -78,7 +78,7 @@ pub struct PlanArgs {
     #[arg(long, short)]
     pub quiet: bool,
     /// Print a JSON summary (stable keys: cycle_time_s, delta_t_s, lower_bound_s, robots,
-    /// unmeasured, compute_s).
+    /// unmeasured, idle_robots, compute_s).
     #[arg(long)]
     pub json: bool,
     /// PCB assembly and CMM inspection: the optimiser (`best` ours, `ga` the paper's GA —
@@ -127,6 +127,8 @@ struct Summary<'a> {
     route_bound: Option<RouteBoundSummary>,
     robots: Vec<RobotSummary<'a>>,
     unmeasured: Vec<&'a str>,
+    /// Robots that can do none of the tasks (they stay at home; Δt leaves them out).
+    idle_robots: Vec<&'a str>,
     legs_planned: usize,
     legs_sampled: usize,
     coordination: &'a output::CoordinationOut,
@@ -333,6 +335,7 @@ pub fn run(args: &PlanArgs) -> Result<(), Failure> {
                 })
                 .collect(),
             unmeasured: doc.unmeasured.iter().map(|u| u.task.as_str()).collect(),
+            idle_robots: doc.idle_robots.iter().map(|i| i.robot.as_str()).collect(),
             legs_planned: doc.stats.legs_planned,
             legs_sampled: doc.stats.legs_sampled,
             coordination: &doc.coordination,
@@ -545,6 +548,12 @@ fn render(doc: &output::Plan, working: &str) -> String {
                 s += &format!(" ({d})");
             }
             s += "\n";
+        }
+    }
+    if !doc.idle_robots.is_empty() {
+        s += "\nidle (can do none of the tasks; Δt leaves them out):\n";
+        for i in &doc.idle_robots {
+            s += &format!("  {}: {}\n", i.robot, i.reason);
         }
     }
     s

@@ -88,6 +88,17 @@ pub struct CheckReport {
     pub shared: Vec<Shared>,
     /// Tasks no robot can do, with reasons.
     pub unmeasurable: Vec<Unmeasurable>,
+    /// Robots that can do none of the tasks (they stay at home), with the reason.
+    pub idle: Vec<IdleRobot>,
+}
+
+/// A robot that can do none of the tasks.
+#[derive(Clone, Debug, Serialize)]
+pub struct IdleRobot {
+    /// Robot name.
+    pub robot: String,
+    /// Why ([`idle_reason`]).
+    pub reason: String,
 }
 
 fn names(cell: &Cell, tasks: &[TaskId]) -> Vec<String> {
@@ -174,17 +185,35 @@ pub fn report(cell: &Cell, table: &CandidateTable) -> CheckReport {
         },
         shared,
         unmeasurable,
+        idle: idle_robots(cell, table)
+            .into_iter()
+            .map(|r| IdleRobot {
+                robot: cell.robots[r.0].name.clone(),
+                reason: idle_reason(cell, table, r),
+            })
+            .collect(),
     }
 }
 
-/// A robot that can do no task at all is a mistake in the cell, not a result: the error points
-/// at its base.
-pub fn idle_robot_error(cell: &Cell, table: &CandidateTable) -> Option<InputError> {
-    let robot = cell.robots.iter().find(|r| {
-        cell.tasks
-            .iter()
-            .all(|t| table.get(t.id, r.id).candidates.is_empty())
-    })?;
+/// The robots that can do none of the cell's tasks, in cell order. Such a robot stays at home:
+/// a plan has no work for it, and Δt leaves it out ([`balance_spread`]).
+pub fn idle_robots(cell: &Cell, table: &CandidateTable) -> Vec<RobotId> {
+    cell.robots
+        .iter()
+        .filter(|r| {
+            cell.tasks
+                .iter()
+                .all(|t| table.get(t.id, r.id).candidates.is_empty())
+        })
+        .map(|r| r.id)
+        .collect()
+}
+
+/// Why `robot` can do none of the tasks, for people: the rejections counted, the nearest task
+/// and the robot's reach ("2 × out of reach (no IK solution); the nearest task is 4108 mm away
+/// and its reach is at most 4527 mm").
+pub fn idle_reason(cell: &Cell, table: &CandidateTable, robot: RobotId) -> String {
+    let robot = &cell.robots[robot.0];
     let nearest = cell
         .tasks
         .iter()
@@ -203,20 +232,75 @@ pub fn idle_robot_error(cell: &Cell, table: &CandidateTable) -> Option<InputErro
         .collect();
     let unit = cell.units.length.to_m();
     let unit_name = if unit == 1.0 { "m" } else { "mm" };
+    format!(
+        "{}; the nearest task is {:.0} {unit_name} away and its reach is at most {:.0} {unit_name}",
+        why.join(", "),
+        nearest / unit,
+        robot.reach / unit,
+    )
+}
+
+/// Δt of robots ending at `ends` (cell order): the latest end less the earliest, over the
+/// robots that can do some task (`idle` lists the others, as [`idle_robots`] gives them; a
+/// robot that can do a task but was given none counts, at its end). 0 when every robot is
+/// idle.
+pub fn balance_spread(ends: &[f64], idle: &[RobotId]) -> f64 {
+    let working = ends
+        .iter()
+        .enumerate()
+        .filter(|(r, _)| !idle.contains(&RobotId(*r)))
+        .map(|(_, &e)| e);
+    let hi = working.clone().fold(f64::NEG_INFINITY, f64::max);
+    let lo = working.fold(f64::INFINITY, f64::min);
+    if hi.is_finite() && lo.is_finite() {
+        (hi - lo).max(0.0)
+    } else {
+        0.0
+    }
+}
+
+/// A cell none of whose robots can do any task is a mistake in the cell, not a result: the
+/// error points at the first robot's base. (A robot that can do none while others can is
+/// planned idle at home, and `check` and `plan` say so: a task file may hold only some of the
+/// part's tasks.)
+pub fn idle_robot_error(cell: &Cell, table: &CandidateTable) -> Option<InputError> {
+    let idle = idle_robots(cell, table);
+    if idle.len() < cell.robots.len() || cell.tasks.is_empty() {
+        return None;
+    }
+    let robot = &cell.robots[idle.first()?.0];
     Some(
         cell.error_at_robot_base(
             robot.id,
             format!(
-                "robot `{}` can do none of the {} tasks from this base ({}); the nearest task is {:.0} {unit_name} away and its reach is at most {:.0} {unit_name}",
-                robot.name,
+                "no robot can do any of the {} tasks: robot `{}` can do none from this base ({})",
                 cell.tasks.len(),
-                why.join(", "),
-                nearest / unit,
-                robot.reach / unit,
+                robot.name,
+                idle_reason(cell, table, robot.id),
             ),
         )
-        .hint("move the robot's `base` towards the part (or remove the robot)"),
+        .hint("move the robots' `base` towards the part (or check the tasks' positions and units)"),
     )
+}
+
+/// The warning for robots that can do none of the tasks (`None` when every robot can do some):
+/// each one's name and why, one per line.
+pub fn idle_robot_warning(cell: &Cell, table: &CandidateTable) -> Option<String> {
+    let idle = idle_robots(cell, table);
+    if idle.is_empty() || idle.len() == cell.robots.len() {
+        return None;
+    }
+    let mut s = String::new();
+    for r in idle {
+        let _ = writeln!(
+            s,
+            "robot `{}` can do none of the {} tasks and stays at home ({}); if it should work, move its `base` towards the part",
+            cell.robots[r.0].name,
+            cell.tasks.len(),
+            idle_reason(cell, table, r)
+        );
+    }
+    Some(s)
 }
 
 /// Task caps that cannot hold every task some robot can do are a mistake in the cell: the same
@@ -368,6 +452,13 @@ pub fn render_text(cell: &Cell, table: &CandidateTable, r: &CheckReport) -> Stri
                 .collect();
             let _ = writeln!(s, "  {}  {}", u.task, parts.join(", "));
         }
+    }
+    for i in &r.idle {
+        let _ = writeln!(
+            s,
+            "robot `{}` can do none of the tasks: it stays at home ({})",
+            i.robot, i.reason
+        );
     }
     s
 }

@@ -31,7 +31,30 @@ pub(super) fn check(
     let mut totals = |detail: String| out.push(Violation::plan(ViolationKind::Totals, detail));
     settings(cell, plan, &mut totals);
     let cycle = times.iter().copied().fold(0.0, f64::max);
-    let delta = cycle - times.iter().copied().fold(f64::INFINITY, f64::min).min(cycle);
+    // Δt over the robots that can do some task: the others stay at home, and the plan names
+    // them with the reason `check` gives.
+    let idle: Vec<bool> = cell
+        .robots
+        .iter()
+        .map(|r| {
+            cell.tasks
+                .iter()
+                .all(|t| table.get(t.id, r.id).candidates.is_empty())
+        })
+        .collect();
+    idle_robots(cell, table, plan, &idle, &mut totals);
+    let working = times
+        .iter()
+        .zip(&idle)
+        .filter(|(_, idle)| !**idle)
+        .map(|(t, _)| *t);
+    let shortest = working.clone().fold(f64::INFINITY, f64::min);
+    let longest = working.fold(f64::NEG_INFINITY, f64::max);
+    let delta = if shortest.is_finite() {
+        (longest - shortest).max(0.0)
+    } else {
+        0.0
+    };
     if (plan.cycle_time_s - cycle).abs() > 1e-6 || (plan.delta_t_s - delta).abs() > 1e-6 {
         totals(format!(
             "states cycle time {:.6} s and Δt {:.6} s; recomputed {cycle:.6} s and {delta:.6} s",
@@ -48,6 +71,67 @@ pub(super) fn check(
     }
     coordination(plan, robots, out);
     (cycle, delta)
+}
+
+/// The robots the plan says can do no task: exactly those whose every task has no candidate
+/// (`idle`, cell order), each with the reason `check` gives.
+fn idle_robots(
+    cell: &Cell,
+    table: &CandidateTable,
+    plan: &Plan,
+    idle: &[bool],
+    totals: &mut dyn FnMut(String),
+) {
+    let derived: Vec<(String, String)> = cell
+        .robots
+        .iter()
+        .zip(idle)
+        .filter(|(_, idle)| **idle)
+        .map(|(r, _)| {
+            (
+                r.name.clone(),
+                cellplan_core::check::idle_reason(cell, table, r.id),
+            )
+        })
+        .collect();
+    let stated: Vec<(String, String)> = plan
+        .idle_robots
+        .iter()
+        .map(|i| (i.robot.clone(), i.reason.clone()))
+        .collect();
+    if stated != derived {
+        let names = |v: &[(String, String)]| {
+            let n: Vec<&str> = v.iter().map(|(r, _)| r.as_str()).collect();
+            if n.is_empty() {
+                "none".to_string()
+            } else {
+                n.join(", ")
+            }
+        };
+        totals(format!(
+            "states the robots that can do no task as {} ({:?}); the cell's are {} ({:?})",
+            names(&stated),
+            stated.iter().map(|(_, w)| w).collect::<Vec<_>>(),
+            names(&derived),
+            derived.iter().map(|(_, w)| w).collect::<Vec<_>>(),
+        ));
+    }
+    // A robot that can do nothing has nothing to do.
+    for ((r, p), _) in cell
+        .robots
+        .iter()
+        .zip(&plan.robots)
+        .zip(idle)
+        .filter(|(_, idle)| **idle)
+    {
+        if !p.tasks.is_empty() {
+            totals(format!(
+                "robot {} can do none of the tasks but is given {}",
+                r.name,
+                p.tasks.len()
+            ));
+        }
+    }
 }
 
 /// The settings the cell fixes: clearance, task cap, balance limit, the process.

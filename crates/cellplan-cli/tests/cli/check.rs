@@ -210,8 +210,9 @@ fn missing_mesh_file_names_the_cell_line() {
     refused(&dir, &dir, "cell.toml", Some(28), "nowhere.obj");
 }
 
+/// A cell none of whose robots can do a task is refused at the first robot's base.
 #[test]
-fn robot_that_reaches_nothing_is_refused_at_its_base() {
+fn cell_whose_robots_reach_nothing_is_refused_at_a_base() {
     let dir = scratch("far");
     let (cell, _) = small_cell(&dir);
     std::fs::write(
@@ -219,7 +220,14 @@ fn robot_that_reaches_nothing_is_refused_at_its_base() {
         cell.replace("base = { xyz = [0, 0, 0] }", "base = { xyz = [-20000, 0, 0] }"),
     )
     .unwrap();
-    refused(&dir, &dir, "cell.toml", Some(22), "can do none of the 3 tasks");
+    let err = refused(
+        &dir,
+        &dir,
+        "cell.toml",
+        Some(22),
+        "no robot can do any of the 3 tasks",
+    );
+    assert!(err.contains("robot `R1` can do none from this base"), "{err}");
 }
 
 #[test]

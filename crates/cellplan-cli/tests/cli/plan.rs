@@ -111,6 +111,83 @@ fn plan_writes_a_plan_and_a_stable_summary() {
     assert!(err.contains("broken.json") && err.contains("help:"), "{err}");
 }
 
+/// A robot that can do none of the tasks (a task file holding only some of the part's MPs,
+/// or a base placed far off) is planned idle at home, not refused: `check` and `plan` name it
+/// with the reason, Δt leaves it out, and the verifier derives both again.
+#[test]
+fn a_robot_that_reaches_no_task_stays_home_and_is_left_out_of_delta_t() {
+    let dir = scratch("idle-robot");
+    let (cell, _) = small_cell(&dir);
+    let far = cell
+        .split("[[objects]]")
+        .next()
+        .unwrap()
+        .split("[[robots]]")
+        .nth(1)
+        .unwrap()
+        .replace("\"R1\"", "\"R2\"")
+        .replace("base = { xyz = [0, 0, 0] }", "base = { xyz = [-20000, 0, 0] }");
+    let two = cell.replace("[[objects]]", &format!("[[robots]]{far}[[objects]]"));
+    std::fs::write(dir.join("cell.toml"), &two).unwrap();
+    let cell = dir.join("cell.toml");
+    let check = json_ok(&["check", cell.to_str().unwrap(), "--json"], &dir);
+    assert_eq!(check["idle"][0]["robot"], "R2", "{check}");
+    assert!(
+        check["idle"][0]["reason"]
+            .as_str()
+            .unwrap()
+            .contains("the nearest task is"),
+        "{check}"
+    );
+    assert_eq!(check["idle"].as_array().unwrap().len(), 1);
+    let out_dir = dir.join("out");
+    let out = cellplan(
+        &["plan", cell.to_str().unwrap(), "-o", out_dir.to_str().unwrap()],
+        &dir,
+    );
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{text}{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(
+        text.contains("idle (can do none of the tasks") && text.contains("  R2: "),
+        "{text}"
+    );
+    let file = out_dir.join("plan.json");
+    let plan: Value = serde_json::from_str(&std::fs::read_to_string(&file).unwrap()).unwrap();
+    assert_eq!(plan["verified"], true);
+    assert_eq!(plan["idle_robots"][0]["robot"], "R2");
+    assert_eq!(plan["robots"][1]["tasks"].as_array().unwrap().len(), 0);
+    assert_eq!(plan["robots"][0]["tasks"].as_array().unwrap().len(), 3);
+    // One robot works: nothing to spread (counted, the idle robot would make Δt the cycle).
+    assert!(plan["cycle_time_s"].as_f64().unwrap() > 1.0);
+    assert_eq!(plan["delta_t_s"], 0.0);
+    let verdict = |file: &std::path::Path| -> Value {
+        let out = cellplan(
+            &["verify", file.to_str().unwrap(), cell.to_str().unwrap(), "--json"],
+            &dir,
+        );
+        serde_json::from_slice(&out.stdout).unwrap()
+    };
+    assert_eq!(verdict(&file)["ok"], true);
+    // Without its idle robot, or with Δt counting it, the plan is refused.
+    for (key, value) in [
+        ("idle_robots", Value::Array(Vec::new())),
+        ("delta_t_s", plan["cycle_time_s"].clone()),
+    ] {
+        let mut broken = plan.clone();
+        broken[key] = value;
+        let bad = dir.join("broken.json");
+        std::fs::write(&bad, serde_json::to_string(&broken).unwrap()).unwrap();
+        let v = verdict(&bad);
+        assert_eq!(v["ok"], false, "{key}: {v}");
+        assert_eq!(v["violations"][0]["kind"], "totals", "{key}: {v}");
+    }
+}
+
 #[test]
 fn plan_refuses_caps_that_cannot_hold_the_tasks() {
     let dir = scratch("plan-cap");

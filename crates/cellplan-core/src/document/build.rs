@@ -1,17 +1,17 @@
 //! The document from a run: per robot its visits, legs, waits and trajectory; the totals; the
 //! coordination record; the unmeasured tasks; the search's counts and times.
 use super::{
-    ActivityOut, BlendOut, ComputeTimes, ConflictOut, CoordinationOut, FORMAT, LegOut, PROBE_TRACK_DT, Plan,
-    PoseOut, ProbeTrack, RobotPlan, RouteBoundOut, RouteBoundRun, Sample, SettingsOut, Stats, UnmeasuredTask,
-    VERSION, Visit, WaitOut,
+    ActivityOut, BlendOut, ComputeTimes, ConflictOut, CoordinationOut, FORMAT, IdleRobotOut, LegOut,
+    PROBE_TRACK_DT, Plan, PoseOut, ProbeTrack, RobotPlan, RouteBoundOut, RouteBoundRun, Sample, SettingsOut,
+    Stats, UnmeasuredTask, VERSION, Visit, WaitOut,
 };
 use crate::candidates::CandidateTable;
 use crate::coord::{Activity, Conflict, Coordinated, Program, Timed};
 use crate::plan::{self, Outcome, PlanSettings, Stage};
-use cellplan_model::Cell;
 use cellplan_model::Process;
 use cellplan_model::robot::Robot;
 use cellplan_model::tasks::TaskId;
+use cellplan_model::{Cell, RobotId};
 
 /// Build the document from a run and its coordination.
 pub fn build(
@@ -37,7 +37,8 @@ pub fn build(
             )
         })
         .collect();
-    let (cycle, delta) = cycle_and_delta(&robots);
+    let idle = crate::check::idle_robots(cell, table);
+    let (cycle, delta) = cycle_and_delta(&robots, &idle);
     // The bound holds for the tasks the plan does: the ones given up are left out of it.
     let left_out: Vec<TaskId> = outcome.unreached.iter().map(|(t, _)| *t).collect();
     let lb = if left_out.is_empty() {
@@ -83,6 +84,13 @@ pub fn build(
         coordination: coordination_out(cell, outcome, coordinated),
         robots,
         unmeasured: unmeasured(cell, table, &outcome.unreached),
+        idle_robots: idle
+            .iter()
+            .map(|&r| IdleRobotOut {
+                robot: cell.robots[r.0].name.clone(),
+                reason: crate::check::idle_reason(cell, table, r),
+            })
+            .collect(),
         stats: Stats {
             time_limit_hit: outcome.time_limit_hit || clock_cut,
             route_bound: route_run,
@@ -102,10 +110,10 @@ pub fn ratio(cycle: f64, lower_bound: f64) -> f64 {
 }
 
 /// The cycle time (longest robot time) and Δt (longest minus shortest).
-fn cycle_and_delta(robots: &[RobotPlan]) -> (f64, f64) {
-    let cycle = robots.iter().map(|r| r.total_s).fold(0.0, f64::max);
-    let shortest = robots.iter().map(|r| r.total_s).fold(f64::INFINITY, f64::min);
-    (cycle, cycle - shortest.min(cycle))
+fn cycle_and_delta(robots: &[RobotPlan], idle: &[RobotId]) -> (f64, f64) {
+    let totals: Vec<f64> = robots.iter().map(|r| r.total_s).collect();
+    let cycle = totals.iter().copied().fold(0.0, f64::max);
+    (cycle, crate::check::balance_spread(&totals, idle))
 }
 
 /// One robot's visits, legs, waits, totals and sampled trajectory.

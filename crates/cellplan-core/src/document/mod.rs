@@ -39,7 +39,8 @@ pub struct Plan {
     pub settings: SettingsOut,
     /// The longest robot time (s).
     pub cycle_time_s: f64,
-    /// Largest difference between robot times (s).
+    /// Δt: the largest difference between the times of the robots that can do some task (s;
+    /// the robots of `idle_robots` are left out).
     pub delta_t_s: f64,
     /// A lower bound of the cycle time over the candidates the planner considered (s): the
     /// min-max bound of paper 000's allocation problem on lower-bound move times, over the
@@ -60,6 +61,10 @@ pub struct Plan {
     pub robots: Vec<RobotPlan>,
     /// Tasks no robot can do, with the reason.
     pub unmeasured: Vec<UnmeasuredTask>,
+    /// Robots that can do none of the tasks, with the reason: they stay at home, and Δt leaves
+    /// them out (absent when every robot can do some task).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub idle_robots: Vec<IdleRobotOut>,
     /// Counts of the search (not claims about the plan; `candidates` is checked).
     pub stats: Stats,
     /// Wall-clock seconds per stage.
@@ -514,6 +519,16 @@ pub struct UnmeasuredTask {
     /// The planner's words for `no-path` (which leg, why); absent otherwise.
     #[serde(default)]
     pub detail: Option<String>,
+}
+
+/// A robot that can do none of the tasks.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct IdleRobotOut {
+    /// Robot name.
+    pub robot: String,
+    /// Why, for people: its rejections counted, the nearest task and its reach.
+    pub reason: String,
 }
 
 /// The reason of a task robots can reach but were given no path to.

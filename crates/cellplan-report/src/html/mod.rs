@@ -483,7 +483,8 @@ fn wait_table(plan: &Plan) -> Markup {
     }
 }
 
-/// The MPs no robot measures, with the furthest check any probe pose passed.
+/// The MPs no robot measures, with the furthest check any probe pose passed; the robots that
+/// can measure none.
 fn unmeasured_section(plan: &Plan) -> Markup {
     html! {
         @if !plan.unmeasured.is_empty() {
@@ -493,6 +494,18 @@ fn unmeasured_section(plan: &Plan) -> Markup {
                     tr { th { "MP" } th class="text" { "furthest check any probe pose passed" } }
                     @for u in &plan.unmeasured {
                         tr { td { (u.task) } td class="text" { (u.reason) } }
+                    }
+                }
+            }
+        }
+        @if !plan.idle_robots.is_empty() {
+            section id="idle" {
+                h2 { "Idle robots" }
+                p { "These robots can do none of the MPs: they stay at home, and Δt leaves them out." }
+                table {
+                    tr { th { "robot" } th class="text" { "why" } }
+                    @for i in &plan.idle_robots {
+                        tr { td { (i.robot) } td class="text" { (i.reason) } }
                     }
                 }
             }

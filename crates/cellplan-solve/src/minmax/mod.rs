@@ -364,14 +364,27 @@ fn is_balanced(p: &MinMaxProblem, times: &[f64]) -> bool {
     violation(p, times) <= 1e-9
 }
 
-/// How far the spread of `times` exceeds the balance limit (0 without one).
+/// How far the spread of `times` exceeds the balance limit (0 without one). A vehicle that can
+/// do none of the tasks (its route is empty in every solution) is left out of the spread.
 pub(crate) fn violation(p: &MinMaxProblem, times: &[f64]) -> f64 {
     match p.balance_limit {
         None => 0.0,
         Some(g) => {
-            let hi = times.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-            let lo = times.iter().copied().fold(f64::INFINITY, f64::min);
-            (hi - lo - g).max(0.0)
+            // Only an empty route (time 0) asks whether its vehicle could do anything.
+            let counts = |v: usize| {
+                times[v] > 0.0
+                    || p.vehicles
+                        .get(v)
+                        .is_none_or(|x| x.alternatives.iter().any(|a| !a.is_empty()))
+            };
+            let spread = (0..times.len()).filter(|&v| counts(v)).map(|v| times[v]);
+            let hi = spread.clone().fold(f64::NEG_INFINITY, f64::max);
+            let lo = spread.fold(f64::INFINITY, f64::min);
+            if hi.is_finite() {
+                (hi - lo - g).max(0.0)
+            } else {
+                0.0
+            }
         }
     }
 }

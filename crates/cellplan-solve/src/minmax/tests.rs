@@ -190,6 +190,37 @@ fn balance_limit_is_reported() {
 }
 
 #[test]
+fn a_vehicle_that_can_do_nothing_is_left_out_of_the_balance() {
+    let mut p = generate(3, 20, (1, 3), 4);
+    let free = solve(&p, &params(MinMaxMethod::Ils, 0, 20));
+    let times = free.routes.times(&p);
+    let (hi, lo) = (
+        times.iter().copied().fold(0.0, f64::max),
+        times.iter().copied().fold(f64::INFINITY, f64::min),
+    );
+    // Counted at its empty route's 0 s, the idle vehicle would break the limit.
+    assert!(lo > 1.0, "every working route lasts more than the margin");
+    p.balance_limit = Some(hi - lo + 1.0);
+    let idle = Vehicle {
+        costs: p.vehicles[0].costs.clone(),
+        depot: p.vehicles[0].depot,
+        cap: 20,
+        alternatives: vec![Vec::new(); 20],
+    };
+    p.vehicles.push(idle);
+    p.validate().unwrap();
+    let sol = solve(&p, &params(MinMaxMethod::Ils, 0, 20));
+    sol.routes.check(&p).unwrap();
+    assert!(sol.balanced);
+    // A vehicle that could work but is given nothing still counts.
+    let mut q = p.clone();
+    q.vehicles[3].alternatives = p.vehicles[0].alternatives.clone();
+    q.validate().unwrap();
+    assert!(super::violation(&q, &[hi, lo, lo, 0.0]) > 0.0);
+    assert_eq!(super::violation(&p, &[hi, lo, lo, 0.0]), 0.0);
+}
+
+#[test]
 fn validation_rejects_bad_problems() {
     let costs = CostMatrix::from_fn(3, |i, j| i.abs_diff(j) as f64);
     let veh = |cap: usize, alts: Vec<Vec<usize>>| Vehicle::new(costs.clone(), 0, cap, alts);
