@@ -1,6 +1,6 @@
 //! The `cellplan check` report: candidates per task and robot, reachability classes, and every
-//! task no robot can do with the reason. Its JSON keys are stable: scripts read `tasks`,
-//! `robots`, `candidates`, `unmeasurable` and `shared`.
+//! task no robot can do with the reason, and every robot that can do none. Its JSON keys are
+//! stable: scripts read `tasks`, `robots`, `candidates`, `unmeasurable`, `shared` and `idle`.
 use crate::candidates::{CandidateTable, Classes, classes};
 use cellplan_model::robot::IkKind;
 use cellplan_model::{Cell, InputError, Rejection, RobotId, TaskId};
