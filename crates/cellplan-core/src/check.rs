@@ -283,26 +283,6 @@ pub fn idle_robot_error(cell: &Cell, table: &CandidateTable) -> Option<InputErro
     )
 }
 
-/// The warning for robots that can do none of the tasks (`None` when every robot can do some):
-/// each one's name and why, one per line.
-pub fn idle_robot_warning(cell: &Cell, table: &CandidateTable) -> Option<String> {
-    let idle = idle_robots(cell, table);
-    if idle.is_empty() || idle.len() == cell.robots.len() {
-        return None;
-    }
-    let mut s = String::new();
-    for r in idle {
-        let _ = writeln!(
-            s,
-            "robot `{}` can do none of the {} tasks and stays at home ({}); if it should work, move its `base` towards the part",
-            cell.robots[r.0].name,
-            cell.tasks.len(),
-            idle_reason(cell, table, r)
-        );
-    }
-    Some(s)
-}
-
 /// Task caps that cannot hold every task some robot can do are a mistake in the cell: the same
 /// test `plan` makes (an assignment of every doable task within the caps), so `check` and `plan`
 /// agree on what they refuse.
