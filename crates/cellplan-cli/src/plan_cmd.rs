@@ -34,7 +34,11 @@ pub struct PlanArgs {
     pub seed: u64,
     /// Wall-clock limit of the whole run in seconds. By default there is none: every search
     /// stops at its work budget, so the plan depends only on the cell and the seed (not on
-    /// the machine or the thread count); when a limit binds, the output says so.
+    /// the machine or the thread count); when a limit binds, the output says so. The limit
+    /// stops the searches (allocation, sequencing rounds, ours' tries and hand-overs, the route
+    /// bound); what a plan needs once one is under way (the legs of its tours, the first
+    /// plan's coordination, the step running when the limit passes, blending and verification)
+    /// still finishes, and the output says by how much the run went past the limit.
     #[arg(long, value_name = "S")]
     pub time_limit: Option<f64>,
     /// ε of paper 000 eq. 4 in metres: MPs closer than this may share a local robust set.
@@ -464,6 +468,14 @@ fn render(doc: &output::Plan, working: &str) -> String {
     }
     if doc.stats.time_limit_hit {
         s += "time limit reached: a search stopped before its work budget, so this plan depends on this machine's speed (a longer --time-limit gives the plan the same input and seed always give)\n";
+        if let Some(limit) = doc.settings.time_limit_s
+            && doc.compute_s.total > limit
+        {
+            s += &format!(
+                "  the run took {:.1} s against the {limit:.1} s limit: what a plan needs once under way (its legs, the first coordination, the step running at the limit, blending, verification) is not cut\n",
+                doc.compute_s.total
+            );
+        }
     }
     s += &format!(
         "legs planned {} ({} by the sampling planner), sequencing rounds {}\n",

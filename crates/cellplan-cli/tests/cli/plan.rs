@@ -65,6 +65,22 @@ fn plan_writes_a_plan_and_a_stable_summary() {
     );
     assert_eq!(cut_summary["time_limit_hit"], true);
     assert_eq!(cut_summary["verified"], true);
+    // In words: the limit bound, and the run went past it by what a plan needs.
+    let text = run_ok(
+        &[
+            "plan",
+            cell.to_str().unwrap(),
+            "-o",
+            dir.join("cut-text").to_str().unwrap(),
+            "--no-report",
+            "--time-limit",
+            "0.000001",
+        ],
+        &dir,
+    );
+    let text = String::from_utf8_lossy(&text.stdout);
+    assert!(text.contains("time limit reached"), "{text}");
+    assert!(text.contains("against the 0.0 s limit"), "{text}");
     // The verifier accepts it (one robot: nothing to coordinate) ...
     let plan_file = out_dir.join("plan.json");
     let out = cellplan(
