@@ -35,10 +35,11 @@ pub struct PlanArgs {
     /// Wall-clock limit of the whole run in seconds. By default there is none: every search
     /// stops at its work budget, so the plan depends only on the cell and the seed (not on
     /// the machine or the thread count); when a limit binds, the output says so. The limit
-    /// stops the searches (allocation, sequencing rounds, ours' tries and hand-overs, the route
-    /// bound); what a plan needs once one is under way (the legs of its tours, the first
-    /// plan's coordination, the step running when the limit passes, blending and verification)
-    /// still finishes, and the output says by how much the run went past the limit.
+    /// stops the searches (allocation, sequencing rounds, the route bound) and gives up the
+    /// plans the run can do without (ours' tries after its first plan, its hand-overs, and
+    /// their coordinations); what the first plan needs (the legs of its tours, its
+    /// coordination), blending and verification still finish, and the output says by how much
+    /// the run went past the limit.
     #[arg(long, value_name = "S")]
     pub time_limit: Option<f64>,
     /// ε of paper 000 eq. 4 in metres: MPs closer than this may share a local robust set.
@@ -472,7 +473,7 @@ fn render(doc: &output::Plan, working: &str) -> String {
             && doc.compute_s.total > limit
         {
             s += &format!(
-                "  the run took {:.1} s against the {limit:.1} s limit: what a plan needs once under way (its legs, the first coordination, the step running at the limit, blending, verification) is not cut\n",
+                "  the run took {:.1} s against the {limit:.1} s limit: what the first plan needs (its legs, its coordination), blending and verification are not cut\n",
                 doc.compute_s.total
             );
         }

@@ -187,6 +187,11 @@ fn plan_try(
     more: &PlanSettings,
     cache: &mut plan::PlanCache,
 ) -> Option<Outcome> {
+    // A try the run can do without: given up at the deadline.
+    let more = &PlanSettings {
+        give_up_at_deadline: true,
+        ..more.clone()
+    };
     if more.allocation == Allocation::Balanced {
         plan::plan_cached(cell, table, more, &|_| {}, &mut cache.graphs_only()).ok()
     } else {
@@ -402,6 +407,18 @@ pub fn coordinate(
         ..coord.clone()
     };
     let coord = if plan_first { &polishing } else { coord };
+    // Past the run's deadline every coordination but the first plan's is given up (the run
+    // needs one plan; the others only compete with it), and the plan says the clock cut it.
+    let cuttable = CoordSettings {
+        deadline: settings.deadline,
+        ..coord.clone()
+    };
+    let clock_stopped = std::sync::atomic::AtomicBool::new(false);
+    let stopped = |r: &Result<Coordinated, PlanError>| {
+        if matches!(r, Err(PlanError::TimeLimit)) {
+            clock_stopped.store(true, std::sync::atomic::Ordering::Relaxed);
+        }
+    };
     // The balanced plan shares with the others only the robot graphs (and their memo of legs)
     // and the diagrams, neither of which changes an answer: where the plans are coordinated as
     // they come, it is planned and coordinated beside them, on what would be an idle core, and
@@ -494,13 +511,22 @@ pub fn coordinate(
     let mut aside_run: AsideRun = None;
     rayon::in_place_scope(|scope| -> Result<(), PlanError> {
         if let Some(more) = aside {
-            let (out, aside_cache, diagrams, bar_now) =
-                (&mut aside_run, &mut aside_cache, &diagrams, &bar_now);
+            let (out, aside_cache, diagrams, bar_now, cuttable, stopped) = (
+                &mut aside_run,
+                &mut aside_cache,
+                &diagrams,
+                &bar_now,
+                &cuttable,
+                &stopped,
+            );
             scope.spawn(move |_| {
                 *out = plan_try(cell, table, &more, aside_cache).map(|o| {
                     let bar = f64::from_bits(bar_now.load(std::sync::atomic::Ordering::Relaxed));
-                    let judged = (makespan(&o) < bar)
-                        .then(|| coordinate_outcome_cached(cell, table, &o, coord, diagrams));
+                    let judged = (makespan(&o) < bar).then(|| {
+                        let r = coordinate_outcome_cached(cell, table, &o, cuttable, diagrams);
+                        stopped(&r);
+                        r
+                    });
                     (o, more, judged)
                 });
             });
@@ -537,8 +563,17 @@ pub fn coordinate(
             let (judged, planned) = rayon::join(
                 || {
                     let (o, _) = pending.as_ref()?;
-                    (makespan(o) < bar && may)
-                        .then(|| coordinate_outcome_cached(cell, table, o, coord, &diagrams))
+                    (makespan(o) < bar && may).then(|| {
+                        let r = coordinate_outcome_cached(
+                            cell,
+                            table,
+                            o,
+                            if first { coord } else { &cuttable },
+                            &diagrams,
+                        );
+                        stopped(&r);
+                        r
+                    })
                 },
                 || plan_try(cell, table, more.as_ref()?, cache),
             );
@@ -613,7 +648,9 @@ pub fn coordinate(
         let mut judge = |o: &Outcome, from: Option<(&Outcome, &Coordinated)>| {
             let turns = from.map(|(f, c)| crate::coord::canonical_turns(f, c));
             let turns = turns.as_deref().unwrap_or(&base_turns);
-            let c = crate::coord::coordinate_outcome_turned(cell, table, o, coord, diagrams, turns).ok()?;
+            let c = crate::coord::coordinate_outcome_turned(cell, table, o, &cuttable, diagrams, turns);
+            stopped(&c);
+            let c = c.ok()?;
             count(&c);
             Some((cycle_and_delta(&c.timed).0, ends(&c), c))
         };
@@ -685,16 +722,21 @@ pub fn coordinate(
     } else {
         let polish = CoordSettings {
             polish: true,
-            ..coord.clone()
+            ..cuttable.clone()
         };
         let turns = crate::coord::canonical_turns(&best.0, &best.2);
-        if let Ok(c) =
-            crate::coord::coordinate_outcome_turned(cell, table, &best.0, &polish, diagrams, &turns)
+        let c = crate::coord::coordinate_outcome_turned(cell, table, &best.0, &polish, diagrams, &turns);
+        stopped(&c);
+        if let Ok(c) = c
             && cycle_and_delta(&c.timed) < cycle_and_delta(&best.2.timed)
         {
             best.2 = c;
             polished = true;
         }
+    }
+    // A coordination the clock gave up: the plan says the clock cut the search.
+    if clock_stopped.load(std::sync::atomic::Ordering::Relaxed) {
+        best.0.time_limit_hit = true;
     }
     let polish_s = lap.elapsed().as_secs_f64() - tries_s - handovers_s;
     // The winner and the runners-up within reach of it, blended; the shortest blended cycle

@@ -230,6 +230,38 @@ fn coordination_from_kept_diagrams_is_the_same() {
     }
 }
 
+/// A coordination given the run's deadline is given up once it has passed: no pair diagram is
+/// started (none is kept), and the answer is `TimeLimit`; without a deadline, or before it,
+/// the same coordination answers as ever.
+#[test]
+fn a_coordination_past_its_deadline_is_given_up() {
+    let f = fixture();
+    let settings = coord::CoordSettings::default();
+    let alone = coord::coordinate_outcome(&f.cell, &f.table, &f.outcome, &settings).unwrap();
+    assert!(
+        alone.resolved > 0,
+        "the crossing robots have something to coordinate"
+    );
+    let past = coord::CoordSettings {
+        deadline: Some(std::time::Instant::now()),
+        ..settings.clone()
+    };
+    let cache = coord::DiagramCache::default();
+    let cut = coord::coordinate_outcome_cached(&f.cell, &f.table, &f.outcome, &past, &cache);
+    assert!(
+        matches!(cut, Err(cellplan_core::plan::PlanError::TimeLimit)),
+        "{cut:?}"
+    );
+    assert_eq!(cache.len(), 0, "no diagram started past the deadline");
+    let later = coord::CoordSettings {
+        deadline: Some(std::time::Instant::now() + std::time::Duration::from_secs(3600)),
+        ..settings
+    };
+    let kept = coord::coordinate_outcome_cached(&f.cell, &f.table, &f.outcome, &later, &cache).unwrap();
+    assert_eq!(kept.programs, alone.programs);
+    assert_eq!(kept.search, alone.search);
+}
+
 /// Keeping pairs of pieces changes no answer: the crossing plan coordinated with a cache that
 /// keeps them is the plan coordinated alone, counts and search included. A hand-over plan (one
 /// MP of the second robot given to the first, the plan made keeping what it can) coordinated

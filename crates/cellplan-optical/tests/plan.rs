@@ -55,6 +55,47 @@ fn the_plan_does_not_depend_on_the_thread_count() {
     let _ = TaskId(0);
 }
 
+/// A plan the run can do without (`give_up_at_deadline`) is given up once the deadline has
+/// passed; the run's own plan stops searching there but finishes, verified, and says the clock
+/// cut it.
+#[test]
+fn a_plan_that_may_be_given_up_is_given_up_at_the_deadline() {
+    let f = fixture();
+    let past = PlanSettings {
+        deadline: Some(std::time::Instant::now()),
+        ..settings(Allocation::Zones)
+    };
+    let kept = plan::plan(&f.cell, &f.table, &past, &|_| {}).expect("the run's plan finishes");
+    assert!(kept.time_limit_hit);
+    assert!(kept.robots.iter().map(|r| r.program.visits.len()).sum::<usize>() > 0);
+    check_plan(&f.cell, &build(&f.cell, &f.table, &kept, &past));
+    let optional = PlanSettings {
+        give_up_at_deadline: true,
+        ..past
+    };
+    let given_up = plan::plan(&f.cell, &f.table, &optional, &|_| {});
+    assert!(
+        matches!(given_up, Err(plan::PlanError::TimeLimit)),
+        "{given_up:?}"
+    );
+    // Before the deadline it is planned as ever.
+    let later = PlanSettings {
+        deadline: Some(std::time::Instant::now() + std::time::Duration::from_secs(3600)),
+        ..optional
+    };
+    let planned = plan::plan(&f.cell, &f.table, &later, &|_| {}).unwrap();
+    let plain = plan::plan(&f.cell, &f.table, &settings(Allocation::Zones), &|_| {}).unwrap();
+    assert!(!planned.time_limit_hit);
+    assert_eq!(
+        planned
+            .robots
+            .iter()
+            .map(|r| &r.program.visits)
+            .collect::<Vec<_>>(),
+        plain.robots.iter().map(|r| &r.program.visits).collect::<Vec<_>>()
+    );
+}
+
 /// Two robots 2 m apart facing a box, four MPs close together on its top, all nearer to R1
 /// and measurable by both: proximity gives all four to R1; local robust sets group them
 /// (closer than ε, same normal) and Algorithm 1 gives the set to R1 (the shorter tour from its

@@ -748,8 +748,8 @@ impl Swept {
 }
 
 /// The conflict boxes of every robot pair (pairs in order, in parallel; the result does not
-/// depend on the thread count).
-pub(crate) fn diagrams(ctx: &Ctx, paths: &[RobotPath]) -> (Vec<ConflictBox>, DiagramWork) {
+/// depend on the thread count); [`PlanError::TimeLimit`] past the context's deadline.
+pub(crate) fn diagrams(ctx: &Ctx, paths: &[RobotPath]) -> Result<(Vec<ConflictBox>, DiagramWork), PlanError> {
     let mut parts = Vec::new();
     diagrams_reusing(ctx, paths, &mut parts)
 }

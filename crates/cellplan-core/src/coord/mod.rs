@@ -172,6 +172,11 @@ pub(crate) struct Ctx<'a> {
 }
 
 impl<'a> Ctx<'a> {
+    /// Whether the coordination's deadline ([`CoordSettings::deadline`]) has passed.
+    pub fn past_deadline(&self) -> bool {
+        self.settings.deadline.is_some_and(|d| Instant::now() >= d)
+    }
+
     pub fn new(
         cell: &'a Cell,
         table: &'a CandidateTable,
@@ -314,6 +319,9 @@ fn coordinate_with(
             // The diagram of the tours as they are certifies where they cannot meet, for the
             // resolutions below (the exact search then looks only where they may).
             let (found, cover, asked) = scheduled(&ctx, &programs, turned)?;
+            if ctx.past_deadline() {
+                return Err(PlanError::TimeLimit);
+            }
             distances = asked;
             let first = match found {
                 Some(done) => done,

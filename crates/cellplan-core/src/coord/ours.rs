@@ -176,7 +176,7 @@ pub(super) fn scheduled(
             .iter()
             .map(|p| diagram::RobotPath::new(ctx, p))
             .collect::<Result<_, _>>()?;
-        let (boxes, work) = diagram::diagrams_reusing(ctx, &paths, &mut parts);
+        let (boxes, work) = diagram::diagrams_reusing(ctx, &paths, &mut parts)?;
         if round == 0 {
             cover = Some(Cover::new(m, &boxes));
         }
@@ -375,6 +375,10 @@ fn directions(
         .collect::<Result<_, _>>()?;
     // One combination's search (a function of the combination alone), and the nodes it took.
     let try_turn = |flip: &[bool]| -> (Option<Directed>, usize) {
+        // Past the deadline no search starts (the coordination is then given up, below).
+        if ctx.past_deadline() {
+            return (None, 0);
+        }
         let flip = flip.to_vec();
         let mirrored: Vec<ConflictBox> = boxes
             .iter()
@@ -435,6 +439,9 @@ fn directions(
         for d in taken {
             keep(d, &mut found);
         }
+    }
+    if ctx.past_deadline() {
+        return Err(PlanError::TimeLimit);
     }
     Ok((found, back, spent))
 }
@@ -606,7 +613,7 @@ pub fn conflict_boxes(
         .iter()
         .map(|p| diagram::RobotPath::new(&ctx, p))
         .collect::<Result<_, _>>()?;
-    Ok(diagram::diagrams(&ctx, &paths).0)
+    Ok(diagram::diagrams(&ctx, &paths)?.0)
 }
 
 /// The boxes of the diagram are larger than the contacts they cover, so the schedule's waits

@@ -43,6 +43,11 @@ pub struct CoordSettings {
     /// unproven, spend one more budget putting each robot back through the others (what ours
     /// does to its winner before blending, see [`crate::pipeline::coordinate`]).
     pub polish: bool,
+    /// The run's wall-clock limit, for a coordination that may be given up: past it, the
+    /// coordination stops between robot pairs' diagrams and between tour directions with
+    /// [`crate::plan::PlanError::TimeLimit`] (ours' tries after the first and its hand-overs;
+    /// `None`, the default: a coordination always finishes).
+    pub deadline: Option<std::time::Instant>,
 }
 
 /// The default of [`CoordSettings::blend_deviation`] (rad).
@@ -63,6 +68,7 @@ impl Default for CoordSettings {
             plan_first_pairs: crate::pipeline::PLAN_FIRST_PAIRS,
             blend_deviation: BLEND_DEVIATION,
             polish: false,
+            deadline: None,
         }
     }
 }

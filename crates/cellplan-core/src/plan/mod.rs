@@ -101,6 +101,11 @@ pub struct PlanSettings {
     /// its pricings look at (`None`: the leg bound alone, as by default). The plan states the
     /// larger bound, and the verifier derives the route bound again under the same budget.
     pub route_bound_work: Option<u64>,
+    /// Give the plan up ([`PlanError::TimeLimit`]) once `deadline` has passed, between
+    /// sequencing rounds and between the phases of full-budget retries, instead of finishing
+    /// it: for a plan the run can do without (ours' tries after the first, its hand-overs).
+    /// Off by default: past the deadline a plan stops searching but finishes its legs.
+    pub give_up_at_deadline: bool,
 }
 
 impl PlanSettings {
@@ -147,6 +152,7 @@ impl Default for PlanSettings {
             late: Vec::new(),
             route_bound_work: None,
             deadline: None,
+            give_up_at_deadline: false,
         }
     }
 }
@@ -288,6 +294,9 @@ pub enum PlanError {
         "coordination: no priority order resolves every conflict (a robot stands in another's path at home)"
     )]
     NoPriorityOrder,
+    /// The run's wall-clock limit passed during a coordination that may be given up.
+    #[error("coordination: the time limit passed before it finished")]
+    TimeLimit,
     /// Timing failed (should not happen on a planner's path).
     #[error("timing: {0}")]
     Timing(#[from] cellplan_motion::timing::TimingError),
@@ -466,7 +475,8 @@ pub fn plan_keeping(
         &mut planned,
         &mut counts,
     )?
-    .expect("no bar, so never beaten");
+    // Without a bar, only the deadline beats a sequence (`give_up_at_deadline`).
+    .ok_or(PlanError::TimeLimit)?;
     if settings.allocation == Allocation::Balanced {
         // Re-allocate on what is known now: planned legs at their real time (paper 002's lazy
         // costs, one level up); keep the better plan. An alternative is sequenced only as long
@@ -648,6 +658,9 @@ fn reassign_dropped(
                 None,
                 &mut planned[s],
             )?;
+            if seq.beaten {
+                return Err(PlanError::TimeLimit);
+            }
             counts[s].0 += seq.legs_planned;
             counts[s].1 += seq.legs_sampled;
             counts[s].2 += seq.legs_failed;

@@ -570,9 +570,11 @@ pub fn rebalance<J>(
                 }
                 tried.push(key.clone());
                 let (tasks, late) = key;
+                // A hand-over the run can do without: given up at the deadline.
                 let next = PlanSettings {
                     tasks: Some(tasks),
                     late,
+                    give_up_at_deadline: true,
                     ..settings.clone()
                 };
                 // First the robots whose tasks did not change keep their programs unless the

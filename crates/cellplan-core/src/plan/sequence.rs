@@ -187,7 +187,14 @@ fn attempt(
     // The best order whose every leg is planned, with its real time.
     let mut best: Option<(f64, Vec<usize>)> = None;
     let mut nodes: Vec<usize>;
+    // A plan the run can do without is given up at the deadline (see
+    // [`PlanSettings::give_up_at_deadline`]): reported as beaten.
+    let give_up = || settings.give_up_at_deadline && Instant::now() >= deadline;
     loop {
+        if give_up() {
+            out.beaten = true;
+            return (out, None);
+        }
         out.rounds += 1;
         nodes = match first.take() {
             Some(order) => order,
@@ -285,6 +292,10 @@ fn attempt(
         ..settings.clone()
     };
     while !retry.is_empty() {
+        if give_up() {
+            out.beaten = true;
+            return (out, None);
+        }
         let reach = Reach::of(graph, planned, settings.final_max_samples);
         let mut taken = std::collections::BTreeSet::new();
         let mut phase: Vec<(usize, usize)> = Vec::new();

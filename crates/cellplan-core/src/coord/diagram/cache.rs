@@ -2,6 +2,7 @@
 //! signatures, and pairs of pieces by what the pieces are ([`DiagramCache`]).
 use super::{ConflictBox, DiagramWork, LocalBox, PieceEnds, RobotPath, pair_boxes};
 use crate::coord::Ctx;
+use crate::plan::PlanError;
 use rayon::prelude::*;
 use std::collections::HashMap;
 
@@ -161,12 +162,14 @@ impl DiagramCache {
 /// As [`super::diagrams`], keeping each pair's boxes in `parts` (pairs `(a, b)`, `a < b`, in order);
 /// a pair whose entry is already there is not built again (clear the entries of pairs whose
 /// paths changed), nor one the context's [`DiagramCache`] holds. The work counts the pairs
-/// whose entries were empty (built now, or as built before when the cache had them).
+/// whose entries were empty (built now, or as built before when the cache had them). Past the
+/// context's deadline ([`Ctx::past_deadline`]) no more pairs are built: those built are kept
+/// (in `parts` and the cache), and the answer is [`PlanError::TimeLimit`].
 pub(crate) fn diagrams_reusing(
     ctx: &Ctx,
     paths: &[RobotPath],
     parts: &mut Vec<PairBoxes>,
-) -> (Vec<ConflictBox>, DiagramWork) {
+) -> Result<(Vec<ConflictBox>, DiagramWork), PlanError> {
     let pairs: Vec<(usize, usize)> = (0..paths.len())
         .flat_map(|a| (a + 1..paths.len()).map(move |b| (a, b)))
         .collect();
@@ -179,21 +182,30 @@ pub(crate) fn diagrams_reusing(
         }
     }
     let todo: Vec<usize> = (0..pairs.len()).filter(|&i| parts[i].is_none()).collect();
-    let built: Vec<(Vec<ConflictBox>, DiagramWork)> = todo
+    // Past the coordination's deadline no pair is started (those built are kept).
+    let built: Vec<Option<(Vec<ConflictBox>, DiagramWork)>> = todo
         .par_iter()
-        .map(|&i| pair_boxes(ctx, &paths[pairs[i].0], &paths[pairs[i].1]))
+        .map(|&i| (!ctx.past_deadline()).then(|| pair_boxes(ctx, &paths[pairs[i].0], &paths[pairs[i].1])))
         .collect();
     let mut work = DiagramWork::default();
+    let mut cut = false;
     for (i, part) in todo.into_iter().zip(built) {
+        let Some(part) = part else {
+            cut = true;
+            continue;
+        };
         if let Some(cache) = ctx.diagrams {
             cache.put(&paths[pairs[i].0], &paths[pairs[i].1], &part);
         }
         parts[i] = Some(part);
+    }
+    if cut {
+        return Err(PlanError::TimeLimit);
     }
     for part in fresh.iter().filter_map(|&i| parts[i].as_ref()) {
         work.cells += part.1.cells;
         work.distances += part.1.distances;
     }
     let boxes = parts.iter().flatten().flat_map(|p| p.0.iter().cloned()).collect();
-    (boxes, work)
+    Ok((boxes, work))
 }
