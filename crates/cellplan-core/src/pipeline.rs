@@ -186,17 +186,22 @@ fn plan_try(
     table: &CandidateTable,
     more: &PlanSettings,
     cache: &mut plan::PlanCache,
+    stopped: &std::sync::atomic::AtomicBool,
 ) -> Option<Outcome> {
-    // A try the run can do without: given up at the deadline.
+    // A try the run can do without: given up at the deadline (and `stopped` says so).
     let more = &PlanSettings {
         give_up_at_deadline: true,
         ..more.clone()
     };
-    if more.allocation == Allocation::Balanced {
-        plan::plan_cached(cell, table, more, &|_| {}, &mut cache.graphs_only()).ok()
+    let planned = if more.allocation == Allocation::Balanced {
+        plan::plan_cached(cell, table, more, &|_| {}, &mut cache.graphs_only())
     } else {
-        plan::plan_cached(cell, table, more, &|_| {}, cache).ok()
+        plan::plan_cached(cell, table, more, &|_| {}, cache)
+    };
+    if matches!(planned, Err(PlanError::TimeLimit)) {
+        stopped.store(true, std::sync::atomic::Ordering::Relaxed);
     }
+    planned.ok()
 }
 
 /// After the strips planned with `more` (as `o`), the strips once more, each robot's estimates
@@ -458,7 +463,7 @@ pub fn coordinate(
                 continue;
             };
             let more = PlanSettings::clone(more);
-            let Some(o) = plan_try(cell, table, &more, cache) else {
+            let Some(o) = plan_try(cell, table, &more, cache, &clock_stopped) else {
                 continue;
             };
             if let Some(again) = strips_again(cell, &more, &o) {
@@ -511,16 +516,17 @@ pub fn coordinate(
     let mut aside_run: AsideRun = None;
     rayon::in_place_scope(|scope| -> Result<(), PlanError> {
         if let Some(more) = aside {
-            let (out, aside_cache, diagrams, bar_now, cuttable, stopped) = (
+            let (out, aside_cache, diagrams, bar_now, cuttable, stopped, clock_stopped) = (
                 &mut aside_run,
                 &mut aside_cache,
                 &diagrams,
                 &bar_now,
                 &cuttable,
                 &stopped,
+                &clock_stopped,
             );
             scope.spawn(move |_| {
-                *out = plan_try(cell, table, &more, aside_cache).map(|o| {
+                *out = plan_try(cell, table, &more, aside_cache, clock_stopped).map(|o| {
                     let bar = f64::from_bits(bar_now.load(std::sync::atomic::Ordering::Relaxed));
                     let judged = (makespan(&o) < bar).then(|| {
                         let r = coordinate_outcome_cached(cell, table, &o, cuttable, diagrams);
@@ -575,7 +581,7 @@ pub fn coordinate(
                         r
                     })
                 },
-                || plan_try(cell, table, more.as_ref()?, cache),
+                || plan_try(cell, table, more.as_ref()?, cache, &clock_stopped),
             );
             if let Some(Ok(c)) = &judged {
                 count(c);

@@ -598,8 +598,11 @@ pub fn rebalance<J>(
                     }
                     budget.plans += 1;
                     let prior = if keep { Some(current) } else { None };
-                    let Ok(mut o) = plan_keeping(cell, table, &next, &|_| {}, cache, prior) else {
-                        continue;
+                    let mut o = match plan_keeping(cell, table, &next, &|_| {}, cache, prior) {
+                        Ok(o) => o,
+                        // Given up at the deadline: the clock ends the hand-overs.
+                        Err(PlanError::TimeLimit) => return Ok((best, true)),
+                        Err(_) => continue,
                     };
                     // The judge's score is never below the robots' latest end without
                     // coordination; a plan the same as the one just judged is not judged again.
