@@ -751,6 +751,8 @@ pub fn coordinate(
         blend_deviation: blend,
         ..coord.clone()
     };
+    // Whether the clock cut anything in the run: said by the plan chosen, whichever it is.
+    let clock_hit = best.0.time_limit_hit;
     let reach = cycle_and_delta(&best.2.timed).0 * (1.0 + RUNNER_UP_REACH);
     let mut chosen: Option<Tried> = None;
     let candidates = std::iter::once(best).chain(
@@ -772,7 +774,8 @@ pub fn coordinate(
             chosen = Some((o, s, c));
         }
     }
-    let (o, s, c) = chosen.expect("the winner is a candidate");
+    let (mut o, s, c) = chosen.expect("the winner is a candidate");
+    o.time_limit_hit |= clock_hit;
     let spent = lap.elapsed().as_secs_f64();
     let ours = (
         crate::document::OursRun {

@@ -42,11 +42,12 @@ pub(super) fn check(
                 .all(|t| table.get(t.id, r.id).candidates.is_empty())
         })
         .collect();
-    idle_robots(cell, table, plan, &idle, &mut totals);
+    idle_robots(cell, table, plan, robots, &idle, &mut totals);
+    // `times` goes with `robots` (the plan's robots paired with the cell's by name).
     let working = times
         .iter()
-        .zip(&idle)
-        .filter(|(_, idle)| !**idle)
+        .zip(robots)
+        .filter(|(_, (r, _))| !idle.get(r.id.0).copied().unwrap_or(false))
         .map(|(t, _)| *t);
     let shortest = working.clone().fold(f64::INFINITY, f64::min);
     let longest = working.fold(f64::NEG_INFINITY, f64::max);
@@ -74,11 +75,13 @@ pub(super) fn check(
 }
 
 /// The robots the plan says can do no task: exactly those whose every task has no candidate
-/// (`idle`, cell order), each with the reason `check` gives.
+/// (`idle`, cell order), each with the reason `check` gives; and none of them, as paired in
+/// `robots` by name, given a task.
 fn idle_robots(
     cell: &Cell,
     table: &CandidateTable,
     plan: &Plan,
+    robots: &[(&Robot, &RobotPlan)],
     idle: &[bool],
     totals: &mut dyn FnMut(String),
 ) {
@@ -117,12 +120,9 @@ fn idle_robots(
         ));
     }
     // A robot that can do nothing has nothing to do.
-    for ((r, p), _) in cell
-        .robots
+    for (r, p) in robots
         .iter()
-        .zip(&plan.robots)
-        .zip(idle)
-        .filter(|(_, idle)| **idle)
+        .filter(|(r, _)| idle.get(r.id.0).copied().unwrap_or(false))
     {
         if !p.tasks.is_empty() {
             totals(format!(

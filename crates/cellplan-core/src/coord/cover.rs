@@ -164,6 +164,7 @@ mod tests {
             visits: vec![(3.0, 4.0)],
             wait_starts: vec![1.0],
             arrivals: vec![vec![0.0, 1.0]],
+            idle: false,
         }
     }
 

@@ -47,7 +47,7 @@ pub use timeline::{Conflict, Scenario, Timeline};
 use crate::candidates::CandidateTable;
 use crate::plan::PlanError;
 use crate::plan::graph::limits_of;
-use cellplan_model::Cell;
+use cellplan_model::{Cell, RobotId};
 use cellplan_motion::timing::Limits;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -169,6 +169,8 @@ pub(crate) struct Ctx<'a> {
     pub validity: Vec<crate::motion::RobotValidity<'a>>,
     /// Pair diagrams built by earlier coordinations of the cell, if kept.
     pub diagrams: Option<&'a DiagramCache>,
+    /// Per robot, whether it can do none of the tasks ([`crate::check::idle_robots`]).
+    pub idle: Vec<bool>,
 }
 
 impl<'a> Ctx<'a> {
@@ -200,11 +202,19 @@ impl<'a> Ctx<'a> {
                 .map(|r| crate::motion::robot_validity(cell, r, cell.planning.clearance))
                 .collect(),
             diagrams,
+            idle: {
+                let idle = crate::check::idle_robots(cell, table);
+                (0..cell.robots.len())
+                    .map(|r| idle.contains(&RobotId(r)))
+                    .collect()
+            },
         }
     }
 
     pub fn timed(&self, p: &Program) -> Result<Timed, PlanError> {
-        p.timed(&self.limits[p.robot])
+        let mut t = p.timed(&self.limits[p.robot])?;
+        t.idle = self.idle.get(p.robot).copied().unwrap_or(false);
+        Ok(t)
     }
 
     /// Robot `r` on the clock as `timed`.
@@ -250,8 +260,8 @@ impl<'a> Ctx<'a> {
 pub fn cycle_and_delta(timed: &[Timed]) -> (f64, f64) {
     let ends: Vec<f64> = timed.iter().map(Timed::end).collect();
     let cycle = ends.iter().copied().fold(0.0, f64::max);
-    let low = ends.iter().copied().fold(f64::INFINITY, f64::min);
-    (cycle, if low.is_finite() { cycle - low } else { 0.0 })
+    let idle: Vec<RobotId> = (0..timed.len()).filter(|&r| timed[r].idle).map(RobotId).collect();
+    (cycle, crate::check::balance_spread(&ends, &idle))
 }
 
 /// Coordinate `programs` (one per robot, cell order, without waits) with `settings.strategy`.

@@ -218,6 +218,9 @@ pub struct Timed {
     pub wait_starts: Vec<f64>,
     /// Arrival time (s) at each waypoint of each leg (before any wait there).
     pub arrivals: Vec<Vec<f64>>,
+    /// Whether the robot can do none of the cell's tasks ([`crate::check::idle_robots`]; set
+    /// by the coordination's context): its end is left out of Δt ([`super::cycle_and_delta`]).
+    pub idle: bool,
 }
 
 impl Timed {
@@ -487,6 +490,7 @@ impl Program {
             visits,
             wait_starts,
             arrivals,
+            idle: false,
         })
     }
 }
@@ -546,5 +550,23 @@ mod tests {
         assert!(idle.working() == 0.0 && idle.working().is_sign_positive());
         assert!(idle.motion() == 0.0 && idle.motion().is_sign_positive());
         assert_eq!(format!("{:.2}", idle.working()), "0.00");
+    }
+
+    /// Δt leaves out a robot that can do no task (its `Timed` says so), not one that could
+    /// work but has nothing to do.
+    #[test]
+    fn delta_t_leaves_out_only_robots_that_can_do_no_task() {
+        let stand = |seconds: f64, idle: bool| Timed {
+            trajectory: Trajectory::dwell(&[0.0], seconds),
+            spans: Vec::new(),
+            visits: Vec::new(),
+            wait_starts: Vec::new(),
+            arrivals: Vec::new(),
+            idle,
+        };
+        let mut timed = vec![stand(10.0, false), stand(8.5, false), stand(0.0, true)];
+        assert_eq!(super::super::cycle_and_delta(&timed), (10.0, 1.5));
+        timed[2].idle = false;
+        assert_eq!(super::super::cycle_and_delta(&timed), (10.0, 10.0));
     }
 }

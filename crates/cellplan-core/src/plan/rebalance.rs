@@ -622,7 +622,15 @@ pub fn rebalance<J>(
                         && sc < score - 1e-6
                     {
                         (score, judged_ends, waits) = (sc, e, waits_of(&j));
-                        best = Some((o, next, j));
+                        // The winner's settings are those it would be planned with again.
+                        best = Some((
+                            o,
+                            PlanSettings {
+                                give_up_at_deadline: false,
+                                ..next
+                            },
+                            j,
+                        ));
                         continue 'rounds;
                     }
                     if far_worse {
