@@ -2,6 +2,7 @@
 //! task no robot can do with the reason, and every robot that can do none. Its JSON keys are
 //! stable: scripts read `tasks`, `robots`, `candidates`, `unmeasurable`, `shared` and `idle`.
 use crate::candidates::{CandidateTable, Classes, classes};
+use crate::document::IdleRobotOut;
 use cellplan_model::robot::IkKind;
 use cellplan_model::{Cell, InputError, Rejection, RobotId, TaskId};
 use serde::Serialize;
@@ -88,17 +89,9 @@ pub struct CheckReport {
     pub shared: Vec<Shared>,
     /// Tasks no robot can do, with reasons.
     pub unmeasurable: Vec<Unmeasurable>,
-    /// Robots that can do none of the tasks (they stay at home), with the reason.
-    pub idle: Vec<IdleRobot>,
-}
-
-/// A robot that can do none of the tasks.
-#[derive(Clone, Debug, Serialize)]
-pub struct IdleRobot {
-    /// Robot name.
-    pub robot: String,
-    /// Why ([`idle_reason`]).
-    pub reason: String,
+    /// Robots that can do none of the tasks (they stay at home), with the reason, as a plan
+    /// states them.
+    pub idle: Vec<IdleRobotOut>,
 }
 
 fn names(cell: &Cell, tasks: &[TaskId]) -> Vec<String> {
@@ -185,14 +178,19 @@ pub fn report(cell: &Cell, table: &CandidateTable) -> CheckReport {
         },
         shared,
         unmeasurable,
-        idle: idle_robots(cell, table)
-            .into_iter()
-            .map(|r| IdleRobot {
-                robot: cell.robots[r.0].name.clone(),
-                reason: idle_reason(cell, table, r),
-            })
-            .collect(),
+        idle: idle_robots_out(cell, table),
     }
+}
+
+/// [`idle_robots`] by name, each with [`idle_reason`]: what `check` reports and a plan states.
+pub fn idle_robots_out(cell: &Cell, table: &CandidateTable) -> Vec<IdleRobotOut> {
+    idle_robots(cell, table)
+        .into_iter()
+        .map(|r| IdleRobotOut {
+            robot: cell.robots[r.0].name.clone(),
+            reason: idle_reason(cell, table, r),
+        })
+        .collect()
 }
 
 /// The robots that can do none of the cell's tasks, in cell order. Such a robot stays at home:

@@ -1,9 +1,9 @@
 //! The document from a run: per robot its visits, legs, waits and trajectory; the totals; the
 //! coordination record; the unmeasured tasks; the search's counts and times.
 use super::{
-    ActivityOut, BlendOut, ComputeTimes, ConflictOut, CoordinationOut, FORMAT, IdleRobotOut, LegOut,
-    PROBE_TRACK_DT, Plan, PoseOut, ProbeTrack, RobotPlan, RouteBoundOut, RouteBoundRun, Sample, SettingsOut,
-    Stats, UnmeasuredTask, VERSION, Visit, WaitOut,
+    ActivityOut, BlendOut, ComputeTimes, ConflictOut, CoordinationOut, FORMAT, LegOut, PROBE_TRACK_DT, Plan,
+    PoseOut, ProbeTrack, RobotPlan, RouteBoundOut, RouteBoundRun, Sample, SettingsOut, Stats, UnmeasuredTask,
+    VERSION, Visit, WaitOut,
 };
 use crate::candidates::CandidateTable;
 use crate::coord::{Activity, Conflict, Coordinated, Program, Timed};
@@ -84,13 +84,7 @@ pub fn build(
         coordination: coordination_out(cell, outcome, coordinated),
         robots,
         unmeasured: unmeasured(cell, table, &outcome.unreached),
-        idle_robots: idle
-            .iter()
-            .map(|&r| IdleRobotOut {
-                robot: cell.robots[r.0].name.clone(),
-                reason: crate::check::idle_reason(cell, table, r),
-            })
-            .collect(),
+        idle_robots: crate::check::idle_robots_out(cell, table),
         stats: Stats {
             time_limit_hit: outcome.time_limit_hit || clock_cut,
             route_bound: route_run,
