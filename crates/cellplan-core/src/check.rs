@@ -198,13 +198,16 @@ pub fn idle_robots_out(cell: &Cell, table: &CandidateTable) -> Vec<IdleRobotOut>
 pub fn idle_robots(cell: &Cell, table: &CandidateTable) -> Vec<RobotId> {
     cell.robots
         .iter()
-        .filter(|r| {
-            cell.tasks
-                .iter()
-                .all(|t| table.get(t.id, r.id).candidates.is_empty())
-        })
         .map(|r| r.id)
+        .filter(|&r| can_do_nothing(cell, table, r))
         .collect()
+}
+
+/// Whether `robot` has no candidate for any of the cell's tasks.
+pub fn can_do_nothing(cell: &Cell, table: &CandidateTable, robot: RobotId) -> bool {
+    cell.tasks
+        .iter()
+        .all(|t| table.get(t.id, robot).candidates.is_empty())
 }
 
 /// Why `robot` can do none of the tasks, for people: the rejections counted, the nearest task
@@ -238,16 +241,10 @@ pub fn idle_reason(cell: &Cell, table: &CandidateTable, robot: RobotId) -> Strin
     )
 }
 
-/// Δt of robots ending at `ends` (cell order): the latest end less the earliest, over the
-/// robots that can do some task (`idle` lists the others, as [`idle_robots`] gives them; a
-/// robot that can do a task but was given none counts, at its end). 0 when every robot is
-/// idle.
-pub fn balance_spread(ends: &[f64], idle: &[RobotId]) -> f64 {
-    let working = ends
-        .iter()
-        .enumerate()
-        .filter(|(r, _)| !idle.contains(&RobotId(*r)))
-        .map(|(_, &e)| e);
+/// Δt: the latest end less the earliest among `working`, the ends of the robots that can do
+/// some task (those [`idle_robots`] does not list; a robot that can do a task but was given
+/// none counts, at its end). 0 without any.
+pub fn balance_spread(working: impl Iterator<Item = f64> + Clone) -> f64 {
     let hi = working.clone().fold(f64::NEG_INFINITY, f64::max);
     let lo = working.fold(f64::INFINITY, f64::min);
     if hi.is_finite() && lo.is_finite() {

@@ -16,6 +16,7 @@ use crate::document::{self, Plan};
 use crate::plan::rebalance::makespan;
 use crate::plan::{self, Allocation, Outcome, PlanError, PlanSettings, Stage};
 use cellplan_model::{Cell, InputError};
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
 mod runners_up;
@@ -189,22 +190,26 @@ fn plan_try(
     table: &CandidateTable,
     more: &PlanSettings,
     cache: &mut plan::PlanCache,
-    stopped: &std::sync::atomic::AtomicBool,
-) -> Option<Outcome> {
-    // A try the run can do without: given up at the deadline (and `stopped` says so).
+) -> Result<Outcome, PlanError> {
+    // A try the run can do without: given up at the deadline.
     let more = &PlanSettings {
         give_up_at_deadline: true,
         ..more.clone()
     };
-    let planned = if more.allocation == Allocation::Balanced {
+    if more.allocation == Allocation::Balanced {
         plan::plan_cached(cell, table, more, &|_| {}, &mut cache.graphs_only())
     } else {
         plan::plan_cached(cell, table, more, &|_| {}, cache)
-    };
-    if matches!(planned, Err(PlanError::TimeLimit)) {
-        stopped.store(true, std::sync::atomic::Ordering::Relaxed);
     }
-    planned.ok()
+}
+
+/// `r`, with `clock` set when it is a plan or coordination given up at the deadline
+/// ([`PlanError::TimeLimit`]): the run's plan then says the clock cut its search.
+fn noting_clock<T>(clock: &AtomicBool, r: Result<T, PlanError>) -> Result<T, PlanError> {
+    if matches!(r, Err(PlanError::TimeLimit)) {
+        clock.store(true, Ordering::Relaxed);
+    }
+    r
 }
 
 /// After the strips planned with `more` (as `o`), the strips once more, each robot's estimates
@@ -366,12 +371,7 @@ pub fn coordinate(
         deadline: settings.deadline,
         ..coord.clone()
     };
-    let clock_stopped = std::sync::atomic::AtomicBool::new(false);
-    let stopped = |r: &Result<Coordinated, PlanError>| {
-        if matches!(r, Err(PlanError::TimeLimit)) {
-            clock_stopped.store(true, std::sync::atomic::Ordering::Relaxed);
-        }
-    };
+    let clock_stopped = AtomicBool::new(false);
     // The balanced plan shares with the others only the robot graphs (and their memo of legs)
     // and the diagrams, neither of which changes an answer: where the plans are coordinated as
     // they come, it is planned and coordinated beside them, on what would be an idle core, and
@@ -411,7 +411,7 @@ pub fn coordinate(
                 continue;
             };
             let more = PlanSettings::clone(more);
-            let Some(o) = plan_try(cell, table, &more, cache, &clock_stopped) else {
+            let Ok(o) = noting_clock(&clock_stopped, plan_try(cell, table, &more, cache)) else {
                 continue;
             };
             if let Some(again) = strips_again(cell, &more, &o) {
@@ -464,25 +464,27 @@ pub fn coordinate(
     let mut aside_run: AsideRun = None;
     rayon::in_place_scope(|scope| -> Result<(), PlanError> {
         if let Some(more) = aside {
-            let (out, aside_cache, diagrams, bar_now, cuttable, stopped, clock_stopped) = (
+            let (out, aside_cache, diagrams, bar_now, cuttable, clock) = (
                 &mut aside_run,
                 &mut aside_cache,
                 &diagrams,
                 &bar_now,
                 &cuttable,
-                &stopped,
                 &clock_stopped,
             );
             scope.spawn(move |_| {
-                *out = plan_try(cell, table, &more, aside_cache, clock_stopped).map(|o| {
-                    let bar = f64::from_bits(bar_now.load(std::sync::atomic::Ordering::Relaxed));
-                    let judged = (makespan(&o) < bar).then(|| {
-                        let r = coordinate_outcome_cached(cell, table, &o, cuttable, diagrams);
-                        stopped(&r);
-                        r
+                *out = noting_clock(clock, plan_try(cell, table, &more, aside_cache))
+                    .ok()
+                    .map(|o| {
+                        let bar = f64::from_bits(bar_now.load(Ordering::Relaxed));
+                        let judged = (makespan(&o) < bar).then(|| {
+                            noting_clock(
+                                clock,
+                                coordinate_outcome_cached(cell, table, &o, cuttable, diagrams),
+                            )
+                        });
+                        (o, more, judged)
                     });
-                    (o, more, judged)
-                });
             });
         }
         loop {
@@ -517,19 +519,15 @@ pub fn coordinate(
             let (judged, planned) = rayon::join(
                 || {
                     let (o, _) = pending.as_ref()?;
+                    let with = if first { coord } else { &cuttable };
                     (makespan(o) < bar && may).then(|| {
-                        let r = coordinate_outcome_cached(
-                            cell,
-                            table,
-                            o,
-                            if first { coord } else { &cuttable },
-                            &diagrams,
-                        );
-                        stopped(&r);
-                        r
+                        noting_clock(
+                            &clock_stopped,
+                            coordinate_outcome_cached(cell, table, o, with, &diagrams),
+                        )
                     })
                 },
-                || plan_try(cell, table, more.as_ref()?, cache, &clock_stopped),
+                || noting_clock(&clock_stopped, plan_try(cell, table, more.as_ref()?, cache)).ok(),
             );
             if let Some(Ok(c)) = &judged {
                 count(c);
@@ -561,7 +559,7 @@ pub fn coordinate(
                     pending = Some((o, more));
                 }
             }
-            bar_now.store(cycle_of(&best).to_bits(), std::sync::atomic::Ordering::Relaxed);
+            bar_now.store(cycle_of(&best).to_bits(), Ordering::Relaxed);
         }
         Ok(())
     })?;
@@ -603,8 +601,7 @@ pub fn coordinate(
             let turns = from.map(|(f, c)| crate::coord::canonical_turns(f, c));
             let turns = turns.as_deref().unwrap_or(&base_turns);
             let c = crate::coord::coordinate_outcome_turned(cell, table, o, &cuttable, diagrams, turns);
-            stopped(&c);
-            let c = c.ok()?;
+            let c = noting_clock(&clock_stopped, c).ok()?;
             count(&c);
             Some((cycle_and_delta(&c.timed).0, ends(&c), c))
         };
@@ -680,8 +677,7 @@ pub fn coordinate(
         };
         let turns = crate::coord::canonical_turns(&best.0, &best.2);
         let c = crate::coord::coordinate_outcome_turned(cell, table, &best.0, &polish, diagrams, &turns);
-        stopped(&c);
-        if let Ok(c) = c
+        if let Ok(c) = noting_clock(&clock_stopped, c)
             && cycle_and_delta(&c.timed) < cycle_and_delta(&best.2.timed)
         {
             best.2 = c;
@@ -689,7 +685,7 @@ pub fn coordinate(
         }
     }
     // A coordination the clock gave up: the plan says the clock cut the search.
-    if clock_stopped.load(std::sync::atomic::Ordering::Relaxed) {
+    if clock_stopped.load(Ordering::Relaxed) {
         best.0.time_limit_hit = true;
     }
     let polish_s = lap.elapsed().as_secs_f64() - tries_s - handovers_s;

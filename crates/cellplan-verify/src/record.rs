@@ -42,7 +42,7 @@ pub(super) fn check(
                 .all(|t| table.get(t.id, r.id).candidates.is_empty())
         })
         .collect();
-    idle_robots(cell, table, plan, robots, &idle, &mut totals);
+    idle_robots(cell, table, plan, &idle, &mut totals);
     // `times` goes with `robots` (the plan's robots paired with the cell's by name).
     let working = times
         .iter()
@@ -75,13 +75,12 @@ pub(super) fn check(
 }
 
 /// The robots the plan says can do no task: exactly those whose every task has no candidate
-/// (`idle`, cell order), each with the reason `check` gives; and none of them, as paired in
-/// `robots` by name, given a task.
+/// (`idle`, cell order), each with the reason `check` gives. (A task given to one of them has
+/// no candidate, which `tasks` reports.)
 fn idle_robots(
     cell: &Cell,
     table: &CandidateTable,
     plan: &Plan,
-    robots: &[(&Robot, &RobotPlan)],
     idle: &[bool],
     totals: &mut dyn FnMut(String),
 ) {
@@ -118,19 +117,6 @@ fn idle_robots(
             names(&derived),
             derived.iter().map(|(_, w)| w).collect::<Vec<_>>(),
         ));
-    }
-    // A robot that can do nothing has nothing to do.
-    for (r, p) in robots
-        .iter()
-        .filter(|(r, _)| idle.get(r.id.0).copied().unwrap_or(false))
-    {
-        if !p.tasks.is_empty() {
-            totals(format!(
-                "robot {} can do none of the tasks but is given {}",
-                r.name,
-                p.tasks.len()
-            ));
-        }
     }
 }
 

@@ -50,7 +50,7 @@ pub use timeline::{Conflict, Scenario, Timeline};
 use crate::candidates::CandidateTable;
 use crate::plan::PlanError;
 use crate::plan::graph::limits_of;
-use cellplan_model::{Cell, RobotId};
+use cellplan_model::Cell;
 use cellplan_motion::timing::Limits;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -205,12 +205,11 @@ impl<'a> Ctx<'a> {
                 .map(|r| crate::motion::robot_validity(cell, r, cell.planning.clearance))
                 .collect(),
             diagrams,
-            idle: {
-                let idle = crate::check::idle_robots(cell, table);
-                (0..cell.robots.len())
-                    .map(|r| idle.contains(&RobotId(r)))
-                    .collect()
-            },
+            idle: cell
+                .robots
+                .iter()
+                .map(|r| crate::check::can_do_nothing(cell, table, r.id))
+                .collect(),
         }
     }
 
@@ -259,12 +258,11 @@ impl<'a> Ctx<'a> {
     }
 }
 
-/// Cycle time and Δt of timed programs.
+/// Cycle time and Δt of timed programs (Δt over the robots that can do some task).
 pub fn cycle_and_delta(timed: &[Timed]) -> (f64, f64) {
-    let ends: Vec<f64> = timed.iter().map(Timed::end).collect();
-    let cycle = ends.iter().copied().fold(0.0, f64::max);
-    let idle: Vec<RobotId> = (0..timed.len()).filter(|&r| timed[r].idle).map(RobotId).collect();
-    (cycle, crate::check::balance_spread(&ends, &idle))
+    let cycle = timed.iter().map(Timed::end).fold(0.0, f64::max);
+    let working = timed.iter().filter(|t| !t.idle).map(Timed::end);
+    (cycle, crate::check::balance_spread(working))
 }
 
 /// Coordinate `programs` (one per robot, cell order, without waits) with `settings.strategy`.

@@ -105,9 +105,13 @@ pub fn ratio(cycle: f64, lower_bound: f64) -> f64 {
 
 /// The cycle time (longest robot time) and Δt (longest minus shortest).
 fn cycle_and_delta(robots: &[RobotPlan], idle: &[RobotId]) -> (f64, f64) {
-    let totals: Vec<f64> = robots.iter().map(|r| r.total_s).collect();
-    let cycle = totals.iter().copied().fold(0.0, f64::max);
-    (cycle, crate::check::balance_spread(&totals, idle))
+    let cycle = robots.iter().map(|r| r.total_s).fold(0.0, f64::max);
+    let working = robots
+        .iter()
+        .enumerate()
+        .filter(|(r, _)| !idle.contains(&RobotId(*r)))
+        .map(|(_, p)| p.total_s);
+    (cycle, crate::check::balance_spread(working))
 }
 
 /// One robot's visits, legs, waits, totals and sampled trajectory.
